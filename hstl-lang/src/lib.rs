@@ -1,1 +1,8 @@
-//! placeholder
+//! The hstl language: grammar, syntax tree, name resolution, checks and the checked spec.
+//!
+//! Parsing and checking never fail: they return what they could build together with a
+//! list of plain-data [`Diagnostic`]s. This crate knows nothing of miette, LSP or proc macros.
+
+pub mod diagnostic;
+
+pub use diagnostic::{Diagnostic, Label, Severity};
