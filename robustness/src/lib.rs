@@ -10,6 +10,7 @@
 
 pub mod formula;
 pub mod reference;
+pub mod segment;
 pub mod trace;
 
 pub use formula::{Bound, CmpOp, Expr, Formula, Interval};
