@@ -227,3 +227,188 @@ impl fmt::Display for Interval {
         }
     }
 }
+
+/// A [`Formula`] or [`Expr`] printed in hstl syntax with the given variable names.
+///
+/// Made by [`Formula::display_with`] and [`Expr::display_with`]. A variable without a name
+/// prints as `v<index>`. Parentheses appear where precedence needs them and around nested
+/// operators of the same level, so the text parses back to the same tree. Infinite
+/// constants print as `1e999` (which reads back as infinity) and NaN as `(0 / 0)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Display<'a, T> {
+    item: &'a T,
+    names: &'a [&'a str],
+}
+
+impl Formula {
+    /// The formula in hstl syntax, `names[i]` naming variable `i`.
+    pub fn display_with<'a>(&'a self, names: &'a [&'a str]) -> Display<'a, Formula> {
+        Display { item: self, names }
+    }
+
+    /// Binding strength, loosest first: `->`, `||`, `&&`, `until`, prefix, atoms.
+    fn level(&self) -> u8 {
+        match self {
+            Formula::Implies(..) => 0,
+            Formula::Or(gs) | Formula::And(gs) if gs.len() == 1 => gs[0].level(),
+            Formula::Or(gs) if !gs.is_empty() => 1,
+            Formula::And(gs) if !gs.is_empty() => 2,
+            Formula::Until(..) => 3,
+            Formula::Not(_) | Formula::Always(..) | Formula::Eventually(..) => 4,
+            _ => 5,
+        }
+    }
+
+    fn write(&self, f: &mut fmt::Formatter<'_>, names: &[&str]) -> fmt::Result {
+        // Operands tighter than `min` print bare; others get parentheses.
+        let operand = |f: &mut fmt::Formatter<'_>, g: &Formula, min: u8| {
+            if g.level() >= min {
+                g.write(f, names)
+            } else {
+                write!(f, "(")?;
+                g.write(f, names)?;
+                write!(f, ")")
+            }
+        };
+        match self {
+            Formula::True => write!(f, "true"),
+            Formula::False => write!(f, "false"),
+            Formula::Cmp { lhs, op, rhs } => {
+                lhs.write(f, names, 0)?;
+                write!(f, " {op} ")?;
+                rhs.write(f, names, 0)
+            }
+            Formula::Not(g) => {
+                write!(f, "!")?;
+                operand(f, g, 4)
+            }
+            Formula::Always(i, g) | Formula::Eventually(i, g) => {
+                let kw = if matches!(self, Formula::Always(..)) { "always" } else { "eventually" };
+                write!(f, "{kw}{i} ")?;
+                operand(f, g, 4)
+            }
+            Formula::Until(i, g, h) => {
+                operand(f, g, 4)?;
+                write!(f, " until{i} ")?;
+                operand(f, h, 4)
+            }
+            Formula::And(gs) | Formula::Or(gs) => {
+                let (sep, level, empty) = match self {
+                    Formula::And(_) => (" && ", 2, "true"),
+                    _ => (" || ", 1, "false"),
+                };
+                match gs.as_slice() {
+                    [] => write!(f, "{empty}"),
+                    [g] => g.write(f, names),
+                    _ => {
+                        for (k, g) in gs.iter().enumerate() {
+                            if k > 0 {
+                                write!(f, "{sep}")?;
+                            }
+                            operand(f, g, level + 1)?;
+                        }
+                        Ok(())
+                    }
+                }
+            }
+            Formula::Implies(g, h) => {
+                operand(f, g, 1)?;
+                write!(f, " -> ")?;
+                operand(f, h, 0)
+            }
+        }
+    }
+}
+
+impl Expr {
+    /// The expression in hstl syntax, `names[i]` naming variable `i`.
+    pub fn display_with<'a>(&'a self, names: &'a [&'a str]) -> Display<'a, Expr> {
+        Display { item: self, names }
+    }
+
+    /// Binding strength: sums, products, factors.
+    fn level(&self) -> u8 {
+        match self {
+            Expr::Add(..) | Expr::Sub(..) => 0,
+            Expr::Mul(..) | Expr::Div(..) => 1,
+            _ => 2,
+        }
+    }
+
+    fn write(&self, f: &mut fmt::Formatter<'_>, names: &[&str], min: u8) -> fmt::Result {
+        if self.level() < min {
+            write!(f, "(")?;
+            self.write(f, names, 0)?;
+            return write!(f, ")");
+        }
+        match self {
+            Expr::Const(c) if c.is_nan() => write!(f, "(0 / 0)"),
+            Expr::Const(c) if c.is_infinite() => {
+                write!(f, "{}1e999", if *c < 0.0 { "-" } else { "" })
+            }
+            Expr::Const(c) => write!(f, "{c}"),
+            Expr::Var(i) => match names.get(*i) {
+                Some(name) => write!(f, "{name}"),
+                None => write!(f, "v{i}"),
+            },
+            Expr::Neg(e) => {
+                write!(f, "-")?;
+                e.write(f, names, 2)
+            }
+            Expr::Abs(e) | Expr::Sqrt(e) => {
+                write!(f, "{}(", if matches!(self, Expr::Abs(_)) { "abs" } else { "sqrt" })?;
+                e.write(f, names, 0)?;
+                write!(f, ")")
+            }
+            Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b) | Expr::Div(a, b) => {
+                let (op, level) = match self {
+                    Expr::Add(..) => ("+", 0),
+                    Expr::Sub(..) => ("-", 0),
+                    Expr::Mul(..) => ("*", 1),
+                    _ => ("/", 1),
+                };
+                // Left-associative: the right operand of the same level needs parentheses.
+                a.write(f, names, level)?;
+                write!(f, " {op} ")?;
+                b.write(f, names, level + 1)
+            }
+        }
+    }
+}
+
+impl fmt::Display for CmpOp {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            CmpOp::Lt => "<",
+            CmpOp::Le => "<=",
+            CmpOp::Gt => ">",
+            CmpOp::Ge => ">=",
+        })
+    }
+}
+
+impl fmt::Display for Display<'_, Formula> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.item.write(f, self.names)
+    }
+}
+
+impl fmt::Display for Display<'_, Expr> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.item.write(f, self.names, 0)
+    }
+}
+
+/// Prints in hstl syntax, variable `i` as `v<i>`; [`Formula::display_with`] names them.
+impl fmt::Display for Formula {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.write(f, &[])
+    }
+}
+
+/// Prints in hstl syntax, variable `i` as `v<i>`; [`Expr::display_with`] names them.
+impl fmt::Display for Expr {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.write(f, &[], 0)
+    }
+}

@@ -7,11 +7,21 @@
 //! empty `eventually` or `until` window is `-inf`.
 //!
 //! - [`reference`] follows the semantics table literally; it is the test oracle.
+//! - [`offline`] computes whole signals fast, and the robustness at step 0 from the
+//!   formula's horizon alone.
+//! - [`online`] monitors a trace fed one state at a time.
+//! - [`segment`] scores option executions and all their suffixes for the learner.
+//!
+//! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
 pub mod formula;
+pub mod offline;
+pub mod online;
 pub mod reference;
 pub mod segment;
 pub mod trace;
 
 pub use formula::{Bound, CmpOp, Expr, Formula, Interval};
+pub use offline::Evaluator;
+pub use online::{OnlineMonitor, Verdict};
 pub use trace::{Trace, TraceError};

@@ -1,0 +1,66 @@
+//! Robustness throughput on a 1,000,000-step random walk on the 15 x 15 grid world.
+//!
+//! `cargo bench -p hstl-robustness --bench robustness -- --warm-up-time 1 --measurement-time 3`
+
+#[path = "walk.rs"]
+mod walk;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use hstl_robustness::{Evaluator, Formula, Trace, segment::TabularScorer};
+use std::hint::black_box;
+
+fn full_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
+    let mut g = c.benchmark_group("signal");
+    g.throughput(Throughput::Elements(trace.len() as u64));
+    g.sample_size(20);
+    let mut ev = Evaluator::new();
+    for (name, f) in cases {
+        g.bench_function(*name, |b| b.iter(|| black_box(ev.signal(f, black_box(trace))[0])));
+    }
+    g.finish();
+}
+
+fn step_zero(c: &mut Criterion, trace: &Trace) {
+    let f = walk::f1(40);
+    let mut ev = Evaluator::new();
+    c.bench_function("step0/F1_w40", |b| b.iter(|| black_box(ev.robustness(&f, black_box(trace)))));
+}
+
+fn suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
+    // The state table is the 15 x 15 grid; a segment is 40 cell indices of a walk.
+    let cells: Vec<(f64, f64)> =
+        (0..15).flat_map(|x| (0..15).map(move |y| (f64::from(x), f64::from(y)))).collect();
+    let states = Trace::from_columns(vec![
+        cells.iter().map(|c| c.0).collect(),
+        cells.iter().map(|c| c.1).collect(),
+    ])
+    .expect("two columns of equal length");
+    let seg = walk::walk(40, rng);
+    let idx: Vec<usize> =
+        (0..40).map(|t| seg.column(0)[t] as usize * 15 + seg.column(1)[t] as usize).collect();
+    let mut scorer = TabularScorer::new(&walk::f2(), &states);
+    let mut out = Vec::new();
+    c.bench_function("suffix_rewards/F2_tabular_40", |b| {
+        b.iter(|| {
+            scorer.suffix_rewards(black_box(&idx), &mut out);
+            black_box(out[0])
+        })
+    });
+}
+
+fn benches(c: &mut Criterion) {
+    let mut rng = walk::SplitMix64(walk::SEED);
+    let trace = walk::walk(walk::STEPS, &mut rng);
+    let cases = [
+        ("F1_w40", walk::f1(40)),
+        ("F1_w4000", walk::f1(4000)),
+        ("F2", walk::f2()),
+        ("F3", walk::f3()),
+    ];
+    full_signal(c, &trace, &cases);
+    step_zero(c, &trace);
+    suffix_rewards(c, &mut rng);
+}
+
+criterion_group!(robustness, benches);
+criterion_main!(robustness);

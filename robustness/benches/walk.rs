@@ -1,0 +1,87 @@
+//! The benchmark data: a random walk on the 15 x 15 grid world, shared by the benches and
+//! the `walk` example (which writes it to CSV for the peers' script).
+
+use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace};
+
+/// Steps in the benchmark walk.
+pub const STEPS: usize = 1_000_000;
+/// The walk's seed.
+pub const SEED: u64 = 0x5eed_2016;
+
+/// splitmix64: small, fast, and easy to reproduce in any language.
+pub struct SplitMix64(pub u64);
+
+impl SplitMix64 {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+}
+
+/// `steps` states of a walk from (7, 7): each step Up, Down, Left or Right with equal
+/// probability; a move off the grid (x, y in 0..=14) stays put.
+pub fn walk(steps: usize, rng: &mut SplitMix64) -> Trace {
+    let (mut x, mut y) = (7i64, 7i64);
+    let mut xs = Vec::with_capacity(steps);
+    let mut ys = Vec::with_capacity(steps);
+    for _ in 0..steps {
+        xs.push(x as f64);
+        ys.push(y as f64);
+        let (dx, dy) = match rng.next_u64() % 4 {
+            0 => (0, 1),
+            1 => (0, -1),
+            2 => (-1, 0),
+            _ => (1, 0),
+        };
+        if (0..=14).contains(&(x + dx)) && (0..=14).contains(&(y + dy)) {
+            x += dx;
+            y += dy;
+        }
+    }
+    Trace::from_columns(vec![xs, ys]).expect("two columns of equal length")
+}
+
+fn cmp(lhs: Expr, op: CmpOp, rhs: Expr) -> Formula {
+    Formula::Cmp { lhs, op, rhs }
+}
+
+/// `lo_x < x < hi_x && lo_y < y < hi_y` over `x` (variable 0) and `y` (variable 1).
+pub fn region(lo_x: f64, hi_x: f64, lo_y: f64, hi_y: f64) -> Formula {
+    let (x, y, c) = (|| Expr::Var(0), || Expr::Var(1), Expr::Const);
+    Formula::And(vec![
+        cmp(x(), CmpOp::Gt, c(lo_x)),
+        cmp(x(), CmpOp::Lt, c(hi_x)),
+        cmp(y(), CmpOp::Gt, c(lo_y)),
+        cmp(y(), CmpOp::Lt, c(hi_y)),
+    ])
+}
+
+/// F1: `always[0..=w] (x > 3 && x < 9 && y > 10 && y < 14)`.
+pub fn f1(w: usize) -> Formula {
+    let i = Interval { start: 0, end: Bound::Inclusive(w) };
+    Formula::Always(i, Box::new(region(3.0, 9.0, 10.0, 14.0)))
+}
+
+/// F2: `always[0..] (eventually[0..40] A && eventually[0..40] B && eventually[0..40] C)`.
+pub fn f2() -> Formula {
+    let ev = |f| Formula::Eventually(Interval { start: 0, end: Bound::Exclusive(40) }, Box::new(f));
+    let body = Formula::And(vec![
+        ev(region(3.0, 9.0, 10.0, 14.0)),
+        ev(region(1.0, 5.0, 1.0, 5.0)),
+        ev(region(9.0, 13.0, 1.0, 7.0)),
+    ]);
+    Formula::Always(Interval::ALL, Box::new(body))
+}
+
+/// F3: `(x > 5) until[0..=20] (y > 10)`.
+pub fn f3() -> Formula {
+    Formula::Until(
+        Interval { start: 0, end: Bound::Inclusive(20) },
+        Box::new(cmp(Expr::Var(0), CmpOp::Gt, Expr::Const(5.0))),
+        Box::new(cmp(Expr::Var(1), CmpOp::Gt, Expr::Const(10.0))),
+    )
+}

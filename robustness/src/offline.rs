@@ -1,0 +1,492 @@
+//! The fast offline evaluator: the whole robustness signal, bottom-up, one pass per operator.
+//!
+//! Every operator works on whole columns (one `Vec<f64>` per subformula, taken from a pool
+//! and reused between calls). State subformulas (no temporal operator) are evaluated in
+//! cache-sized chunks, so `x > 3 && x < 9 && y > 10` writes its output once.
+//! `always` and `eventually` use the van Herk/Gil-Werman algorithm: prefix and suffix
+//! minima over blocks as long as the window, then one branch-free, vectorisable pass; the
+//! cost per sample does not depend on the window length. `until` takes linear time: a
+//! backward recurrence when unbounded, a backward sweep with a monotonic deque when bounded.
+//!
+//! # Values
+//! The results equal [`reference`](crate::reference) exactly: min and max are selections,
+//! never arithmetic, so no rounding can differ. Minimum and maximum follow IEEE 754
+//! `minNum`/`maxNum` as Rust's [`f64::min`] and [`f64::max`] do, and as the reference does:
+//! a NaN operand is ignored. A NaN therefore appears in a signal only where an atom
+//! evaluates to NaN (`sqrt(-1)`, `inf - inf`, a variable the trace lacks) and reaches the
+//! output through `!` or `->`; `always`, `eventually`, `&&` and `||` skip it, as if the
+//! sample were not there. The one thing not pinned is the sign of a zero (`min(0, -0)`).
+
+use crate::{Bound, CmpOp, Expr, Formula, Interval, Trace};
+
+const INF: f64 = f64::INFINITY;
+const NEG_INF: f64 = f64::NEG_INFINITY;
+/// Samples per chunk for state formulas: a handful of chunk buffers stay in L1.
+const CHUNK: usize = 512;
+
+/// A reusable evaluator: keeps its buffers between calls, so repeated evaluation (the RL
+/// reward pattern) allocates nothing once warmed up.
+#[derive(Clone, Debug, Default)]
+pub struct Evaluator {
+    pool: Vec<Vec<f64>>,
+    chunks: Vec<Vec<f64>>,
+    result: Vec<f64>,
+    scratch_a: Vec<f64>,
+    scratch_b: Vec<f64>,
+    deque_at: Vec<usize>,
+    deque_val: Vec<f64>,
+}
+
+/// The full robustness signal of `f` on `trace`: `rho(f, t)` for every step `t`.
+pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
+    let mut e = Evaluator::new();
+    e.signal(f, trace);
+    std::mem::take(&mut e.result)
+}
+
+/// The robustness of `f` at step 0 of `trace`; see [`Evaluator::robustness`].
+pub fn robustness(f: &Formula, trace: &Trace) -> f64 {
+    Evaluator::new().robustness(f, trace)
+}
+
+impl Evaluator {
+    /// An evaluator with no buffers yet.
+    pub fn new() -> Evaluator {
+        Evaluator::default()
+    }
+
+    /// The full robustness signal of `f` on `trace`, valid until the next call.
+    pub fn signal(&mut self, f: &Formula, trace: &Trace) -> &[f64] {
+        let cols = columns(trace);
+        self.signal_of_columns(f, &cols, trace.len())
+    }
+
+    /// The robustness of `f` at step 0 of `trace`.
+    ///
+    /// For a formula with a finite horizon `H` only the first `H + 1` steps are read, so
+    /// the cost does not depend on the trace length; an unbounded formula reads the whole
+    /// trace. On the empty trace every window is empty and an atom is NaN, as in
+    /// [`reference::robustness`](crate::reference::robustness).
+    pub fn robustness(&mut self, f: &Formula, trace: &Trace) -> f64 {
+        let cols = columns(trace);
+        self.robustness_of_columns(f, &cols, trace.len())
+    }
+
+    /// [`Evaluator::signal`] over columns given as slices, each at least `n` long.
+    pub(crate) fn signal_of_columns(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> &[f64] {
+        let out = self.eval(f, cols, n);
+        let old = std::mem::replace(&mut self.result, out);
+        self.pool.push(old);
+        &self.result
+    }
+
+    /// [`Evaluator::robustness`] over columns given as slices, each at least `n` long.
+    pub(crate) fn robustness_of_columns(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> f64 {
+        let n = match f.horizon() {
+            Some(h) => n.min(h.saturating_add(1)),
+            None => n,
+        };
+        if n == 0 {
+            return empty_trace_value(f);
+        }
+        let out = self.eval(f, cols, n);
+        let v = out[0];
+        self.pool.push(out);
+        v
+    }
+
+    fn take(&mut self, n: usize) -> Vec<f64> {
+        let mut v = self.pool.pop().unwrap_or_default();
+        // Every operator overwrites its whole output, so stale values may stay.
+        if v.len() < n {
+            v.resize(n, 0.0);
+        } else {
+            v.truncate(n);
+        }
+        v
+    }
+
+    fn take_chunk(&mut self) -> Vec<f64> {
+        self.chunks.pop().unwrap_or_else(|| vec![0.0; CHUNK])
+    }
+
+    /// The signal of `f` over the first `n` steps, in a buffer from the pool.
+    fn eval(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
+        if f.is_state_formula() {
+            let mut out = self.take(n);
+            let mut lo = 0;
+            while lo < n {
+                let hi = (lo + CHUNK).min(n);
+                self.state_chunk(f, cols, lo, &mut out[lo..hi]);
+                lo = hi;
+            }
+            return out;
+        }
+        match f {
+            Formula::Not(g) => {
+                let mut out = self.eval(g, cols, n);
+                out.iter_mut().for_each(|v| *v = -*v);
+                out
+            }
+            Formula::And(gs) => self.fold::<Min>(gs, cols, n),
+            Formula::Or(gs) => self.fold::<Max>(gs, cols, n),
+            Formula::Implies(g, h) => {
+                let mut out = self.eval(g, cols, n);
+                let rhs = self.eval(h, cols, n);
+                out.iter_mut().zip(&rhs).for_each(|(a, b)| *a = (-*a).max(*b));
+                self.pool.push(rhs);
+                out
+            }
+            Formula::Always(i, g) => {
+                let mut out = self.eval(g, cols, n);
+                self.window::<Min>(&mut out, i);
+                out
+            }
+            Formula::Eventually(i, g) => {
+                let mut out = self.eval(g, cols, n);
+                self.window::<Max>(&mut out, i);
+                out
+            }
+            Formula::Until(i, g, h) => {
+                let mut lhs = self.eval(g, cols, n);
+                let mut out = self.eval(h, cols, n);
+                self.until(i, &mut lhs, &mut out);
+                self.pool.push(lhs);
+                out
+            }
+            // State formulas were handled above.
+            Formula::True | Formula::False | Formula::Cmp { .. } => {
+                unreachable!("state formulas are evaluated in chunks")
+            }
+        }
+    }
+
+    fn fold<L: Lattice>(&mut self, gs: &[Formula], cols: &[&[f64]], n: usize) -> Vec<f64> {
+        let mut out = self.take(n);
+        out.fill(L::ID);
+        for g in gs {
+            let v = self.eval(g, cols, n);
+            out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::op(*a, *b));
+            self.pool.push(v);
+        }
+        out
+    }
+
+    /// A state formula on steps `lo .. lo + out.len()`.
+    fn state_chunk(&mut self, f: &Formula, cols: &[&[f64]], lo: usize, out: &mut [f64]) {
+        match f {
+            Formula::True => out.fill(INF),
+            Formula::False => out.fill(NEG_INF),
+            Formula::Cmp { lhs, op, rhs } => self.cmp_chunk(lhs, *op, rhs, cols, lo, out),
+            Formula::Not(g) => {
+                self.state_chunk(g, cols, lo, out);
+                out.iter_mut().for_each(|v| *v = -*v);
+            }
+            Formula::And(gs) => self.fold_chunk::<Min>(gs, cols, lo, out),
+            Formula::Or(gs) => self.fold_chunk::<Max>(gs, cols, lo, out),
+            Formula::Implies(g, h) => {
+                self.state_chunk(g, cols, lo, out);
+                let mut tmp = self.take_chunk();
+                let tmp_s = &mut tmp[..out.len()];
+                self.state_chunk(h, cols, lo, tmp_s);
+                out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = (-*a).max(*b));
+                self.chunks.push(tmp);
+            }
+            // Temporal operators never reach here: `eval` sends only state formulas.
+            Formula::Always(..) | Formula::Eventually(..) | Formula::Until(..) => {
+                unreachable!("temporal operators are not state formulas")
+            }
+        }
+    }
+
+    fn fold_chunk<L: Lattice>(
+        &mut self,
+        gs: &[Formula],
+        cols: &[&[f64]],
+        lo: usize,
+        out: &mut [f64],
+    ) {
+        out.fill(L::ID);
+        let mut tmp = self.take_chunk();
+        let tmp_s = &mut tmp[..out.len()];
+        for g in gs {
+            self.state_chunk(g, cols, lo, tmp_s);
+            out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = L::op(*a, *b));
+        }
+        self.chunks.push(tmp);
+    }
+
+    fn cmp_chunk(
+        &mut self,
+        lhs: &Expr,
+        op: CmpOp,
+        rhs: &Expr,
+        cols: &[&[f64]],
+        lo: usize,
+        out: &mut [f64],
+    ) {
+        let hi = lo + out.len();
+        // `x op c` and `c op x` are the common atoms: one pass, no copy.
+        let (var, c, var_left) = match (lhs, rhs) {
+            (Expr::Var(i), Expr::Const(c)) => (*i, *c, true),
+            (Expr::Const(c), Expr::Var(i)) => (*i, *c, false),
+            _ => {
+                self.expr_chunk(lhs, cols, lo, out);
+                let mut tmp = self.take_chunk();
+                let tmp_s = &mut tmp[..out.len()];
+                self.expr_chunk(rhs, cols, lo, tmp_s);
+                out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = op.robustness(*a, *b));
+                self.chunks.push(tmp);
+                return;
+            }
+        };
+        let Some(col) = cols.get(var) else {
+            out.fill(f64::NAN);
+            return;
+        };
+        let col = &col[lo..hi];
+        let x_minus_c = matches!(op, CmpOp::Gt | CmpOp::Ge) == var_left;
+        if x_minus_c {
+            out.iter_mut().zip(col).for_each(|(o, x)| *o = *x - c);
+        } else {
+            out.iter_mut().zip(col).for_each(|(o, x)| *o = c - *x);
+        }
+    }
+
+    fn expr_chunk(&mut self, e: &Expr, cols: &[&[f64]], lo: usize, out: &mut [f64]) {
+        let hi = lo + out.len();
+        match e {
+            Expr::Const(c) => out.fill(*c),
+            Expr::Var(i) => match cols.get(*i) {
+                Some(col) => out.copy_from_slice(&col[lo..hi]),
+                None => out.fill(f64::NAN),
+            },
+            Expr::Neg(a) => {
+                self.expr_chunk(a, cols, lo, out);
+                out.iter_mut().for_each(|v| *v = -*v);
+            }
+            Expr::Abs(a) => {
+                self.expr_chunk(a, cols, lo, out);
+                out.iter_mut().for_each(|v| *v = v.abs());
+            }
+            Expr::Sqrt(a) => {
+                self.expr_chunk(a, cols, lo, out);
+                out.iter_mut().for_each(|v| *v = v.sqrt());
+            }
+            Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b) | Expr::Div(a, b) => {
+                self.expr_chunk(a, cols, lo, out);
+                let mut tmp = self.take_chunk();
+                let tmp_s = &mut tmp[..out.len()];
+                self.expr_chunk(b, cols, lo, tmp_s);
+                let pairs = out.iter_mut().zip(tmp_s.iter());
+                match e {
+                    Expr::Add(..) => pairs.for_each(|(x, y)| *x += *y),
+                    Expr::Sub(..) => pairs.for_each(|(x, y)| *x -= *y),
+                    Expr::Mul(..) => pairs.for_each(|(x, y)| *x *= *y),
+                    _ => pairs.for_each(|(x, y)| *x /= *y),
+                }
+                self.chunks.push(tmp);
+            }
+        }
+    }
+
+    /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, in place.
+    fn window<L: Lattice>(&mut self, buf: &mut [f64], i: &Interval) {
+        let n = buf.len();
+        let a = i.start;
+        if i.is_empty() || a >= n {
+            buf.fill(L::ID);
+            return;
+        }
+        let Some(last) = i.last_offset() else {
+            // Unbounded: a suffix fold, then a shift by `a`.
+            let mut acc = L::ID;
+            for v in buf.iter_mut().rev() {
+                acc = L::op(*v, acc);
+                *v = acc;
+            }
+            shift_left::<L>(buf, a);
+            return;
+        };
+        // The window at `t` is `s ..= s + len - 1` with `s = t + a`, clipped at `n`.
+        let len = last - a + 1;
+        if len == 1 {
+            buf.iter_mut().for_each(|v| *v = L::op(L::ID, *v));
+            shift_left::<L>(buf, a);
+            return;
+        }
+        let len = len.min(n);
+        van_herk::<L>(buf, a, len, &mut self.scratch_a, &mut self.scratch_b);
+    }
+
+    /// `out[t]` becomes `rho(lhs until[i] out, t)` given the two operand signals.
+    fn until(&mut self, i: &Interval, lhs: &mut [f64], out: &mut [f64]) {
+        let n = out.len();
+        let a = i.start;
+        if i.is_empty() || a >= n {
+            out.fill(NEG_INF);
+            return;
+        }
+        // rho(t) = min(always[0..a] lhs at t, U(t + a)), where U is `until[0..=len-1]`
+        // (or unbounded) at `t + a`: the `lhs` samples before `t + a` bound every candidate.
+        match i.last_offset() {
+            None => {
+                let mut next = NEG_INF;
+                for (g, f) in out.iter_mut().zip(lhs.iter()).rev() {
+                    next = g.min(INF).max(f.min(next));
+                    *g = next;
+                }
+            }
+            Some(last) => self.bounded_until(lhs, out, last - a),
+        }
+        if a > 0 {
+            self.window::<Min>(lhs, &Interval { start: 0, end: Bound::Exclusive(a) });
+            for t in 0..n - a {
+                out[t] = lhs[t].min(out[t + a]);
+            }
+            out[n - a..].fill(NEG_INF);
+        }
+    }
+
+    /// `out[s]` becomes the max over `s <= u <= min(s + span, n - 1)` of
+    /// `min(out[u], lhs[s..u])`, by a backward sweep over `s`.
+    ///
+    /// The deque holds candidates `u` with their values `min(g[u], lhs[s..u])`; a newer
+    /// candidate (smaller `u`) lives longer, so it removes older ones it dominates and the
+    /// values decrease from front (oldest) to back. Capping every value by `lhs[s]` turns
+    /// the front run above it into one candidate.
+    fn bounded_until(&mut self, lhs: &[f64], out: &mut [f64], span: usize) {
+        let n = out.len();
+        self.deque_at.clear();
+        self.deque_at.resize(n + 1, 0);
+        self.deque_val.clear();
+        self.deque_val.resize(n + 1, 0.0);
+        let (at, val) = (&mut self.deque_at[..], &mut self.deque_val[..]);
+        // Live entries are `head .. tail`; the back grows upwards.
+        let (mut head, mut tail) = (0usize, 0usize);
+        for s in (0..n).rev() {
+            let cap = lhs[s];
+            if !cap.is_nan() && head < tail && val[head] > cap {
+                while head < tail && val[head] >= cap {
+                    head += 1;
+                }
+                // The newest capped candidate lives longest; it takes the freed slot.
+                head -= 1;
+                val[head] = cap;
+            }
+            while head < tail && at[head] > s + span {
+                head += 1;
+            }
+            let v = out[s].min(INF);
+            while head < tail && val[tail - 1] <= v {
+                tail -= 1;
+            }
+            if tail == head {
+                // Restart at the bottom so the slots below `head` stay free for caps.
+                head = 0;
+                tail = 0;
+            }
+            at[tail] = s;
+            val[tail] = v;
+            tail += 1;
+            out[s] = val[head];
+        }
+    }
+}
+
+/// A min or a max, with its identity.
+trait Lattice {
+    const ID: f64;
+    fn op(a: f64, b: f64) -> f64;
+}
+
+struct Min;
+struct Max;
+
+impl Lattice for Min {
+    const ID: f64 = INF;
+    #[inline(always)]
+    fn op(a: f64, b: f64) -> f64 {
+        a.min(b)
+    }
+}
+
+impl Lattice for Max {
+    const ID: f64 = NEG_INF;
+    #[inline(always)]
+    fn op(a: f64, b: f64) -> f64 {
+        a.max(b)
+    }
+}
+
+fn columns(trace: &Trace) -> Vec<&[f64]> {
+    (0..trace.vars()).map(|i| trace.column(i)).collect()
+}
+
+/// `buf[t] = buf[t + a]`, and the identity where `t + a` is past the end.
+fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
+    let n = buf.len();
+    let a = a.min(n);
+    buf.copy_within(a.., 0);
+    buf[n - a..].fill(L::ID);
+}
+
+/// `buf[t]` becomes the fold of `buf[t + a ..= t + a + len - 1]` (clipped at the end), with
+/// `2 <= len <= n` and `a < n`: van Herk/Gil-Werman over blocks of `len` samples.
+fn van_herk<L: Lattice>(
+    buf: &mut [f64],
+    a: usize,
+    len: usize,
+    pre: &mut Vec<f64>,
+    suf: &mut Vec<f64>,
+) {
+    let n = buf.len();
+    pre.clear();
+    pre.resize(n, 0.0);
+    suf.clear();
+    suf.resize(n, 0.0);
+    // Prefix folds run forwards and suffix folds backwards inside each block; the two
+    // chains are independent, so one loop runs both.
+    let mut b0 = 0;
+    while b0 < n {
+        let b1 = (b0 + len).min(n);
+        let (x, p, s) = (&buf[b0..b1], &mut pre[b0..b1], &mut suf[b0..b1]);
+        let m = x.len();
+        let (mut pa, mut sa) = (L::ID, L::ID);
+        for j in 0..m {
+            pa = L::op(pa, x[j]);
+            p[j] = pa;
+            sa = L::op(x[m - 1 - j], sa);
+            s[m - 1 - j] = sa;
+        }
+        b0 = b1;
+    }
+    // Window `s ..= e`: the suffix of `s`'s block and the prefix of the next block up to
+    // `e`. When `s` starts a block both halves cover the same block.
+    let span = len - 1;
+    let full = n.saturating_sub(span + a);
+    let (pre, suf) = (&pre[..], &suf[..]);
+    for (t, o) in buf[..full].iter_mut().enumerate() {
+        *o = L::op(suf[t + a], pre[t + a + span]);
+    }
+    // Windows clipped at the end: they reach at most into the last block.
+    let last_block = (n - 1) / len * len;
+    for (t, o) in buf.iter_mut().enumerate().take(n - a).skip(full) {
+        let s = t + a;
+        *o = if s >= last_block { suf[s] } else { L::op(suf[s], pre[n - 1]) };
+    }
+    buf[n - a..].fill(L::ID);
+}
+
+/// `rho(f, 0)` on the empty trace, as the reference evaluator gives it.
+fn empty_trace_value(f: &Formula) -> f64 {
+    match f {
+        Formula::True | Formula::Always(..) => INF,
+        Formula::False | Formula::Eventually(..) | Formula::Until(..) => NEG_INF,
+        Formula::Cmp { .. } => f64::NAN,
+        Formula::Not(g) => -empty_trace_value(g),
+        Formula::And(gs) => gs.iter().map(empty_trace_value).fold(INF, f64::min),
+        Formula::Or(gs) => gs.iter().map(empty_trace_value).fold(NEG_INF, f64::max),
+        Formula::Implies(g, h) => (-empty_trace_value(g)).max(empty_trace_value(h)),
+    }
+}

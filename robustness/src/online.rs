@@ -1,0 +1,138 @@
+//! The online monitor: states arrive one at a time, verdicts leave as soon as they are known.
+//!
+//! For a formula with a finite horizon `H`, `rho(f, t)` depends on `s_t ..= s_{t+H}` only,
+//! so it is final once state `t + H` has arrived: [`OnlineMonitor::push`] returns it then.
+//! The monitor keeps at most about `2 (H + 1)` states per variable, whatever the trace
+//! length, and each verdict costs one evaluation of those `H + 1` states (`O(H)` times the
+//! formula size). [`OnlineMonitor::finish`] ends the trace and returns the steps still
+//! open, with their windows clipped at the end of the trace, exactly as the offline
+//! evaluators clip them.
+//!
+//! For a formula with an unbounded operator no verdict is final before the trace ends: a
+//! later state can still change `rho(f, t)`. [`OnlineMonitor::push`] then returns nothing,
+//! the monitor keeps every state, and [`OnlineMonitor::provisional`] gives the value the
+//! first open step would have if the trace ended now (it is not a verdict).
+
+use crate::{Formula, TraceError, offline::Evaluator};
+
+/// The final robustness of the trace at one step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Verdict {
+    /// The step `t`, counted from the first state pushed after creation or [`finish`].
+    ///
+    /// [`finish`]: OnlineMonitor::finish
+    pub step: usize,
+    /// `rho(f, t)`.
+    pub value: f64,
+}
+
+/// Monitors one formula over a trace pushed state by state.
+#[derive(Clone, Debug)]
+pub struct OnlineMonitor {
+    formula: Formula,
+    horizon: Option<usize>,
+    columns: Vec<Vec<f64>>,
+    /// The length of every column (kept apart so a formula over no variable works).
+    len: usize,
+    /// Index in `columns` of the first step without a verdict.
+    start: usize,
+    /// The step number of that index.
+    first_step: usize,
+    eval: Evaluator,
+}
+
+impl OnlineMonitor {
+    /// A monitor for `formula` over states of `vars` variables.
+    pub fn new(formula: &Formula, vars: usize) -> OnlineMonitor {
+        OnlineMonitor {
+            formula: formula.clone(),
+            horizon: formula.horizon(),
+            columns: vec![Vec::new(); vars],
+            len: 0,
+            start: 0,
+            first_step: 0,
+            eval: Evaluator::new(),
+        }
+    }
+
+    /// The formula's horizon; `None` when unbounded (no verdict before [`finish`]).
+    ///
+    /// [`finish`]: OnlineMonitor::finish
+    pub fn horizon(&self) -> Option<usize> {
+        self.horizon
+    }
+
+    /// The number of states pushed since creation or the last [`finish`].
+    ///
+    /// [`finish`]: OnlineMonitor::finish
+    pub fn steps(&self) -> usize {
+        self.first_step + self.buffered()
+    }
+
+    /// Appends one state, `state[i]` being variable `i`, and returns the verdict it
+    /// completes: `rho(f, t)` for `t = steps - 1 - H`, once `H + 1` states are in.
+    pub fn push(&mut self, state: &[f64]) -> Result<Option<Verdict>, TraceError> {
+        if state.len() != self.columns.len() {
+            return Err(TraceError::RowWidth { expected: self.columns.len(), found: state.len() });
+        }
+        for (c, v) in self.columns.iter_mut().zip(state) {
+            c.push(*v);
+        }
+        self.len += 1;
+        let Some(h) = self.horizon else { return Ok(None) };
+        let window = h.saturating_add(1);
+        if self.buffered() < window {
+            return Ok(None);
+        }
+        let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
+        let value = self.eval.robustness_of_columns(&self.formula, &cols, window);
+        let verdict = Verdict { step: self.first_step, value };
+        self.start += 1;
+        self.first_step += 1;
+        // Dropping the decided prefix now and then keeps memory at O(H), amortised O(1).
+        if self.start >= window.max(64) {
+            let start = self.start;
+            self.columns.iter_mut().for_each(|c| {
+                c.drain(..start);
+            });
+            self.len -= start;
+            self.start = 0;
+        }
+        Ok(Some(verdict))
+    }
+
+    /// What `rho(f, t)` at the first step without a verdict would be if the trace ended
+    /// now; `None` when every pushed step has its verdict. Not final: later states may
+    /// change it.
+    pub fn provisional(&mut self) -> Option<f64> {
+        if self.buffered() == 0 {
+            return None;
+        }
+        let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
+        Some(self.eval.robustness_of_columns(&self.formula, &cols, self.buffered()))
+    }
+
+    /// Ends the trace: the verdicts of every step still open, windows clipped at the end
+    /// of the trace. The monitor is then ready for a new trace, counting from step 0.
+    pub fn finish(&mut self) -> Vec<Verdict> {
+        let n = self.buffered();
+        let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
+        let first = self.first_step;
+        let out = self
+            .eval
+            .signal_of_columns(&self.formula, &cols, n)
+            .iter()
+            .enumerate()
+            .map(|(i, &value)| Verdict { step: first + i, value })
+            .collect();
+        self.columns.iter_mut().for_each(Vec::clear);
+        self.len = 0;
+        self.start = 0;
+        self.first_step = 0;
+        out
+    }
+
+    fn buffered(&self) -> usize {
+        self.len - self.start
+    }
+}
