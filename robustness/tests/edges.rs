@@ -1,0 +1,89 @@
+//! Edge cases per operator, with signals worked out by hand from the semantics table of
+//! the language reference; every evaluator must give them.
+
+mod common;
+
+use common::{check_all, parse, trace_xy};
+use hstl_robustness::{Formula, Trace, offline, reference};
+
+const INF: f64 = f64::INFINITY;
+const NEG: f64 = f64::NEG_INFINITY;
+
+/// `(formula, x, y, expected signal)`.
+const CASES: &[(&str, &[f64], &[f64], &[f64])] = &[
+    // Empty windows: `[3..3]` and `[3..=2]` hold no step.
+    ("always[3..3] (x > 0)", &[1.0, 2.0], &[0.0, 0.0], &[INF, INF]),
+    ("eventually[3..=2] (x > 0)", &[1.0, 2.0], &[0.0, 0.0], &[NEG, NEG]),
+    ("(x > 0) until[2..2] (y > 0)", &[1.0, 2.0], &[5.0, 5.0], &[NEG, NEG]),
+    // Windows clipped by the end of the trace, and windows starting past it.
+    ("always[0..=5] (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[1.0, 1.0, 2.0]),
+    ("always[2..=5] (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[2.0, INF, INF]),
+    ("eventually[1..] (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[2.0, 2.0, NEG]),
+    ("eventually[0..] (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[3.0, 2.0, 2.0]),
+    // `[a..b]` excludes `b`, `[a..=b]` includes it.
+    ("always[0..2] (x > 0)", &[5.0, 4.0, 1.0, 6.0], &[0.0; 4], &[4.0, 1.0, 1.0, 6.0]),
+    ("always[0..=2] (x > 0)", &[5.0, 4.0, 1.0, 6.0], &[0.0; 4], &[1.0, 1.0, 1.0, 6.0]),
+    ("eventually[1..3] (x > 0)", &[5.0, 4.0, 1.0, 6.0], &[0.0; 4], &[4.0, 6.0, 6.0, NEG]),
+    ("eventually[1..=3] (x > 0)", &[5.0, 4.0, 1.0, 6.0], &[0.0; 4], &[6.0, 6.0, 6.0, NEG]),
+    // Until needs its left operand on [t, t'): at t' = t it is not read at all.
+    ("(x > 0) until[0..=0] (y > 0)", &[-9.0, -9.0], &[2.0, 3.0], &[2.0, 3.0]),
+    ("(x > 0) until (y > 0)", &[4.0, -1.0, 7.0], &[-5.0, -6.0, 9.0], &[-1.0, -1.0, 9.0]),
+    // A lower bound above 0: the left operand must hold from t up to t'.
+    ("(x > 0) until[2..=3] (y > 0)", &[1.0, 5.0, 5.0, 5.0], &[0.0, 0.0, 9.0, 9.0], &[1.0, 5.0, NEG, NEG]),
+    ("(x > 0) until[1..] (y > 0)", &[2.0, -3.0, 4.0], &[0.0, 1.0, 8.0], &[1.0, -3.0, NEG]),
+    // true and false, alone and inside temporal operators.
+    ("true", &[1.0, 2.0], &[0.0, 0.0], &[INF, INF]),
+    ("false", &[1.0, 2.0], &[0.0, 0.0], &[NEG, NEG]),
+    ("always[0..] false", &[1.0, 2.0], &[0.0, 0.0], &[NEG, NEG]),
+    ("eventually[0..=1] true", &[1.0, 2.0], &[0.0, 0.0], &[INF, INF]),
+    ("true until[1..=1] (x > 0)", &[1.0, 2.0], &[0.0, 0.0], &[2.0, NEG]),
+    // Infinite samples stay exact: `x > 3` with x = inf is inf.
+    ("always[0..=1] (x > 3)", &[INF, INF, NEG], &[0.0; 3], &[INF, NEG, NEG]),
+    ("!(x > 3) -> y < 1", &[INF, 0.0], &[NEG, 5.0], &[INF, -3.0]),
+];
+
+fn signal(v: &[f64]) -> Vec<f64> {
+    v.to_vec()
+}
+
+#[test]
+fn hand_worked_signals() {
+    for (src, x, y, want) in CASES {
+        check_all(&parse(src), &trace_xy(x, y), &signal(want));
+    }
+}
+
+/// On the empty trace the signal is empty and step 0 sees empty windows everywhere.
+#[test]
+fn empty_trace() {
+    let empty = Trace::new(2);
+    let cases: &[(&str, f64)] = &[
+        ("always[0..=3] (x > 0)", INF),
+        ("eventually (x > 0)", NEG),
+        ("(x > 0) until (y > 0)", NEG),
+        ("true", INF),
+        ("!always[0..] (x > 0)", NEG),
+        ("always[0..] (x > 0) && eventually (y > 1)", NEG),
+    ];
+    for (src, want) in cases {
+        let f = parse(src);
+        check_all(&f, &empty, &[]);
+        assert_eq!(offline::robustness(&f, &empty), *want, "{src}");
+        assert_eq!(reference::robustness(&f, &empty, 0), *want, "{src}");
+    }
+    // An atom at a step the trace does not have is NaN in every evaluator.
+    assert!(offline::robustness(&parse("x > 0"), &empty).is_nan());
+}
+
+/// Step 0 of a bounded formula reads only the horizon: the samples after it change nothing.
+#[test]
+fn step_zero_reads_the_horizon_only() {
+    let f: Formula = parse("always[0..=3] eventually[1..=2] (x > 2)");
+    let h = f.horizon().expect("bounded");
+    let x: Vec<f64> = (0..50).map(|t| f64::from(t % 7)).collect();
+    let mut poisoned = x.clone();
+    poisoned[h + 1..].fill(f64::NAN);
+    let t = trace_xy(&x, &x);
+    let p = trace_xy(&poisoned, &poisoned);
+    assert_eq!(offline::robustness(&f, &p), reference::robustness(&f, &t, 0));
+}

@@ -1,0 +1,131 @@
+//! Random formulas with every operator and interval form, on random traces with ±inf and
+//! NaN samples: every evaluator agrees with the reference, and `Display` parses back.
+
+mod common;
+
+use common::{check_all, parse};
+use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace, reference};
+use proptest::prelude::*;
+
+fn value() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        8 => (-6i32..=6).prop_map(f64::from),
+        1 => Just(f64::INFINITY),
+        1 => Just(f64::NEG_INFINITY),
+        1 => (-60i32..=60).prop_map(|v| f64::from(v) / 8.0),
+    ]
+}
+
+fn trace(vars: usize, nan: bool) -> impl Strategy<Value = Trace> {
+    let v = if nan { prop_oneof![15 => value(), 1 => Just(f64::NAN)].boxed() } else { value().boxed() };
+    (0usize..=30).prop_flat_map(move |n| {
+        proptest::collection::vec(proptest::collection::vec(v.clone(), n), vars)
+            .prop_map(|cols| Trace::from_columns(cols).expect("equal lengths"))
+    })
+}
+
+fn interval() -> impl Strategy<Value = Interval> {
+    let end = prop_oneof![
+        1 => Just(Bound::Unbounded),
+        2 => (0usize..9).prop_map(Bound::Exclusive),
+        2 => (0usize..9).prop_map(Bound::Inclusive),
+    ];
+    (0usize..5, end).prop_map(|(start, end)| Interval { start, end })
+}
+
+fn expr() -> impl Strategy<Value = Expr> {
+    let leaf = prop_oneof![
+        3 => (0usize..2).prop_map(Expr::Var),
+        2 => (-4i32..=4).prop_map(|c| Expr::Const(f64::from(c))),
+    ];
+    leaf.prop_recursive(2, 6, 2, |e| {
+        prop_oneof![
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Add(Box::new(a), Box::new(b))),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Sub(Box::new(a), Box::new(b))),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Mul(Box::new(a), Box::new(b))),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Div(Box::new(a), Box::new(b))),
+            e.clone().prop_map(|a| Expr::Neg(Box::new(a))),
+            e.clone().prop_map(|a| Expr::Abs(Box::new(a))),
+            e.prop_map(|a| Expr::Sqrt(Box::new(a))),
+        ]
+    })
+}
+
+fn cmp_op() -> impl Strategy<Value = CmpOp> {
+    prop_oneof![Just(CmpOp::Lt), Just(CmpOp::Le), Just(CmpOp::Gt), Just(CmpOp::Ge)]
+}
+
+/// Formulas over `x` and `y`; `min_kids` is the least number of `&&`/`||` operands.
+fn formula(min_kids: usize) -> impl Strategy<Value = Formula> {
+    let simple = (0usize..2, cmp_op(), -4i32..=4).prop_map(|(v, op, c)| Formula::Cmp {
+        lhs: Expr::Var(v),
+        op,
+        rhs: Expr::Const(f64::from(c)),
+    });
+    let general =
+        (expr(), cmp_op(), expr()).prop_map(|(lhs, op, rhs)| Formula::Cmp { lhs, op, rhs });
+    let leaf = prop_oneof![
+        6 => simple,
+        2 => general,
+        1 => Just(Formula::True),
+        1 => Just(Formula::False),
+    ];
+    leaf.prop_recursive(4, 24, 3, move |f| {
+        let kids = proptest::collection::vec(f.clone(), min_kids..=3);
+        prop_oneof![
+            f.clone().prop_map(|g| Formula::Not(Box::new(g))),
+            kids.clone().prop_map(Formula::And),
+            kids.prop_map(Formula::Or),
+            (f.clone(), f.clone()).prop_map(|(g, h)| Formula::Implies(Box::new(g), Box::new(h))),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::Eventually(i, Box::new(g))),
+            (interval(), f.clone(), f.clone())
+                .prop_map(|(i, g, h)| Formula::Until(i, Box::new(g), Box::new(h))),
+            (interval(), f).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
+        ]
+    })
+}
+
+/// A persistent task `always[0..] f`, the shape whose segment reward cuts the horizon.
+fn persistent() -> impl Strategy<Value = Formula> {
+    formula(0).prop_map(|f| Formula::Always(Interval::ALL, Box::new(f)))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn evaluators_agree(f in formula(0), t in trace(2, false)) {
+        let want = reference::signal(&f, &t);
+        check_all(&f, &t, &want);
+    }
+
+    #[test]
+    fn evaluators_agree_with_nan(f in formula(0), t in trace(2, true)) {
+        let want = reference::signal(&f, &t);
+        check_all(&f, &t, &want);
+    }
+
+    #[test]
+    fn persistent_segment_rewards(f in persistent(), t in trace(2, false)) {
+        let want = reference::signal(&f, &t);
+        check_all(&f, &t, &want);
+    }
+
+    #[test]
+    fn display_parses_back(f in formula(2), t in trace(2, false)) {
+        let text = f.display_with(&common::VARS).to_string();
+        let back = parse(&text);
+        prop_assert_eq!(back.display_with(&common::VARS).to_string(), text.clone());
+        common::assert_same(&text, &reference::signal(&back, &t), &reference::signal(&f, &t));
+    }
+}
+
+/// A variable the trace lacks reads as NaN everywhere, never a panic.
+#[test]
+fn missing_variable_is_nan() {
+    let f = Formula::Cmp { lhs: Expr::Var(5), op: CmpOp::Gt, rhs: Expr::Const(0.0) };
+    let t = common::trace_xy(&[1.0, 2.0], &[3.0, 4.0]);
+    check_all(&f, &t, &reference::signal(&f, &t));
+    assert!(reference::signal(&f, &t).iter().all(|v| v.is_nan()));
+}
