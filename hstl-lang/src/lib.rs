@@ -3,6 +3,10 @@
 //! Parsing and checking never fail: they return what they could build together with a
 //! list of plain-data [`Diagnostic`]s. This crate knows nothing of miette, LSP or proc macros.
 
+pub mod codes;
 pub mod diagnostic;
+pub mod parser;
+pub mod syntax;
 
 pub use diagnostic::{Diagnostic, Label, Severity};
+pub use parser::{Parsed, parse};

@@ -1,0 +1,320 @@
+//! Every diagnostic code with its name, severity, summary and long explanation.
+//! `hstlc explain CODE` prints [`CodeInfo::explanation`]. Codes are stable: new ones are
+//! added at the end.
+
+use crate::diagnostic::Severity;
+
+/// One diagnostic code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CodeInfo {
+    /// The code, such as `HSTL003`.
+    pub code: &'static str,
+    /// A short kebab-case name, such as `duplicate-name`.
+    pub name: &'static str,
+    /// Error or warning.
+    pub severity: Severity,
+    /// One line.
+    pub summary: &'static str,
+    /// What triggers it, an example that does, and the fix.
+    pub explanation: &'static str,
+}
+
+/// Looks a code up (case-insensitive).
+pub fn lookup(code: &str) -> Option<&'static CodeInfo> {
+    CODES.iter().find(|c| c.code.eq_ignore_ascii_case(code))
+}
+
+use Severity::{Error as E, Warning as W};
+
+/// The table of every code, in numeric order.
+pub static CODES: &[CodeInfo] = &[
+    CodeInfo {
+        code: "HSTL001",
+        name: "syntax-error",
+        severity: E,
+        summary: "the text does not follow the grammar",
+        explanation: "The parser expected something else at this place; the message says what it \
+expected and what it found. Each item (`let`, `task`, `option`, ...) is parsed on its own, so \
+an error in one item does not hide errors in the others: the broken item is skipped.\n\n\
+Example:\n    let A = x > 3     // missing `;`\n    let B = y < 2;\n\n\
+Fix: write what the message asks for (here `;`). Brackets nested more than 64 levels deep \
+and formulas more than 256 levels tall are also reported under this code: split them into \
+several `let`s.",
+    },
+    CodeInfo {
+        code: "HSTL002",
+        name: "unknown-name",
+        severity: E,
+        summary: "a name that is not declared",
+        explanation: "A name in a formula must be a `let`; a name in an arithmetic expression \
+must be a state variable. This one is neither.\n\n\
+Example:\n    state { x: int in 0..=9 }\n    let A = z > 3;    // `z` is not declared\n\n\
+Fix: declare the variable in `state { ... }` or the formula with `let`, or correct the \
+spelling (the help suggests a close name when there is one).",
+    },
+    CodeInfo {
+        code: "HSTL003",
+        name: "duplicate-name",
+        severity: E,
+        summary: "a name (or a once-only item) is declared twice",
+        explanation: "State variables and `let`s share one namespace, options have their own, and \
+spec names must be unique in a file. A spec has at most one `state`, `task`, `options` and \
+`learn` item. The label points at the first declaration.\n\n\
+Example:\n    let A = x > 3;\n    let A = x < 9;\n\n\
+Fix: rename one of them, or merge the two items.",
+    },
+    CodeInfo {
+        code: "HSTL004",
+        name: "let-cycle",
+        severity: E,
+        summary: "a `let` refers to itself, directly or through other lets",
+        explanation: "A `let` names a formula; a definition that uses itself has no meaning. The \
+message names the cycle.\n\n\
+Example:\n    let A = B && x > 1;\n    let B = A || y > 2;\n\n\
+Fix: write one of the formulas without the reference.",
+    },
+    CodeInfo {
+        code: "HSTL005",
+        name: "empty-interval",
+        severity: E,
+        summary: "an empty or inverted interval or `int` range",
+        explanation: "`[a..b]` covers the steps a to b - 1 and is empty when b <= a; `[a..=b]` \
+is empty when b < a. The same holds for `int` ranges such as `in 5..2`.\n\n\
+Example:\n    task eventually[5..2] A;\n    task eventually[3..3] A;\n\n\
+Fix: swap the bounds, or use `..=` to include the upper one (`[3..=3]` is the single step 3).",
+    },
+    CodeInfo {
+        code: "HSTL006",
+        name: "non-integer-bound",
+        severity: E,
+        summary: "an interval bound or `int` range bound that is not a whole number",
+        explanation: "Time is discrete: interval bounds count steps. `int` ranges hold \
+integers. Bounds must be written as plain digits.\n\n\
+Example:\n    task eventually[0..2.5] A;\n    state { x: int in 0..=1e3 }\n\n\
+Fix: write an integer, such as `[0..3]` or `0..=1000`.",
+    },
+    CodeInfo {
+        code: "HSTL007",
+        name: "equality",
+        severity: E,
+        summary: "`==` or `!=` in a comparison",
+        explanation: "Robustness measures how far a comparison is from flipping; equality has no \
+useful robustness (it holds on a set of measure zero).\n\n\
+Example:\n    let Home = x == 3;\n\n\
+Fix: use a band, such as `abs(x - 3) < 0.5`, or `2 < x < 4` on an integer grid.",
+    },
+    CodeInfo {
+        code: "HSTL008",
+        name: "kind-mismatch",
+        severity: E,
+        summary: "a formula where a number is expected, or the reverse",
+        explanation: "Comparisons relate numbers (state variables, constants, arithmetic); \
+`&&`, `||`, `!` and the temporal operators combine formulas (`let`s, comparisons). A `let` \
+inside arithmetic, a state variable used as a formula, or `argmax` outside `terminate` is \
+this error.\n\n\
+Example:\n    let A = x > 3;\n    let B = A < 3;    // `A` is a formula\n\n\
+Fix: compare the variables themselves, or combine formulas with `&&`, `||`.",
+    },
+    CodeInfo {
+        code: "HSTL009",
+        name: "temporal-in-option",
+        severity: E,
+        summary: "a temporal operator in `reach`, `init` or `terminate`",
+        explanation: "An option's reach, initiation and termination conditions are evaluated on \
+one state, so they must be state formulas: no `always`, `eventually` or `until`, also not \
+through a `let`.\n\n\
+Example:\n    let A = eventually[0..5] x > 3;\n    option A;\n\n\
+Fix: reach a state formula, such as `let A = x > 3;`.",
+    },
+    CodeInfo {
+        code: "HSTL010",
+        name: "option-without-let",
+        severity: E,
+        summary: "an option that names no `let`",
+        explanation: "`option A;` reaches the `let` named `A`; the long form without `reach` does \
+too. There is no such `let`.\n\n\
+Example:\n    let A = x > 3;\n    option Goal;\n\n\
+Fix: declare `let Goal = ...;`, or give the option a `reach` field: \
+`option Goal { reach: A }`.",
+    },
+    CodeInfo {
+        code: "HSTL011",
+        name: "unknown-option",
+        severity: E,
+        summary: "a sequence names an option that is not declared",
+        explanation: "`options` lists and `sequences(...)`/`permutations(...)` combine declared \
+primitive options only.\n\n\
+Example:\n    option A;\n    options { A, [A, D] }\n\n\
+Fix: declare `option D;` or remove it from the sequence.",
+    },
+    CodeInfo {
+        code: "HSTL012",
+        name: "repeated-option",
+        severity: E,
+        summary: "a sequence repeats an option",
+        explanation: "A combined option runs each leg once; a repeated leg, or a name listed twice \
+in `sequences(...)`/`permutations(...)`, is rejected.\n\n\
+Example:\n    options { [A, B, A] }\n\n\
+Fix: remove the repetition.",
+    },
+    CodeInfo {
+        code: "HSTL013",
+        name: "option-name-collision",
+        severity: E,
+        summary: "two options of the set get the same generated name",
+        explanation: "Every option of the set is named by concatenating its legs' names (`A`, \
+`AB`, `ABC`). Two entries with the same name cannot be told apart, in `policy.json` nor in \
+generated code.\n\n\
+Example:\n    option A; option B; option AB;\n    options { AB, [A, B] }\n\n\
+Fix: rename a primitive option (or the `let` it reaches) or drop one entry.",
+    },
+    CodeInfo {
+        code: "HSTL014",
+        name: "infinite-domain",
+        severity: E,
+        summary: "a state variable without a finite `int` range while options are declared",
+        explanation: "Options are learned with tables over every state, so every state variable \
+must be `int` with a range when the spec declares an option.\n\n\
+Example:\n    state { x: float, y: int }\n    option A;\n\n\
+Fix: declare `x: int in 0..=14`, or remove the options (a spec without options is still a \
+monitor).",
+    },
+    CodeInfo {
+        code: "HSTL015",
+        name: "missing-task",
+        severity: E,
+        summary: "a spec without a `task`",
+        explanation: "Every spec needs the task its options are rewarded for.\n\n\
+Example:\n    spec S { state { x: int in 0..=3 } let A = x > 1; }\n\n\
+Fix: add `task always[0..] eventually[0..10] A;` or similar.",
+    },
+    CodeInfo {
+        code: "HSTL016",
+        name: "parameter-out-of-range",
+        severity: E,
+        summary: "a learning parameter value out of range or of the wrong kind",
+        explanation: "gamma and alpha lie in (0, 1]; 0 <= min_epsilon <= epsilon <= 1; decay >= \
+0; episodes, choices and max_steps are whole numbers > 0; memory is a whole number >= 0; \
+`intra` is `paper` or `remaining`; `reward` is `segment` or `window`; `flat` and `options` are \
+groups `{ gamma: ..., ... }`.\n\n\
+Example:\n    learn { episodes: 0, flat: { gamma: 1.5 } }\n\n\
+Fix: use a value in the stated range.",
+    },
+    CodeInfo {
+        code: "HSTL017",
+        name: "task-not-persistent",
+        severity: E,
+        summary: "`memory` or `reward: window` with a task not of the form they need",
+        explanation: "Both need a task `always[0..] (eventually[0..N1] R1 && ... && \
+eventually[0..Nk] Rk)` where each Rj is a state formula: the memory tracks the steps since \
+each Rj last held.\n\n\
+Example:\n    task eventually[0..40] A;\n    learn { memory: 8 }\n\n\
+Fix: write the task in that form, or remove `memory` and `reward: window`.",
+    },
+    CodeInfo {
+        code: "HSTL018",
+        name: "no-option-can-start",
+        severity: E,
+        summary: "a state of the domain where no option of the set can start",
+        explanation: "The options policy must choose an option in every state it can reach. In \
+this state every option's `init` (of its first leg) is false. The message shows one such \
+state and how many there are.\n\n\
+Example:\n    option A { reach: A, init: x < 5 }\n    options { A }\n\n\
+Fix: widen the `init` conditions or add an option that can start there.",
+    },
+    CodeInfo {
+        code: "HSTL019",
+        name: "unknown-parameter",
+        severity: E,
+        summary: "an unknown or repeated parameter or option field name",
+        explanation: "`learn` knows episodes, choices, max_steps, memory, intra, reward, flat and \
+options; `flat`/`options` groups know gamma, alpha, epsilon, min_epsilon and decay; an option \
+knows reach, init and terminate. Each may be given once.\n\n\
+Example:\n    learn { episode: 100 }\n\n\
+Fix: correct the spelling (the help suggests the closest name) or remove the repetition.",
+    },
+    CodeInfo {
+        code: "HSTL020",
+        name: "sequence-gap",
+        severity: E,
+        summary: "an option of a sequence can terminate where the next cannot start",
+        explanation: "A combined option `[A, B]` runs `A` to termination and then `B`; every state \
+where `A` may terminate must lie in `B`'s initiation set. The message shows a state where `A` \
+terminates and `B` cannot start.\n\n\
+Example:\n    option A { reach: A, terminate: A }\n    option B { reach: B, init: !A }\n    \
+options { [A, B] }\n\n\
+Fix: widen `B`'s `init`, or narrow `A`'s `terminate`.",
+    },
+    CodeInfo {
+        code: "HSTL021",
+        name: "until-chain",
+        severity: E,
+        summary: "`a until b until c` without parentheses",
+        explanation: "`until` is not associative, so a chain is ambiguous and rejected.\n\n\
+Example:\n    task a until b until c;\n\n\
+Fix: add parentheses: `(a until b) until c` or `a until (b until c)`.",
+    },
+    CodeInfo {
+        code: "HSTL022",
+        name: "domain-too-large",
+        severity: W,
+        summary: "the declared domain is too large to enumerate",
+        explanation: "The finite-domain checks (HSTL018, HSTL020, HSTL102, HSTL103, argmax \
+termination sets) enumerate every state of the declared `int` domain, up to 1,000,000 states. \
+Beyond that they are skipped, and tabular learning would be slow anyway.\n\n\
+Example:\n    state { x: int in 0..=9999, y: int in 0..=9999 }\n\n\
+Fix: shrink the ranges, or accept that those checks are skipped.",
+    },
+    CodeInfo {
+        code: "HSTL023",
+        name: "options-set-too-large",
+        severity: E,
+        summary: "the expanded options set has more than 10,000 options",
+        explanation: "`sequences` of n options has 2^n - 1 members and `permutations` grows \
+faster still; the default set is `sequences` of every declared option. Sets beyond 10,000 \
+options are rejected.\n\n\
+Example:\n    options permutations(A, B, C, D, E, F, G, H);\n\n\
+Fix: list the sequences you need with `options { ... }`.",
+    },
+    CodeInfo {
+        code: "HSTL024",
+        name: "too-many-diagnostics",
+        severity: W,
+        summary: "more diagnostics were found than are reported",
+        explanation: "At most 200 diagnostics are reported per file; this one says how many more \
+there were (it is an error when some of those were errors).\n\n\
+Fix: fix the reported ones and check again.",
+    },
+    CodeInfo {
+        code: "HSTL101",
+        name: "unused-let",
+        severity: W,
+        summary: "a `let` that neither the task nor any option uses",
+        explanation: "A `let` is used when the task or an option refers to it, directly or through \
+other used lets (a short-form `option A;` uses `A`).\n\n\
+Example:\n    let Old = x > 3;    // nothing refers to it\n\n\
+Fix: remove it, or use it. Generated code still gets a monitor for it.",
+    },
+    CodeInfo {
+        code: "HSTL102",
+        name: "empty-region",
+        severity: W,
+        summary: "a region no state of the domain satisfies",
+        explanation: "A region is a `let` that an option reaches, or the state formula Rj of a \
+task conjunct `eventually[0..N] Rj` under `always[0..]`. When the state domain is finite, \
+every state is tried: none satisfies this one (robustness > 0), so its option cannot succeed \
+and the task cannot be kept.\n\n\
+Example:\n    state { x: int in 0..=14 }\n    let A = x > 20;\n\n\
+Fix: correct the bounds (on an integer grid `3 < x < 4` is empty).",
+    },
+    CodeInfo {
+        code: "HSTL103",
+        name: "full-region",
+        severity: W,
+        summary: "a region every state of the domain satisfies",
+        explanation: "Every state of the finite domain satisfies this region (see HSTL102 for \
+what a region is), so reaching it needs no learning.\n\n\
+Example:\n    state { x: int in 0..=14 }\n    let A = x >= 0;\n\n\
+Fix: tighten the formula.",
+    },
+];

@@ -1,0 +1,1050 @@
+//! Parsing with recovery: a small lexer finds comments and tokens, a balanced-delimiter
+//! scanner splits the file into spec headers and items, and pest parses each piece on its
+//! own. A broken item is reported at its exact position and skipped.
+
+use std::ops::Range;
+
+use pest::Parser as _;
+use pest::iterators::Pair;
+
+use crate::diagnostic::Diagnostic;
+use crate::syntax::*;
+
+/// The result of [`parse`]: the syntax tree of everything that parsed, and the syntax
+/// errors (HSTL001, HSTL021).
+#[derive(Clone, Debug, Default)]
+pub struct Parsed {
+    /// The syntax tree; broken items are left out.
+    pub file: File,
+    /// Syntax diagnostics, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Deepest bracket nesting the parser accepts; deeper input is reported, not parsed.
+pub const MAX_NESTING: usize = 64;
+
+/// Tallest formula or expression tree the parser builds (a long `a + b + ...` chain counts
+/// one level per operator); taller ones are reported so that later passes cannot
+/// overflow the stack.
+pub const MAX_HEIGHT: usize = 256;
+
+mod grammar {
+    #![allow(missing_docs)]
+    #[derive(pest_derive::Parser)]
+    #[grammar = "grammar.pest"]
+    pub struct HstlParser;
+}
+
+use grammar::{HstlParser, Rule};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TokKind {
+    Word,
+    Number,
+    Punct,
+    Doc,
+    Other,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Tok {
+    kind: TokKind,
+    start: usize,
+    end: usize,
+}
+
+/// Why building a node failed: the item is reported and skipped.
+struct Fail(Diagnostic);
+
+/// Parses a source text. Never fails: what cannot be parsed is reported and skipped.
+pub fn parse(src: &str) -> Parsed {
+    let mut diagnostics = Vec::new();
+    let mut comments = Vec::new();
+    let toks = lex(src, &mut comments, &mut diagnostics);
+    let mut specs = Vec::new();
+    let mut p = Splitter { src, toks: &toks, i: 0, diagnostics: &mut diagnostics };
+    while p.i < toks.len() {
+        if let Some(spec) = p.spec() {
+            specs.push(spec);
+        }
+    }
+    Parsed { file: File { specs, comments }, diagnostics }
+}
+
+fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> Vec<Tok> {
+    let b = src.as_bytes();
+    let mut toks = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        let start = i;
+        if c.is_ascii_whitespace() {
+            i += 1;
+        } else if b[i..].starts_with(b"//") {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+            let is_doc = b[start..].starts_with(b"///") && !b[start..].starts_with(b"////");
+            if is_doc {
+                toks.push(Tok { kind: TokKind::Doc, start, end: i });
+            }
+            let kind = if is_doc { CommentKind::Doc } else { CommentKind::Line };
+            comments.push(Comment { kind, range: start..i });
+        } else if b[i..].starts_with(b"/*") {
+            let mut depth = 0usize;
+            while i < b.len() {
+                if b[i..].starts_with(b"/*") {
+                    depth += 1;
+                    i += 2;
+                } else if b[i..].starts_with(b"*/") {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+            if depth > 0 {
+                i = b.len();
+                diags.push(
+                    Diagnostic::new("HSTL001", start..start + 2, "unterminated block comment")
+                        .with_help("close it with `*/`"),
+                );
+            }
+            comments.push(Comment { kind: CommentKind::Block, range: start..i });
+        } else if c.is_ascii_alphabetic() || c == b'_' {
+            while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
+                i += 1;
+            }
+            toks.push(Tok { kind: TokKind::Word, start, end: i });
+        } else if c.is_ascii_digit() {
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+            if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
+                i += 1;
+                while i < b.len() && b[i].is_ascii_digit() {
+                    i += 1;
+                }
+            }
+            if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+                let mut j = i + 1;
+                if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
+                    j += 1;
+                }
+                if j < b.len() && b[j].is_ascii_digit() {
+                    i = j;
+                    while i < b.len() && b[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                }
+            }
+            toks.push(Tok { kind: TokKind::Number, start, end: i });
+        } else if c.is_ascii() {
+            // Joint operators stay one token so that an error points at all of `..=`.
+            let ops: [&[u8]; 10] =
+                [b"..=", b"..", b"->", b"&&", b"||", b"<=", b">=", b"==", b"!=", b"::"];
+            let len = ops.iter().find(|op| b[i..].starts_with(op)).map_or(1, |op| op.len());
+            i += len;
+            toks.push(Tok { kind: TokKind::Punct, start, end: i });
+        } else {
+            let len = src[i..].chars().next().map_or(1, char::len_utf8);
+            i += len;
+            toks.push(Tok { kind: TokKind::Other, start, end: i });
+        }
+    }
+    toks
+}
+
+const ITEM_KEYWORDS: [&str; 6] = ["let", "task", "option", "state", "learn", "spec"];
+
+struct Splitter<'a, 'd> {
+    src: &'a str,
+    toks: &'a [Tok],
+    i: usize,
+    diagnostics: &'d mut Vec<Diagnostic>,
+}
+
+impl Splitter<'_, '_> {
+    fn text(&self, k: usize) -> &str {
+        let t = self.toks[k];
+        &self.src[t.start..t.end]
+    }
+
+    fn is(&self, k: usize, s: &str) -> bool {
+        k < self.toks.len() && self.text(k) == s
+    }
+
+    /// Parses one spec starting at `self.i`, or skips junk up to the next `spec`.
+    fn spec(&mut self) -> Option<Spec> {
+        let start = self.i;
+        let mut k = start;
+        while k < self.toks.len() && self.toks[k].kind == TokKind::Doc {
+            k += 1;
+        }
+        if !self.is(k, "spec") {
+            // Junk at the top level: report it once and skip to the next spec.
+            let bad = if k < self.toks.len() { k } else { start };
+            let t = self.toks[bad];
+            let (range, found) = if k < self.toks.len() {
+                (t.start..t.end, format!("`{}`", self.text(bad)))
+            } else {
+                (t.end..t.end, "end of file".to_string())
+            };
+            self.diagnostics.push(
+                Diagnostic::new("HSTL001", range, format!("expected `spec`, found {found}"))
+                    .with_help("a file holds specs: `spec Name { ... }`"),
+            );
+            self.i = k + 1;
+            while self.i < self.toks.len() && !self.is(self.i, "spec") {
+                self.i += 1;
+            }
+            // Docs in front of the next spec belong to it.
+            while self.i > k + 1 && self.toks[self.i - 1].kind == TokKind::Doc {
+                self.i -= 1;
+            }
+            return None;
+        }
+        let spec_kw = k;
+        // Header: docs, `spec`, a name and `{`.
+        let mut h = spec_kw + 1;
+        while h < self.toks.len() && h < spec_kw + 3 && !self.is(h, "{") {
+            h += 1;
+        }
+        let has_brace = self.is(h, "{");
+        let header_end = if has_brace { h + 1 } else { h.min(self.toks.len()) };
+        let head_range = self.toks[start].start..self.toks[header_end - 1].end;
+        let mut doc = None;
+        let mut name =
+            Ident { name: String::new(), range: self.toks[spec_kw].start..self.toks[spec_kw].end };
+        match HstlParser::parse(Rule::spec_head, &self.src[head_range.clone()]) {
+            Ok(mut pairs) => {
+                let mut docs = Vec::new();
+                if let Some(head) = pairs.next() {
+                    for p in head.into_inner() {
+                        match p.as_rule() {
+                            Rule::doc => docs.push(p),
+                            Rule::ident => name = ident(&p, head_range.start),
+                            _ => {}
+                        }
+                    }
+                }
+                doc = make_doc(docs, head_range.start);
+            }
+            Err(e) => {
+                let text = &self.src[head_range.clone()];
+                let e = reparse_with_detail(Rule::spec_head, text).unwrap_or(e);
+                self.diagnostics.push(self.syntax_error(&e, head_range.clone()));
+            }
+        }
+        self.i = header_end;
+        let mut items = Vec::new();
+        let mut end = head_range.end;
+        if !has_brace {
+            // Without a body there is nothing more to read in this spec.
+            return Some(Spec { doc, name, items, range: head_range.start..end });
+        }
+        loop {
+            if self.i >= self.toks.len() {
+                let at = self.src.len();
+                self.diagnostics.push(
+                    Diagnostic::new("HSTL001", at..at, "expected `}`, found end of file")
+                        .with_label(self.toks[h].start..self.toks[h].end, "this `{` is not closed")
+                        .with_help("close the spec with `}`"),
+                );
+                end = at;
+                break;
+            }
+            if self.is(self.i, "}") {
+                end = self.toks[self.i].end;
+                self.i += 1;
+                break;
+            }
+            if self.is(self.i, "spec") {
+                let t = self.toks[self.i];
+                self.diagnostics.push(
+                    Diagnostic::new("HSTL001", t.start..t.end, "expected `}`, found `spec`")
+                        .with_label(self.toks[h].start..self.toks[h].end, "this `{` is not closed")
+                        .with_help("close the previous spec with `}` before starting another"),
+                );
+                end = self.toks[self.i - 1].end;
+                break;
+            }
+            let (a, b) = self.item_bounds();
+            self.i = b;
+            if let Some(item) = self.item(a, b) {
+                items.push(item);
+            }
+        }
+        Some(Spec { doc, name, items, range: head_range.start..end })
+    }
+
+    /// Finds the tokens `[a, b)` of the item starting at `self.i`.
+    fn item_bounds(&mut self) -> (usize, usize) {
+        let a = self.i;
+        let mut k = a;
+        let mut depth = 0usize;
+        let mut brace_depth = 0usize;
+        let mut seen_non_doc = false;
+        while k < self.toks.len() {
+            let t = self.toks[k];
+            let s = self.text(k);
+            if seen_non_doc && k > a {
+                let starts_item = (t.kind == TokKind::Word && ITEM_KEYWORDS.contains(&s))
+                    || (s == "options" && brace_depth == 0)
+                    || (t.kind == TokKind::Doc && depth == 0);
+                if starts_item {
+                    break;
+                }
+            }
+            if depth == 0 && s == "}" {
+                break;
+            }
+            if t.kind != TokKind::Doc {
+                seen_non_doc = true;
+            }
+            k += 1;
+            match s {
+                "(" | "[" | "{" => {
+                    depth += 1;
+                    brace_depth += usize::from(s == "{");
+                }
+                ")" | "]" | "}" => {
+                    depth = depth.saturating_sub(1);
+                    if s == "}" {
+                        brace_depth = brace_depth.saturating_sub(1);
+                        if depth == 0 {
+                            break;
+                        }
+                    }
+                }
+                ";" if depth == 0 => break,
+                _ => {}
+            }
+        }
+        (a, k.max(a + 1).min(self.toks.len()))
+    }
+
+    fn item(&mut self, a: usize, b: usize) -> Option<Item> {
+        let range = self.toks[a].start..self.toks[b - 1].end;
+        // Bracket nesting is checked before pest so that deep input cannot exhaust the stack.
+        let mut depth = 0usize;
+        for k in a..b {
+            match self.text(k) {
+                "(" | "[" | "{" => {
+                    depth += 1;
+                    if depth > MAX_NESTING {
+                        let t = self.toks[k];
+                        self.diagnostics.push(Diagnostic::new(
+                            "HSTL001",
+                            t.start..t.end,
+                            format!("brackets nested too deeply (more than {MAX_NESTING} levels)"),
+                        ));
+                        return None;
+                    }
+                }
+                ")" | "]" | "}" => depth = depth.saturating_sub(1),
+                _ => {}
+            }
+        }
+        let text = &self.src[range.clone()];
+        match HstlParser::parse(Rule::item_entry, text) {
+            Ok(mut pairs) => {
+                let entry = pairs.next()?;
+                let inner = entry.into_inner().find(|p| p.as_rule() != Rule::EOI)?;
+                let mut b = Builder { offset: range.start, diagnostics: Vec::new() };
+                match b.item(inner) {
+                    Ok(item) => {
+                        self.diagnostics.append(&mut b.diagnostics);
+                        Some(item)
+                    }
+                    Err(Fail(d)) => {
+                        self.diagnostics.push(d);
+                        None
+                    }
+                }
+            }
+            Err(e) => {
+                let e = reparse_with_detail(Rule::item_entry, text).unwrap_or(e);
+                self.diagnostics.push(self.syntax_error(&e, range));
+                None
+            }
+        }
+    }
+
+    /// Turns a pest error on the text `piece` into an HSTL001 with readable expectations.
+    fn syntax_error(&self, e: &pest::error::Error<Rule>, piece: Range<usize>) -> Diagnostic {
+        let loc = match e.location {
+            pest::error::InputLocation::Pos(p) => p,
+            pest::error::InputLocation::Span((s, _)) => s,
+        };
+        let attempts = e.parse_attempts();
+        let far = attempts.as_ref().map_or(loc, |a| a.max_position.max(loc));
+        let pos = piece.start + far;
+        let mut expected: Vec<String> = Vec::new();
+        if let Some(attempts) = &attempts {
+            // `ParsingToken` is not exported; its display is the literal for exact tokens.
+            let tokens: Vec<String> =
+                attempts.expected_tokens().iter().map(ToString::to_string).collect();
+            expected.extend(describe_tokens(tokens));
+        }
+        if expected.is_empty() && far == loc {
+            if let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant {
+                expected.extend(positives.iter().filter_map(|r| rule_words(*r)).map(String::from));
+            }
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        expected.retain(|w| seen.insert(w.clone()));
+        expected.sort_by_key(|w| (w.starts_with('`'), w.clone()));
+        let what = match expected.len() {
+            0 => "something else".to_string(),
+            1 => expected[0].clone(),
+            n => format!("{} or {}", expected[..n - 1].join(", "), expected[n - 1]),
+        };
+        // What was found: the next token in the whole file after the error position.
+        let next = self.toks.iter().find(|t| t.start >= pos);
+        let (range, found) = match next {
+            Some(t) if t.start < piece.end => {
+                (t.start..t.end, format!("`{}`", &self.src[t.start..t.end]))
+            }
+            Some(t) => (pos..pos, format!("`{}`", &self.src[t.start..t.end])),
+            None => (pos..pos, "end of file".to_string()),
+        };
+        let message = if e.to_string().contains("limit reached") {
+            "input too deeply nested to parse".to_string()
+        } else {
+            format!("expected {what}, found {found}")
+        };
+        Diagnostic::new("HSTL001", range, message)
+    }
+}
+
+/// Parses `text` again with pest's error details on, which name the literal tokens that
+/// were expected (`;`, `&&`, ...). Details are switched on for the rest of the process
+/// rather than toggled, so that parallel parses always see the same setting once an
+/// error has been seen; they cost time only on the slow path of reporting.
+fn reparse_with_detail(rule: Rule, text: &str) -> Option<pest::error::Error<Rule>> {
+    pest::set_error_detail(true);
+    HstlParser::parse(rule, text).err()
+}
+
+/// Groups the literal tokens pest expected into a few readable words.
+fn describe_tokens(tokens: Vec<String>) -> Vec<String> {
+    const NOISE: [&str; 8] = ["/*", "//", "\u{feff}", ".", "e", "E", "BUILTIN_RULE", "+"];
+    let mut set: std::collections::BTreeSet<String> = tokens
+        .into_iter()
+        .filter(|t| !t.trim().is_empty() && !(t.len() == 4 && &t[1..3] == ".."))
+        .collect();
+    // `+` alone is the exponent sign of a number; as an operator it comes with `*` and `/`.
+    if set.contains("*") {
+        set.insert("plus".into());
+    }
+    for n in NOISE {
+        set.remove(n);
+    }
+    let mut out = Vec::new();
+    let take = |set: &mut std::collections::BTreeSet<String>, group: &[&str]| -> bool {
+        let mut any = false;
+        for g in group {
+            any |= set.remove(*g);
+        }
+        any
+    };
+    if take(&mut set, &["!", "always", "eventually", "true", "false"]) {
+        take(&mut set, &["(", "-", "abs", "sqrt", "_"]);
+        out.push("a formula".to_string());
+    } else if take(&mut set, &["abs", "sqrt"]) {
+        take(&mut set, &["(", "-", "_"]);
+        out.push("an expression".to_string());
+    }
+    if take(&mut set, &["_"]) {
+        out.push("a name".to_string());
+    }
+    let cmp = take(&mut set, &["<", "<=", ">", ">=", "==", "!="]);
+    let arith = take(&mut set, &["plus", "-", "*", "/"]);
+    let logic = ["&&", "||", "->", "until"].iter().any(|t| set.contains(*t));
+    if cmp as u8 + arith as u8 + logic as u8 >= 2 {
+        take(&mut set, &["&&", "||", "->", "until"]);
+        out.push("an operator".to_string());
+    } else if cmp {
+        out.push("a comparison operator".to_string());
+    } else if arith {
+        out.push("an arithmetic operator".to_string());
+    }
+    out.extend(set.into_iter().map(|t| format!("`{t}`")));
+    out
+}
+
+/// Readable words for the rules pest reports as expected; `None` hides a rule.
+fn rule_words(r: Rule) -> Option<&'static str> {
+    Some(match r {
+        Rule::ident => "a name",
+        Rule::number | Rule::neg_number => "a number",
+        Rule::doc => "a doc comment",
+        Rule::formula | Rule::or_f | Rule::and_f | Rule::until_f | Rule::unary => "a formula",
+        Rule::paren_f => "a formula",
+        Rule::comparison | Rule::expr | Rule::term | Rule::factor => "an expression",
+        Rule::cmp_op => "a comparison operator",
+        Rule::add_op | Rule::mul_op => "an arithmetic operator",
+        Rule::implies_op => "`->`",
+        Rule::until_op => "`until`",
+        Rule::prefix_op | Rule::not_op => "`!`",
+        Rule::always_op => "`always`",
+        Rule::eventually_op => "`eventually`",
+        Rule::interval => "an interval such as `[0..40]`",
+        Rule::incl_op | Rule::excl_op | Rule::range_op => "`..` or `..=`",
+        Rule::var => "a state variable",
+        Rule::var_type => "`int` or `float`",
+        Rule::range_lit => "a range such as `0..=14`",
+        Rule::field => "an option field (`reach`, `init` or `terminate`)",
+        Rule::field_value => "a formula or `argmax`",
+        Rule::option_body => "`;` or `{`",
+        Rule::options_list => "`{`",
+        Rule::options_gen | Rule::gen_kind => "`sequences` or `permutations`",
+        Rule::seq => "an option name or `[A, B, ...]`",
+        Rule::param => "a learning parameter",
+        Rule::param_name => "a parameter name",
+        Rule::param_value => "a parameter value",
+        Rule::param_group => "`{`",
+        Rule::state_item
+        | Rule::let_item
+        | Rule::task_item
+        | Rule::option_item
+        | Rule::options_item
+        | Rule::learn_item => "an item (`state`, `let`, `task`, `option`, `options` or `learn`)",
+        Rule::func => "`abs` or `sqrt`",
+        Rule::call => "a function call",
+        Rule::k_spec => "`spec`",
+        Rule::k_state => "`state`",
+        Rule::k_int => "`int`",
+        Rule::k_float => "`float`",
+        Rule::k_in => "`in`",
+        Rule::k_let => "`let`",
+        Rule::k_task => "`task`",
+        Rule::k_option => "`option`",
+        Rule::k_options => "`options`",
+        Rule::k_sequences => "`sequences`",
+        Rule::k_permutations => "`permutations`",
+        Rule::k_learn => "`learn`",
+        Rule::k_always => "`always`",
+        Rule::k_eventually => "`eventually`",
+        Rule::k_until => "`until`",
+        Rule::k_true => "`true`",
+        Rule::k_false => "`false`",
+        Rule::k_abs => "`abs`",
+        Rule::k_sqrt => "`sqrt`",
+        Rule::k_argmax => "`argmax`",
+        Rule::EOI => "the end of the item",
+        _ => return None,
+    })
+}
+
+fn ident(p: &Pair<'_, Rule>, offset: usize) -> Ident {
+    let s = p.as_span();
+    Ident { name: s.as_str().to_string(), range: s.start() + offset..s.end() + offset }
+}
+
+fn make_doc(docs: Vec<Pair<'_, Rule>>, offset: usize) -> Option<Doc> {
+    if docs.is_empty() {
+        return None;
+    }
+    let mut doc = Doc::default();
+    for d in docs {
+        let s = d.as_span();
+        let text = s.as_str().trim_start_matches("///").trim_end_matches('\r');
+        doc.lines.push(text.strip_prefix(' ').unwrap_or(text).to_string());
+        doc.ranges.push(s.start() + offset..s.end() + offset);
+    }
+    Some(doc)
+}
+
+/// Builds syntax nodes from pest pairs of one item; `offset` is the item's byte offset.
+struct Builder {
+    offset: usize,
+    diagnostics: Vec<Diagnostic>,
+}
+
+type Res<T> = Result<T, Fail>;
+
+impl Builder {
+    fn range(&self, p: &Pair<'_, Rule>) -> Range<usize> {
+        let s = p.as_span();
+        s.start() + self.offset..s.end() + self.offset
+    }
+
+    fn number(&self, p: &Pair<'_, Rule>) -> NumberLit {
+        let text = p.as_str().to_string();
+        NumberLit { value: text.parse().unwrap_or(f64::NAN), text, range: self.range(p) }
+    }
+
+    fn too_tall(&self, range: Range<usize>) -> Fail {
+        Fail(
+            Diagnostic::new(
+                "HSTL001",
+                range,
+                format!("formula or expression too deeply nested (more than {MAX_HEIGHT} levels)"),
+            )
+            .with_help("split it into several `let`s"),
+        )
+    }
+
+    fn item(&mut self, p: Pair<'_, Rule>) -> Res<Item> {
+        let range = self.range(&p);
+        let rule = p.as_rule();
+        let mut docs = Vec::new();
+        let mut rest = Vec::new();
+        for c in p.into_inner() {
+            if c.as_rule() == Rule::doc { docs.push(c) } else { rest.push(c) }
+        }
+        let doc = make_doc(docs, self.offset);
+        Ok(match rule {
+            Rule::state_item => {
+                let mut vars = Vec::new();
+                for v in rest.into_iter().filter(|c| c.as_rule() == Rule::var) {
+                    vars.push(self.var(v));
+                }
+                Item::State(StateBlock { vars, range })
+            }
+            Rule::let_item => {
+                let name =
+                    rest.iter().find(|c| c.as_rule() == Rule::ident).map(|c| ident(c, self.offset));
+                let f = rest.into_iter().find(|c| c.as_rule() == Rule::formula);
+                match (name, f) {
+                    (Some(name), Some(f)) => {
+                        let (formula, _) = self.formula(f)?;
+                        Item::Let(Let { doc, name, formula, range })
+                    }
+                    _ => return Err(self.internal(range)),
+                }
+            }
+            Rule::task_item => {
+                let kw = rest.iter().find(|c| c.as_rule() == Rule::k_task).map(|c| self.range(c));
+                let f = rest.into_iter().find(|c| c.as_rule() == Rule::formula);
+                match (kw, f) {
+                    (Some(keyword_range), Some(f)) => {
+                        let (formula, _) = self.formula(f)?;
+                        Item::Task(Task { doc, formula, keyword_range, range })
+                    }
+                    _ => return Err(self.internal(range)),
+                }
+            }
+            Rule::option_item => {
+                let mut name = None;
+                let mut fields = None;
+                for c in rest {
+                    match c.as_rule() {
+                        Rule::ident => name = Some(ident(&c, self.offset)),
+                        Rule::option_body => {
+                            let mut fs = Vec::new();
+                            for f in c.into_inner() {
+                                fs.push(self.field(f)?);
+                            }
+                            fields = Some(fs);
+                        }
+                        _ => {}
+                    }
+                }
+                let Some(name) = name else { return Err(self.internal(range)) };
+                Item::Option(OptionDecl { doc, name, fields, range })
+            }
+            Rule::options_item => {
+                let mut kind = None;
+                for c in rest {
+                    match c.as_rule() {
+                        Rule::options_list => {
+                            let mut seqs = Vec::new();
+                            for s in c.into_inner() {
+                                let r = self.range(&s);
+                                let bracketed = s.as_str().starts_with('[');
+                                let legs = s.into_inner().map(|i| ident(&i, self.offset)).collect();
+                                seqs.push(SeqItem { legs, bracketed, range: r });
+                            }
+                            kind = Some(OptionsKind::List(seqs));
+                        }
+                        Rule::options_gen => {
+                            let mut perm = false;
+                            let mut names = Vec::new();
+                            for g in c.into_inner() {
+                                match g.as_rule() {
+                                    Rule::gen_kind => perm = g.as_str() == "permutations",
+                                    Rule::ident => names.push(ident(&g, self.offset)),
+                                    _ => {}
+                                }
+                            }
+                            kind = Some(if perm {
+                                OptionsKind::Permutations(names)
+                            } else {
+                                OptionsKind::Sequences(names)
+                            });
+                        }
+                        _ => {}
+                    }
+                }
+                let Some(kind) = kind else { return Err(self.internal(range)) };
+                Item::Options(OptionsItem { kind, range })
+            }
+            Rule::learn_item => {
+                let params = rest
+                    .into_iter()
+                    .filter(|c| c.as_rule() == Rule::param)
+                    .map(|c| self.param(c))
+                    .collect::<Res<Vec<_>>>()?;
+                Item::Learn(Learn { params, range })
+            }
+            _ => return Err(self.internal(range)),
+        })
+    }
+
+    fn internal(&self, range: Range<usize>) -> Fail {
+        Fail(Diagnostic::new("HSTL001", range, "could not read this item"))
+    }
+
+    fn var(&self, p: Pair<'_, Rule>) -> StateVar {
+        let range = self.range(&p);
+        let mut docs = Vec::new();
+        let mut name = Ident { name: String::new(), range: range.clone() };
+        let mut ty = VarType::Int;
+        let mut ty_range = range.clone();
+        let mut domain = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::doc => docs.push(c),
+                Rule::ident => name = ident(&c, self.offset),
+                Rule::var_type => {
+                    ty_range = self.range(&c);
+                    ty = if c.as_str() == "int" { VarType::Int } else { VarType::Float };
+                }
+                Rule::range_lit => {
+                    let r = self.range(&c);
+                    let mut nums = Vec::new();
+                    let mut inclusive = false;
+                    for x in c.into_inner() {
+                        match x.as_rule() {
+                            Rule::number => nums.push(self.number(&x)),
+                            Rule::range_op => inclusive = x.as_str() == "..=",
+                            _ => {}
+                        }
+                    }
+                    if let (Some(hi), Some(lo)) = (nums.pop(), nums.pop()) {
+                        domain = Some(RangeLit { lo, hi, inclusive, range: r });
+                    }
+                }
+                _ => {}
+            }
+        }
+        StateVar { doc: make_doc(docs, self.offset), name, ty, ty_range, domain, range }
+    }
+
+    fn field(&mut self, p: Pair<'_, Rule>) -> Res<OptionField> {
+        let range = self.range(&p);
+        let mut name = None;
+        let mut value = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::ident => name = Some(ident(&c, self.offset)),
+                Rule::field_value => {
+                    let r = self.range(&c);
+                    let inner = c.into_inner().next();
+                    value = Some(match inner {
+                        Some(f) if f.as_rule() == Rule::formula => {
+                            FieldValue::Formula(self.formula(f)?.0)
+                        }
+                        _ => FieldValue::Argmax(r),
+                    });
+                }
+                _ => {}
+            }
+        }
+        match (name, value) {
+            (Some(name), Some(value)) => Ok(OptionField { name, value, range }),
+            _ => Err(self.internal(range)),
+        }
+    }
+
+    fn param(&self, p: Pair<'_, Rule>) -> Res<Param> {
+        let range = self.range(&p);
+        let mut name = None;
+        let mut value = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::param_name => name = Some(ident(&c, self.offset)),
+                Rule::param_value => {
+                    let Some(v) = c.into_inner().next() else { continue };
+                    value = Some(match v.as_rule() {
+                        Rule::number => ParamValue::Number(self.number(&v)),
+                        Rule::neg_number => {
+                            let r = self.range(&v);
+                            let text: String = v.as_str().split_whitespace().collect();
+                            let value = text.parse().unwrap_or(f64::NAN);
+                            ParamValue::Number(NumberLit { value, text, range: r })
+                        }
+                        Rule::ident => ParamValue::Word(ident(&v, self.offset)),
+                        _ => {
+                            let r = self.range(&v);
+                            let ps =
+                                v.into_inner().map(|q| self.param(q)).collect::<Res<Vec<_>>>()?;
+                            ParamValue::Group(ps, r)
+                        }
+                    });
+                }
+                _ => {}
+            }
+        }
+        match (name, value) {
+            (Some(name), Some(value)) => Ok(Param { name, value, range }),
+            _ => Err(self.internal(range)),
+        }
+    }
+
+    fn interval(&self, p: Pair<'_, Rule>) -> Interval {
+        let range = self.range(&p);
+        let mut nums = Vec::new();
+        let mut inclusive = false;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::number => nums.push(self.number(&c)),
+                Rule::incl_op => inclusive = true,
+                _ => {}
+            }
+        }
+        let mut it = nums.into_iter();
+        let start = it.next().unwrap_or(NumberLit {
+            value: 0.0,
+            text: "0".into(),
+            range: range.start..range.start,
+        });
+        Interval { start, end: it.next(), inclusive, range }
+    }
+
+    /// Builds a formula and returns it with its height.
+    fn formula(&mut self, p: Pair<'_, Rule>) -> Res<(Formula, usize)> {
+        let range = self.range(&p);
+        let rule = p.as_rule();
+        let mut inner: Vec<Pair<'_, Rule>> = p.into_inner().collect();
+        let built = match rule {
+            Rule::formula => {
+                let rhs = if inner.len() >= 3 { inner.pop() } else { None };
+                let first = inner.into_iter().next().ok_or_else(|| self.internal(range.clone()))?;
+                let (lhs, h1) = self.formula(first)?;
+                match rhs {
+                    Some(r) => {
+                        let (rhs, h2) = self.formula(r)?;
+                        (
+                            Formula {
+                                kind: FormulaKind::Implies(Box::new(lhs), Box::new(rhs)),
+                                range: range.clone(),
+                            },
+                            h1.max(h2) + 1,
+                        )
+                    }
+                    None => (lhs, h1),
+                }
+            }
+            Rule::or_f | Rule::and_f => {
+                let mut parts = Vec::new();
+                let mut h = 0;
+                for c in inner {
+                    let (f, hc) = self.formula(c)?;
+                    h = h.max(hc);
+                    parts.push(f);
+                }
+                if parts.len() == 1 {
+                    (parts.pop().ok_or_else(|| self.internal(range.clone()))?, h)
+                } else {
+                    let kind = if rule == Rule::or_f {
+                        FormulaKind::Or(parts)
+                    } else {
+                        FormulaKind::And(parts)
+                    };
+                    (Formula { kind, range: range.clone() }, h + 1)
+                }
+            }
+            Rule::until_f => {
+                let mut it = inner.into_iter();
+                let first = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                let (mut acc, mut h) = self.formula(first)?;
+                let mut count = 0;
+                while let (Some(op), Some(rhs)) = (it.next(), it.next()) {
+                    count += 1;
+                    let op_range = self.range(&op);
+                    if count == 2 {
+                        self.diagnostics.push(
+                            Diagnostic::new(
+                                "HSTL021",
+                                op_range.clone(),
+                                "`until` is not chainable",
+                            )
+                            .with_label(acc.range.clone(), "this is already an `until` formula")
+                            .with_help(
+                                "add parentheses: `(a until b) until c` or `a until (b until c)`",
+                            ),
+                        );
+                    }
+                    let interval = op.into_inner().find(|c| c.as_rule() == Rule::interval);
+                    let interval = interval.map(|i| self.interval(i));
+                    let (rhs, hr) = self.formula(rhs)?;
+                    let r = acc.range.start..rhs.range.end;
+                    h = h.max(hr) + 1;
+                    acc = Formula {
+                        kind: FormulaKind::Until(Box::new(acc), interval, Box::new(rhs)),
+                        range: r,
+                    };
+                }
+                (acc, h)
+            }
+            Rule::unary => {
+                let first = inner.remove(0);
+                match first.as_rule() {
+                    Rule::prefix_op => {
+                        let op = first
+                            .into_inner()
+                            .next()
+                            .ok_or_else(|| self.internal(range.clone()))?;
+                        let operand = inner.pop().ok_or_else(|| self.internal(range.clone()))?;
+                        let (f, h) = self.formula(operand)?;
+                        let f = Box::new(f);
+                        let kind = match op.as_rule() {
+                            Rule::not_op => FormulaKind::Not(f),
+                            Rule::always_op => {
+                                let i = op.into_inner().find(|c| c.as_rule() == Rule::interval);
+                                FormulaKind::Always(i.map(|i| self.interval(i)), f)
+                            }
+                            _ => {
+                                let i = op.into_inner().find(|c| c.as_rule() == Rule::interval);
+                                FormulaKind::Eventually(i.map(|i| self.interval(i)), f)
+                            }
+                        };
+                        (Formula { kind, range: range.clone() }, h + 1)
+                    }
+                    Rule::comparison => {
+                        let mut it = first.into_inner();
+                        let e0 = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                        let (first_e, mut h) = self.expr(e0)?;
+                        let mut rest = Vec::new();
+                        while let (Some(op), Some(e)) = (it.next(), it.next()) {
+                            let cmp = match op.as_str() {
+                                "<" => CmpOp::Lt,
+                                "<=" => CmpOp::Le,
+                                ">" => CmpOp::Gt,
+                                ">=" => CmpOp::Ge,
+                                "==" => CmpOp::Eq,
+                                _ => CmpOp::Ne,
+                            };
+                            let (e, he) = self.expr(e)?;
+                            h = h.max(he);
+                            rest.push((cmp, self.range(&op), e));
+                        }
+                        (
+                            Formula {
+                                kind: FormulaKind::Compare { first: first_e, rest },
+                                range: range.clone(),
+                            },
+                            h + 1,
+                        )
+                    }
+                    Rule::k_true => (Formula { kind: FormulaKind::True, range: range.clone() }, 1),
+                    Rule::k_false => {
+                        (Formula { kind: FormulaKind::False, range: range.clone() }, 1)
+                    }
+                    Rule::paren_f => {
+                        let f = first
+                            .into_inner()
+                            .next()
+                            .ok_or_else(|| self.internal(range.clone()))?;
+                        let (f, h) = self.formula(f)?;
+                        (
+                            Formula { kind: FormulaKind::Paren(Box::new(f)), range: range.clone() },
+                            h + 1,
+                        )
+                    }
+                    _ => (
+                        Formula {
+                            kind: FormulaKind::Name(ident(&first, self.offset)),
+                            range: range.clone(),
+                        },
+                        1,
+                    ),
+                }
+            }
+            _ => return Err(self.internal(range)),
+        };
+        if built.1 > MAX_HEIGHT {
+            return Err(self.too_tall(range));
+        }
+        Ok(built)
+    }
+
+    /// Builds an expression and returns it with its height.
+    fn expr(&mut self, p: Pair<'_, Rule>) -> Res<(Expr, usize)> {
+        let range = self.range(&p);
+        let rule = p.as_rule();
+        let built = match rule {
+            Rule::expr | Rule::term => {
+                let mut it = p.into_inner();
+                let first = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                let (mut acc, mut h) = self.expr(first)?;
+                while let (Some(op), Some(rhs)) = (it.next(), it.next()) {
+                    let bop = match op.as_str().trim() {
+                        "+" => BinOp::Add,
+                        "*" => BinOp::Mul,
+                        "/" => BinOp::Div,
+                        _ => BinOp::Sub,
+                    };
+                    let (rhs, hr) = self.expr(rhs)?;
+                    h = h.max(hr) + 1;
+                    if h > MAX_HEIGHT {
+                        return Err(self.too_tall(range));
+                    }
+                    let r = acc.range.start..rhs.range.end;
+                    acc = Expr {
+                        kind: ExprKind::Binary(bop, Box::new(acc), Box::new(rhs)),
+                        range: r,
+                    };
+                }
+                (acc, h)
+            }
+            Rule::factor => {
+                let c = p.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
+                match c.as_rule() {
+                    Rule::number => {
+                        (Expr { kind: ExprKind::Number(self.number(&c)), range: range.clone() }, 1)
+                    }
+                    Rule::ident => (
+                        Expr { kind: ExprKind::Name(ident(&c, self.offset)), range: range.clone() },
+                        1,
+                    ),
+                    Rule::neg => {
+                        let f =
+                            c.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
+                        let (e, h) = self.expr(f)?;
+                        (Expr { kind: ExprKind::Neg(Box::new(e)), range: range.clone() }, h + 1)
+                    }
+                    Rule::paren_e => {
+                        let f =
+                            c.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
+                        let (e, h) = self.expr(f)?;
+                        (Expr { kind: ExprKind::Paren(Box::new(e)), range: range.clone() }, h + 1)
+                    }
+                    _ => {
+                        let mut it = c.into_inner();
+                        let func = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                        let func = if func.as_str() == "abs" { Func::Abs } else { Func::Sqrt };
+                        let arg = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                        let (e, h) = self.expr(arg)?;
+                        (
+                            Expr { kind: ExprKind::Call(func, Box::new(e)), range: range.clone() },
+                            h + 1,
+                        )
+                    }
+                }
+            }
+            _ => return Err(self.internal(range)),
+        };
+        if built.1 > MAX_HEIGHT {
+            return Err(self.too_tall(range));
+        }
+        Ok(built)
+    }
+}
