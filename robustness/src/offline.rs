@@ -166,7 +166,7 @@ impl Evaluator {
         out.fill(L::ID);
         for g in gs {
             let v = self.eval(g, cols, n);
-            out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::op(*a, *b));
+            out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(*a, *b));
             self.pool.push(v);
         }
         out
@@ -211,7 +211,7 @@ impl Evaluator {
         let tmp_s = &mut tmp[..out.len()];
         for g in gs {
             self.state_chunk(g, cols, lo, tmp_s);
-            out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = L::op(*a, *b));
+            out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = L::acc(*a, *b));
         }
         self.chunks.push(tmp);
     }
@@ -302,7 +302,7 @@ impl Evaluator {
             // Unbounded: a suffix fold, then a shift by `a`.
             let mut acc = L::ID;
             for v in buf.iter_mut().rev() {
-                acc = L::op(*v, acc);
+                acc = L::acc(acc, *v);
                 *v = acc;
             }
             shift_left::<L>(buf, a);
@@ -311,7 +311,7 @@ impl Evaluator {
         // The window at `t` is `s ..= s + len - 1` with `s = t + a`, clipped at `n`.
         let len = last - a + 1;
         if len == 1 {
-            buf.iter_mut().for_each(|v| *v = L::op(L::ID, *v));
+            buf.iter_mut().for_each(|v| *v = L::acc(L::ID, *v));
             shift_left::<L>(buf, a);
             return;
         }
@@ -333,7 +333,7 @@ impl Evaluator {
             None => {
                 let mut next = NEG_INF;
                 for (g, f) in out.iter_mut().zip(lhs.iter()).rev() {
-                    next = g.min(INF).max(f.min(next));
+                    next = Max::acc(Min::acc(next, *f), Min::acc(INF, *g));
                     *g = next;
                 }
             }
@@ -342,7 +342,7 @@ impl Evaluator {
         if a > 0 {
             self.window::<Min>(lhs, &Interval { start: 0, end: Bound::Exclusive(a) });
             for t in 0..n - a {
-                out[t] = lhs[t].min(out[t + a]);
+                out[t] = Min::acc(lhs[t], out[t + a]);
             }
             out[n - a..].fill(NEG_INF);
         }
@@ -377,7 +377,7 @@ impl Evaluator {
             while head < tail && at[head] > s + span {
                 head += 1;
             }
-            let v = out[s].min(INF);
+            let v = Min::acc(INF, out[s]);
             while head < tail && val[tail - 1] <= v {
                 tail -= 1;
             }
@@ -397,7 +397,9 @@ impl Evaluator {
 /// A min or a max, with its identity.
 trait Lattice {
     const ID: f64;
-    fn op(a: f64, b: f64) -> f64;
+    /// `minNum(acc, x)` (or `maxNum`) when `acc` is not NaN, in one instruction: a NaN `x`
+    /// fails the comparison and leaves `acc`. Every fold starts at `ID`, so none holds NaN.
+    fn acc(acc: f64, x: f64) -> f64;
 }
 
 struct Min;
@@ -406,16 +408,16 @@ struct Max;
 impl Lattice for Min {
     const ID: f64 = INF;
     #[inline(always)]
-    fn op(a: f64, b: f64) -> f64 {
-        a.min(b)
+    fn acc(acc: f64, x: f64) -> f64 {
+        if x < acc { x } else { acc }
     }
 }
 
 impl Lattice for Max {
     const ID: f64 = NEG_INF;
     #[inline(always)]
-    fn op(a: f64, b: f64) -> f64 {
-        a.max(b)
+    fn acc(acc: f64, x: f64) -> f64 {
+        if x > acc { x } else { acc }
     }
 }
 
@@ -441,10 +443,11 @@ fn van_herk<L: Lattice>(
     suf: &mut Vec<f64>,
 ) {
     let n = buf.len();
-    pre.clear();
+    // Both are overwritten in full below: only their lengths matter.
     pre.resize(n, 0.0);
-    suf.clear();
+    pre.truncate(n);
     suf.resize(n, 0.0);
+    suf.truncate(n);
     // Prefix folds run forwards and suffix folds backwards inside each block; the two
     // chains are independent, so one loop runs both.
     let mut b0 = 0;
@@ -454,9 +457,9 @@ fn van_herk<L: Lattice>(
         let m = x.len();
         let (mut pa, mut sa) = (L::ID, L::ID);
         for j in 0..m {
-            pa = L::op(pa, x[j]);
+            pa = L::acc(pa, x[j]);
             p[j] = pa;
-            sa = L::op(x[m - 1 - j], sa);
+            sa = L::acc(sa, x[m - 1 - j]);
             s[m - 1 - j] = sa;
         }
         b0 = b1;
@@ -467,13 +470,13 @@ fn van_herk<L: Lattice>(
     let full = n.saturating_sub(span + a);
     let (pre, suf) = (&pre[..], &suf[..]);
     for (t, o) in buf[..full].iter_mut().enumerate() {
-        *o = L::op(suf[t + a], pre[t + a + span]);
+        *o = L::acc(suf[t + a], pre[t + a + span]);
     }
     // Windows clipped at the end: they reach at most into the last block.
     let last_block = (n - 1) / len * len;
     for (t, o) in buf.iter_mut().enumerate().take(n - a).skip(full) {
         let s = t + a;
-        *o = if s >= last_block { suf[s] } else { L::op(suf[s], pre[n - 1]) };
+        *o = if s >= last_block { suf[s] } else { L::acc(suf[s], pre[n - 1]) };
     }
     buf[n - a..].fill(L::ID);
 }
