@@ -1,1 +1,98 @@
-//! placeholder
+//! SVG pictures of hstl policies, sample runs and learning curves.
+//!
+//! The functions take plain data (no learner types) and return a complete SVG document as a
+//! `String`, in the style of Figures 2 and 3 of Li & Belta (2016): flat policies as arrow
+//! fields, the options policy as a coloured map, sample runs as coloured paths and the
+//! learning curve as a mean line over a band of seeds.
+//!
+//! Grid coordinates follow the GridWorld contract: `x` is the column from left to right, `y`
+//! the row from bottom to top, and `(0, 0)` is the bottom-left cell.
+//!
+//! Every function checks its input and returns a [`PictureError`] instead of panicking, for
+//! example for an empty grid or a cell outside it.
+
+mod curve;
+mod draw;
+mod grid;
+mod palette;
+
+use std::fmt;
+
+pub use curve::learning_curve;
+pub use grid::{flat_policy, options_policy, sample_run, sample_run_ordered};
+
+/// The largest grid side that can be drawn; larger grids would give unreadable pictures.
+pub const MAX_GRID_SIDE: usize = 256;
+
+/// A rectangular grid world with named regions, as drawn under every grid picture.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Grid {
+    /// Number of columns; `x` runs over `0..width`.
+    pub width: usize,
+    /// Number of rows; `y` runs over `0..height`, bottom to top.
+    pub height: usize,
+    /// Regions drawn as shaded, outlined and labelled cells.
+    pub regions: Vec<Region>,
+}
+
+/// A named set of cells, drawn shaded with its name written over it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Region {
+    /// The label written on the region (for example `A`).
+    pub name: String,
+    /// The cells of the region as `(x, y)`; any shape is allowed, an empty region is not drawn.
+    pub cells: Vec<(i64, i64)>,
+}
+
+/// A primitive action of the grid world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Action {
+    /// Move to `y + 1`.
+    Up,
+    /// Move to `y - 1`.
+    Down,
+    /// Move to `x - 1`.
+    Left,
+    /// Move to `x + 1`.
+    Right,
+}
+
+/// The action a flat policy takes in one cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cell {
+    /// Column, left to right.
+    pub x: i64,
+    /// Row, bottom to top.
+    pub y: i64,
+    /// The action chosen in this cell.
+    pub action: Action,
+}
+
+/// Why a picture could not be drawn.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PictureError {
+    message: String,
+}
+
+/// The result of drawing a picture: an SVG document or the reason it could not be drawn.
+pub type Result<T> = std::result::Result<T, PictureError>;
+
+impl PictureError {
+    /// An error with the given message.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self { message: message.into() }
+    }
+
+    /// The message, without a trailing period.
+    pub fn message(&self) -> &str {
+        &self.message
+    }
+}
+
+impl fmt::Display for PictureError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for PictureError {}
