@@ -1,1 +1,40 @@
-//! placeholder
+//! The hierarchical learner of Li & Belta, "A Hierarchical Reinforcement Learning Method
+//! for Persistent Time-Sensitive Tasks" (2016), Algorithm 1, for hstl task specs.
+//!
+//! - [`spec`]: the plain data a checked spec lowers into ([`TaskSpec`]) and the [`Spec`]
+//!   trait generated code implements.
+//! - [`env`]: the [`Env`] trait (gymnasium conventions) and the [`GridWorld`] of the paper.
+//! - [`learn`]: Algorithm 1: flat Q-learning per primitive option, options Q-learning with
+//!   intra-option updates, seeded and bit-for-bit reproducible.
+//! - [`policy`]: greedy policies and the `policy.json` document.
+//! - [`eval`]: greedy rollouts, sample runs and the window rate.
+//! - [`optimum`]: the exact optimal window rate by relative value iteration.
+//!
+//! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
+
+pub mod env;
+mod error;
+pub mod eval;
+pub mod learn;
+pub mod optimum;
+pub mod policy;
+pub mod spec;
+mod tables;
+
+pub use env::{Env, GridWorld};
+pub use error::Error;
+pub use hstl_robustness as robustness;
+pub use learn::{Learner, QTables, Trained};
+pub use policy::{Agent, Policy};
+pub use spec::{
+    CombinedOption, Intra, LearnParams, LevelParams, PrimitiveOption, Region, RewardKind, Spec,
+    StateVar, TaskSpec, Terminate,
+};
+
+/// The one random generator of the crate: every draw comes from a value of this type.
+pub type Rng = rand_chacha::ChaCha8Rng;
+
+/// A generator seeded with `seed`; the same seed gives the same draws on every platform.
+pub fn seeded_rng(seed: u64) -> Rng {
+    rand::SeedableRng::seed_from_u64(seed)
+}

@@ -1,0 +1,133 @@
+//! Trains the case study over many seeds for four variants (O_T1/O_T2 x argmax/entry
+//! termination) on two threads and reports the window rate, W/W*, training time and the
+//! O_T2 vs O_T1 reward difference.
+//!
+//! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES]`
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::time::Instant;
+
+use hstl_runtime::eval::{AgentController, EntryCycle, RegionTable, WindowConfig, window_rate};
+use hstl_runtime::optimum::{SolveConfig, solve};
+use hstl_runtime::{GridWorld, Learner, seeded_rng};
+
+/// What one training run measured.
+#[derive(Clone, Debug)]
+struct Outcome {
+    rate: f64,
+    secs: f64,
+    tail_reward: f64,
+    steps: u64,
+}
+
+fn run(permutations: bool, entry: bool, seed: u64, episodes: Option<usize>) -> Outcome {
+    let mut spec = common::case_study(permutations, entry);
+    if let Some(e) = episodes {
+        spec.learn.episodes = e;
+    }
+    let env = GridWorld::default();
+    let mut rng = seeded_rng(seed);
+    let t = Instant::now();
+    let mut learner = Learner::new(&spec, &env).expect("the case study is valid");
+    let trained = learner.train(&mut rng, |_, _| {});
+    let secs = t.elapsed().as_secs_f64();
+    let agent = learner.agent();
+    let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
+    let mut eval_rng = seeded_rng(seed ^ 0x5eed);
+    let report = window_rate(
+        &env,
+        &mut AgentController::new(&agent),
+        &regions,
+        WindowConfig::default(),
+        &mut eval_rng,
+    )
+    .expect("default window config is valid");
+    let tail = &trained.curve[trained.curve.len().saturating_sub(100)..];
+    Outcome {
+        rate: report.rate,
+        secs,
+        tail_reward: tail.iter().sum::<f64>() / tail.len() as f64,
+        steps: trained.steps,
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let seeds: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20);
+    let episodes: Option<usize> = args.get(2).and_then(|a| a.parse().ok());
+    let env = GridWorld::default();
+    let spec = common::case_study(false, false);
+    let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
+    let t = Instant::now();
+    let optimum = solve(&env, &regions, SolveConfig::default()).expect("the optimum is solvable");
+    println!(
+        "W* = {:.4} in [{:.5}, {:.5}], {} sweeps over {} states, {:.1} s (converged: {})",
+        optimum.gain,
+        optimum.lower,
+        optimum.upper,
+        optimum.iterations,
+        optimum.states,
+        t.elapsed().as_secs_f64(),
+        optimum.converged
+    );
+    let w_star = optimum.gain;
+    let mut rng = seeded_rng(1);
+    let check =
+        window_rate(&env, &mut optimum.controller(), &regions, WindowConfig::default(), &mut rng)
+            .expect("valid config");
+    println!("greedy on the optimal values, simulated: {:.4}", check.rate);
+    let mut cycle = EntryCycle::new(&env, &regions).expect("regions are non-empty");
+    let c = window_rate(&env, &mut cycle, &regions, WindowConfig::default(), &mut rng)
+        .expect("valid config");
+    println!("nearest-cell entry cycle A->B->C: {:.4} (W/W* {:.3})", c.rate, c.rate / w_star);
+    let mut tails = Vec::new();
+    for (permutations, entry, name) in [
+        (false, false, "O_T1 argmax"),
+        (true, false, "O_T2 argmax"),
+        (false, true, "O_T1 entry"),
+        (true, true, "O_T2 entry"),
+    ] {
+        let outcomes: Vec<Outcome> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..2u64)
+                .map(|w| {
+                    scope.spawn(move || {
+                        (0..seeds)
+                            .filter(|s| s % 2 == w)
+                            .map(|s| (s, run(permutations, entry, s, episodes)))
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            let mut all: Vec<(u64, Outcome)> =
+                handles.into_iter().flat_map(|h| h.join().expect("worker")).collect();
+            all.sort_by_key(|(s, _)| *s);
+            all.into_iter().map(|(_, o)| o).collect()
+        });
+        let stat = |f: &dyn Fn(&Outcome) -> f64| {
+            let v: Vec<f64> = outcomes.iter().map(f).collect();
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+            (mean, lo, hi)
+        };
+        let (r, rlo, rhi) = stat(&|o| o.rate);
+        let (s, slo, shi) = stat(&|o| o.secs);
+        let (tr, _, _) = stat(&|o| o.tail_reward);
+        let (st, _, _) = stat(&|o| o.steps as f64);
+        println!(
+            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}",
+            r / w_star,
+            st / s / 1e6
+        );
+        tails.push(tr);
+    }
+    let diff = |a: f64, b: f64| 100.0 * (b - a) / a.abs();
+    println!(
+        "O_T2 vs O_T1 reward: argmax {:+.1}%, entry {:+.1}%",
+        diff(tails[0], tails[1]),
+        diff(tails[2], tails[3])
+    );
+}

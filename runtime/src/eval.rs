@@ -1,0 +1,300 @@
+//! Greedy rollouts, sample runs, and the window rate of persistent tasks.
+//!
+//! **Window rate.** For a task `always[0..] (eventually[0..N1] R1 && ... && eventually[0..Nk]
+//! Rk)`, step `t` of a rollout keeps its windows when, for every region `j`, `R_j` held at
+//! some step of the `N_j`-step window `t-N_j+1 ..= t` ending at `t`; regions with
+//! different `N_j` are each checked over their own window, and step `t` counts once. This
+//! is `psi(t)` of LANGUAGE.md: `tau_j` (steps since `R_j` last held) starts at `N_j`, or 0
+//! when the start state satisfies `R_j`. The rate is the share of the steps
+//! `burn_in..steps` with `psi(t) = 1`, pooled over all rollouts.
+
+use hstl_robustness::{Trace, reference};
+
+use crate::{Agent, Env, Error, Rng, TaskSpec};
+
+/// Decides actions step by step: a greedy [`Agent`] or a hand-written controller.
+pub trait Controller {
+    /// Forgets any execution in progress; the next step starts afresh.
+    fn reset(&mut self);
+    /// The decision in state `s` (a state index).
+    fn act(&mut self, s: usize) -> Decision;
+    /// Sees the state the last action led to.
+    fn observe(&mut self, next: usize);
+}
+
+/// One decision of a [`Controller`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decision {
+    /// The action taken.
+    pub action: usize,
+    /// The running option (or phase, for a hand-written controller).
+    pub option: usize,
+    /// The leg of that option.
+    pub leg: usize,
+}
+
+/// One step of a rollout: the state and what was decided there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Step {
+    /// The state index.
+    pub state: usize,
+    /// The decision taken in it.
+    pub decision: Decision,
+}
+
+/// How the window rate is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WindowConfig {
+    /// Rollouts, each from a random start (`env.reset`).
+    pub starts: usize,
+    /// Steps per rollout.
+    pub steps: usize,
+    /// Steps at the start of each rollout that are not counted.
+    pub burn_in: usize,
+}
+
+/// The window rate of a controller, with the task's robustness over each rollout.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WindowReport {
+    /// The share of counted steps whose windows all visit their region.
+    pub rate: f64,
+    /// The window rate of each rollout.
+    pub per_rollout: Vec<f64>,
+    /// The task's robustness `rho(task, 0)` over each whole rollout.
+    pub robustness: Vec<f64>,
+}
+
+/// Region membership per state index, for the window rate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RegionTable {
+    /// `holds[j][s]`: region `j` holds in state `s`.
+    pub holds: Vec<Vec<bool>>,
+    /// `N_j` of each region.
+    pub horizons: Vec<usize>,
+    /// Row `s`: state `s`'s values in the spec's variable order.
+    trace: Trace,
+    task: hstl_robustness::Formula,
+}
+
+/// A greedy [`Agent`] executing options: the options policy picks an option where none
+/// runs, its legs follow their flat policies greedily.
+#[derive(Clone, Debug)]
+pub struct AgentController<'a> {
+    agent: &'a Agent,
+    running: Option<(usize, usize, usize)>,
+}
+
+/// The hand-written "nearest-cell entry cycle" on a [`crate::GridWorld`]: visit the regions in
+/// turn; in each phase head for the nearest cell (Manhattan) of the current region, moving
+/// along x first, and switch to the next region on entering it.
+#[derive(Clone, Debug)]
+pub struct EntryCycle {
+    targets: Vec<Vec<(usize, usize)>>,
+    holds: Vec<Vec<bool>>,
+    width: usize,
+    phase: usize,
+}
+
+impl Default for WindowConfig {
+    /// 100 rollouts of 2000 steps, the first 100 not counted.
+    fn default() -> WindowConfig {
+        WindowConfig { starts: 100, steps: 2000, burn_in: 100 }
+    }
+}
+
+impl RegionTable {
+    /// The regions of `spec` over `env`'s states. Fails when the task has no regions or the
+    /// spec does not fit the environment.
+    pub fn new<E: Env>(spec: &TaskSpec, env: &E) -> Result<RegionTable, Error> {
+        if spec.regions.is_empty() {
+            return Err(Error::Config(
+                "the window rate needs a task of the form always[0..] (eventually[0..N1] R1 \
+                 && ...) and its regions"
+                    .into(),
+            ));
+        }
+        let trace = crate::tables::valuations(spec, env)?;
+        let holds = spec
+            .regions
+            .iter()
+            .map(|r| {
+                (0..trace.len())
+                    .map(|s| reference::robustness(&r.formula, &trace, s) > 0.0)
+                    .collect()
+            })
+            .collect();
+        let horizons = spec.regions.iter().map(|r| r.horizon).collect();
+        Ok(RegionTable { holds, horizons, trace, task: spec.task.clone() })
+    }
+
+    /// The task's robustness over the states of a rollout.
+    pub fn robustness(&self, states: &[usize]) -> f64 {
+        let mut t = Trace::new(self.trace.vars());
+        let mut row = Vec::new();
+        for &s in states {
+            self.trace.row_into(s, &mut row);
+            if t.push(&row).is_err() {
+                return f64::NAN;
+            }
+        }
+        reference::robustness(&self.task, &t, 0)
+    }
+
+    /// `psi(t)` for every step of a rollout through `states`.
+    pub fn psi(&self, states: &[usize]) -> Vec<bool> {
+        let mut tau = self.horizons.clone();
+        states
+            .iter()
+            .map(|&s| {
+                let mut kept = true;
+                for (j, t) in tau.iter_mut().enumerate() {
+                    *t = if self.holds[j][s] { 0 } else { (*t + 1).min(self.horizons[j]) };
+                    kept &= *t < self.horizons[j];
+                }
+                kept
+            })
+            .collect()
+    }
+}
+
+impl<'a> AgentController<'a> {
+    /// A controller following `agent`.
+    pub fn new(agent: &'a Agent) -> AgentController<'a> {
+        AgentController { agent, running: None }
+    }
+}
+
+impl Controller for AgentController<'_> {
+    fn reset(&mut self) {
+        self.running = None;
+    }
+
+    fn act(&mut self, s: usize) -> Decision {
+        let (o, leg, _) = *self.running.get_or_insert((self.agent.options[s], 0, 0));
+        let p = self.agent.legs[o][leg];
+        Decision { action: self.agent.flat[p][s], option: o, leg }
+    }
+
+    fn observe(&mut self, next: usize) {
+        let Some((o, leg, steps)) = self.running else { return };
+        let p = self.agent.legs[o][leg];
+        self.running = if self.agent.terminate[p][next] || steps + 1 >= self.agent.max_steps {
+            (leg + 1 < self.agent.legs[o].len()).then_some((o, leg + 1, 0))
+        } else {
+            Some((o, leg, steps + 1))
+        };
+    }
+}
+
+impl EntryCycle {
+    /// The cycle through `regions` on `grid`, in region order.
+    pub fn new(grid: &crate::GridWorld, regions: &RegionTable) -> Result<EntryCycle, Error> {
+        let width = grid.width();
+        let targets: Vec<Vec<(usize, usize)>> = regions
+            .holds
+            .iter()
+            .map(|h| (0..h.len()).filter(|&s| h[s]).map(|s| (s % width, s / width)).collect())
+            .collect();
+        if targets.iter().any(Vec::is_empty) {
+            return Err(Error::Config("a region holds in no cell of the grid".into()));
+        }
+        Ok(EntryCycle { targets, holds: regions.holds.clone(), width, phase: 0 })
+    }
+}
+
+impl Controller for EntryCycle {
+    fn reset(&mut self) {
+        self.phase = 0;
+    }
+
+    fn act(&mut self, s: usize) -> Decision {
+        let (x, y) = (s % self.width, s / self.width);
+        let dist = |&(tx, ty): &(usize, usize)| tx.abs_diff(x) + ty.abs_diff(y);
+        let (tx, ty) = self.targets[self.phase].iter().copied().min_by_key(dist).unwrap_or((x, y));
+        let action = if tx > x {
+            3
+        } else if tx < x {
+            2
+        } else if ty > y {
+            0
+        } else {
+            1
+        };
+        Decision { action, option: self.phase, leg: 0 }
+    }
+
+    fn observe(&mut self, next: usize) {
+        if self.holds[self.phase][next] {
+            self.phase = (self.phase + 1) % self.holds.len();
+        }
+    }
+}
+
+/// A rollout of `steps` states from `start` (a state index): the state and decision at each
+/// step; the last decision is taken but its outcome not recorded.
+pub fn rollout<E: Env, C: Controller>(
+    env: &E,
+    controller: &mut C,
+    start: usize,
+    steps: usize,
+    rng: &mut Rng,
+) -> Vec<Step> {
+    controller.reset();
+    let mut out = Vec::with_capacity(steps);
+    let mut s = start;
+    for _ in 0..steps {
+        let decision = controller.act(s);
+        out.push(Step { state: s, decision });
+        let next =
+            env.state(s).map_or(s, |state| env.index(&env.step(&state, decision.action, rng)));
+        controller.observe(next);
+        s = next;
+    }
+    out
+}
+
+/// `runs` rollouts of `steps` states from random starts, for pictures.
+pub fn sample_runs<E: Env, C: Controller>(
+    env: &E,
+    controller: &mut C,
+    runs: usize,
+    steps: usize,
+    rng: &mut Rng,
+) -> Vec<Vec<Step>> {
+    (0..runs)
+        .map(|_| {
+            let start = env.index(&env.reset(rng));
+            rollout(env, controller, start, steps, rng)
+        })
+        .collect()
+}
+
+/// The window rate of `controller` (see the module docs), with the task's robustness
+/// over each rollout.
+pub fn window_rate<E: Env, C: Controller>(
+    env: &E,
+    controller: &mut C,
+    regions: &RegionTable,
+    config: WindowConfig,
+    rng: &mut Rng,
+) -> Result<WindowReport, Error> {
+    if config.starts == 0 || config.burn_in >= config.steps {
+        return Err(Error::Config(format!(
+            "the window rate needs starts > 0 and burn_in < steps, not {config:?}"
+        )));
+    }
+    let mut per_rollout = Vec::with_capacity(config.starts);
+    let mut robustness = Vec::with_capacity(config.starts);
+    let mut kept = 0usize;
+    for _ in 0..config.starts {
+        let start = env.index(&env.reset(rng));
+        let states: Vec<usize> =
+            rollout(env, controller, start, config.steps, rng).iter().map(|s| s.state).collect();
+        let here = regions.psi(&states)[config.burn_in..].iter().filter(|&&k| k).count();
+        kept += here;
+        per_rollout.push(here as f64 / (config.steps - config.burn_in) as f64);
+        robustness.push(regions.robustness(&states));
+    }
+    let rate = kept as f64 / (config.starts * (config.steps - config.burn_in)) as f64;
+    Ok(WindowReport { rate, per_rollout, robustness })
+}

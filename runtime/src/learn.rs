@@ -1,0 +1,301 @@
+//! Algorithm 1 of Li & Belta (2016): hierarchical Q-learning with options.
+//!
+//! **Flat level.** Every primitive option `p` has a Q-table over (state, action). Every
+//! primitive step `s -a-> s'`, whichever option is running, updates the table of *every*
+//! primitive (off-policy): reward `rho(reach_p, s')`, target
+//! `r + gamma * max_a' Q_p(s', a')`. The bootstrap is not cut at `p`'s termination set:
+//! the paper learns each flat policy as a continuing task, and so do we.
+//!
+//! **Options level.** An option run from `s_0` to `s_k` (`k` primitive steps over all its
+//! legs) updates `Q(s_0, o) += alpha (R + gamma^k max_{o' available at s_k} Q(s_k, o') -
+//! Q(s_0, o))`, `R` being the task's segment reward over `s_0 .. s_k`. Then, for
+//! `j = 1, ..., k-1` in that order, the suffix `s_j .. s_k` updates the same way with its
+//! own reward and `gamma^(k-j)`: `intra: paper` credits the executed option; `intra:
+//! remaining` credits the option made of the legs that remain at `s_j` (the state where
+//! a leg starts belongs to that leg) when it is in the set and available at `s_j`, and
+//! skips the suffix otherwise. Each update reads the table as the earlier ones left it.
+//!
+//! **Options.** An option runs at least one step; a leg stops at the first `s'` in its
+//! termination set, or is cut off after `max_steps` steps. Exploration is epsilon-greedy
+//! at both levels with linear decay and a floor: the flat epsilon decays per primitive
+//! step, the options epsilon per option choice. Greedy ties go to the lowest index.
+
+use hstl_robustness::segment::TabularScorer;
+use rand::RngExt;
+
+use crate::spec::{Intra, LearnParams, RewardKind};
+use crate::tables::Tables;
+use crate::{Env, Error, Rng, TaskSpec};
+
+/// Trains one spec on one environment.
+#[derive(Clone, Debug)]
+pub struct Learner<'e, E: Env> {
+    env: &'e E,
+    spec: TaskSpec,
+    tables: Tables,
+    view: StateView,
+    reward: SegmentReward,
+    q: QTables,
+}
+
+/// The learned values, enough to continue training.
+#[derive(Clone, Debug, PartialEq)]
+pub struct QTables {
+    /// `flat[p][s * actions + a]`: primitive `p`'s Q-value of action `a` in state `s`.
+    pub flat: Vec<Vec<f64>>,
+    /// `options[obs * n_options + o]`: the value of choosing option `o` on observing `obs`.
+    pub options: Vec<f64>,
+    /// Primitive steps taken so far (drives the flat epsilon).
+    pub steps: u64,
+    /// Option choices made so far (drives the options epsilon).
+    pub choices: u64,
+}
+
+/// The result of [`Learner::train`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trained {
+    /// The learning curve: per episode, the sum of the rewards of its options.
+    pub curve: Vec<f64>,
+    /// Primitive steps taken in this call.
+    pub steps: u64,
+}
+
+/// What the options policy observes: the state index today. Issue 7 adds a memory of
+/// recently visited regions here.
+#[derive(Clone, Debug)]
+struct StateView {
+    states: usize,
+}
+
+/// How an option execution and its suffixes are rewarded: the task's segment robustness
+/// today.
+#[derive(Clone, Debug)]
+struct SegmentReward {
+    scorer: TabularScorer,
+}
+
+/// The trajectory of one option execution.
+#[derive(Clone, Debug, Default)]
+struct Run {
+    /// `s_0 .. s_k`.
+    states: Vec<usize>,
+    /// Position in `states` where each leg starts.
+    leg_starts: Vec<usize>,
+}
+
+impl<'e, E: Env> Learner<'e, E> {
+    /// A learner with zeroed Q-tables. Fails when the spec is invalid, does not fit `env`,
+    /// or some state has no available option.
+    pub fn new(spec: &TaskSpec, env: &'e E) -> Result<Learner<'e, E>, Error> {
+        if spec.learn.memory > 0 || spec.learn.reward == RewardKind::Window {
+            return Err(Error::Config(
+                "memory and reward: window are not implemented by this learner yet".into(),
+            ));
+        }
+        let tables = Tables::new(spec, env)?;
+        let view = StateView { states: tables.states };
+        let q = QTables {
+            flat: vec![vec![0.0; tables.states * tables.actions]; tables.reach.len()],
+            options: vec![0.0; view.size() * tables.legs.len()],
+            steps: 0,
+            choices: 0,
+        };
+        let reward = SegmentReward { scorer: TabularScorer::new(&spec.task, &tables.trace) };
+        Ok(Learner { env, spec: spec.clone(), tables, view, reward, q })
+    }
+
+    /// Continues from earlier Q-tables (for instance from a loaded `policy.json`).
+    pub fn with_tables(mut self, q: QTables) -> Result<Learner<'e, E>, Error> {
+        let flat_ok = q.flat.len() == self.q.flat.len()
+            && q.flat.iter().all(|t| t.len() == self.tables.states * self.tables.actions);
+        if !flat_ok || q.options.len() != self.q.options.len() {
+            return Err(Error::Config(
+                "the Q-tables do not have the shape of this spec and environment".into(),
+            ));
+        }
+        self.q = q;
+        Ok(self)
+    }
+
+    /// The spec being learned.
+    pub fn spec(&self) -> &TaskSpec {
+        &self.spec
+    }
+
+    /// The environment.
+    pub fn env(&self) -> &'e E {
+        self.env
+    }
+
+    /// The current Q-tables.
+    pub fn q(&self) -> &QTables {
+        &self.q
+    }
+
+    /// The greedy policies of the current Q-tables.
+    pub fn agent(&self) -> crate::Agent {
+        crate::Agent::from_q(&self.tables, &self.q, self.spec.learn.max_steps)
+    }
+
+    /// The learner's per-state tables (crate-internal).
+    pub(crate) fn tables(&self) -> &Tables {
+        &self.tables
+    }
+
+    /// Runs `learn.episodes` episodes, calling `progress(episode, reward)` after each.
+    pub fn train(&mut self, rng: &mut Rng, mut progress: impl FnMut(usize, f64)) -> Trained {
+        let episodes = self.spec.learn.episodes;
+        let mut curve = Vec::with_capacity(episodes);
+        let steps_before = self.q.steps;
+        let mut run = Run::default();
+        let mut rewards = Vec::new();
+        for episode in 0..episodes {
+            let reward = self.episode(rng, &mut run, &mut rewards);
+            curve.push(reward);
+            progress(episode, reward);
+        }
+        Trained { curve, steps: self.q.steps - steps_before }
+    }
+
+    fn episode(&mut self, rng: &mut Rng, run: &mut Run, rewards: &mut Vec<f64>) -> f64 {
+        let start = self.env.reset(rng);
+        let mut s = self.env.index(&start);
+        let mut total = 0.0;
+        for _ in 0..self.spec.learn.choices {
+            let o = self.choose_option(s, rng);
+            self.run_option(o, s, rng, run);
+            self.reward.suffix_rewards(&run.states, rewards);
+            total += rewards[0];
+            self.update_options(o, run, rewards);
+            s = *run.states.last().unwrap_or(&s);
+        }
+        total
+    }
+
+    fn choose_option(&mut self, s: usize, rng: &mut Rng) -> usize {
+        let eps = self.spec.learn.options.epsilon_at(self.q.choices);
+        self.q.choices += 1;
+        let available = &self.tables.available[s];
+        if rng.random::<f64>() < eps {
+            return available[rng.random_range(0..available.len())];
+        }
+        let n = self.tables.legs.len();
+        let row = &self.q.options[self.view.observe(s) * n..][..n];
+        best_of(available, row)
+    }
+
+    fn run_option(&mut self, o: usize, mut s: usize, rng: &mut Rng, run: &mut Run) {
+        let LearnParams { max_steps, flat, .. } = self.spec.learn;
+        let actions = self.tables.actions;
+        run.states.clear();
+        run.leg_starts.clear();
+        run.states.push(s);
+        for l in 0..self.tables.legs[o].len() {
+            let p = self.tables.legs[o][l];
+            run.leg_starts.push(run.states.len() - 1);
+            for _ in 0..max_steps {
+                let eps = flat.epsilon_at(self.q.steps);
+                self.q.steps += 1;
+                let a = if rng.random::<f64>() < eps {
+                    rng.random_range(0..actions)
+                } else {
+                    argmax(&self.q.flat[p][s * actions..][..actions])
+                };
+                let next = match self.env.state(s) {
+                    Some(state) => self.env.index(&self.env.step(&state, a, rng)),
+                    None => s,
+                };
+                self.update_flat(s, a, next);
+                run.states.push(next);
+                s = next;
+                if self.tables.term[p][next] {
+                    break;
+                }
+            }
+        }
+    }
+
+    fn update_flat(&mut self, s: usize, a: usize, next: usize) {
+        let actions = self.tables.actions;
+        let flat = self.spec.learn.flat;
+        for (q, reach) in self.q.flat.iter_mut().zip(&self.tables.reach) {
+            let best = max_of(&q[next * actions..][..actions]);
+            let cell = &mut q[s * actions + a];
+            *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
+        }
+    }
+
+    fn update_options(&mut self, o: usize, run: &Run, rewards: &[f64]) {
+        let n = self.tables.legs.len();
+        let params = self.spec.learn.options;
+        let k = run.states.len() - 1;
+        let end = run.states[k];
+        let end_row = self.view.observe(end) * n;
+        let mut leg = 0;
+        for j in 0..k {
+            while leg + 1 < run.leg_starts.len() && run.leg_starts[leg + 1] <= j {
+                leg += 1;
+            }
+            let s = run.states[j];
+            let credited = match (j, self.spec.learn.intra) {
+                (0, _) | (_, Intra::Paper) => Some(o),
+                (_, Intra::Remaining) => {
+                    self.tables.remaining[o][leg].filter(|r| self.tables.available[s].contains(r))
+                }
+            };
+            let Some(c) = credited else { continue };
+            let best = self.tables.available[end]
+                .iter()
+                .map(|&b| self.q.options[end_row + b])
+                .fold(f64::NEG_INFINITY, f64::max);
+            let target = rewards[j] + params.gamma.powi((k - j) as i32) * best;
+            let cell = &mut self.q.options[self.view.observe(s) * n + c];
+            *cell += params.alpha * (target - *cell);
+        }
+    }
+}
+
+impl StateView {
+    /// The number of distinct observations.
+    fn size(&self) -> usize {
+        self.states
+    }
+
+    /// What the options policy sees in state `s`.
+    fn observe(&self, s: usize) -> usize {
+        s
+    }
+}
+
+impl SegmentReward {
+    /// `out[j]`: the reward of the suffix `states[j..]`.
+    fn suffix_rewards(&mut self, states: &[usize], out: &mut Vec<f64>) {
+        self.scorer.suffix_rewards(states, out);
+    }
+}
+
+/// The index of the largest value; the lowest index among ties, 0 when all are NaN.
+pub(crate) fn argmax(row: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, &v) in row.iter().enumerate().skip(1) {
+        if v > row[best] || row[best].is_nan() && !v.is_nan() {
+            best = i;
+        }
+    }
+    best
+}
+
+/// The candidate with the largest value in `row`; the first among ties.
+pub(crate) fn best_of(candidates: &[usize], row: &[f64]) -> usize {
+    let mut best = candidates[0];
+    for &c in &candidates[1..] {
+        if row[c] > row[best] || row[best].is_nan() && !row[c].is_nan() {
+            best = c;
+        }
+    }
+    best
+}
+
+fn max_of(row: &[f64]) -> f64 {
+    row.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}

@@ -1,0 +1,344 @@
+//! Task specs as plain data: what a checked hstl spec lowers into.
+//!
+//! Formulas refer to state variables by index, in declaration order. Nothing here depends
+//! on the language front end: the facade builds a [`TaskSpec`] from a checked spec, and
+//! generated code implements [`Spec`].
+
+use std::ops::RangeInclusive;
+
+use hstl_robustness::{Bound, Formula, Interval};
+
+use crate::Error;
+
+/// A task with its options and learning parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskSpec {
+    /// The spec's name.
+    pub name: String,
+    /// The state variables, in declaration order; formulas use these indices.
+    pub state_vars: Vec<StateVar>,
+    /// The task the learner pursues.
+    pub task: Formula,
+    /// The primitive options, one per reached region.
+    pub primitives: Vec<PrimitiveOption>,
+    /// The options set the options policy chooses among.
+    pub options: Vec<CombinedOption>,
+    /// Learning parameters.
+    pub learn: LearnParams,
+    /// The regions of a task `always[0..] (eventually[0..N1] R1 && ...)`, in conjunct
+    /// order; empty for a task of any other form.
+    pub regions: Vec<Region>,
+}
+
+/// A state variable and its domain.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StateVar {
+    /// The variable's name, as the environment names it.
+    pub name: String,
+    /// The declared `int` range; `None` for a variable without a finite `int` range,
+    /// which options cannot use.
+    pub domain: Option<RangeInclusive<i64>>,
+}
+
+/// A primitive option: reach a region.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrimitiveOption {
+    /// The option's name.
+    pub name: String,
+    /// The state formula whose robustness at `s'` rewards each step.
+    pub reach: Formula,
+    /// Where the option may start (`rho > 0`).
+    pub init: Formula,
+    /// Where it stops.
+    pub terminate: Terminate,
+}
+
+/// Where a primitive option terminates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Terminate {
+    /// In the states where the reach robustness is largest over the domain.
+    Argmax,
+    /// In the states where this state formula holds (`rho > 0`).
+    Formula(Formula),
+}
+
+/// A member of the options set: one or more primitive options run in turn.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CombinedOption {
+    /// The option's name, such as `AB`.
+    pub name: String,
+    /// Indices into [`TaskSpec::primitives`], in execution order.
+    pub sequence: Vec<usize>,
+}
+
+/// A region of a persistent task: `eventually[0..horizon] formula`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    /// The region's name (the `let` it comes from).
+    pub name: String,
+    /// The region's state formula.
+    pub formula: Formula,
+    /// `N_j`: the number of steps in its window.
+    pub horizon: usize,
+}
+
+/// Learning parameters, with the paper's Table II as [`Default`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct LearnParams {
+    /// Training episodes.
+    pub episodes: usize,
+    /// Option choices per episode.
+    pub choices: usize,
+    /// Steps after which a leg of an option is cut off.
+    pub max_steps: usize,
+    /// Memory buckets of the options state (0: off, as in the paper).
+    pub memory: usize,
+    /// Which option intra-option updates credit.
+    pub intra: Intra,
+    /// How an option execution is rewarded.
+    pub reward: RewardKind,
+    /// The flat (primitive) level; epsilon decays per primitive step.
+    pub flat: LevelParams,
+    /// The options level; epsilon decays per option choice.
+    pub options: LevelParams,
+}
+
+/// Q-learning parameters of one level.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelParams {
+    /// Discount per step.
+    pub gamma: f64,
+    /// Learning rate.
+    pub alpha: f64,
+    /// Initial exploration rate.
+    pub epsilon: f64,
+    /// Exploration floor.
+    pub min_epsilon: f64,
+    /// Linear decay of epsilon per step or choice.
+    pub decay: f64,
+}
+
+/// Which option an intra-option update credits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Intra {
+    /// Every suffix to the executed option, as in the paper.
+    #[default]
+    Paper,
+    /// A suffix to the option made of the remaining legs, when it is in the set.
+    Remaining,
+}
+
+/// How the options level rewards an option execution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum RewardKind {
+    /// The task's robustness over the segment, as in the paper.
+    #[default]
+    Segment,
+    /// The discounted count of kept windows (needs `memory`).
+    Window,
+}
+
+/// What generated code implements: a spec that can hand its data to the runtime.
+pub trait Spec {
+    /// The spec as plain data.
+    fn task_spec(&self) -> TaskSpec;
+}
+
+impl Default for LearnParams {
+    fn default() -> LearnParams {
+        LearnParams {
+            episodes: 1200,
+            choices: 200,
+            max_steps: 500,
+            memory: 0,
+            intra: Intra::Paper,
+            reward: RewardKind::Segment,
+            flat: LevelParams::FLAT,
+            options: LevelParams::OPTIONS,
+        }
+    }
+}
+
+impl LevelParams {
+    /// The paper's flat level: gamma 0.9, alpha 0.2, epsilon 0.8 down to 0.1 by 1e-6.
+    pub const FLAT: LevelParams =
+        LevelParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 };
+    /// The paper's options level: gamma 0.9, alpha 0.5, epsilon 0.8 down to 0.1 by 1e-4.
+    pub const OPTIONS: LevelParams =
+        LevelParams { gamma: 0.9, alpha: 0.5, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-4 };
+
+    /// The exploration rate after `n` decay steps.
+    pub fn epsilon_at(&self, n: u64) -> f64 {
+        (self.epsilon - self.decay * n as f64).max(self.min_epsilon)
+    }
+
+    fn validate(&self, level: &str) -> Result<(), Error> {
+        let bad = |what: &str| Err(Error::Spec(format!("{level} {what}")));
+        if !(self.gamma > 0.0 && self.gamma <= 1.0) {
+            return bad(&format!("gamma {} is not in (0, 1]", self.gamma));
+        }
+        if !(self.alpha > 0.0 && self.alpha <= 1.0) {
+            return bad(&format!("alpha {} is not in (0, 1]", self.alpha));
+        }
+        if !(0.0 <= self.min_epsilon && self.min_epsilon <= self.epsilon && self.epsilon <= 1.0) {
+            return bad(&format!(
+                "epsilon {} and min_epsilon {} break 0 <= min_epsilon <= epsilon <= 1",
+                self.epsilon, self.min_epsilon
+            ));
+        }
+        if !(self.decay >= 0.0 && self.decay.is_finite()) {
+            return bad(&format!("decay {} is not a finite number >= 0", self.decay));
+        }
+        Ok(())
+    }
+}
+
+impl Spec for TaskSpec {
+    fn task_spec(&self) -> TaskSpec {
+        self.clone()
+    }
+}
+
+impl TaskSpec {
+    /// Checks the spec on its own: names, indices, domains, state formulas, parameters and
+    /// regions. Fitting it to an environment is checked when training starts.
+    pub fn validate(&self) -> Result<(), Error> {
+        let err = |m: String| Err(Error::Spec(m));
+        if self.state_vars.is_empty() {
+            return err("the spec has no state variable".into());
+        }
+        for v in &self.state_vars {
+            match &v.domain {
+                None => return err(format!("state variable {} has no finite int range", v.name)),
+                Some(d) if d.is_empty() => {
+                    return err(format!(
+                        "state variable {} has an empty range {}..={}",
+                        v.name,
+                        d.start(),
+                        d.end()
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
+        let vars = self.state_vars.len();
+        let reads_known = |f: &Formula| f.max_var().is_none_or(|i| i < vars);
+        if !reads_known(&self.task) {
+            return err("the task reads a state variable the spec does not declare".into());
+        }
+        if self.primitives.is_empty() {
+            return err("the spec declares no primitive option".into());
+        }
+        for p in &self.primitives {
+            let mut formulas = vec![("reach", &p.reach), ("init", &p.init)];
+            if let Terminate::Formula(f) = &p.terminate {
+                formulas.push(("terminate", f));
+            }
+            for (part, f) in formulas {
+                if !f.is_state_formula() {
+                    return err(format!("the {part} formula of option {} is temporal", p.name));
+                }
+                if !reads_known(f) {
+                    return err(format!(
+                        "the {part} formula of option {} reads an undeclared variable",
+                        p.name
+                    ));
+                }
+            }
+        }
+        if self.options.is_empty() {
+            return err("the options set is empty".into());
+        }
+        for o in &self.options {
+            if o.sequence.is_empty() {
+                return err(format!("option {} has an empty sequence", o.name));
+            }
+            if let Some(&i) = o.sequence.iter().find(|&&i| i >= self.primitives.len()) {
+                return err(format!("option {} names primitive {i}, which does not exist", o.name));
+            }
+        }
+        for (i, o) in self.options.iter().enumerate() {
+            if self.options[..i].iter().any(|p| p.name == o.name) {
+                return err(format!("two options are named {}", o.name));
+            }
+        }
+        let l = &self.learn;
+        for (name, value) in
+            [("episodes", l.episodes), ("choices", l.choices), ("max_steps", l.max_steps)]
+        {
+            if value == 0 {
+                return err(format!("{name} must be > 0"));
+            }
+        }
+        l.flat.validate("flat")?;
+        l.options.validate("options")?;
+        if !self.regions.is_empty() {
+            let Some(found) = persistent_regions(&self.task) else {
+                return err("regions are given, but the task is not of the form always[0..] \
+                            (eventually[0..N1] R1 && ...)"
+                    .into());
+            };
+            let same = found.len() == self.regions.len()
+                && found
+                    .iter()
+                    .zip(&self.regions)
+                    .all(|((f, n), r)| *f == r.formula && *n == r.horizon);
+            if !same {
+                return err("the regions do not match the task's conjuncts".into());
+            }
+        }
+        if (l.memory > 0 || l.reward == RewardKind::Window) && self.regions.is_empty() {
+            return err("memory and reward: window need a task of the form always[0..] \
+                        (eventually[0..N1] R1 && ...) and its regions"
+                .into());
+        }
+        Ok(())
+    }
+
+    /// The regions of the task read off its form, named `R1`, `R2`, ..., or `None` when
+    /// the task is not `always[0..] (eventually[0..N1] R1 && ...)`.
+    pub fn regions_from_task(&self) -> Option<Vec<Region>> {
+        let found = persistent_regions(&self.task)?;
+        Some(
+            found
+                .into_iter()
+                .enumerate()
+                .map(|(i, (formula, horizon))| Region {
+                    name: format!("R{}", i + 1),
+                    formula,
+                    horizon,
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The conjuncts `(R_j, N_j)` of a task `always[0..] (eventually[0..N1] R1 && ...)` whose
+/// `R_j` are state formulas, or `None` for a task of another form.
+pub fn persistent_regions(task: &Formula) -> Option<Vec<(Formula, usize)>> {
+    let Formula::Always(outer, body) = task else { return None };
+    if *outer != Interval::ALL {
+        return None;
+    }
+    let conjuncts: Vec<&Formula> = match body.as_ref() {
+        Formula::And(fs) => fs.iter().collect(),
+        f => vec![f],
+    };
+    let mut out = Vec::with_capacity(conjuncts.len());
+    for c in conjuncts {
+        let Formula::Eventually(i, r) = c else { return None };
+        if i.start != 0 || !r.is_state_formula() {
+            return None;
+        }
+        let n = match i.end {
+            Bound::Exclusive(b) => b,
+            Bound::Inclusive(b) => b.checked_add(1)?,
+            Bound::Unbounded => return None,
+        };
+        if n == 0 {
+            return None;
+        }
+        out.push((r.as_ref().clone(), n));
+    }
+    if out.is_empty() { None } else { Some(out) }
+}

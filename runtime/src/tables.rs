@@ -1,0 +1,128 @@
+//! Per-state tables computed once before training: valuations, reach robustness,
+//! initiation and termination sets.
+
+use hstl_robustness::{Formula, Trace, reference};
+
+use crate::spec::Terminate;
+use crate::{Env, Error, TaskSpec};
+
+/// Everything the learner and the evaluator look up per state index.
+#[derive(Clone, Debug)]
+pub(crate) struct Tables {
+    /// Number of states.
+    pub states: usize,
+    /// Number of actions.
+    pub actions: usize,
+    /// Row `s` holds state `s`'s values in the spec's variable order.
+    pub trace: Trace,
+    /// `reach[p][s]`: robustness of primitive `p`'s reach formula at `s`.
+    pub reach: Vec<Vec<f64>>,
+    /// `term[p][s]`: primitive `p` stops at `s`.
+    pub term: Vec<Vec<bool>>,
+    /// `legs[o]`: the primitives option `o` runs, in order.
+    pub legs: Vec<Vec<usize>>,
+    /// `available[s]`: the options whose first leg may start at `s`, in set order.
+    pub available: Vec<Vec<usize>>,
+    /// `remaining[o][l]`: the option made of legs `l..` of option `o`, if in the set.
+    pub remaining: Vec<Vec<Option<usize>>>,
+}
+
+impl Tables {
+    /// The tables of `spec` over the states of `env`. Fails when the spec does not fit the
+    /// environment or some state has no available option.
+    pub fn new<E: Env>(spec: &TaskSpec, env: &E) -> Result<Tables, Error> {
+        spec.validate()?;
+        let trace = valuations(spec, env)?;
+        let states = trace.len();
+        let actions = env.actions().len();
+        if actions == 0 {
+            return Err(Error::Env(format!("environment {} has no action", env.name())));
+        }
+        let signal = |f: &Formula| -> Vec<f64> {
+            (0..states).map(|s| reference::robustness(f, &trace, s)).collect()
+        };
+        let holds = |f: &Formula| -> Vec<bool> { signal(f).into_iter().map(|r| r > 0.0).collect() };
+        let mut reach = Vec::new();
+        let mut init = Vec::new();
+        let mut term = Vec::new();
+        for p in &spec.primitives {
+            let r = signal(&p.reach);
+            term.push(match &p.terminate {
+                Terminate::Argmax => {
+                    let max = r.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    r.iter().map(|&v| v == max).collect()
+                }
+                Terminate::Formula(f) => holds(f),
+            });
+            init.push(holds(&p.init));
+            reach.push(r);
+        }
+        let legs: Vec<Vec<usize>> = spec.options.iter().map(|o| o.sequence.clone()).collect();
+        let mut available = Vec::with_capacity(states);
+        for s in 0..states {
+            let here: Vec<usize> = (0..legs.len()).filter(|&o| init[legs[o][0]][s]).collect();
+            if here.is_empty() {
+                return Err(Error::Spec(format!(
+                    "no option of the set can start in state {:?}",
+                    env.state(s)
+                )));
+            }
+            available.push(here);
+        }
+        let remaining = legs
+            .iter()
+            .map(|seq| {
+                (0..seq.len())
+                    .map(|l| legs.iter().position(|other| other[..] == seq[l..]))
+                    .collect()
+            })
+            .collect();
+        Ok(Tables { states, actions, trace, reach, term, legs, available, remaining })
+    }
+}
+
+/// Row `s`: the values of state `s` of `env` in the spec's variable order. Fails when a
+/// spec variable is missing from the environment or a value lies outside its domain.
+pub(crate) fn valuations<E: Env>(spec: &TaskSpec, env: &E) -> Result<Trace, Error> {
+    let env_vars = env.state_vars();
+    let mut columns = Vec::with_capacity(spec.state_vars.len());
+    for v in &spec.state_vars {
+        let Some(i) = env_vars.iter().position(|e| *e == v.name) else {
+            return Err(Error::Spec(format!(
+                "state variable {} is not a variable of environment {} ({})",
+                v.name,
+                env.name(),
+                env_vars.join(", ")
+            )));
+        };
+        columns.push(i);
+    }
+    let states = env.num_states();
+    if states == 0 {
+        return Err(Error::Env(format!("environment {} has no state", env.name())));
+    }
+    let mut trace = Trace::new(spec.state_vars.len());
+    let (mut env_row, mut row) = (Vec::new(), Vec::new());
+    for s in 0..states {
+        let state = env
+            .state(s)
+            .ok_or_else(|| Error::Env(format!("state index {s} of {} has no state", env.name())))?;
+        env.valuation(&state, &mut env_row);
+        row.clear();
+        for (v, &c) in spec.state_vars.iter().zip(&columns) {
+            let value = env_row.get(c).copied().unwrap_or(f64::NAN);
+            let in_domain = v.domain.as_ref().is_some_and(|d| {
+                value.fract() == 0.0 && value >= *d.start() as f64 && value <= *d.end() as f64
+            });
+            if !in_domain {
+                return Err(Error::Spec(format!(
+                    "state {state:?} gives {} = {value}, outside its declared domain",
+                    v.name
+                )));
+            }
+            row.push(value);
+        }
+        trace.push(&row).map_err(|e| Error::Env(e.to_string()))?;
+    }
+    Ok(trace)
+}
