@@ -448,9 +448,28 @@ fn van_herk<L: Lattice>(
     pre.truncate(n);
     suf.resize(n, 0.0);
     suf.truncate(n);
-    // Prefix folds run forwards and suffix folds backwards inside each block; the two
-    // chains are independent, so one loop runs both.
+    // Prefix folds run forwards and suffix folds backwards inside each block. Each fold is
+    // a dependency chain, so four blocks run side by side: eight independent chains keep
+    // the min/max unit busy instead of waiting on one chain's latency.
+    const LANES: usize = 4;
     let mut b0 = 0;
+    while b0 + LANES * len <= n {
+        let x = &buf[b0..b0 + LANES * len];
+        let p = &mut pre[b0..b0 + LANES * len];
+        let s = &mut suf[b0..b0 + LANES * len];
+        let (mut pa, mut sa) = ([L::ID; LANES], [L::ID; LANES]);
+        for j in 0..len {
+            for q in 0..LANES {
+                let f = q * len + j;
+                pa[q] = L::acc(pa[q], x[f]);
+                p[f] = pa[q];
+                let b = q * len + len - 1 - j;
+                sa[q] = L::acc(sa[q], x[b]);
+                s[b] = sa[q];
+            }
+        }
+        b0 += LANES * len;
+    }
     while b0 < n {
         let b1 = (b0 + len).min(n);
         let (x, p, s) = (&buf[b0..b1], &mut pre[b0..b1], &mut suf[b0..b1]);

@@ -9,8 +9,10 @@ use hstl_robustness::{Formula, Trace, offline, reference};
 const INF: f64 = f64::INFINITY;
 const NEG: f64 = f64::NEG_INFINITY;
 
-/// `(formula, x, y, expected signal)`.
-const CASES: &[(&str, &[f64], &[f64], &[f64])] = &[
+/// A formula, the `x` and `y` columns, and the expected signal.
+type Case = (&'static str, &'static [f64], &'static [f64], &'static [f64]);
+
+const CASES: &[Case] = &[
     // Empty windows: `[3..3]` and `[3..=2]` hold no step.
     ("always[3..3] (x > 0)", &[1.0, 2.0], &[0.0, 0.0], &[INF, INF]),
     ("eventually[3..=2] (x > 0)", &[1.0, 2.0], &[0.0, 0.0], &[NEG, NEG]),
@@ -29,7 +31,12 @@ const CASES: &[(&str, &[f64], &[f64], &[f64])] = &[
     ("(x > 0) until[0..=0] (y > 0)", &[-9.0, -9.0], &[2.0, 3.0], &[2.0, 3.0]),
     ("(x > 0) until (y > 0)", &[4.0, -1.0, 7.0], &[-5.0, -6.0, 9.0], &[-1.0, -1.0, 9.0]),
     // A lower bound above 0: the left operand must hold from t up to t'.
-    ("(x > 0) until[2..=3] (y > 0)", &[1.0, 5.0, 5.0, 5.0], &[0.0, 0.0, 9.0, 9.0], &[1.0, 5.0, NEG, NEG]),
+    (
+        "(x > 0) until[2..=3] (y > 0)",
+        &[1.0, 5.0, 5.0, 5.0],
+        &[0.0, 0.0, 9.0, 9.0],
+        &[1.0, 5.0, NEG, NEG],
+    ),
     ("(x > 0) until[1..] (y > 0)", &[2.0, -3.0, 4.0], &[0.0, 1.0, 8.0], &[1.0, -3.0, NEG]),
     // true and false, alone and inside temporal operators.
     ("true", &[1.0, 2.0], &[0.0, 0.0], &[INF, INF]),
@@ -42,14 +49,10 @@ const CASES: &[(&str, &[f64], &[f64], &[f64])] = &[
     ("!(x > 3) -> y < 1", &[INF, 0.0], &[NEG, 5.0], &[INF, -3.0]),
 ];
 
-fn signal(v: &[f64]) -> Vec<f64> {
-    v.to_vec()
-}
-
 #[test]
 fn hand_worked_signals() {
     for (src, x, y, want) in CASES {
-        check_all(&parse(src), &trace_xy(x, y), &signal(want));
+        check_all(&parse(src), &trace_xy(x, y), want);
     }
 }
 

@@ -17,7 +17,8 @@ fn value() -> impl Strategy<Value = f64> {
 }
 
 fn trace(vars: usize, nan: bool) -> impl Strategy<Value = Trace> {
-    let v = if nan { prop_oneof![15 => value(), 1 => Just(f64::NAN)].boxed() } else { value().boxed() };
+    let v =
+        if nan { prop_oneof![15 => value(), 1 => Just(f64::NAN)].boxed() } else { value().boxed() };
     (0usize..=30).prop_flat_map(move |n| {
         proptest::collection::vec(proptest::collection::vec(v.clone(), n), vars)
             .prop_map(|cols| Trace::from_columns(cols).expect("equal lengths"))
@@ -79,8 +80,11 @@ fn formula(min_kids: usize) -> impl Strategy<Value = Formula> {
             (f.clone(), f.clone()).prop_map(|(g, h)| Formula::Implies(Box::new(g), Box::new(h))),
             (interval(), f.clone()).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
             (interval(), f.clone()).prop_map(|(i, g)| Formula::Eventually(i, Box::new(g))),
-            (interval(), f.clone(), f.clone())
-                .prop_map(|(i, g, h)| Formula::Until(i, Box::new(g), Box::new(h))),
+            (interval(), f.clone(), f.clone()).prop_map(|(i, g, h)| Formula::Until(
+                i,
+                Box::new(g),
+                Box::new(h)
+            )),
             (interval(), f).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
         ]
     })

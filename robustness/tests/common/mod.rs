@@ -27,7 +27,6 @@ pub fn assert_same(what: &str, got: &[f64], want: &[f64]) {
 /// offline signal, the step-0 robustness (on every suffix), the online monitor, and the
 /// segment scorers against the reference segment reward of every suffix.
 pub fn check_all(f: &Formula, trace: &Trace, want: &[f64]) {
-    let n = trace.len();
     let label = format!("{}", f.display_with(&VARS));
     assert_same(&format!("reference {label}"), &reference::signal(f, trace), want);
     assert_same(&format!("offline {label}"), &offline::signal(f, trace), want);
@@ -38,10 +37,9 @@ pub fn check_all(f: &Formula, trace: &Trace, want: &[f64]) {
     }
     let r0 = ev.robustness(f, trace);
     assert!(same(r0, reference::robustness(f, trace, 0)), "{label}: step 0 gave {r0}");
-    for i in 0..n {
-        let suffix = suffix(trace, i);
-        let r = ev.robustness(f, &suffix);
-        assert!(same(r, want[i]), "{label}: step 0 of suffix {i} gave {r}, want {}", want[i]);
+    for (i, w) in want.iter().enumerate() {
+        let r = ev.robustness(f, &suffix(trace, i));
+        assert!(same(r, *w), "{label}: step 0 of suffix {i} gave {r}, want {w}");
     }
     check_online(f, trace, want, &label);
     check_segments(f, trace, &label);
