@@ -193,7 +193,7 @@ pub(crate) fn draw_arrow(
             (cy + dy * along + py * across).round() as i32,
         )
     };
-    let tail = -cell * 0.32;
+    let tail = -cell * 0.34;
     let neck = cell * 0.02;
     let tip = cell * 0.34;
     let points = vec![
