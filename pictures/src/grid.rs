@@ -141,6 +141,9 @@ pub fn options_policy(
         .enumerate()
         .map(|(i, name)| LegendEntry::new(Mark::Swatch(option_color(i)), name))
         .collect();
+    if seen.len() < grid.width * grid.height {
+        legend.push(LegendEntry::new(Mark::Swatch(WHITE), "no choice"));
+    }
     legend.extend(region_legend(grid));
     let index: HashMap<&str, usize> =
         order.iter().enumerate().map(|(i, name)| (name.as_str(), i)).collect();

@@ -8,6 +8,20 @@
 //! Grid coordinates follow the GridWorld contract: `x` is the column from left to right, `y`
 //! the row from bottom to top, and `(0, 0)` is the bottom-left cell.
 //!
+//! ```
+//! use hstl_pictures::{Action, Cell, Grid, Region, flat_policy};
+//!
+//! let grid = Grid {
+//!     width: 3,
+//!     height: 2,
+//!     regions: vec![Region { name: "A".into(), cells: vec![(2, 1)] }],
+//! };
+//! let arrows = [Cell { x: 0, y: 1, action: Action::Right }, Cell { x: 1, y: 1, action: Action::Right }];
+//! let svg = flat_policy(&grid, "Go to A", &arrows, &[(2, 1)])?;
+//! assert!(svg.starts_with("<svg"));
+//! # Ok::<(), hstl_pictures::PictureError>(())
+//! ```
+//!
 //! Every function checks its input and returns a [`PictureError`] instead of panicking, for
 //! example for an empty grid or a cell outside it.
 

@@ -160,7 +160,9 @@ fn options_policy_colours_each_choice_and_lists_every_option() {
     ];
     let svg = options_policy(&grid, "Options", &choices, &order).expect("draws");
     let doc = parse(&svg);
-    for wanted in ["Options", "Option", "go A", "go B", "unused", "extra", "A", "Base"] {
+    // Eight of the twelve cells have no choice.
+    for wanted in ["Options", "Option", "go A", "go B", "unused", "extra", "no choice", "A", "Base"]
+    {
         assert!(has_text(&doc, wanted), "missing text {wanted:?} in {:?}", texts(&doc));
     }
     // Legend order: the given order, then the others as they first appear.
@@ -209,6 +211,7 @@ fn options_policy_tells_sixteen_options_apart() {
     let doc = parse(&doc_text);
     let colours = rect_fills(&doc).into_keys().filter(|f| !is_neutral(f)).count();
     assert_eq!(colours, order.len());
+    assert!(!has_text(&doc, "no choice"), "every cell has a choice");
 }
 
 #[test]
