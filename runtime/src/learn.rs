@@ -299,3 +299,139 @@ pub(crate) fn best_of(candidates: &[usize], row: &[f64]) -> usize {
 fn max_of(row: &[f64]) -> f64 {
     row.iter().copied().fold(f64::NEG_INFINITY, f64::max)
 }
+
+#[cfg(test)]
+mod tests {
+    use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval};
+
+    use super::*;
+    use crate::spec::{CombinedOption, LevelParams, PrimitiveOption, StateVar, Terminate};
+    use crate::{GridWorld, seeded_rng};
+
+    /// `x op c` on the one-row grids below.
+    fn x(op: CmpOp, c: f64) -> Formula {
+        Formula::Cmp { lhs: Expr::Var(0), op, rhs: Expr::Const(c) }
+    }
+
+    /// A 5 x 1 deterministic line: P1 reaches `x > 1` (stops there), P2 reaches `x > 3`
+    /// (stops at the argmax x = 4); options [P1, P2] and [P2]; task
+    /// `eventually[0..10] x < 1`, so the suffix from `x_j` on a rightward run earns `1 - x_j`.
+    fn line(intra: Intra, max_steps: usize, p2_terminate: Terminate) -> TaskSpec {
+        let prim = |name: &str, reach: Formula, terminate| PrimitiveOption {
+            name: name.into(),
+            reach,
+            init: Formula::True,
+            terminate,
+        };
+        TaskSpec {
+            name: "Line".into(),
+            state_vars: vec![
+                StateVar { name: "x".into(), domain: Some(0..=4) },
+                StateVar { name: "y".into(), domain: Some(0..=0) },
+            ],
+            task: Formula::Eventually(
+                Interval { start: 0, end: Bound::Exclusive(10) },
+                Box::new(x(CmpOp::Lt, 1.0)),
+            ),
+            primitives: vec![
+                prim("P1", x(CmpOp::Gt, 1.0), Terminate::Formula(x(CmpOp::Gt, 1.0))),
+                prim("P2", x(CmpOp::Gt, 3.0), p2_terminate),
+            ],
+            options: vec![
+                CombinedOption { name: "P1P2".into(), sequence: vec![0, 1] },
+                CombinedOption { name: "P2".into(), sequence: vec![1] },
+            ],
+            learn: LearnParams {
+                max_steps,
+                intra,
+                flat: LevelParams { epsilon: 0.0, min_epsilon: 0.0, ..LevelParams::FLAT },
+                options: LevelParams { epsilon: 0.0, min_epsilon: 0.0, ..LevelParams::OPTIONS },
+                ..LearnParams::default()
+            },
+            regions: vec![],
+        }
+    }
+
+    /// A learner on the line whose flat policies all go Right (action 3), with
+    /// `Q(x=4, [P2]) = 2` so that the bootstrap is not zero.
+    fn rightward<'e>(spec: &TaskSpec, env: &'e GridWorld) -> Learner<'e, GridWorld> {
+        let learner = Learner::new(spec, env).unwrap();
+        let mut q = learner.q().clone();
+        for t in &mut q.flat {
+            for s in 0..5 {
+                t[s * 4 + 3] = 1.0;
+            }
+        }
+        q.options[4 * 2 + 1] = 2.0;
+        learner.with_tables(q).unwrap()
+    }
+
+    fn run(learner: &mut Learner<'_, GridWorld>, o: usize, s: usize) -> (Run, Vec<f64>) {
+        let mut rng = seeded_rng(0);
+        let mut run = Run::default();
+        let mut rewards = Vec::new();
+        learner.run_option(o, s, &mut rng, &mut run);
+        learner.reward.suffix_rewards(&run.states, &mut rewards);
+        learner.update_options(o, &run, &rewards);
+        (run, rewards)
+    }
+
+    #[test]
+    fn intra_option_updates_match_a_hand_computed_example() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        // (intra, the option credited for the suffix from x_j, j = 0..4)
+        let cases = [(Intra::Paper, [0, 0, 0, 0]), (Intra::Remaining, [0, 0, 1, 1])];
+        for (intra, credited) in cases {
+            let spec = line(intra, 500, Terminate::Argmax);
+            let mut learner = rightward(&spec, &env);
+            let (run, rewards) = run(&mut learner, 0, 0);
+            assert_eq!(run.states, [0, 1, 2, 3, 4]);
+            assert_eq!(run.leg_starts, [0, 2]);
+            assert_eq!(rewards[..4], [1.0, 0.0, -1.0, -2.0]);
+            for j in 0..4 {
+                // alpha (r_j + gamma^(4-j) * max_o Q(x=4, o) - 0), max = 2.
+                let want = 0.5 * ((1.0 - j as f64) + 0.9f64.powi(4 - j as i32) * 2.0);
+                let q = &learner.q().options;
+                assert_eq!(q[j * 2 + credited[j]], want, "{intra:?} suffix {j}");
+                assert_eq!(q[j * 2 + 1 - credited[j]], 0.0, "{intra:?} suffix {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn options_run_at_least_one_step_and_are_cut_off() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        // Starting in P2's termination set still takes a step (Right at x = 4 stays).
+        let spec = line(Intra::Paper, 500, Terminate::Argmax);
+        let mut learner = rightward(&spec, &env);
+        assert_eq!(run(&mut learner, 1, 4).0.states, [4, 4]);
+        // A leg that never terminates is cut off after max_steps steps, then the next runs.
+        let spec = line(Intra::Paper, 3, Terminate::Formula(Formula::False));
+        let mut learner = rightward(&spec, &env);
+        let (r, _) = run(&mut learner, 1, 0);
+        assert_eq!(r.states, [0, 1, 2, 3]);
+        let (r, _) = run(&mut learner, 0, 0);
+        assert_eq!(r.states, [0, 1, 2, 3, 4, 4]);
+        assert_eq!(r.leg_starts, [0, 2]);
+    }
+
+    #[test]
+    fn only_available_options_are_chosen() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
+        // [P1, P2] may start only where x < 2.
+        spec.primitives[0].init = x(CmpOp::Lt, 2.0);
+        spec.learn.options = LevelParams { epsilon: 1.0, min_epsilon: 1.0, ..LevelParams::OPTIONS };
+        let mut learner = Learner::new(&spec, &env).unwrap();
+        let mut rng = seeded_rng(3);
+        for s in 0..5 {
+            let chosen: Vec<usize> = (0..200).map(|_| learner.choose_option(s, &mut rng)).collect();
+            assert_eq!(chosen.contains(&0), s < 2, "state {s}");
+            assert!(chosen.contains(&1));
+        }
+        // An option set with a state where nothing may start is rejected up front.
+        spec.primitives[1].init = x(CmpOp::Lt, 2.0);
+        let err = Learner::new(&spec, &env).unwrap_err();
+        assert!(err.to_string().contains("no option of the set can start"), "{err}");
+    }
+}

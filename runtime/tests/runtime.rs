@@ -1,0 +1,283 @@
+//! Integration tests: determinism, the grid world, policy.json, evaluation, the optimum
+//! and configuration errors.
+
+mod common;
+
+use std::collections::HashMap;
+
+use hstl_runtime::env::{Cell, Env};
+use hstl_runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
+use hstl_runtime::optimum::{SolveConfig, solve};
+use hstl_runtime::robustness::Formula;
+use hstl_runtime::{Error, GridWorld, Learner, Policy, QTables, TaskSpec, seeded_rng};
+
+/// The case study cut down so that a debug build trains it in a moment.
+fn small(permutations: bool, entry: bool) -> TaskSpec {
+    let mut spec = common::case_study(permutations, entry);
+    spec.learn.episodes = 6;
+    spec.learn.choices = 20;
+    spec
+}
+
+fn train(spec: &TaskSpec, env: &GridWorld, seed: u64) -> QTables {
+    let mut learner = Learner::new(spec, env).unwrap();
+    learner.train(&mut seeded_rng(seed), |_, _| {});
+    learner.q().clone()
+}
+
+fn bits(q: &QTables) -> Vec<u64> {
+    q.flat.iter().flatten().chain(&q.options).map(|v| v.to_bits()).collect()
+}
+
+#[test]
+fn same_seed_same_bits_other_seed_other_bits() {
+    let env = GridWorld::default();
+    for (permutations, entry) in [(false, false), (true, true)] {
+        let spec = small(permutations, entry);
+        let a = train(&spec, &env, 7);
+        assert_eq!(bits(&a), bits(&train(&spec, &env, 7)));
+        assert_eq!((a.steps, a.choices), (train(&spec, &env, 7).steps, 120));
+        assert_ne!(bits(&a), bits(&train(&spec, &env, 8)));
+    }
+}
+
+#[test]
+fn progress_reports_every_episode_and_the_curve() {
+    let env = GridWorld::default();
+    let spec = small(false, true);
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    let mut seen = Vec::new();
+    let trained = learner.train(&mut seeded_rng(1), |e, r| seen.push((e, r)));
+    let want: Vec<(usize, f64)> = trained.curve.iter().copied().enumerate().collect();
+    assert_eq!(seen, want);
+    assert_eq!(trained.steps, learner.q().steps);
+}
+
+#[test]
+fn grid_world_slips_to_each_other_action_equally() {
+    let env = GridWorld::default();
+    let mut rng = seeded_rng(42);
+    let centre = Cell { x: 7, y: 7 };
+    let n = 100_000;
+    for action in 0..4 {
+        let mut counts: HashMap<usize, usize> = HashMap::new();
+        for _ in 0..n {
+            let to = env.step(&centre, action, &mut rng);
+            let moved = (0..4).find(|&d| env.intended(centre, d) == to).unwrap();
+            *counts.entry(moved).or_default() += 1;
+        }
+        for d in 0..4 {
+            let want = if d == action { 0.7 } else { 0.1 };
+            let got = counts.get(&d).copied().unwrap_or(0) as f64 / n as f64;
+            // About seven standard deviations of a binomial share at n = 1e5.
+            assert!((got - want).abs() < 0.01, "action {action} moved {d}: {got}");
+        }
+    }
+}
+
+#[test]
+fn grid_world_follows_the_contract() {
+    let env = GridWorld::new(3, 2, 1.0).unwrap();
+    let mut rng = seeded_rng(0);
+    // (from, action, to): x left to right, y bottom to top, off the grid stays.
+    let cases = [
+        ((0, 0), 0, (0, 1)),
+        ((0, 1), 0, (0, 1)),
+        ((0, 1), 1, (0, 0)),
+        ((0, 0), 1, (0, 0)),
+        ((1, 0), 2, (0, 0)),
+        ((0, 0), 2, (0, 0)),
+        ((1, 0), 3, (2, 0)),
+        ((2, 0), 3, (2, 0)),
+    ];
+    for ((x, y), a, (tx, ty)) in cases {
+        assert_eq!(env.step(&Cell { x, y }, a, &mut rng), Cell { x: tx, y: ty }, "{x},{y} {a}");
+    }
+    for s in 0..env.num_states() {
+        assert_eq!(env.index(&env.state(s).unwrap()), s);
+    }
+    assert_eq!(env.state(6), None);
+}
+
+#[test]
+fn bad_environments_are_errors() {
+    for (w, h, p) in [(0, 15, 0.7), (15, 0, 0.7), (15, 15, 1.5), (15, 15, -0.1), (15, 15, f64::NAN)]
+    {
+        assert!(matches!(GridWorld::new(w, h, p), Err(Error::Env(_))), "{w} {h} {p}");
+    }
+    let params = serde_json::json!({ "width": 15, "height": "15", "p": 0.7 });
+    assert!(GridWorld::from_params(&params).is_err());
+}
+
+#[test]
+fn bad_specs_are_errors() {
+    type Break = fn(&mut TaskSpec);
+    let cases: [(&str, Break); 9] = [
+        ("is not a variable of environment", |s| s.state_vars[0].name = "z".into()),
+        ("no finite int range", |s| s.state_vars[1].domain = None),
+        ("outside its declared domain", |s| s.state_vars[0].domain = Some(0..=9)),
+        ("the options set is empty", |s| s.options.clear()),
+        ("no primitive option", |s| s.primitives.clear()),
+        ("no option of the set can start", |s| {
+            s.primitives.iter_mut().for_each(|p| p.init = Formula::False)
+        }),
+        ("flat gamma", |s| s.learn.flat.gamma = 1.5),
+        ("episodes must be > 0", |s| s.learn.episodes = 0),
+        ("the regions do not match", |s| s.regions[0].horizon = 30),
+    ];
+    let env = GridWorld::default();
+    for (want, change) in cases {
+        let mut spec = small(false, false);
+        change(&mut spec);
+        let err = Learner::new(&spec, &env).map(|_| ()).unwrap_err();
+        assert!(err.to_string().contains(want), "{want}: {err}");
+    }
+}
+
+#[test]
+fn policy_json_round_trips_bit_for_bit() {
+    let env = GridWorld::default();
+    let spec = small(false, true);
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(5), |_, _| {});
+    // Non-finite values must survive too.
+    let mut q = learner.q().clone();
+    q.flat[0][0] = f64::INFINITY;
+    q.flat[1][1] = f64::NEG_INFINITY;
+    q.options[2] = f64::from_bits(0x7ff8_0000_dead_beef);
+    q.options[3] = -0.0;
+    let learner = learner.with_tables(q.clone()).unwrap();
+    let policy = Policy::new(&learner);
+    let text = policy.to_json();
+    let back = Policy::from_json(&text).unwrap();
+    assert_eq!(back, policy);
+    assert_eq!(bits(&back.q_tables().unwrap()), bits(&q));
+    assert_eq!(back.agent(&env).unwrap(), learner.agent());
+    // The contract's fields, as scripts read them.
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(doc["spec"], "Surveillance");
+    assert_eq!(doc["env"]["name"], "gridworld");
+    assert_eq!(doc["state_vars"], serde_json::json!(["x", "y"]));
+    assert_eq!(doc["actions"], serde_json::json!(["Up", "Down", "Left", "Right"]));
+    assert_eq!(
+        doc["options"][6],
+        serde_json::json!({ "name": "ABC", "sequence": ["A", "B", "C"] })
+    );
+    assert_eq!(doc["options_policy"].as_array().unwrap().len(), 225);
+    assert_eq!(doc["flat_policies"]["B"].as_array().unwrap().len(), 225);
+    assert_eq!(doc["flat_policies"]["B"][16]["state"], serde_json::json!({ "x": 1, "y": 1 }));
+    // Entry termination for A: 5 x 3 cells.
+    assert_eq!(doc["primitives"][0]["terminate"].as_array().unwrap().len(), 15);
+    // Training continues from the reloaded tables.
+    let resumed = Learner::new(&spec, &env).unwrap().with_tables(back.q_tables().unwrap()).unwrap();
+    assert_eq!(bits(resumed.q()), bits(&q));
+}
+
+#[test]
+fn bad_policy_documents_say_what_is_wrong() {
+    let env = GridWorld::default();
+    let learner = Learner::new(&small(false, false), &env).unwrap();
+    let good: serde_json::Value = serde_json::from_str(&Policy::new(&learner).to_json()).unwrap();
+    type Break = fn(&mut serde_json::Value);
+    let cases: [(&str, Break); 6] = [
+        ("missing field `spec`", |d| {
+            d.as_object_mut().unwrap().remove("spec");
+        }),
+        ("not 16 hex digits", |d| d["q_tables"]["options"][0] = "xyz".into()),
+        ("does not cover state index", |d| {
+            d["options_policy"].as_array_mut().unwrap().pop();
+        }),
+        ("chooses unknown", |d| d["flat_policies"]["A"][0]["choice"] = "Jump".into()),
+        ("which the environment lacks", |d| d["options_policy"][0]["state"]["x"] = 99.into()),
+        ("trained on gridworld", |d| d["env"]["params"]["p"] = 0.9.into()),
+    ];
+    for (want, change) in cases {
+        let mut doc = good.clone();
+        change(&mut doc);
+        let err = Policy::from_json(&doc.to_string())
+            .and_then(|p| p.q_tables().and_then(|_| p.agent(&env)))
+            .unwrap_err();
+        assert!(err.to_string().contains(want), "{want}: {err}");
+    }
+    assert!(Policy::from_json("{").unwrap_err().to_string().contains("EOF"));
+}
+
+#[test]
+fn window_rate_counts_each_region_over_its_own_window() {
+    let env = GridWorld::new(4, 1, 1.0).unwrap();
+    let mut spec = small(false, false);
+    spec.state_vars[0].domain = Some(0..=3);
+    spec.state_vars[1].domain = Some(0..=0);
+    // R1: x < 1 within 3 steps; R2: x > 2 within 5 steps.
+    let r1 = common::cmp(0, hstl_runtime::robustness::CmpOp::Lt, 1.0);
+    let r2 = common::cmp(0, hstl_runtime::robustness::CmpOp::Gt, 2.0);
+    spec.regions = vec![
+        hstl_runtime::Region { name: "R1".into(), formula: r1, horizon: 3 },
+        hstl_runtime::Region { name: "R2".into(), formula: r2, horizon: 5 },
+    ];
+    let table = RegionTable::new(&spec, &env).unwrap();
+    let states = [0, 1, 2, 3, 2, 1, 0, 1, 2, 3, 3, 3];
+    // tau_1: 0 1 2 3 3 3 0 1 2 3 3 3  (kept while < 3)
+    // tau_2: 5 5 5 0 1 2 3 4 5 0 0 0  (kept while < 5)
+    let want = [false, false, false, false, false, false, true, true, false, false, false, false];
+    assert_eq!(table.psi(&states), want);
+}
+
+#[test]
+fn the_optimum_matches_its_greedy_policy_in_simulation() {
+    let env = GridWorld::new(6, 6, 0.7).unwrap();
+    let mut spec = small(false, false);
+    spec.state_vars[0].domain = Some(0..=5);
+    spec.state_vars[1].domain = Some(0..=5);
+    let corner = |x: (f64, f64), y: (f64, f64)| common::rect(x, y);
+    spec.regions = vec![
+        hstl_runtime::Region {
+            name: "L".into(),
+            formula: corner((-1.0, 1.0), (-1.0, 1.0)),
+            horizon: 12,
+        },
+        hstl_runtime::Region {
+            name: "R".into(),
+            formula: corner((4.0, 6.0), (4.0, 6.0)),
+            horizon: 14,
+        },
+    ];
+    let table = RegionTable::new(&spec, &env).unwrap();
+    let optimum =
+        solve(&env, &table, SolveConfig { threads: 1, ..SolveConfig::default() }).unwrap();
+    assert!(optimum.converged && optimum.upper - optimum.lower < 1e-4);
+    assert!(optimum.gain > 0.0 && optimum.gain < 1.0, "{}", optimum.gain);
+    let config = WindowConfig { starts: 40, steps: 3000, burn_in: 100 };
+    let report =
+        window_rate(&env, &mut optimum.controller(), &table, config, &mut seeded_rng(9)).unwrap();
+    // 116k counted steps; correlated, so allow a few hundredths.
+    assert!((report.rate - optimum.gain).abs() < 0.03, "{} vs {}", report.rate, optimum.gain);
+    // Two threads give the same values.
+    let two = solve(&env, &table, SolveConfig { threads: 2, ..SolveConfig::default() }).unwrap();
+    assert_eq!(
+        (two.lower, two.upper, two.iterations),
+        (optimum.lower, optimum.upper, optimum.iterations)
+    );
+}
+
+#[test]
+fn greedy_rollouts_follow_option_legs() {
+    let env = GridWorld::default();
+    let spec = small(false, false);
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(2), |_, _| {});
+    let agent = learner.agent();
+    let steps = rollout(&env, &mut AgentController::new(&agent), 0, 300, &mut seeded_rng(3));
+    assert_eq!(steps.len(), 300);
+    for w in steps.windows(2) {
+        let (a, b) = (w[0].decision, w[1].decision);
+        let p = agent.legs[a.option][a.leg];
+        assert_eq!(a.action, agent.flat[p][w[0].state]);
+        if agent.terminate[p][w[1].state] {
+            // The leg ends on reaching its termination set: the next leg or a new choice.
+            assert!(b.option != a.option || b.leg == a.leg + 1 || b.leg == 0);
+        } else {
+            assert_eq!((b.option, b.leg), (a.option, a.leg));
+        }
+    }
+}
