@@ -1,6 +1,6 @@
 //! Grid pictures: flat policies, the options policy and sample runs.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
@@ -103,7 +103,7 @@ pub fn flat_policy(
             };
             draw_arrow(area, (cx as f64, cy as f64), dir, canvas.cell as f64)?;
         }
-        for &(x, y) in terminate.iter().collect::<HashSet<_>>() {
+        for &(x, y) in terminate.iter().collect::<BTreeSet<_>>() {
             draw_terminate(area, canvas.centre(x, y), canvas.cell as f64)?;
         }
         Ok(())
@@ -373,7 +373,7 @@ fn render(
         area.fill(&WHITE).map_err(draw_err)?;
         draw_title(&area, title, width / 2)?;
         for region in &grid.regions {
-            let cells: HashSet<(i64, i64)> = region.cells.iter().copied().collect();
+            let cells: BTreeSet<(i64, i64)> = region.cells.iter().copied().collect();
             for &(x, y) in &cells {
                 area.draw(&Rectangle::new(canvas.rect(x, y), REGION.mix(REGION_ALPHA).filled()))
                     .map_err(draw_err)?;

@@ -423,3 +423,14 @@ fn bad_input_is_an_error_with_a_clear_message() {
         assert!(!message.ends_with('.'), "{name}: {message:?} ends with a period");
     }
 }
+
+#[test]
+fn the_same_input_gives_the_same_picture() {
+    let grid = small_grid();
+    let cells = [Cell { x: 0, y: 0, action: Action::Up }];
+    let terminate = [(1, 1), (2, 2), (3, 0), (0, 2)];
+    let first = flat_policy(&grid, "Same", &cells, &terminate).expect("draws");
+    for _ in 0..5 {
+        assert_eq!(flat_policy(&grid, "Same", &cells, &terminate).expect("draws"), first);
+    }
+}
