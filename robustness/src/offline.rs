@@ -162,11 +162,24 @@ impl Evaluator {
     }
 
     fn fold<L: Lattice>(&mut self, gs: &[Formula], cols: &[&[f64]], n: usize) -> Vec<f64> {
-        let mut out = self.take(n);
-        out.fill(L::ID);
-        for g in gs {
+        let Some((first, rest)) = gs.split_first() else {
+            let mut out = self.take(n);
+            out.fill(L::ID);
+            return out;
+        };
+        // The first operand's buffer becomes the output; folding it into `ID` (which
+        // drops a NaN) happens in the first combining pass rather than a pass of its own.
+        let mut out = self.eval(first, cols, n);
+        if rest.is_empty() {
+            out.iter_mut().for_each(|a| *a = L::acc(L::ID, *a));
+        }
+        for (k, g) in rest.iter().enumerate() {
             let v = self.eval(g, cols, n);
-            out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(*a, *b));
+            if k == 0 {
+                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(L::acc(L::ID, *a), *b));
+            } else {
+                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(*a, *b));
+            }
             self.pool.push(v);
         }
         out
@@ -300,16 +313,12 @@ impl Evaluator {
         }
         let Some(last) = i.last_offset() else {
             // Unbounded: a suffix fold, then a shift by `a`.
-            let mut acc = L::ID;
-            for v in buf.iter_mut().rev() {
-                acc = L::acc(acc, *v);
-                *v = acc;
-            }
+            suffix_fold::<L>(buf);
             shift_left::<L>(buf, a);
             return;
         };
         // The window at `t` is `s ..= s + len - 1` with `s = t + a`, clipped at `n`.
-        let len = last - a + 1;
+        let len = (last - a).saturating_add(1);
         if len == 1 {
             buf.iter_mut().for_each(|v| *v = L::acc(L::ID, *v));
             shift_left::<L>(buf, a);
@@ -337,7 +346,8 @@ impl Evaluator {
                     *g = next;
                 }
             }
-            Some(last) => self.bounded_until(lhs, out, last - a),
+            // A span past the trace's end is as good as `n`, and cannot overflow.
+            Some(last) => self.bounded_until(lhs, out, (last - a).min(n)),
         }
         if a > 0 {
             self.window::<Min>(lhs, &Interval { start: 0, end: Bound::Exclusive(a) });
@@ -431,6 +441,37 @@ fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
     let a = a.min(n);
     buf.copy_within(a.., 0);
     buf[n - a..].fill(L::ID);
+}
+
+/// `buf[t]` becomes the fold of `buf[t..]`. A suffix fold is one dependency chain, so the
+/// buffer is cut into four pieces folded side by side, then each piece takes in the fold of
+/// the pieces after it.
+fn suffix_fold<L: Lattice>(buf: &mut [f64]) {
+    const LANES: usize = 4;
+    let n = buf.len();
+    let q = n / LANES;
+    // The remainder past the four pieces goes first; its fold carries into the last piece.
+    let mut carry = L::ID;
+    for v in buf[LANES * q..].iter_mut().rev() {
+        carry = L::acc(carry, *v);
+        *v = carry;
+    }
+    if q == 0 {
+        return;
+    }
+    let mut acc = [L::ID; LANES];
+    for j in (0..q).rev() {
+        for (k, a) in acc.iter_mut().enumerate() {
+            let v = &mut buf[k * q + j];
+            *a = L::acc(*a, *v);
+            *v = *a;
+        }
+    }
+    for k in (0..LANES).rev() {
+        let piece = &mut buf[k * q..(k + 1) * q];
+        piece.iter_mut().for_each(|v| *v = L::acc(*v, carry));
+        carry = piece[0];
+    }
 }
 
 /// `buf[t]` becomes the fold of `buf[t + a ..= t + a + len - 1]` (clipped at the end), with

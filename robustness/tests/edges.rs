@@ -90,3 +90,22 @@ fn step_zero_reads_the_horizon_only() {
     let p = trace_xy(&poisoned, &poisoned);
     assert_eq!(offline::robustness(&f, &p), reference::robustness(&f, &t, 0));
 }
+
+/// Bounds near `usize::MAX` behave as very long windows: no overflow, no panic.
+#[test]
+fn huge_bounds() {
+    let x = [3.0, -1.0, 4.0, 1.0, -5.0];
+    let t = trace_xy(&x, &x);
+    let m = usize::MAX;
+    for src in [
+        format!("always[0..={m}] (x > 0)"),
+        format!("eventually[2..={m}] (x > 0)"),
+        format!("(y > -2) until[1..={m}] (x > 3)"),
+        format!("(y > -2) until[{m}..={m}] (x > 3)"),
+        format!("always[{m}..] (x > 0)"),
+        format!("always[0..{m}] (x > 0) && eventually[1..={}] (y < 0)", m - 1),
+    ] {
+        let f = parse(&src);
+        check_all(&f, &t, &reference::signal(&f, &t));
+    }
+}
