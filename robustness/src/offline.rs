@@ -443,34 +443,13 @@ fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
     buf[n - a..].fill(L::ID);
 }
 
-/// `buf[t]` becomes the fold of `buf[t..]`. A suffix fold is one dependency chain, so the
-/// buffer is cut into four pieces folded side by side, then each piece takes in the fold of
-/// the pieces after it.
+/// `buf[t]` becomes the fold of `buf[t..]`. (Folding four pieces side by side to break
+/// the dependency chain measured no faster.)
 fn suffix_fold<L: Lattice>(buf: &mut [f64]) {
-    const LANES: usize = 4;
-    let n = buf.len();
-    let q = n / LANES;
-    // The remainder past the four pieces goes first; its fold carries into the last piece.
-    let mut carry = L::ID;
-    for v in buf[LANES * q..].iter_mut().rev() {
-        carry = L::acc(carry, *v);
-        *v = carry;
-    }
-    if q == 0 {
-        return;
-    }
-    let mut acc = [L::ID; LANES];
-    for j in (0..q).rev() {
-        for (k, a) in acc.iter_mut().enumerate() {
-            let v = &mut buf[k * q + j];
-            *a = L::acc(*a, *v);
-            *v = *a;
-        }
-    }
-    for k in (0..LANES).rev() {
-        let piece = &mut buf[k * q..(k + 1) * q];
-        piece.iter_mut().for_each(|v| *v = L::acc(*v, carry));
-        carry = piece[0];
+    let mut acc = L::ID;
+    for v in buf.iter_mut().rev() {
+        acc = L::acc(acc, *v);
+        *v = acc;
     }
 }
 
@@ -489,28 +468,10 @@ fn van_herk<L: Lattice>(
     pre.truncate(n);
     suf.resize(n, 0.0);
     suf.truncate(n);
-    // Prefix folds run forwards and suffix folds backwards inside each block. Each fold is
-    // a dependency chain, so four blocks run side by side: eight independent chains keep
-    // the min/max unit busy instead of waiting on one chain's latency.
-    const LANES: usize = 4;
+    // Prefix folds run forwards and suffix folds backwards inside each block; the two
+    // chains are independent, so one loop runs both. (Running four blocks side by side
+    // measured slower: the strided indexing costs more than the latency it hides.)
     let mut b0 = 0;
-    while b0 + LANES * len <= n {
-        let x = &buf[b0..b0 + LANES * len];
-        let p = &mut pre[b0..b0 + LANES * len];
-        let s = &mut suf[b0..b0 + LANES * len];
-        let (mut pa, mut sa) = ([L::ID; LANES], [L::ID; LANES]);
-        for j in 0..len {
-            for q in 0..LANES {
-                let f = q * len + j;
-                pa[q] = L::acc(pa[q], x[f]);
-                p[f] = pa[q];
-                let b = q * len + len - 1 - j;
-                sa[q] = L::acc(sa[q], x[b]);
-                s[b] = sa[q];
-            }
-        }
-        b0 += LANES * len;
-    }
     while b0 < n {
         let b1 = (b0 + len).min(n);
         let (x, p, s) = (&buf[b0..b1], &mut pre[b0..b1], &mut suf[b0..b1]);
