@@ -1,18 +1,10 @@
+//! Scratch.
 fn main() {
     let path = std::env::args().nth(1).unwrap();
     let src = std::fs::read_to_string(&path).unwrap();
-    let p = hstl_lang::parse(&src);
+    let c = hstl_lang::check(&src);
     if std::env::args().nth(2).is_some() {
-        println!("{:#?}", p.file);
+        println!("{:#?}", c.specs);
     }
-    for d in &p.diagnostics {
-        println!(
-            "{:?} {} {:?} {} {:?}",
-            d.code,
-            d.message,
-            d.range,
-            &src[d.range.clone()],
-            d.labels
-        );
-    }
+    print!("{}", hstl_lang::render_plain(&path, &src, &c.diagnostics));
 }

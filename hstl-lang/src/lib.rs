@@ -10,3 +10,13 @@ pub mod syntax;
 
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use parser::{Parsed, parse};
+pub mod check;
+pub mod checked;
+
+pub use check::{Checked, check};
+pub use checked::*;
+pub mod position;
+pub mod render;
+
+pub use position::{LineIndex, Position};
+pub use render::render_plain;

@@ -241,10 +241,17 @@ impl Splitter<'_, '_> {
         }
         self.i = header_end;
         let mut items = Vec::new();
+        let mut broken = Vec::new();
         let mut end = head_range.end;
         if !has_brace {
             // Without a body there is nothing more to read in this spec.
-            return Some(Spec { doc, name, items, range: head_range.start..end });
+            return Some(Spec {
+                doc,
+                name,
+                items,
+                broken: Vec::new(),
+                range: head_range.start..end,
+            });
         }
         loop {
             if self.i >= self.toks.len() {
@@ -274,11 +281,12 @@ impl Splitter<'_, '_> {
             }
             let (a, b) = self.item_bounds();
             self.i = b;
-            if let Some(item) = self.item(a, b) {
-                items.push(item);
+            match self.item(a, b) {
+                Some(item) => items.push(item),
+                None => broken.push(self.broken(a, b)),
             }
         }
-        Some(Spec { doc, name, items, range: head_range.start..end })
+        Some(Spec { doc, name, items, broken, range: head_range.start..end })
     }
 
     /// Finds the tokens `[a, b)` of the item starting at `self.i`.
@@ -325,6 +333,31 @@ impl Splitter<'_, '_> {
             }
         }
         (a, k.max(a + 1).min(self.toks.len()))
+    }
+
+    /// What a broken item seems to declare, from its tokens.
+    fn broken(&self, a: usize, b: usize) -> BrokenItem {
+        let mut k = a;
+        while k < b && self.toks[k].kind == TokKind::Doc {
+            k += 1;
+        }
+        let keyword =
+            (k < b && self.toks[k].kind == TokKind::Word).then(|| self.text(k).to_string());
+        let mut names = Vec::new();
+        match keyword.as_deref() {
+            Some("let" | "option") if k + 1 < b && self.toks[k + 1].kind == TokKind::Word => {
+                names.push(self.text(k + 1).to_string());
+            }
+            Some("state") => {
+                for j in k + 1..b.saturating_sub(1) {
+                    if self.toks[j].kind == TokKind::Word && self.is(j + 1, ":") {
+                        names.push(self.text(j).to_string());
+                    }
+                }
+            }
+            _ => {}
+        }
+        BrokenItem { keyword, names, range: self.toks[a].start..self.toks[b - 1].end }
     }
 
     fn item(&mut self, a: usize, b: usize) -> Option<Item> {

@@ -86,7 +86,21 @@ pub struct Spec {
     pub name: Ident,
     /// The items that parsed, in source order; broken items are left out.
     pub items: Vec<Item>,
+    /// Items that did not parse (already reported), so that later passes can stay quiet
+    /// about what they may have declared.
+    pub broken: Vec<BrokenItem>,
     /// Byte range from the first doc line (or `spec`) to the closing brace.
+    pub range: Range<usize>,
+}
+
+/// An item that did not parse: its keyword and the names it seems to declare.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BrokenItem {
+    /// The first word of the item (`let`, `task`, `state`, ...), if it starts with one.
+    pub keyword: Option<String>,
+    /// Names it seems to declare: the name after `let`/`option`, or state variable names.
+    pub names: Vec<String>,
+    /// Byte range of the item.
     pub range: Range<usize>,
 }
 

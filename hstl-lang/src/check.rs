@@ -1,0 +1,1573 @@
+//! Name resolution and every check of LANGUAGE.md, building [`CheckedSpec`]s.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use crate::checked::*;
+use crate::diagnostic::{self, Diagnostic};
+use crate::parser::parse;
+use crate::syntax::{self, FieldValue, Formula, FormulaKind, Item, OptionsKind, ParamValue};
+
+/// At most this many diagnostics are reported per file.
+pub const MAX_DIAGNOSTICS: usize = 200;
+
+/// The finite-domain checks enumerate at most this many states.
+pub const MAX_DOMAIN_STATES: u64 = 1_000_000;
+
+/// The expanded options set may hold at most this many options.
+pub const MAX_OPTIONS: u64 = 10_000;
+
+/// The result of [`check`].
+#[derive(Clone, Debug)]
+pub struct Checked {
+    /// The syntax tree the checks ran on (for tools that need both).
+    pub file: syntax::File,
+    /// One checked spec per spec of the file whose header parsed, in source order. A spec
+    /// with errors is still present, with the parts that did check.
+    pub specs: Vec<CheckedSpec>,
+    /// Every diagnostic (syntax and semantic), sorted by position, deduplicated, capped at
+    /// [`MAX_DIAGNOSTICS`].
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Checked {
+    /// Whether any diagnostic is an error.
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
+/// Parses and checks a source text. Never fails and never panics.
+pub fn check(src: &str) -> Checked {
+    let parsed = parse(src);
+    let mut diags = parsed.diagnostics;
+    let mut specs = Vec::new();
+    let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+    for spec in &parsed.file.specs {
+        if spec.name.name.is_empty() {
+            continue;
+        }
+        if let Some(first) = seen.get(&spec.name.name) {
+            diags.push(
+                Diagnostic::new(
+                    "HSTL003",
+                    spec.name.range.clone(),
+                    format!("duplicate spec name `{}`", spec.name.name),
+                )
+                .with_label(first.clone(), "first defined here")
+                .with_help("give each spec of a file its own name"),
+            );
+        } else {
+            seen.insert(spec.name.name.clone(), spec.name.range.clone());
+        }
+        let mut cx = Cx {
+            src,
+            diags: Vec::new(),
+            names: HashMap::new(),
+            let_refs: Vec::new(),
+            broken_names: spec.broken.iter().flat_map(|b| b.names.iter().cloned()).collect(),
+        };
+        let checked = cx.spec(spec);
+        diags.append(&mut cx.diags);
+        specs.push(checked);
+    }
+    let diagnostics = diagnostic::finish(diags, MAX_DIAGNOSTICS, src.len());
+    Checked { file: parsed.file, specs, diagnostics }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum NameRef {
+    Var(usize),
+    Let(usize),
+}
+
+/// Per-spec checking state.
+struct Cx<'s> {
+    src: &'s str,
+    diags: Vec<Diagnostic>,
+    names: HashMap<String, (NameRef, Range<usize>)>,
+    /// Let references found while resolving the current formula: (let index, range).
+    let_refs: Vec<(usize, Range<usize>)>,
+    /// Names declared by items that did not parse: unknown-name errors about them would
+    /// only repeat the syntax error.
+    broken_names: std::collections::HashSet<String>,
+}
+
+fn doc_text(d: &Option<syntax::Doc>) -> Option<String> {
+    d.as_ref().map(syntax::Doc::text)
+}
+
+/// Levenshtein distance, for "did you mean" help.
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let len = name.chars().count();
+    let limit = (len / 3).max(1);
+    candidates
+        .map(|c| (distance(name, c), c))
+        .filter(|(d, _)| *d <= limit && *d < len)
+        .min()
+        .map(|(_, c)| c)
+}
+
+fn state_text(spec_vars: &[StateVarInfo], s: &[f64]) -> String {
+    spec_vars
+        .iter()
+        .zip(s)
+        .map(|(v, x)| format!("{} = {}", v.name, x))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn plural(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+impl Cx<'_> {
+    fn push(&mut self, d: Diagnostic) {
+        self.diags.push(d);
+    }
+
+    fn error_count(&self) -> usize {
+        self.diags.iter().filter(|d| d.is_error()).count()
+    }
+
+    fn spec(&mut self, spec: &syntax::Spec) -> CheckedSpec {
+        let mut out = CheckedSpec {
+            name: spec.name.name.clone(),
+            doc: doc_text(&spec.doc),
+            name_range: spec.name.range.clone(),
+            range: spec.range.clone(),
+            state_vars: Vec::new(),
+            lets: Vec::new(),
+            let_order: Vec::new(),
+            task: None,
+            primitives: Vec::new(),
+            options: Vec::new(),
+            learn: LearnParams::default(),
+        };
+        // Once-only items.
+        let mut firsts: HashMap<&'static str, Range<usize>> = HashMap::new();
+        let mut lets = Vec::new();
+        let mut tasks = Vec::new();
+        let mut option_decls = Vec::new();
+        let mut options_item = None;
+        let mut learn = None;
+        for item in &spec.items {
+            let once = match item {
+                Item::State(_) => Some("state"),
+                Item::Task(_) => Some("task"),
+                Item::Options(_) => Some("options"),
+                Item::Learn(_) => Some("learn"),
+                _ => None,
+            };
+            if let Some(kw) = once {
+                let r = item.range();
+                let kw_range = r.start..(r.start + kw.len()).min(r.end);
+                let kw_range = match item {
+                    Item::Task(t) => t.keyword_range.clone(),
+                    _ => kw_range,
+                };
+                if let Some(first) = firsts.get(kw) {
+                    self.push(
+                        Diagnostic::new("HSTL003", kw_range, format!("a second `{kw}` item"))
+                            .with_label(first.clone(), "first given here")
+                            .with_help(format!("a spec has at most one `{kw}` item: merge them")),
+                    );
+                    continue;
+                }
+                firsts.insert(kw, kw_range);
+            }
+            match item {
+                Item::State(b) => self.state_block(b, &mut out),
+                Item::Let(l) => lets.push(l),
+                Item::Task(t) => tasks.push(t),
+                Item::Option(o) => option_decls.push(o),
+                Item::Options(o) => options_item = Some(o),
+                Item::Learn(l) => learn = Some(l),
+            }
+        }
+        self.lets(&lets, &mut out);
+        match tasks.first() {
+            Some(t) => {
+                let formula = self.formula(&t.formula);
+                out.task =
+                    Some(TaskInfo { formula, doc: doc_text(&t.doc), range: t.range.clone() });
+            }
+            None if spec.broken.iter().any(|b| b.keyword.as_deref() == Some("task")) => {}
+            None => {
+                let r = if spec.name.name.is_empty() {
+                    spec.range.start..spec.range.start
+                } else {
+                    spec.name.range.clone()
+                };
+                self.push(
+                    Diagnostic::new(
+                        "HSTL015",
+                        r,
+                        format!("spec `{}` has no `task`", spec.name.name),
+                    )
+                    .with_help("add the task, such as `task always[0..] eventually[0..40] A;`"),
+                );
+            }
+        }
+        self.options(&option_decls, options_item, spec, &mut out);
+        if let Some(l) = learn {
+            self.learn(l, &mut out);
+        }
+        self.persistent_needs(learn, &out);
+        self.mark_used(&mut out);
+        // A broken item may have used any let: stay quiet then.
+        if out.task.is_some() && spec.broken.is_empty() {
+            for l in &out.lets {
+                if !l.used {
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL101",
+                            l.name_range.clone(),
+                            format!("unused `let` `{}`", l.name),
+                        )
+                        .with_help("use it in the task or an option, or remove it"),
+                    );
+                }
+            }
+        }
+        if self.error_count() == 0 {
+            self.finite_domain(&out, options_item, spec);
+        }
+        out
+    }
+
+    fn state_block(&mut self, b: &syntax::StateBlock, out: &mut CheckedSpec) {
+        for v in &b.vars {
+            let domain = self.domain(v);
+            if let Some((_, first)) = self.names.get(&v.name.name) {
+                let first = first.clone();
+                self.push(
+                    Diagnostic::new(
+                        "HSTL003",
+                        v.name.range.clone(),
+                        format!("duplicate name `{}`", v.name.name),
+                    )
+                    .with_label(first, "first defined here")
+                    .with_help("rename one of them"),
+                );
+                continue;
+            }
+            self.names.insert(
+                v.name.name.clone(),
+                (NameRef::Var(out.state_vars.len()), v.name.range.clone()),
+            );
+            out.state_vars.push(StateVarInfo {
+                name: v.name.name.clone(),
+                ty: v.ty,
+                domain,
+                doc: doc_text(&v.doc),
+                name_range: v.name.range.clone(),
+                range: v.range.clone(),
+            });
+        }
+    }
+
+    fn domain(&mut self, v: &syntax::StateVar) -> Domain {
+        let Some(r) = &v.domain else { return Domain::Unbounded };
+        match v.ty {
+            syntax::VarType::Float => {
+                let empty =
+                    if r.inclusive { r.hi.value < r.lo.value } else { r.hi.value <= r.lo.value };
+                if empty {
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL005",
+                            r.range.clone(),
+                            format!("empty range `{}` for `{}`", self.text(&r.range), v.name.name),
+                        )
+                        .with_help("the upper bound must exceed the lower one"),
+                    );
+                    return Domain::Unbounded;
+                }
+                Domain::Float { lo: r.lo.value, hi: r.hi.value, inclusive: r.inclusive }
+            }
+            syntax::VarType::Int => {
+                let lo = self.int_bound(&r.lo, "range");
+                let hi = self.int_bound(&r.hi, "range");
+                let (Some(lo), Some(hi)) = (lo, hi) else { return Domain::Unbounded };
+                let hi_incl = if r.inclusive { hi } else { hi - 1 };
+                if hi_incl < lo {
+                    let (msg, help) = if hi < lo {
+                        ("inverted", "swap the bounds".to_string())
+                    } else {
+                        (
+                            "empty",
+                            format!(
+                                "`{lo}..{hi}` excludes {hi}: write `{lo}..={hi}` to include it"
+                            ),
+                        )
+                    };
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL005",
+                            r.range.clone(),
+                            format!("{msg} range `{}` for `{}`", self.text(&r.range), v.name.name),
+                        )
+                        .with_help(help),
+                    );
+                    return Domain::Unbounded;
+                }
+                Domain::Int { lo, hi: hi_incl }
+            }
+        }
+    }
+
+    fn text(&self, r: &Range<usize>) -> &str {
+        self.src.get(r.clone()).unwrap_or("")
+    }
+
+    fn int_bound(&mut self, n: &syntax::NumberLit, what: &str) -> Option<i64> {
+        match n.as_integer().and_then(|v| i64::try_from(v).ok()) {
+            Some(v) if v < i64::MAX / 4 => Some(v),
+            _ => {
+                let whole = n.as_integer().is_some() || n.text.bytes().all(|b| b.is_ascii_digit());
+                let msg = if whole {
+                    format!("{what} bound `{}` is too large", n.text)
+                } else {
+                    format!("{what} bound `{}` is not a whole number", n.text)
+                };
+                self.push(Diagnostic::new("HSTL006", n.range.clone(), msg).with_help(
+                    "bounds count steps or integer values: write digits only, such as `40`",
+                ));
+                None
+            }
+        }
+    }
+
+    fn lets(&mut self, lets: &[&syntax::Let], out: &mut CheckedSpec) {
+        // Declare every name first so that lets may refer to later ones.
+        let mut kept = Vec::new();
+        for l in lets {
+            if let Some((_, first)) = self.names.get(&l.name.name) {
+                let first = first.clone();
+                self.push(
+                    Diagnostic::new(
+                        "HSTL003",
+                        l.name.range.clone(),
+                        format!("duplicate name `{}`", l.name.name),
+                    )
+                    .with_label(first, "first defined here")
+                    .with_help("rename one of them"),
+                );
+                kept.push(false);
+                continue;
+            }
+            let idx = out.lets.len();
+            self.names.insert(l.name.name.clone(), (NameRef::Let(idx), l.name.range.clone()));
+            out.lets.push(LetInfo {
+                name: l.name.name.clone(),
+                formula: CFormula { kind: CFormulaKind::Invalid, range: l.formula.range.clone() },
+                kind: LetKind::State,
+                used: false,
+                doc: doc_text(&l.doc),
+                name_range: l.name.range.clone(),
+                range: l.range.clone(),
+            });
+            kept.push(true);
+        }
+        let mut edges: Vec<Vec<(usize, Range<usize>)>> = vec![Vec::new(); out.lets.len()];
+        let mut idx = 0;
+        for (l, keep) in lets.iter().zip(kept) {
+            self.let_refs.clear();
+            let f = self.formula(&l.formula);
+            if keep {
+                out.lets[idx].formula = f;
+                edges[idx] = std::mem::take(&mut self.let_refs);
+                idx += 1;
+            }
+        }
+        // Kahn's algorithm: lets left over are in or behind a cycle.
+        let n = out.lets.len();
+        let mut indeg = vec![0usize; n];
+        let mut users: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (i, es) in edges.iter().enumerate() {
+            for (j, _) in es {
+                indeg[i] += 1;
+                users[*j].push(i);
+            }
+        }
+        let mut queue: Vec<usize> = (0..n).filter(|&i| indeg[i] == 0).collect();
+        let mut order = Vec::new();
+        while let Some(j) = queue.pop() {
+            order.push(j);
+            for &i in &users[j] {
+                indeg[i] -= 1;
+                if indeg[i] == 0 {
+                    queue.push(i);
+                }
+            }
+        }
+        let mut placed = vec![false; n];
+        for &i in &order {
+            placed[i] = true;
+        }
+        let mut reported = vec![false; n];
+        for start in 0..n {
+            if placed[start] || reported[start] {
+                continue;
+            }
+            // Follow unplaced references until a let repeats: that is a cycle.
+            let mut path: Vec<(usize, Range<usize>)> = Vec::new();
+            let mut pos: HashMap<usize, usize> = HashMap::new();
+            let mut cur = start;
+            let cycle = loop {
+                if let Some(&p) = pos.get(&cur) {
+                    break path[p..].to_vec();
+                }
+                pos.insert(cur, path.len());
+                let Some((next, r)) = edges[cur].iter().find(|(j, _)| !placed[*j]).cloned() else {
+                    break Vec::new();
+                };
+                path.push((cur, r));
+                cur = next;
+            };
+            if cycle.is_empty() || cycle.iter().any(|(i, _)| reported[*i]) {
+                continue;
+            }
+            for (i, _) in &cycle {
+                reported[*i] = true;
+            }
+            let first = cycle[0].0;
+            let lname = &out.lets[first].name;
+            let d = if cycle.len() == 1 {
+                Diagnostic::new(
+                    "HSTL004",
+                    out.lets[first].name_range.clone(),
+                    format!("`{lname}` refers to itself"),
+                )
+                .with_label(cycle[0].1.clone(), "here")
+            } else {
+                let mut names: Vec<String> =
+                    cycle.iter().map(|(i, _)| format!("`{}`", out.lets[*i].name)).collect();
+                names.push(format!("`{lname}`"));
+                let mut d = Diagnostic::new(
+                    "HSTL004",
+                    out.lets[first].name_range.clone(),
+                    format!("`{lname}` refers to itself through {}", names.join(" -> ")),
+                );
+                for (i, r) in &cycle {
+                    let to = match edges[*i].iter().find(|(_, rr)| rr == r) {
+                        Some((j, _)) => out.lets[*j].name.clone(),
+                        None => String::new(),
+                    };
+                    d = d
+                        .with_label(r.clone(), format!("`{}` uses `{to}` here", out.lets[*i].name));
+                }
+                d
+            };
+            self.push(d.with_help("write one of these formulas without the reference"));
+        }
+        // Kinds, in dependency order; lets in or behind a cycle are judged on their own text.
+        let mut temporal = vec![false; n];
+        for &i in &order {
+            let mut t = has_temporal_node(&out.lets[i].formula);
+            for (j, _) in &edges[i] {
+                t |= temporal[*j];
+            }
+            temporal[i] = t;
+        }
+        for i in 0..n {
+            if !placed[i] {
+                temporal[i] = has_temporal_node(&out.lets[i].formula);
+            }
+            out.lets[i].kind = if temporal[i] { LetKind::Temporal } else { LetKind::State };
+        }
+        // A dependency order with ties broken by declaration order, for stable output.
+        out.let_order = dependency_order(&edges, &placed);
+    }
+
+    fn interval(&mut self, i: &Option<syntax::Interval>) -> Option<Interval> {
+        let Some(i) = i else {
+            return Some(Interval { start: 0, end: Bound::Unbounded, range: None });
+        };
+        let a = self.int_bound(&i.start, "interval");
+        let b = match &i.end {
+            Some(e) => Some(self.int_bound(e, "interval")?),
+            None => None,
+        };
+        let a = a?;
+        let end = match b {
+            None => Bound::Unbounded,
+            Some(b) => {
+                let empty = if i.inclusive { b < a } else { b <= a };
+                if empty {
+                    let text = self.text(&i.range).to_string();
+                    let (msg, help) = if b < a {
+                        (format!("inverted interval `{text}`"), "swap the bounds".to_string())
+                    } else {
+                        (
+                            format!("empty interval `{text}`"),
+                            format!(
+                                "`[{a}..{b}]` excludes step {b}: write `[{a}..={b}]` for that single step"
+                            ),
+                        )
+                    };
+                    self.push(Diagnostic::new("HSTL005", i.range.clone(), msg).with_help(help));
+                    return None;
+                }
+                if i.inclusive { Bound::Inclusive(b as u64) } else { Bound::Exclusive(b as u64) }
+            }
+        };
+        Some(Interval { start: a as u64, end, range: Some(i.range.clone()) })
+    }
+
+    fn formula(&mut self, f: &Formula) -> CFormula {
+        let range = f.range.clone();
+        let invalid = CFormula { kind: CFormulaKind::Invalid, range: range.clone() };
+        let kind = match &f.kind {
+            FormulaKind::True => CFormulaKind::True,
+            FormulaKind::False => CFormulaKind::False,
+            FormulaKind::Paren(g) => return self.formula(g),
+            FormulaKind::Name(id) => match self.names.get(&id.name) {
+                Some((NameRef::Let(j), _)) => {
+                    let j = *j;
+                    self.let_refs.push((j, id.range.clone()));
+                    CFormulaKind::Let(j)
+                }
+                Some((NameRef::Var(_), def)) => {
+                    let def = def.clone();
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL008",
+                            id.range.clone(),
+                            format!("`{}` is a state variable, not a formula", id.name),
+                        )
+                        .with_label(def, "declared here")
+                        .with_help(format!("compare it, such as `{} > 0`", id.name)),
+                    );
+                    return invalid;
+                }
+                None => {
+                    self.unknown(id, true);
+                    return invalid;
+                }
+            },
+            FormulaKind::Compare { first, rest } => {
+                let mut parts = Vec::new();
+                let mut lhs = self.expr(first);
+                let mut ok = true;
+                for (op, op_range, e) in rest {
+                    let rhs = self.expr(e);
+                    let cop = match op {
+                        syntax::CmpOp::Lt => Some(CmpOp::Lt),
+                        syntax::CmpOp::Le => Some(CmpOp::Le),
+                        syntax::CmpOp::Gt => Some(CmpOp::Gt),
+                        syntax::CmpOp::Ge => Some(CmpOp::Ge),
+                        syntax::CmpOp::Eq | syntax::CmpOp::Ne => {
+                            self.push(
+                                Diagnostic::new(
+                                    "HSTL007",
+                                    op_range.clone(),
+                                    format!("`{}` has no robustness", op.as_str()),
+                                )
+                                .with_help("use a band, such as `abs(x - 3) < 0.5`"),
+                            );
+                            None
+                        }
+                    };
+                    match cop {
+                        Some(c) => parts.push(CFormula {
+                            range: lhs.range.start..rhs.range.end,
+                            kind: CFormulaKind::Cmp(c, lhs, rhs.clone()),
+                        }),
+                        None => ok = false,
+                    }
+                    lhs = rhs;
+                }
+                if !ok {
+                    return invalid;
+                }
+                if parts.len() == 1 {
+                    return parts.pop().unwrap_or(invalid);
+                }
+                CFormulaKind::And(parts)
+            }
+            FormulaKind::Not(g) => CFormulaKind::Not(Box::new(self.formula(g))),
+            FormulaKind::Always(i, g) => {
+                let iv = self.interval(i);
+                let g = self.formula(g);
+                match iv {
+                    Some(iv) => CFormulaKind::Always(iv, Box::new(g)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::Eventually(i, g) => {
+                let iv = self.interval(i);
+                let g = self.formula(g);
+                match iv {
+                    Some(iv) => CFormulaKind::Eventually(iv, Box::new(g)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::Until(a, i, b) => {
+                let a = self.formula(a);
+                let iv = self.interval(i);
+                let b = self.formula(b);
+                match iv {
+                    Some(iv) => CFormulaKind::Until(iv, Box::new(a), Box::new(b)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::And(v) => CFormulaKind::And(v.iter().map(|g| self.formula(g)).collect()),
+            FormulaKind::Or(v) => CFormulaKind::Or(v.iter().map(|g| self.formula(g)).collect()),
+            FormulaKind::Implies(a, b) => {
+                CFormulaKind::Implies(Box::new(self.formula(a)), Box::new(self.formula(b)))
+            }
+        };
+        CFormula { kind, range }
+    }
+
+    fn unknown(&mut self, id: &syntax::Ident, formula: bool) {
+        if self.broken_names.contains(&id.name) {
+            return;
+        }
+        let want = if formula { NameRef::Let(0) } else { NameRef::Var(0) };
+        let same_kind = |r: &NameRef| {
+            matches!(
+                (r, want),
+                (NameRef::Let(_), NameRef::Let(_)) | (NameRef::Var(_), NameRef::Var(_))
+            )
+        };
+        let cands: Vec<&str> =
+            self.names.iter().filter(|(_, (r, _))| same_kind(r)).map(|(n, _)| n.as_str()).collect();
+        let mut sorted = cands.clone();
+        sorted.sort_unstable();
+        let mut d =
+            Diagnostic::new("HSTL002", id.range.clone(), format!("unknown name `{}`", id.name));
+        d = match closest(&id.name, sorted.iter().copied()) {
+            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+            None if formula => d.with_help(format!("declare it: `let {} = ...;`", id.name)),
+            None => d.with_help(format!("declare it in `state {{ {}: int in 0..=9 }}`", id.name)),
+        };
+        self.push(d);
+    }
+
+    fn expr(&mut self, e: &syntax::Expr) -> CExpr {
+        use syntax::ExprKind as K;
+        let range = e.range.clone();
+        let invalid = CExpr { kind: CExprKind::Invalid, range: range.clone() };
+        let kind = match &e.kind {
+            K::Number(n) => CExprKind::Const(n.value),
+            K::Paren(a) => return self.expr(a),
+            K::Name(id) => match self.names.get(&id.name) {
+                Some((NameRef::Var(i), _)) => CExprKind::Var(*i),
+                Some((NameRef::Let(_), def)) => {
+                    let def = def.clone();
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL008",
+                            id.range.clone(),
+                            format!("`{}` is a formula, not a number", id.name),
+                        )
+                        .with_label(def, "defined here")
+                        .with_help("comparisons relate numbers: state variables, constants and arithmetic; combine formulas with `&&`, `||`"),
+                    );
+                    return invalid;
+                }
+                None => {
+                    self.unknown(id, false);
+                    return invalid;
+                }
+            },
+            K::Neg(a) => CExprKind::Neg(Box::new(self.expr(a))),
+            K::Call(f, a) => {
+                let a = Box::new(self.expr(a));
+                match f {
+                    syntax::Func::Abs => CExprKind::Abs(a),
+                    syntax::Func::Sqrt => CExprKind::Sqrt(a),
+                }
+            }
+            K::Binary(op, a, b) => {
+                let (a, b) = (Box::new(self.expr(a)), Box::new(self.expr(b)));
+                match op {
+                    syntax::BinOp::Add => CExprKind::Add(a, b),
+                    syntax::BinOp::Sub => CExprKind::Sub(a, b),
+                    syntax::BinOp::Mul => CExprKind::Mul(a, b),
+                    syntax::BinOp::Div => CExprKind::Div(a, b),
+                }
+            }
+        };
+        CExpr { kind, range }
+    }
+
+    /// Where a formula stops being a state formula: the temporal node, or a let reference
+    /// to a temporal let (with that let's name range).
+    fn temporal_site(
+        &self,
+        f: &CFormula,
+        lets: &[LetInfo],
+    ) -> Option<(Range<usize>, Option<(Range<usize>, String)>)> {
+        match &f.kind {
+            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
+                Some((f.range.clone(), None))
+            }
+            CFormulaKind::Let(i) => {
+                let l = lets.get(*i)?;
+                (l.kind == LetKind::Temporal)
+                    .then(|| (f.range.clone(), Some((l.name_range.clone(), l.name.clone()))))
+            }
+            CFormulaKind::Not(a) => self.temporal_site(a, lets),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                v.iter().find_map(|g| self.temporal_site(g, lets))
+            }
+            CFormulaKind::Implies(a, b) => {
+                self.temporal_site(a, lets).or_else(|| self.temporal_site(b, lets))
+            }
+            _ => None,
+        }
+    }
+
+    fn require_state(&mut self, f: &CFormula, field: &str, option: &str, lets: &[LetInfo]) {
+        if let Some((r, via)) = self.temporal_site(f, lets) {
+            let mut d = Diagnostic::new(
+                "HSTL009",
+                r,
+                format!("temporal operator in the `{field}` of option `{option}`"),
+            )
+            .with_help("reach, init and terminate are evaluated on one state: use a formula without `always`, `eventually` or `until`");
+            if let Some((lr, name)) = via {
+                d = d.with_label(lr, format!("`{name}` is a temporal formula"));
+            }
+            self.push(d);
+        }
+    }
+
+    fn options(
+        &mut self,
+        decls: &[&syntax::OptionDecl],
+        item: Option<&syntax::OptionsItem>,
+        spec: &syntax::Spec,
+        out: &mut CheckedSpec,
+    ) {
+        let mut by_name: HashMap<String, (usize, Range<usize>)> = HashMap::new();
+        for o in decls {
+            if let Some((_, first)) = by_name.get(&o.name.name) {
+                let first = first.clone();
+                self.push(
+                    Diagnostic::new(
+                        "HSTL003",
+                        o.name.range.clone(),
+                        format!("duplicate option `{}`", o.name.name),
+                    )
+                    .with_label(first, "first declared here")
+                    .with_help("rename one of them"),
+                );
+                continue;
+            }
+            let mut reach = None;
+            let mut init = None;
+            let mut terminate = None;
+            let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+            for f in o.fields.iter().flatten() {
+                let key = f.name.name.as_str();
+                if !["reach", "init", "terminate"].contains(&key) {
+                    let mut d = Diagnostic::new(
+                        "HSTL019",
+                        f.name.range.clone(),
+                        format!("unknown option field `{key}`"),
+                    );
+                    d = match closest(key, ["reach", "init", "terminate"].into_iter()) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help("an option has `reach`, `init` and `terminate`"),
+                    };
+                    self.push(d);
+                    continue;
+                }
+                if let Some(first) = seen.get(key) {
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL019",
+                            f.name.range.clone(),
+                            format!("`{key}` given twice"),
+                        )
+                        .with_label(first.clone(), "first given here")
+                        .with_help("give each field once"),
+                    );
+                    continue;
+                }
+                seen.insert(key.to_string(), f.name.range.clone());
+                let value = match &f.value {
+                    FieldValue::Argmax(_) if key == "terminate" => {
+                        terminate = Some(Terminate::Argmax);
+                        continue;
+                    }
+                    FieldValue::Argmax(r) => {
+                        self.push(
+                            Diagnostic::new(
+                                "HSTL008",
+                                r.clone(),
+                                format!("`argmax` where the `{key}` formula is expected"),
+                            )
+                            .with_help("`argmax` is only allowed in `terminate`"),
+                        );
+                        CFormula { kind: CFormulaKind::Invalid, range: r.clone() }
+                    }
+                    FieldValue::Formula(g) => self.formula(g),
+                };
+                self.require_state(&value, key, &o.name.name, &out.lets);
+                match key {
+                    "reach" => reach = Some(value),
+                    "init" => init = Some(value),
+                    _ => terminate = Some(Terminate::Formula(value)),
+                }
+            }
+            let reach = match reach {
+                Some(r) => r,
+                None => {
+                    let kind = match self.names.get(&o.name.name) {
+                        Some((NameRef::Let(j), _)) => CFormulaKind::Let(*j),
+                        Some((NameRef::Var(_), def)) => {
+                            let def = def.clone();
+                            self.push(
+                                Diagnostic::new(
+                                    "HSTL010",
+                                    o.name.range.clone(),
+                                    format!(
+                                        "option `{}` names a state variable, not a `let`",
+                                        o.name.name
+                                    ),
+                                )
+                                .with_label(def, "declared here")
+                                .with_help(
+                                    "give the option a `reach` field, or name it after a `let`",
+                                ),
+                            );
+                            CFormulaKind::Invalid
+                        }
+                        None if self.broken_names.contains(&o.name.name) => CFormulaKind::Invalid,
+                        None => {
+                            let lets: Vec<&str> =
+                                out.lets.iter().map(|l| l.name.as_str()).collect();
+                            let mut d = Diagnostic::new(
+                                "HSTL010",
+                                o.name.range.clone(),
+                                format!("option `{}` names no `let`", o.name.name),
+                            );
+                            d = match closest(&o.name.name, lets.into_iter()) {
+                                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                                None => d.with_help(format!(
+                                    "declare `let {} = ...;` or give the option a `reach` field",
+                                    o.name.name
+                                )),
+                            };
+                            self.push(d);
+                            CFormulaKind::Invalid
+                        }
+                    };
+                    let f = CFormula { kind, range: o.name.range.clone() };
+                    self.require_state(&f, "reach", &o.name.name, &out.lets);
+                    f
+                }
+            };
+            by_name.insert(o.name.name.clone(), (out.primitives.len(), o.name.range.clone()));
+            out.primitives.push(PrimitiveOption {
+                name: o.name.name.clone(),
+                reach,
+                init: init
+                    .unwrap_or(CFormula { kind: CFormulaKind::True, range: o.name.range.clone() }),
+                terminate: terminate.unwrap_or(Terminate::Argmax),
+                doc: doc_text(&o.doc),
+                name_range: o.name.range.clone(),
+                range: o.range.clone(),
+            });
+        }
+        // HSTL014: options need a finite state space.
+        if let Some(first) = decls.first() {
+            for v in &out.state_vars {
+                if !matches!(v.domain, Domain::Int { .. }) {
+                    let ty = if v.ty == syntax::VarType::Int { "int" } else { "float" };
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL014",
+                            v.name_range.clone(),
+                            format!("state variable `{}` has no finite `int` range", v.name),
+                        )
+                        .with_label(first.name.range.clone(), "options are declared here")
+                        .with_help(format!(
+                            "options need a finite state space: declare `{}: int in 0..=N` (it is `{ty}`{})",
+                            v.name,
+                            if ty == "int" { " without a range" } else { "" }
+                        )),
+                    );
+                }
+            }
+        }
+        // The options set.
+        let names: Vec<String> = out.primitives.iter().map(|p| p.name.clone()).collect();
+        let mut declared: Vec<&str> = names.iter().map(String::as_str).collect();
+        declared.sort_unstable();
+        let declared_list = declared.join(", ");
+        let resolve = |cx: &mut Self, legs: &[syntax::Ident]| -> Option<Vec<usize>> {
+            let mut seq: Vec<usize> = Vec::new();
+            let mut firsts: HashMap<usize, Range<usize>> = HashMap::new();
+            let mut ok = true;
+            for leg in legs {
+                match by_name.get(&leg.name) {
+                    None if cx.broken_names.contains(&leg.name) => ok = false,
+                    None => {
+                        let mut d = Diagnostic::new(
+                            "HSTL011",
+                            leg.range.clone(),
+                            format!("unknown option `{}`", leg.name),
+                        );
+                        d = match closest(&leg.name, declared.iter().copied()) {
+                            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                            None if declared.is_empty() => {
+                                d.with_help(format!("declare it: `option {};`", leg.name))
+                            }
+                            None => d.with_help(format!("declared options: {declared_list}")),
+                        };
+                        cx.push(d);
+                        ok = false;
+                    }
+                    Some((i, _)) => {
+                        if let Some(first) = firsts.get(i) {
+                            cx.push(
+                                Diagnostic::new(
+                                    "HSTL012",
+                                    leg.range.clone(),
+                                    format!("option `{}` is repeated", leg.name),
+                                )
+                                .with_label(first.clone(), "first listed here")
+                                .with_help("list each option once"),
+                            );
+                            ok = false;
+                        } else {
+                            firsts.insert(*i, leg.range.clone());
+                            seq.push(*i);
+                        }
+                    }
+                }
+            }
+            ok.then_some(seq)
+        };
+        let mut set: Vec<CombinedOption> = Vec::new();
+        let make = |seq: Vec<usize>, range: Range<usize>| CombinedOption {
+            name: seq.iter().map(|&i| names[i].as_str()).collect(),
+            sequence: seq,
+            range,
+        };
+        match item.map(|i| (&i.kind, i.range.clone())) {
+            Some((OptionsKind::List(items), _)) => {
+                for s in items {
+                    if let Some(seq) = resolve(self, &s.legs) {
+                        set.push(make(seq, s.range.clone()));
+                    }
+                }
+            }
+            Some((OptionsKind::Sequences(legs), r))
+            | Some((OptionsKind::Permutations(legs), r)) => {
+                let perm = matches!(item.map(|i| &i.kind), Some(OptionsKind::Permutations(_)));
+                if let Some(base) = resolve(self, legs) {
+                    if self.set_size_ok(base.len(), perm, r.clone()) {
+                        for seq in expand(&base, perm) {
+                            set.push(make(seq, r.clone()));
+                        }
+                    }
+                }
+            }
+            None => {
+                let base: Vec<usize> = (0..out.primitives.len()).collect();
+                let r = decls.first().map_or(spec.name.range.clone(), |d| d.name.range.clone());
+                if self.set_size_ok(base.len(), false, r.clone()) {
+                    for seq in expand(&base, false) {
+                        set.push(make(seq, r.clone()));
+                    }
+                }
+            }
+        }
+        let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+        for o in set {
+            if let Some(first) = seen.get(&o.name) {
+                self.push(
+                    Diagnostic::new("HSTL013", o.range.clone(), format!("two options named `{}`", o.name))
+                        .with_label(first.clone(), "the first one comes from here")
+                        .with_help("combined options are named by concatenating their legs: rename a primitive option or drop an entry"),
+                );
+                continue;
+            }
+            seen.insert(o.name.clone(), o.range.clone());
+            out.options.push(o);
+        }
+    }
+
+    fn set_size_ok(&mut self, n: usize, perm: bool, range: Range<usize>) -> bool {
+        let size = set_size(n, perm);
+        if size > MAX_OPTIONS {
+            let what = if perm { "permutations" } else { "sequences" };
+            self.push(
+                Diagnostic::new(
+                    "HSTL023",
+                    range,
+                    format!("`{what}` of {n} options gives more than {MAX_OPTIONS} options"),
+                )
+                .with_help("list the sequences you need: `options { A, [A, B], ... }`"),
+            );
+            return false;
+        }
+        true
+    }
+
+    fn learn(&mut self, l: &syntax::Learn, out: &mut CheckedSpec) {
+        const TOP: [&str; 8] =
+            ["episodes", "choices", "max_steps", "memory", "intra", "reward", "flat", "options"];
+        let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+        for p in &l.params {
+            let key = p.name.name.as_str();
+            if !self.param_name_ok(p, &TOP, &mut seen) {
+                continue;
+            }
+            match key {
+                "episodes" | "choices" | "max_steps" | "memory" => {
+                    let min = if key == "memory" { 0 } else { 1 };
+                    if let Some(v) = self.whole(p, min) {
+                        match key {
+                            "episodes" => out.learn.episodes = v,
+                            "choices" => out.learn.choices = v,
+                            "max_steps" => out.learn.max_steps = v,
+                            _ => out.learn.memory = v,
+                        }
+                    }
+                }
+                "intra" => match self.word(p, &["paper", "remaining"]).as_deref() {
+                    Some("paper") => out.learn.intra = Intra::Paper,
+                    Some(_) => out.learn.intra = Intra::Remaining,
+                    None => {}
+                },
+                "reward" => match self.word(p, &["segment", "window"]).as_deref() {
+                    Some("segment") => out.learn.reward = Reward::Segment,
+                    Some(_) => out.learn.reward = Reward::Window,
+                    None => {}
+                },
+                _ => {
+                    let ParamValue::Group(ps, _) = &p.value else {
+                        self.push(
+                            Diagnostic::new(
+                                "HSTL016",
+                                value_range(&p.value),
+                                format!("`{key}` takes a group of parameters"),
+                            )
+                            .with_help(format!("write `{key}: {{ gamma: 0.9, alpha: 0.5 }}`")),
+                        );
+                        continue;
+                    };
+                    let mut q = if key == "flat" { out.learn.flat } else { out.learn.options };
+                    self.qparams(ps, key, &mut q);
+                    if key == "flat" { out.learn.flat = q } else { out.learn.options = q }
+                }
+            }
+        }
+    }
+
+    fn param_name_ok(
+        &mut self,
+        p: &syntax::Param,
+        known: &[&str],
+        seen: &mut HashMap<String, Range<usize>>,
+    ) -> bool {
+        let key = p.name.name.as_str();
+        if !known.contains(&key) {
+            let mut d = Diagnostic::new(
+                "HSTL019",
+                p.name.range.clone(),
+                format!("unknown parameter `{key}`"),
+            );
+            d = match closest(key, known.iter().copied()) {
+                Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                None => d.with_help(format!("known parameters: {}", known.join(", "))),
+            };
+            self.push(d);
+            return false;
+        }
+        if let Some(first) = seen.get(key) {
+            self.push(
+                Diagnostic::new(
+                    "HSTL019",
+                    p.name.range.clone(),
+                    format!("parameter `{key}` given twice"),
+                )
+                .with_label(first.clone(), "first given here")
+                .with_help("give each parameter once"),
+            );
+            return false;
+        }
+        seen.insert(key.to_string(), p.name.range.clone());
+        true
+    }
+
+    fn whole(&mut self, p: &syntax::Param, min: u64) -> Option<u64> {
+        let key = &p.name.name;
+        let cond = if min == 0 { ">= 0" } else { "> 0" };
+        match &p.value {
+            ParamValue::Number(n) => match n.as_integer() {
+                Some(v) if v >= min => Some(v),
+                _ => {
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL016",
+                            n.range.clone(),
+                            format!("`{key}` must be a whole number {cond}, found `{}`", n.text),
+                        )
+                        .with_help(format!(
+                            "write a whole number {cond}, such as `{}`",
+                            min.max(1) * 100
+                        )),
+                    );
+                    None
+                }
+            },
+            v => {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL016",
+                        value_range(v),
+                        format!("`{key}` must be a whole number {cond}"),
+                    )
+                    .with_help(format!("write a number, such as `{key}: {}`", min.max(1) * 100)),
+                );
+                None
+            }
+        }
+    }
+
+    fn word(&mut self, p: &syntax::Param, allowed: &[&str]) -> Option<String> {
+        let key = &p.name.name;
+        let options = format!("`{}` or `{}`", allowed[0], allowed[1]);
+        match &p.value {
+            ParamValue::Word(w) if allowed.contains(&w.name.as_str()) => Some(w.name.clone()),
+            v => {
+                let mut d = Diagnostic::new(
+                    "HSTL016",
+                    value_range(v),
+                    format!("`{key}` must be {options}, found `{}`", self.text(&value_range(v))),
+                );
+                d = match v {
+                    ParamValue::Word(w) => match closest(&w.name, allowed.iter().copied()) {
+                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                        None => d.with_help(format!("write {options}")),
+                    },
+                    _ => d.with_help(format!("write {options}")),
+                };
+                self.push(d);
+                None
+            }
+        }
+    }
+
+    fn qparams(&mut self, ps: &[syntax::Param], group: &str, q: &mut QParams) {
+        const KNOWN: [&str; 5] = ["gamma", "alpha", "epsilon", "min_epsilon", "decay"];
+        let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+        let mut ranges: HashMap<&str, Range<usize>> = HashMap::new();
+        for p in ps {
+            if !self.param_name_ok(p, &KNOWN, &mut seen) {
+                continue;
+            }
+            let key = p.name.name.as_str();
+            let ParamValue::Number(n) = &p.value else {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL016",
+                        value_range(&p.value),
+                        format!("`{group}.{key}` must be a number"),
+                    )
+                    .with_help("write a number, such as `0.9`"),
+                );
+                continue;
+            };
+            let v = n.value;
+            let (ok, cond) = match key {
+                "gamma" | "alpha" => (v > 0.0 && v <= 1.0, "in (0, 1]"),
+                "epsilon" | "min_epsilon" => ((0.0..=1.0).contains(&v), "in [0, 1]"),
+                _ => (v >= 0.0 && v.is_finite(), ">= 0"),
+            };
+            if !ok {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL016",
+                        n.range.clone(),
+                        format!("`{group}.{key}` must be {cond}, found `{}`", n.text),
+                    )
+                    .with_help(format!("choose a value {cond}")),
+                );
+                continue;
+            }
+            let k = KNOWN.iter().copied().find(|k| *k == key).unwrap_or("decay");
+            ranges.insert(k, n.range.clone());
+            match key {
+                "gamma" => q.gamma = v,
+                "alpha" => q.alpha = v,
+                "epsilon" => q.epsilon = v,
+                "min_epsilon" => q.min_epsilon = v,
+                _ => q.decay = v,
+            }
+        }
+        if q.min_epsilon > q.epsilon {
+            let r = ranges.get("min_epsilon").or(ranges.get("epsilon")).cloned();
+            if let Some(r) = r {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL016",
+                        r,
+                        format!(
+                            "`{group}.min_epsilon` ({}) exceeds `{group}.epsilon` ({})",
+                            q.min_epsilon, q.epsilon
+                        ),
+                    )
+                    .with_help("0 <= min_epsilon <= epsilon <= 1"),
+                );
+            }
+        }
+    }
+
+    fn persistent_needs(&mut self, learn: Option<&syntax::Learn>, out: &CheckedSpec) {
+        let Some(l) = learn else { return };
+        let Some(task) = &out.task else { return };
+        if matches!(task.formula.kind, CFormulaKind::Invalid)
+            || out.persistent_conjuncts(self.src).is_some()
+        {
+            return;
+        }
+        for p in &l.params {
+            let needs = match (&p.name.name[..], &p.value) {
+                ("memory", ParamValue::Number(n)) => n.as_integer().is_some_and(|v| v > 0),
+                ("reward", ParamValue::Word(w)) => w.name == "window",
+                _ => false,
+            };
+            if needs {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL017",
+                        p.range.clone(),
+                        format!("`{}` needs a persistent task", self.text(&p.range)),
+                    )
+                    .with_label(task.formula.range.clone(), "this task is not of that form")
+                    .with_help("write the task as `always[0..] (eventually[0..N1] R1 && ... && eventually[0..Nk] Rk)` with state formulas Rj"),
+                );
+            }
+        }
+    }
+
+    fn mark_used(&mut self, out: &mut CheckedSpec) {
+        let mut stack: Vec<usize> = Vec::new();
+        let push_refs =
+            |f: &CFormula, stack: &mut Vec<usize>| visit_lets(f, &mut |i| stack.push(i));
+        if let Some(t) = &out.task {
+            push_refs(&t.formula, &mut stack);
+        }
+        for p in &out.primitives {
+            push_refs(&p.reach, &mut stack);
+            push_refs(&p.init, &mut stack);
+            if let Terminate::Formula(f) = &p.terminate {
+                push_refs(f, &mut stack);
+            }
+        }
+        while let Some(i) = stack.pop() {
+            if let Some(l) = out.lets.get_mut(i) {
+                if !l.used {
+                    l.used = true;
+                    let f = l.formula.clone();
+                    push_refs(&f, &mut stack);
+                }
+            }
+        }
+    }
+
+    /// The checks that enumerate the declared `int` domain: empty and full regions,
+    /// states where no option can start, and gaps inside sequences.
+    fn finite_domain(
+        &mut self,
+        out: &CheckedSpec,
+        item: Option<&syntax::OptionsItem>,
+        spec: &syntax::Spec,
+    ) {
+        let Some(size) = out.domain_size() else { return };
+        if out.state_vars.is_empty() {
+            return;
+        }
+        if size > MAX_DOMAIN_STATES {
+            let r =
+                out.state_vars[0].range.start..out.state_vars[out.state_vars.len() - 1].range.end;
+            self.push(
+                Diagnostic::new(
+                    "HSTL022",
+                    r,
+                    format!(
+                        "the domain has {size} states, more than the 1,000,000 the finite-domain checks enumerate; they are skipped"
+                    ),
+                )
+                .with_help("shrink the `int` ranges to get the region and option checks"),
+            );
+            return;
+        }
+        // Regions: lets an option reaches, and the Rj of a persistent task.
+        let mut regions: Vec<(CFormula, Range<usize>, String)> = Vec::new();
+        let add_region = |f: &CFormula, regions: &mut Vec<(CFormula, Range<usize>, String)>| {
+            if !out.is_state_formula(f) {
+                return;
+            }
+            let (range, name) = match f.kind {
+                CFormulaKind::Let(i) => (out.lets[i].name_range.clone(), out.lets[i].name.clone()),
+                _ => (f.range.clone(), self.src.get(f.range.clone()).unwrap_or("").to_string()),
+            };
+            if !regions.iter().any(|(_, r, _)| *r == range) {
+                regions.push((f.clone(), range, name));
+            }
+        };
+        for p in &out.primitives {
+            add_region(&p.reach, &mut regions);
+        }
+        for c in out.persistent_conjuncts(self.src).unwrap_or_default() {
+            add_region(&c.region, &mut regions);
+        }
+        let np = out.primitives.len();
+        let mut roots: Vec<&CFormula> = regions.iter().map(|(f, _, _)| f).collect();
+        for p in &out.primitives {
+            roots.push(&p.reach);
+            roots.push(&p.init);
+            if let Terminate::Formula(f) = &p.terminate {
+                roots.push(f);
+            }
+        }
+        let mut ev = StateEvaluator::new(out, &roots);
+        let n = size as usize;
+        let states = |k: usize| -> Vec<f64> {
+            let mut s = vec![0.0; out.state_vars.len()];
+            let mut rest = k;
+            for (j, v) in out.state_vars.iter().enumerate().rev() {
+                if let Domain::Int { lo, hi } = v.domain {
+                    let w = (hi - lo + 1) as usize;
+                    s[j] = (lo + (rest % w) as i64) as f64;
+                    rest /= w;
+                }
+            }
+            s
+        };
+        // Pass 1: region counts and the maximum robustness of each reach.
+        let mut region_sat = vec![0u64; regions.len()];
+        let mut reach_max = vec![f64::NEG_INFINITY; np];
+        let mut init_set = vec![vec![false; n]; np];
+        for k in 0..n {
+            let s = states(k);
+            ev.load(&s);
+            for (r, (f, _, _)) in regions.iter().enumerate() {
+                if ev.robustness(f, &s) > 0.0 {
+                    region_sat[r] += 1;
+                }
+            }
+            for (p, prim) in out.primitives.iter().enumerate() {
+                let v = ev.robustness(&prim.reach, &s);
+                if v > reach_max[p] {
+                    reach_max[p] = v;
+                }
+                init_set[p][k] = ev.robustness(&prim.init, &s) > 0.0;
+            }
+        }
+        for (r, (_, range, name)) in regions.iter().enumerate() {
+            if region_sat[r] == 0 {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL102",
+                        range.clone(),
+                        format!("no state of the domain satisfies region `{name}`"),
+                    )
+                    .with_help("check the bounds against the `int` ranges (on integers, `3 < x < 4` is empty)"),
+                );
+            } else if region_sat[r] == size {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL103",
+                        range.clone(),
+                        format!("every state of the domain satisfies region `{name}`"),
+                    )
+                    .with_help("tighten the formula: reaching it needs no learning"),
+                );
+            }
+        }
+        if out.options.is_empty() {
+            return;
+        }
+        // Pass 2: termination sets.
+        let mut term_set = vec![vec![false; n]; np];
+        for k in 0..n {
+            let s = states(k);
+            ev.load(&s);
+            for (p, prim) in out.primitives.iter().enumerate() {
+                term_set[p][k] = match &prim.terminate {
+                    Terminate::Argmax => ev.robustness(&prim.reach, &s) == reach_max[p],
+                    Terminate::Formula(f) => ev.robustness(f, &s) > 0.0,
+                };
+            }
+        }
+        // HSTL018: states where no option of the set can start.
+        let firsts: Vec<usize> =
+            out.options.iter().filter_map(|o| o.sequence.first().copied()).collect();
+        let stuck: Vec<usize> =
+            (0..n).filter(|&k| !firsts.iter().any(|&p| init_set[p][k])).collect();
+        if let Some(&k) = stuck.first() {
+            let r = item.map_or(spec.name.range.clone(), |i| i.range.clone());
+            self.push(
+                Diagnostic::new(
+                    "HSTL018",
+                    r,
+                    format!(
+                        "no option of the set can start in {}, such as {}",
+                        plural(stuck.len() as u64, "state", "states"),
+                        state_text(&out.state_vars, &states(k))
+                    ),
+                )
+                .with_help("widen an option's `init`, or add an option that can start there"),
+            );
+        }
+        // HSTL020: a leg that can terminate outside the next leg's initiation set.
+        let mut reported: Vec<(usize, usize)> = Vec::new();
+        for o in &out.options {
+            for w in o.sequence.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                if reported.contains(&(a, b)) {
+                    continue;
+                }
+                let bad: Vec<usize> =
+                    (0..n).filter(|&k| term_set[a][k] && !init_set[b][k]).collect();
+                if let Some(&k) = bad.first() {
+                    reported.push((a, b));
+                    let (pa, pb) = (&out.primitives[a], &out.primitives[b]);
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL020",
+                            o.range.clone(),
+                            format!(
+                                "in `{}`, `{}` can terminate in {} where `{}` cannot start, such as {}",
+                                o.name,
+                                pa.name,
+                                plural(bad.len() as u64, "state", "states"),
+                                pb.name,
+                                state_text(&out.state_vars, &states(k))
+                            ),
+                        )
+                        .with_label(pa.name_range.clone(), format!("`{}` is declared here", pa.name))
+                        .with_label(pb.init.range.clone(), format!("`{}` can start only where this holds", pb.name))
+                        .with_help(format!("widen the `init` of `{}` or narrow the `terminate` of `{}`", pb.name, pa.name)),
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn value_range(v: &ParamValue) -> Range<usize> {
+    match v {
+        ParamValue::Number(n) => n.range.clone(),
+        ParamValue::Word(w) => w.range.clone(),
+        ParamValue::Group(_, r) => r.clone(),
+    }
+}
+
+fn has_temporal_node(f: &CFormula) -> bool {
+    match &f.kind {
+        CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => true,
+        CFormulaKind::Not(a) => has_temporal_node(a),
+        CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().any(has_temporal_node),
+        CFormulaKind::Implies(a, b) => has_temporal_node(a) || has_temporal_node(b),
+        _ => false,
+    }
+}
+
+/// Lets in an order where each comes after the lets it uses, ties by declaration order;
+/// lets not placed (in or behind a cycle) are left out.
+fn dependency_order(edges: &[Vec<(usize, Range<usize>)>], placed: &[bool]) -> Vec<usize> {
+    let n = edges.len();
+    let mut indeg = vec![0usize; n];
+    let mut users: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, es) in edges.iter().enumerate() {
+        for (j, _) in es {
+            indeg[i] += 1;
+            users[*j].push(i);
+        }
+    }
+    let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<usize>> =
+        (0..n).filter(|&i| indeg[i] == 0 && placed[i]).map(std::cmp::Reverse).collect();
+    let mut order = Vec::new();
+    while let Some(std::cmp::Reverse(j)) = heap.pop() {
+        order.push(j);
+        for &i in &users[j] {
+            indeg[i] -= 1;
+            if indeg[i] == 0 && placed[i] {
+                heap.push(std::cmp::Reverse(i));
+            }
+        }
+    }
+    order
+}
+
+/// Number of options `sequences` (2^n - 1) or `permutations` (sum of n!/(n-k)!) gives,
+/// saturating.
+fn set_size(n: usize, perm: bool) -> u64 {
+    if !perm {
+        return if n >= 63 { u64::MAX } else { (1u64 << n) - 1 };
+    }
+    let mut total: u64 = 0;
+    let mut term: u64 = 1;
+    for k in 0..n {
+        term = term.saturating_mul((n - k) as u64);
+        total = total.saturating_add(term);
+    }
+    total
+}
+
+/// Expands `sequences` (subsequences in listed order) or `permutations` (orderings of
+/// subsets), by size and then lexicographic order of positions.
+pub fn expand(base: &[usize], perm: bool) -> Vec<Vec<usize>> {
+    let n = base.len();
+    let mut out = Vec::new();
+    for size in 1..=n {
+        let mut found: Vec<Vec<usize>> = Vec::new();
+        let mut cur: Vec<usize> = Vec::new();
+        let mut used = vec![false; n];
+        gen_positions(n, size, perm, &mut cur, &mut used, &mut found);
+        out.extend(found.into_iter().map(|pos| pos.into_iter().map(|p| base[p]).collect()));
+    }
+    out
+}
+
+fn gen_positions(
+    n: usize,
+    size: usize,
+    perm: bool,
+    cur: &mut Vec<usize>,
+    used: &mut [bool],
+    out: &mut Vec<Vec<usize>>,
+) {
+    if cur.len() == size {
+        out.push(cur.clone());
+        return;
+    }
+    let from = if perm { 0 } else { cur.last().map_or(0, |&l| l + 1) };
+    for p in from..n {
+        if used[p] {
+            continue;
+        }
+        used[p] = true;
+        cur.push(p);
+        gen_positions(n, size, perm, cur, used, out);
+        cur.pop();
+        used[p] = false;
+    }
+}

@@ -1,0 +1,526 @@
+//! The checked spec: names resolved to indices, defaults filled in, the options set
+//! expanded. Formula and expression nodes keep their byte ranges.
+
+use std::ops::Range;
+
+pub use crate::syntax::VarType;
+
+/// A checked formula node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CFormula {
+    /// What it is.
+    pub kind: CFormulaKind,
+    /// Byte range in the source.
+    pub range: Range<usize>,
+}
+
+/// A comparison operator (`==` and `!=` are rejected before this point).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CmpOp {
+    /// `<`.
+    Lt,
+    /// `<=`.
+    Le,
+    /// `>`.
+    Gt,
+    /// `>=`.
+    Ge,
+}
+
+/// The end of a time interval.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bound {
+    /// `[a..]`.
+    Unbounded,
+    /// `[a..b]`: b itself is excluded.
+    Exclusive(u64),
+    /// `[a..=b]`: b itself is included.
+    Inclusive(u64),
+}
+
+/// A checked time interval (non-empty).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interval {
+    /// First step offset.
+    pub start: u64,
+    /// End bound.
+    pub end: Bound,
+    /// Byte range of `[...]`; `None` when the interval was omitted (`[0..]`).
+    pub range: Option<Range<usize>>,
+}
+
+/// The kinds of checked formula.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CFormulaKind {
+    /// `true`.
+    True,
+    /// `false`.
+    False,
+    /// A reference to the `let` with this index.
+    Let(usize),
+    /// `lhs op rhs` (a chained comparison becomes an `And` of these).
+    Cmp(CmpOp, CExpr, CExpr),
+    /// `!f`.
+    Not(Box<CFormula>),
+    /// Conjunction of two or more formulas.
+    And(Vec<CFormula>),
+    /// Disjunction of two or more formulas.
+    Or(Vec<CFormula>),
+    /// `f -> g`.
+    Implies(Box<CFormula>, Box<CFormula>),
+    /// `always[I] f`.
+    Always(Interval, Box<CFormula>),
+    /// `eventually[I] f`.
+    Eventually(Interval, Box<CFormula>),
+    /// `f until[I] g`.
+    Until(Interval, Box<CFormula>, Box<CFormula>),
+    /// Stands for a part that did not check; only present when an error was reported.
+    Invalid,
+}
+
+/// A checked expression node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CExpr {
+    /// What it is.
+    pub kind: CExprKind,
+    /// Byte range in the source.
+    pub range: Range<usize>,
+}
+
+/// The kinds of checked expression.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CExprKind {
+    /// A constant.
+    Const(f64),
+    /// The state variable with this index.
+    Var(usize),
+    /// `-e`.
+    Neg(Box<CExpr>),
+    /// `a + b`.
+    Add(Box<CExpr>, Box<CExpr>),
+    /// `a - b`.
+    Sub(Box<CExpr>, Box<CExpr>),
+    /// `a * b`.
+    Mul(Box<CExpr>, Box<CExpr>),
+    /// `a / b`.
+    Div(Box<CExpr>, Box<CExpr>),
+    /// `abs(e)`.
+    Abs(Box<CExpr>),
+    /// `sqrt(e)`.
+    Sqrt(Box<CExpr>),
+    /// Stands for a part that did not check; only present when an error was reported.
+    Invalid,
+}
+
+/// The set of values a state variable ranges over.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Domain {
+    /// No range declared.
+    Unbounded,
+    /// `int in lo..=hi` (a `lo..hi` range is stored as `lo..=hi-1`); never empty.
+    Int {
+        /// Smallest value.
+        lo: i64,
+        /// Largest value.
+        hi: i64,
+    },
+    /// `float in lo..hi` or `lo..=hi`.
+    Float {
+        /// Lower bound.
+        lo: f64,
+        /// Upper bound.
+        hi: f64,
+        /// Whether `hi` is included.
+        inclusive: bool,
+    },
+}
+
+/// A state variable.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateVarInfo {
+    /// Name.
+    pub name: String,
+    /// Declared type.
+    pub ty: VarType,
+    /// Declared domain.
+    pub domain: Domain,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the name.
+    pub name_range: Range<usize>,
+    /// Byte range of the declaration.
+    pub range: Range<usize>,
+}
+
+/// Whether a `let` is evaluated on one state or on a trace.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LetKind {
+    /// No temporal operator, also not through other lets: usable as a region.
+    State,
+    /// Contains `always`, `eventually` or `until` (directly or through other lets).
+    Temporal,
+}
+
+/// A `let`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LetInfo {
+    /// Name.
+    pub name: String,
+    /// The resolved definition.
+    pub formula: CFormula,
+    /// State formula or temporal.
+    pub kind: LetKind,
+    /// Whether the task or an option uses it (directly or through used lets).
+    pub used: bool,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the name.
+    pub name_range: Range<usize>,
+    /// Byte range of the item.
+    pub range: Range<usize>,
+}
+
+/// The task.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskInfo {
+    /// The resolved formula.
+    pub formula: CFormula,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the item.
+    pub range: Range<usize>,
+}
+
+/// Where a primitive option stops.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Terminate {
+    /// In the states where `rho(reach, s)` is largest over the declared domain.
+    Argmax,
+    /// In the states that satisfy this formula.
+    Formula(CFormula),
+}
+
+/// A primitive option.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrimitiveOption {
+    /// Name.
+    pub name: String,
+    /// The state formula whose robustness is the flat reward.
+    pub reach: CFormula,
+    /// Where the option may start (`true` by default).
+    pub init: CFormula,
+    /// Where it stops (`argmax` by default).
+    pub terminate: Terminate,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the name.
+    pub name_range: Range<usize>,
+    /// Byte range of the item.
+    pub range: Range<usize>,
+}
+
+/// A member of the options set: a sequence of primitive options.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CombinedOption {
+    /// The concatenated leg names, such as `AB`.
+    pub name: String,
+    /// Indices into [`CheckedSpec::primitives`], in running order.
+    pub sequence: Vec<usize>,
+    /// Byte range of the source that produced it (the list entry, or the `options` item).
+    pub range: Range<usize>,
+}
+
+/// How intra-option updates credit suffixes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Intra {
+    /// Every suffix to the executed option (the paper).
+    Paper,
+    /// A suffix to the option made of the remaining legs, when it is in the set.
+    Remaining,
+}
+
+/// The options-level reward.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reward {
+    /// Robustness of the task over the option's segment (the paper).
+    Segment,
+    /// Discounted count of kept windows.
+    Window,
+}
+
+/// Q-learning parameters of one level.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QParams {
+    /// Discount factor, in (0, 1].
+    pub gamma: f64,
+    /// Learning rate, in (0, 1].
+    pub alpha: f64,
+    /// Initial exploration rate.
+    pub epsilon: f64,
+    /// Exploration floor.
+    pub min_epsilon: f64,
+    /// Linear decay of epsilon per step (flat) or per choice (options).
+    pub decay: f64,
+}
+
+/// Learning parameters with the paper's defaults filled in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LearnParams {
+    /// Episodes (1200).
+    pub episodes: u64,
+    /// Option choices per episode (200).
+    pub choices: u64,
+    /// Steps after which a running option is cut off (500).
+    pub max_steps: u64,
+    /// Memory buckets, 0 = off (0).
+    pub memory: u64,
+    /// Intra-option credit (`paper`).
+    pub intra: Intra,
+    /// Options-level reward (`segment`).
+    pub reward: Reward,
+    /// Flat level (gamma 0.9, alpha 0.2, epsilon 0.8, min_epsilon 0.1, decay 1e-6).
+    pub flat: QParams,
+    /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
+    pub options: QParams,
+}
+
+impl Default for LearnParams {
+    fn default() -> Self {
+        LearnParams {
+            episodes: 1200,
+            choices: 200,
+            max_steps: 500,
+            memory: 0,
+            intra: Intra::Paper,
+            reward: Reward::Segment,
+            flat: QParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 },
+            options: QParams {
+                gamma: 0.9,
+                alpha: 0.5,
+                epsilon: 0.8,
+                min_epsilon: 0.1,
+                decay: 1e-4,
+            },
+        }
+    }
+}
+
+/// One spec after checking.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckedSpec {
+    /// Name.
+    pub name: String,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the name.
+    pub name_range: Range<usize>,
+    /// Byte range of the spec.
+    pub range: Range<usize>,
+    /// State variables, in declaration order (a valuation lists values in this order).
+    pub state_vars: Vec<StateVarInfo>,
+    /// Lets, in declaration order.
+    pub lets: Vec<LetInfo>,
+    /// Let indices in an order where every let comes after the lets it uses (lets in a
+    /// cycle are left out).
+    pub let_order: Vec<usize>,
+    /// The task; `None` only when an error was reported.
+    pub task: Option<TaskInfo>,
+    /// Primitive options, in declaration order.
+    pub primitives: Vec<PrimitiveOption>,
+    /// The expanded options set.
+    pub options: Vec<CombinedOption>,
+    /// Learning parameters.
+    pub learn: LearnParams,
+}
+
+/// One conjunct `eventually[0..N] R` of a persistent task.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PersistentConjunct {
+    /// The region's name: the `let` name, or the source text of the formula.
+    pub name: String,
+    /// The `let` it names, if it is a plain reference.
+    pub let_index: Option<usize>,
+    /// The region formula.
+    pub region: CFormula,
+    /// Steps in the window: 40 for `[0..40]`, 41 for `[0..=40]`.
+    pub steps: u64,
+}
+
+impl CheckedSpec {
+    /// For a task `always[0..] (eventually[0..N1] R1 && ... && eventually[0..Nk] Rk)` with
+    /// state formulas Rj, the conjuncts in order; `None` for any other task.
+    pub fn persistent_conjuncts(&self, src: &str) -> Option<Vec<PersistentConjunct>> {
+        let task = self.task.as_ref()?;
+        let CFormulaKind::Always(iv, body) = &task.formula.kind else { return None };
+        if iv.start != 0 || iv.end != Bound::Unbounded {
+            return None;
+        }
+        let parts: Vec<&CFormula> = match &body.kind {
+            CFormulaKind::And(parts) => parts.iter().collect(),
+            _ => vec![body.as_ref()],
+        };
+        let mut out = Vec::new();
+        for part in parts {
+            let CFormulaKind::Eventually(iv, region) = &part.kind else { return None };
+            let steps = match iv.end {
+                Bound::Exclusive(b) => b,
+                Bound::Inclusive(b) => b.checked_add(1)?,
+                Bound::Unbounded => return None,
+            };
+            if iv.start != 0 || steps == 0 || !self.is_state_formula(region) {
+                return None;
+            }
+            let (name, let_index) = match region.kind {
+                CFormulaKind::Let(i) => (self.lets.get(i)?.name.clone(), Some(i)),
+                _ => (src.get(region.range.clone()).unwrap_or("").trim().to_string(), None),
+            };
+            out.push(PersistentConjunct { name, let_index, region: (**region).clone(), steps });
+        }
+        Some(out)
+    }
+
+    /// Whether a formula has no temporal operator, also not through lets.
+    pub fn is_state_formula(&self, f: &CFormula) -> bool {
+        match &f.kind {
+            CFormulaKind::True | CFormulaKind::False | CFormulaKind::Cmp(..) => true,
+            CFormulaKind::Invalid => false,
+            CFormulaKind::Let(i) => self.lets.get(*i).is_some_and(|l| l.kind == LetKind::State),
+            CFormulaKind::Not(a) => self.is_state_formula(a),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                v.iter().all(|g| self.is_state_formula(g))
+            }
+            CFormulaKind::Implies(a, b) => self.is_state_formula(a) && self.is_state_formula(b),
+            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
+                false
+            }
+        }
+    }
+
+    /// Robustness of a state formula on one valuation (values in the order of
+    /// [`CheckedSpec::state_vars`]); `None` for a temporal formula or a short valuation.
+    pub fn state_robustness(&self, f: &CFormula, valuation: &[f64]) -> Option<f64> {
+        if !self.is_state_formula(f) || valuation.len() < self.state_vars.len() {
+            return None;
+        }
+        let mut ev = StateEvaluator::new(self, &[f]);
+        ev.load(valuation);
+        Some(ev.robustness(f, valuation))
+    }
+
+    /// The number of states of the declared domain, if every variable is a finite `int`
+    /// (saturating at `u64::MAX`).
+    pub fn domain_size(&self) -> Option<u64> {
+        let mut n: u64 = 1;
+        for v in &self.state_vars {
+            let Domain::Int { lo, hi } = v.domain else { return None };
+            let width = (hi as i128 - lo as i128 + 1).clamp(0, u64::MAX as i128) as u64;
+            n = n.saturating_mul(width);
+        }
+        Some(n)
+    }
+}
+
+/// Evaluates state formulas on one valuation at a time. The lets the given formulas
+/// need are computed once per valuation, in dependency order, so evaluation never
+/// recurses through chains of lets.
+#[derive(Clone, Debug)]
+pub struct StateEvaluator<'a> {
+    spec: &'a CheckedSpec,
+    needed: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl<'a> StateEvaluator<'a> {
+    /// Prepares to evaluate `formulas` (and any formula using only the lets they use).
+    pub fn new(spec: &'a CheckedSpec, formulas: &[&CFormula]) -> Self {
+        let mut mark = vec![false; spec.lets.len()];
+        let mut stack: Vec<&CFormula> = formulas.to_vec();
+        while let Some(f) = stack.pop() {
+            visit_lets(f, &mut |i| {
+                if i < mark.len() && !mark[i] {
+                    mark[i] = true;
+                    stack.push(&spec.lets[i].formula);
+                }
+            });
+        }
+        let needed = spec.let_order.iter().copied().filter(|&i| mark[i]).collect();
+        StateEvaluator { spec, needed, values: vec![f64::NAN; spec.lets.len()] }
+    }
+
+    /// Computes the needed lets on `valuation`.
+    pub fn load(&mut self, valuation: &[f64]) {
+        for k in 0..self.needed.len() {
+            let i = self.needed[k];
+            let v = eval_formula(&self.spec.lets[i].formula, &self.values, valuation);
+            self.values[i] = v;
+        }
+    }
+
+    /// Robustness of `f` on the valuation last passed to [`StateEvaluator::load`].
+    /// Temporal operators and invalid parts give NaN.
+    pub fn robustness(&self, f: &CFormula, valuation: &[f64]) -> f64 {
+        eval_formula(f, &self.values, valuation)
+    }
+}
+
+/// Calls `visit` with every let index that `f` refers to directly.
+pub fn visit_lets(f: &CFormula, visit: &mut dyn FnMut(usize)) {
+    match &f.kind {
+        CFormulaKind::Let(i) => visit(*i),
+        CFormulaKind::Not(a) | CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => {
+            visit_lets(a, visit)
+        }
+        CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().for_each(|g| visit_lets(g, visit)),
+        CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+            visit_lets(a, visit);
+            visit_lets(b, visit);
+        }
+        CFormulaKind::True
+        | CFormulaKind::False
+        | CFormulaKind::Cmp(..)
+        | CFormulaKind::Invalid => {}
+    }
+}
+
+fn eval_formula(f: &CFormula, lets: &[f64], s: &[f64]) -> f64 {
+    match &f.kind {
+        CFormulaKind::True => f64::INFINITY,
+        CFormulaKind::False => f64::NEG_INFINITY,
+        CFormulaKind::Let(i) => lets.get(*i).copied().unwrap_or(f64::NAN),
+        CFormulaKind::Cmp(op, a, b) => {
+            let (a, b) = (eval_expr(a, s), eval_expr(b, s));
+            match op {
+                CmpOp::Lt | CmpOp::Le => b - a,
+                CmpOp::Gt | CmpOp::Ge => a - b,
+            }
+        }
+        CFormulaKind::Not(a) => -eval_formula(a, lets, s),
+        CFormulaKind::And(v) => {
+            v.iter().map(|g| eval_formula(g, lets, s)).fold(f64::INFINITY, f64::min)
+        }
+        CFormulaKind::Or(v) => {
+            v.iter().map(|g| eval_formula(g, lets, s)).fold(f64::NEG_INFINITY, f64::max)
+        }
+        CFormulaKind::Implies(a, b) => (-eval_formula(a, lets, s)).max(eval_formula(b, lets, s)),
+        CFormulaKind::Always(..)
+        | CFormulaKind::Eventually(..)
+        | CFormulaKind::Until(..)
+        | CFormulaKind::Invalid => f64::NAN,
+    }
+}
+
+/// Value of an expression on one valuation (NaN for an invalid part or a missing value).
+pub fn eval_expr(e: &CExpr, s: &[f64]) -> f64 {
+    match &e.kind {
+        CExprKind::Const(c) => *c,
+        CExprKind::Var(i) => s.get(*i).copied().unwrap_or(f64::NAN),
+        CExprKind::Neg(a) => -eval_expr(a, s),
+        CExprKind::Add(a, b) => eval_expr(a, s) + eval_expr(b, s),
+        CExprKind::Sub(a, b) => eval_expr(a, s) - eval_expr(b, s),
+        CExprKind::Mul(a, b) => eval_expr(a, s) * eval_expr(b, s),
+        CExprKind::Div(a, b) => eval_expr(a, s) / eval_expr(b, s),
+        CExprKind::Abs(a) => eval_expr(a, s).abs(),
+        CExprKind::Sqrt(a) => eval_expr(a, s).sqrt(),
+        CExprKind::Invalid => f64::NAN,
+    }
+}

@@ -1,0 +1,84 @@
+//! Byte offsets to line and column, shared by the CLI's JSON and the language server.
+
+/// A position in a source text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Position {
+    /// 1-based line number.
+    pub line: usize,
+    /// 1-based column, counted in characters (Unicode scalar values).
+    pub column: usize,
+    /// 0-based column counted in UTF-16 code units (what LSP calls `character`).
+    pub utf16_column: usize,
+}
+
+/// Maps byte offsets of one source text to [`Position`]s. Lines end at `\n`; a `\r`
+/// before it counts as a character of the line.
+#[derive(Clone, Debug)]
+pub struct LineIndex {
+    starts: Vec<usize>,
+    len: usize,
+}
+
+impl LineIndex {
+    /// Indexes `src`.
+    pub fn new(src: &str) -> Self {
+        let mut starts = vec![0];
+        starts.extend(src.bytes().enumerate().filter(|(_, b)| *b == b'\n').map(|(i, _)| i + 1));
+        LineIndex { starts, len: src.len() }
+    }
+
+    /// The position of byte `offset` in `src` (the text given to [`LineIndex::new`]).
+    /// An offset past the end is clamped to the end; one inside a character is moved back
+    /// to the start of that character.
+    pub fn position(&self, src: &str, offset: usize) -> Position {
+        let mut offset = offset.min(self.len).min(src.len());
+        while offset > 0 && !src.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self.starts.partition_point(|&s| s <= offset).max(1) - 1;
+        let start = self.starts[line].min(offset);
+        let text = &src[start..offset];
+        Position {
+            line: line + 1,
+            column: text.chars().count() + 1,
+            utf16_column: text.chars().map(char::len_utf16).sum(),
+        }
+    }
+
+    /// The byte offset of a 1-based line and 1-based character column, clamped to the line.
+    pub fn offset(&self, src: &str, line: usize, column: usize) -> usize {
+        let l = line.saturating_sub(1).min(self.starts.len() - 1);
+        let start = self.starts[l].min(src.len());
+        let end = self.starts.get(l + 1).copied().unwrap_or(src.len()).min(src.len());
+        let text = &src[start..end];
+        let skip = column.saturating_sub(1);
+        start + text.char_indices().nth(skip).map_or(text.len(), |(i, _)| i)
+    }
+
+    /// The byte offset of a 0-based line and 0-based UTF-16 column (LSP positions).
+    pub fn offset_utf16(&self, src: &str, line: usize, utf16_column: usize) -> usize {
+        let l = line.min(self.starts.len() - 1);
+        let start = self.starts[l].min(src.len());
+        let end = self.starts.get(l + 1).copied().unwrap_or(src.len()).min(src.len());
+        let mut units = 0;
+        for (i, c) in src[start..end].char_indices() {
+            if units >= utf16_column || c == '\n' {
+                return start + i;
+            }
+            units += c.len_utf16();
+        }
+        end
+    }
+
+    /// The byte range of the 1-based line `line`, without its line break.
+    pub fn line_range(&self, src: &str, line: usize) -> std::ops::Range<usize> {
+        let l = line.saturating_sub(1).min(self.starts.len() - 1);
+        let start = self.starts[l].min(src.len());
+        let mut end = self.starts.get(l + 1).copied().unwrap_or(src.len()).min(src.len());
+        let bytes = src.as_bytes();
+        while end > start && (bytes[end - 1] == b'\n' || bytes[end - 1] == b'\r') {
+            end -= 1;
+        }
+        start..end
+    }
+}
