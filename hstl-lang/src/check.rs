@@ -228,8 +228,8 @@ impl Cx<'_> {
         }
         self.persistent_needs(learn, &out);
         self.mark_used(&mut out);
-        // A broken item may have used any let: stay quiet then.
-        if out.task.is_some() && spec.broken.is_empty() {
+        // A broken item or an invalid part may have used any let: stay quiet then.
+        if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {
             for l in &out.lets {
                 if !l.used {
                     self.push(
@@ -461,7 +461,7 @@ impl Cx<'_> {
                 let mut d = Diagnostic::new(
                     "HSTL004",
                     out.lets[first].name_range.clone(),
-                    format!("`{lname}` refers to itself through {}", names.join(" -> ")),
+                    format!("`{lname}` refers to itself: {}", names.join(" -> ")),
                 );
                 for (i, r) in &cycle {
                     let to = match edges[*i].iter().find(|(_, rr)| rr == r) {
@@ -1017,7 +1017,11 @@ impl Cx<'_> {
                 Diagnostic::new(
                     "HSTL023",
                     range,
-                    format!("`{what}` of {n} options gives more than {MAX_OPTIONS} options"),
+                    format!(
+                        "`{what}` of {n} options gives {} options, more than {}",
+                        thousands(size),
+                        thousands(MAX_OPTIONS)
+                    ),
                 )
                 .with_help("list the sequences you need: `options { A, [A, B], ... }`"),
             );
@@ -1310,7 +1314,8 @@ impl Cx<'_> {
                     "HSTL022",
                     r,
                     format!(
-                        "the domain has {size} states, more than the 1,000,000 the finite-domain checks enumerate; they are skipped"
+                        "the domain has {} states, more than the 1,000,000 the finite-domain checks enumerate; they are skipped",
+                        thousands(size)
                     ),
                 )
                 .with_help("shrink the `int` ranges to get the region and option checks"),
@@ -1470,6 +1475,19 @@ impl Cx<'_> {
             }
         }
     }
+}
+
+/// `1234567` as `1,234,567`.
+fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 fn value_range(v: &ParamValue) -> Range<usize> {

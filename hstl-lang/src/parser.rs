@@ -62,7 +62,8 @@ pub fn parse(src: &str) -> Parsed {
     let mut comments = Vec::new();
     let toks = lex(src, &mut comments, &mut diagnostics);
     let mut specs = Vec::new();
-    let mut p = Splitter { src, toks: &toks, i: 0, diagnostics: &mut diagnostics };
+    let ends: Vec<usize> = toks.iter().map(|t| t.end).collect();
+    let mut p = Splitter { src, toks: &toks, ends: &ends, i: 0, diagnostics: &mut diagnostics };
     while p.i < toks.len() {
         if let Some(spec) = p.spec() {
             specs.push(spec);
@@ -163,6 +164,7 @@ const ITEM_KEYWORDS: [&str; 6] = ["let", "task", "option", "state", "learn", "sp
 struct Splitter<'a, 'd> {
     src: &'a str,
     toks: &'a [Tok],
+    ends: &'a [usize],
     i: usize,
     diagnostics: &'d mut Vec<Diagnostic>,
 }
@@ -387,7 +389,8 @@ impl Splitter<'_, '_> {
             Ok(mut pairs) => {
                 let entry = pairs.next()?;
                 let inner = entry.into_inner().find(|p| p.as_rule() != Rule::EOI)?;
-                let mut b = Builder { offset: range.start, diagnostics: Vec::new() };
+                let mut b =
+                    Builder { offset: range.start, ends: self.ends, diagnostics: Vec::new() };
                 match b.item(inner) {
                     Ok(item) => {
                         self.diagnostics.append(&mut b.diagnostics);
@@ -594,17 +597,25 @@ fn make_doc(docs: Vec<Pair<'_, Rule>>, offset: usize) -> Option<Doc> {
 }
 
 /// Builds syntax nodes from pest pairs of one item; `offset` is the item's byte offset.
-struct Builder {
+struct Builder<'t> {
     offset: usize,
+    /// End offsets of every token of the file, ascending: pest spans may include trailing
+    /// whitespace and comments, and node ranges end at their last token instead.
+    ends: &'t [usize],
     diagnostics: Vec<Diagnostic>,
 }
 
 type Res<T> = Result<T, Fail>;
 
-impl Builder {
+impl Builder<'_> {
     fn range(&self, p: &Pair<'_, Rule>) -> Range<usize> {
         let s = p.as_span();
-        s.start() + self.offset..s.end() + self.offset
+        let (start, mut end) = (s.start() + self.offset, s.end() + self.offset);
+        let k = self.ends.partition_point(|&e| e <= end);
+        if k > 0 && self.ends[k - 1] > start {
+            end = self.ends[k - 1];
+        }
+        start..end
     }
 
     fn number(&self, p: &Pair<'_, Rule>) -> NumberLit {

@@ -1,0 +1,189 @@
+//! Data-driven tests over `tests/fixtures`: every invalid fixture's rendered diagnostics
+//! are snapshotted and must contain the code its file name starts with; every valid
+//! fixture checks without errors and its checked spec is summarised in a snapshot.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use hstl_lang::{
+    CFormula, CFormulaKind, CheckedSpec, Domain, Terminate, check, codes, render_plain,
+};
+
+/// `(file name, source)` of every `.hstl` file in `tests/fixtures/<dir>`, sorted.
+fn fixtures(dir: &str) -> Vec<(String, String)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(dir);
+    let mut out: Vec<(String, String)> = std::fs::read_dir(&root)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", root.display()))
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "hstl"))
+        .map(|p| {
+            let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let src = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+            (name, src)
+        })
+        .collect();
+    out.sort();
+    assert!(!out.is_empty(), "no fixtures in {}", root.display());
+    out
+}
+
+#[test]
+fn invalid_fixtures_render() {
+    for (name, src) in fixtures("invalid") {
+        let checked = check(&src);
+        let rendered = render_plain(&format!("invalid/{name}"), &src, &checked.diagnostics);
+        insta::assert_snapshot!(name.trim_end_matches(".hstl"), rendered);
+    }
+}
+
+#[test]
+fn invalid_fixtures_produce_their_code() {
+    for (name, src) in fixtures("invalid") {
+        let code = &name[..7];
+        let checked = check(&src);
+        assert!(
+            checked.diagnostics.iter().any(|d| d.code == code),
+            "{name} does not produce {code}: {:#?}",
+            checked.diagnostics
+        );
+    }
+}
+
+#[test]
+fn every_code_has_an_entry_and_a_fixture() {
+    let with_fixture: BTreeSet<String> =
+        fixtures("invalid").into_iter().map(|(n, _)| n[..7].to_string()).collect();
+    for c in codes::CODES {
+        assert!(with_fixture.contains(c.code), "{} has no fixture", c.code);
+        assert!(!c.summary.ends_with('.'), "{} summary ends with a period", c.code);
+        assert!(c.explanation.contains("Fix"), "{} explanation names no fix", c.code);
+        assert_eq!(codes::lookup(&c.code.to_lowercase()), Some(c));
+    }
+    for (name, src) in fixtures("invalid").into_iter().chain(fixtures("valid")) {
+        for d in check(&src).diagnostics {
+            let info = codes::lookup(d.code)
+                .unwrap_or_else(|| panic!("{name}: {} not in the table", d.code));
+            if d.code != "HSTL024" {
+                assert_eq!(info.severity, d.severity, "{name}: {}", d.code);
+            }
+            assert!(!d.message.ends_with('.'), "{name}: message ends with a period: {}", d.message);
+            assert!(
+                d.range.end <= src.len() && d.range.start <= d.range.end,
+                "{name}: {:?}",
+                d.range
+            );
+        }
+    }
+}
+
+#[test]
+fn valid_fixtures_check_without_errors() {
+    for (name, src) in fixtures("valid") {
+        let checked = check(&src);
+        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
+        assert!(errors.is_empty(), "{name}: {}", render_plain(&name, &src, &checked.diagnostics));
+        let mut summary = String::new();
+        for spec in &checked.specs {
+            summarise(&mut summary, spec, &src);
+        }
+        summary.push_str(&render_plain(&name, &src, &checked.diagnostics));
+        insta::assert_snapshot!(format!("valid_{}", name.trim_end_matches(".hstl")), summary);
+    }
+}
+
+fn text<'a>(src: &'a str, f: &CFormula) -> &'a str {
+    let t = src.get(f.range.clone()).unwrap_or("?");
+    // A default `init: true` carries the option name's range.
+    if f.kind == CFormulaKind::True && t != "true" { "true (default)" } else { t }
+}
+
+/// A readable summary of a checked spec for snapshots.
+fn summarise(out: &mut String, spec: &CheckedSpec, src: &str) {
+    let _ = writeln!(out, "spec {} (doc: {:?})", spec.name, spec.doc);
+    for v in &spec.state_vars {
+        let dom = match v.domain {
+            Domain::Unbounded => "unbounded".to_string(),
+            Domain::Int { lo, hi } => format!("{lo}..={hi}"),
+            Domain::Float { lo, hi, inclusive } => {
+                format!("{lo}{}{hi}", if inclusive { "..=" } else { ".." })
+            }
+        };
+        let _ = writeln!(out, "  var {}: {:?} in {dom} (doc: {:?})", v.name, v.ty, v.doc);
+    }
+    for l in &spec.lets {
+        let _ = writeln!(
+            out,
+            "  let {}: {:?}, used {} = {}",
+            l.name,
+            l.kind,
+            l.used,
+            text(src, &l.formula)
+        );
+    }
+    if let Some(t) = &spec.task {
+        let _ = writeln!(out, "  task {}", text(src, &t.formula));
+    }
+    match spec.persistent_conjuncts(src) {
+        Some(cs) => {
+            let parts: Vec<String> =
+                cs.iter().map(|c| format!("({}, {})", c.name, c.steps)).collect();
+            let _ = writeln!(out, "  persistent: {}", parts.join(" "));
+        }
+        None => {
+            let _ = writeln!(out, "  persistent: no");
+        }
+    }
+    for p in &spec.primitives {
+        let term = match &p.terminate {
+            Terminate::Argmax => "argmax".to_string(),
+            Terminate::Formula(f) => text(src, f).to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "  option {}: reach {}, init {}, terminate {term}",
+            p.name,
+            text(src, &p.reach),
+            text(src, &p.init)
+        );
+    }
+    let set: Vec<String> = spec
+        .options
+        .iter()
+        .map(|o| {
+            let legs: Vec<&str> =
+                o.sequence.iter().map(|&i| spec.primitives[i].name.as_str()).collect();
+            format!("{}=[{}]", o.name, legs.join(","))
+        })
+        .collect();
+    let _ = writeln!(out, "  options ({}): {}", set.len(), set.join(" "));
+    let _ = writeln!(out, "  learn {:?}", spec.learn);
+}
+
+#[test]
+fn recovery_reports_syntax_and_semantic_errors_of_different_items() {
+    let src = "spec S {\n    state { x: int in 0..=9 }\n    let A = x > ;\n    let B = q > 1;\n    task always[0..] eventually[0..10] B;\n}\n";
+    let checked = check(src);
+    let codes: Vec<&str> = checked.diagnostics.iter().map(|d| d.code).collect();
+    assert!(codes.contains(&"HSTL001"), "{codes:?}");
+    assert!(codes.contains(&"HSTL002"), "{codes:?}");
+    let syntax = checked.diagnostics.iter().find(|d| d.code == "HSTL001").map(|d| d.range.clone());
+    assert_eq!(syntax.map(|r| &src[r]), Some(";"));
+    let unknown = checked.diagnostics.iter().find(|d| d.code == "HSTL002").map(|d| d.range.clone());
+    assert_eq!(unknown.map(|r| &src[r]), Some("q"));
+}
+
+#[test]
+fn diagnostics_are_deduplicated_and_capped() {
+    let (_, src) = fixtures("invalid")
+        .into_iter()
+        .find(|(n, _)| n.starts_with("HSTL024"))
+        .expect("the HSTL024 fixture");
+    let d = check(&src).diagnostics;
+    assert_eq!(d.len(), hstl_lang::check::MAX_DIAGNOSTICS + 1);
+    assert_eq!(d.last().map(|d| d.code), Some("HSTL024"));
+    let unique: BTreeSet<_> =
+        d.iter().map(|d| (d.range.start, d.range.end, d.code, d.message.clone())).collect();
+    assert_eq!(unique.len(), d.len());
+}
