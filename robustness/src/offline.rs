@@ -6,7 +6,7 @@
 //! `always` and `eventually` use the van Herk/Gil-Werman algorithm: prefix and suffix
 //! minima over blocks as long as the window, then one branch-free, vectorisable pass; the
 //! cost per sample does not depend on the window length. `until` takes linear time: a
-//! backward recurrence when unbounded, a backward sweep with a monotonic deque when bounded.
+//! backward recurrence when unbounded, and the same block decomposition when bounded.
 //!
 //! # Values
 //! The results equal [`reference`](crate::reference) exactly: min and max are selections,
@@ -33,8 +33,7 @@ pub struct Evaluator {
     result: Vec<f64>,
     scratch_a: Vec<f64>,
     scratch_b: Vec<f64>,
-    deque_at: Vec<usize>,
-    deque_val: Vec<f64>,
+    scratch_c: Vec<f64>,
 }
 
 /// The full robustness signal of `f` on `trace`: `rho(f, t)` for every step `t`.
@@ -347,7 +346,12 @@ impl Evaluator {
                 }
             }
             // A span past the trace's end is as good as `n`, and cannot overflow.
-            Some(last) => self.bounded_until(lhs, out, (last - a).min(n)),
+            Some(last) => block_until(
+                lhs,
+                out,
+                (last - a).min(n),
+                [&mut self.scratch_a, &mut self.scratch_b, &mut self.scratch_c],
+            ),
         }
         if a > 0 {
             self.window::<Min>(lhs, &Interval { start: 0, end: Bound::Exclusive(a) });
@@ -355,51 +359,6 @@ impl Evaluator {
                 out[t] = Min::acc(lhs[t], out[t + a]);
             }
             out[n - a..].fill(NEG_INF);
-        }
-    }
-
-    /// `out[s]` becomes the max over `s <= u <= min(s + span, n - 1)` of
-    /// `min(out[u], lhs[s..u])`, by a backward sweep over `s`.
-    ///
-    /// The deque holds candidates `u` with their values `min(g[u], lhs[s..u])`; a newer
-    /// candidate (smaller `u`) lives longer, so it removes older ones it dominates and the
-    /// values decrease from front (oldest) to back. Capping every value by `lhs[s]` turns
-    /// the front run above it into one candidate.
-    fn bounded_until(&mut self, lhs: &[f64], out: &mut [f64], span: usize) {
-        let n = out.len();
-        self.deque_at.clear();
-        self.deque_at.resize(n + 1, 0);
-        self.deque_val.clear();
-        self.deque_val.resize(n + 1, 0.0);
-        let (at, val) = (&mut self.deque_at[..], &mut self.deque_val[..]);
-        // Live entries are `head .. tail`; the back grows upwards.
-        let (mut head, mut tail) = (0usize, 0usize);
-        for s in (0..n).rev() {
-            let cap = lhs[s];
-            if !cap.is_nan() && head < tail && val[head] > cap {
-                while head < tail && val[head] >= cap {
-                    head += 1;
-                }
-                // The newest capped candidate lives longest; it takes the freed slot.
-                head -= 1;
-                val[head] = cap;
-            }
-            while head < tail && at[head] > s + span {
-                head += 1;
-            }
-            let v = Min::acc(INF, out[s]);
-            while head < tail && val[tail - 1] <= v {
-                tail -= 1;
-            }
-            if tail == head {
-                // Restart at the bottom so the slots below `head` stay free for caps.
-                head = 0;
-                tail = 0;
-            }
-            at[tail] = s;
-            val[tail] = v;
-            tail += 1;
-            out[s] = val[head];
         }
     }
 }
@@ -441,6 +400,60 @@ fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
     let a = a.min(n);
     buf.copy_within(a.., 0);
     buf[n - a..].fill(L::ID);
+}
+
+/// `out[s]` becomes `max over s <= u <= min(s + span, n - 1) of min(g[u], lhs[s..u])`, `g`
+/// being `out` on entry: `lhs until[0..=span] g` at every `s`.
+///
+/// The van Herk idea carried over to until: cut the trace into blocks of `span + 1`. The
+/// window of `s` covers the rest of its block and a prefix of the next one. Within the
+/// block the answer is the unbounded until restricted to the block (`su`, a backward
+/// recurrence); in the next block it is `min(lhs[s..block end], p[e])`, where `p[e]` is the
+/// until over the next block's prefix up to `e` (a forward recurrence). Every sample costs
+/// a fixed number of min/max, whatever the span, and no step branches on the data.
+fn block_until(lhs: &[f64], out: &mut [f64], span: usize, scratch: [&mut Vec<f64>; 3]) {
+    let n = out.len();
+    let [su, sf, p] = scratch;
+    for v in [&mut *su, &mut *sf, &mut *p] {
+        v.resize(n, 0.0);
+        v.truncate(n);
+    }
+    let len = span + 1;
+    let mut b0 = 0;
+    while b0 < n {
+        let b1 = (b0 + len).min(n);
+        let (f, g) = (&lhs[b0..b1], &out[b0..b1]);
+        let (su, sf, p) = (&mut su[b0..b1], &mut sf[b0..b1], &mut p[b0..b1]);
+        let m = f.len();
+        // Forwards: `pf` = min lhs[b0..u), `pu` = the until over [b0, u].
+        let (mut pf, mut pu) = (INF, NEG_INF);
+        // Backwards: `sfa` = min lhs[u..b1), `sua` = the until over [u, b1).
+        let (mut sfa, mut sua) = (INF, NEG_INF);
+        for j in 0..m {
+            // A NaN `g` leaves only the `lhs` part: `min(INF, NaN)` is `INF`.
+            pu = Max::acc(pu, Min::acc(Min::acc(INF, g[j]), pf));
+            p[j] = pu;
+            pf = Min::acc(pf, f[j]);
+            let k = m - 1 - j;
+            sua = Max::acc(Min::acc(sua, f[k]), Min::acc(INF, g[k]));
+            su[k] = sua;
+            sfa = Min::acc(sfa, f[k]);
+            sf[k] = sfa;
+        }
+        b0 = b1;
+    }
+    let (su, sf, p) = (&su[..], &sf[..], &p[..]);
+    // Unclipped windows: when `s` starts a block, `p[s + span]` is `su[s]`, so one formula
+    // serves every `s`.
+    let full = n.saturating_sub(span);
+    for (s, o) in out[..full].iter_mut().enumerate() {
+        *o = Max::acc(su[s], Min::acc(sf[s], p[s + span]));
+    }
+    // Windows clipped at the end reach at most into the last block.
+    let last_block = (n - 1) / len * len;
+    for (s, o) in out.iter_mut().enumerate().skip(full) {
+        *o = if s >= last_block { su[s] } else { Max::acc(su[s], Min::acc(sf[s], p[n - 1])) };
+    }
 }
 
 /// `buf[t]` becomes the fold of `buf[t..]`. (Folding four pieces side by side to break

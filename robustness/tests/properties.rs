@@ -17,9 +17,13 @@ fn value() -> impl Strategy<Value = f64> {
 }
 
 fn trace(vars: usize, nan: bool) -> impl Strategy<Value = Trace> {
+    trace_up_to(vars, nan, 30)
+}
+
+fn trace_up_to(vars: usize, nan: bool, max_len: usize) -> impl Strategy<Value = Trace> {
     let v =
         if nan { prop_oneof![15 => value(), 1 => Just(f64::NAN)].boxed() } else { value().boxed() };
-    (0usize..=30).prop_flat_map(move |n| {
+    (0usize..=max_len).prop_flat_map(move |n| {
         proptest::collection::vec(proptest::collection::vec(v.clone(), n), vars)
             .prop_map(|cols| Trace::from_columns(cols).expect("equal lengths"))
     })
@@ -122,6 +126,18 @@ proptest! {
         let back = parse(&text);
         prop_assert_eq!(back.display_with(&common::VARS).to_string(), text.clone());
         common::assert_same(&text, &reference::signal(&back, &t), &reference::signal(&f, &t));
+    }
+}
+
+proptest! {
+    // The reference evaluator is cubic in the trace length on nested until: fewer cases.
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Longer traces: many van Herk blocks per window length.
+    #[test]
+    fn evaluators_agree_on_long_traces(f in formula(0), t in trace_up_to(2, true, 80)) {
+        let want = reference::signal(&f, &t);
+        check_all(&f, &t, &want);
     }
 }
 
