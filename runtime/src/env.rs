@@ -169,11 +169,14 @@ impl Env for GridWorld {
         if action >= GRID_ACTIONS.len() {
             return *state;
         }
-        let taken = if rng.random::<f64>() < self.p {
+        // One uniform draw decides both whether the robot slips and where: below `p` it
+        // takes the chosen action, the rest of [0, 1) splits evenly over the other three.
+        let u = rng.random::<f64>();
+        let taken = if u < self.p {
             action
         } else {
-            // One of the other three actions, each equally likely.
-            let k = rng.random_range(0..3usize);
+            let k = (((u - self.p) / (1.0 - self.p)) * 3.0) as usize;
+            let k = k.min(2);
             if k >= action { k + 1 } else { k }
         };
         self.intended(*state, taken)

@@ -8,7 +8,7 @@
 //! when the start state satisfies `R_j`. The rate is the share of the steps
 //! `burn_in..steps` with `psi(t) = 1`, pooled over all rollouts.
 
-use hstl_robustness::{Trace, reference};
+use hstl_robustness::{Trace, offline, reference};
 
 use crate::{Agent, Env, Error, Rng, TaskSpec};
 
@@ -127,7 +127,8 @@ impl RegionTable {
         Ok(RegionTable { holds, horizons, trace, task: spec.task.clone() })
     }
 
-    /// The task's robustness over the states of a rollout.
+    /// The task's robustness over the states of a rollout (by the offline evaluator, which
+    /// gives the reference evaluator's values in linear time).
     pub fn robustness(&self, states: &[usize]) -> f64 {
         let mut t = Trace::new(self.trace.vars());
         let mut row = Vec::new();
@@ -137,7 +138,7 @@ impl RegionTable {
                 return f64::NAN;
             }
         }
-        reference::robustness(&self.task, &t, 0)
+        offline::robustness(&self.task, &t)
     }
 
     /// `psi(t)` for every step of a rollout through `states`.

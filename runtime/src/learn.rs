@@ -13,7 +13,9 @@
 //! own reward and `gamma^(k-j)`: `intra: paper` credits the executed option; `intra:
 //! remaining` credits the option made of the legs that remain at `s_j` (the state where
 //! a leg starts belongs to that leg) when it is in the set and available at `s_j`, and
-//! skips the suffix otherwise. Each update reads the table as the earlier ones left it.
+//! skips the suffix otherwise. All of them bootstrap from `max Q(s_k, .)` as it was
+//! before this execution's updates; a later update of a cell that an earlier one changed
+//! (a state visited twice) starts from the changed value.
 //!
 //! **Options.** An option runs at least one step; a leg stops at the first `s'` in its
 //! termination set, or is cut off after `max_steps` steps. Exploration is epsilon-greedy
@@ -36,6 +38,8 @@ pub struct Learner<'e, E: Env> {
     view: StateView,
     reward: SegmentReward,
     q: QTables,
+    /// `gamma_powers[i]`: the options gamma to the power `i`, grown on demand.
+    gamma_powers: Vec<f64>,
 }
 
 /// The learned values, enough to continue training.
@@ -101,7 +105,7 @@ impl<'e, E: Env> Learner<'e, E> {
             choices: 0,
         };
         let reward = SegmentReward { scorer: TabularScorer::new(&spec.task, &tables.trace) };
-        Ok(Learner { env, spec: spec.clone(), tables, view, reward, q })
+        Ok(Learner { env, spec: spec.clone(), tables, view, reward, q, gamma_powers: vec![1.0] })
     }
 
     /// Continues from earlier Q-tables (for instance from a loaded `policy.json`).
@@ -231,12 +235,21 @@ impl<'e, E: Env> Learner<'e, E> {
         let k = run.states.len() - 1;
         let end = run.states[k];
         let end_row = self.view.observe(end) * n;
+        // Every suffix bootstraps from the same end state, read before any update so that
+        // the order of the updates below changes only their shared cells.
+        let best = self.tables.available[end]
+            .iter()
+            .map(|&b| self.q.options[end_row + b])
+            .fold(f64::NEG_INFINITY, f64::max);
+        if self.gamma_powers.len() <= k {
+            let last = self.gamma_powers.len();
+            self.gamma_powers.extend((last..=k).map(|i| params.gamma.powi(i as i32)));
+        }
         let mut leg = 0;
-        for j in 0..k {
+        for (j, (&s, &reward)) in run.states[..k].iter().zip(rewards).enumerate() {
             while leg + 1 < run.leg_starts.len() && run.leg_starts[leg + 1] <= j {
                 leg += 1;
             }
-            let s = run.states[j];
             let credited = match (j, self.spec.learn.intra) {
                 (0, _) | (_, Intra::Paper) => Some(o),
                 (_, Intra::Remaining) => {
@@ -244,11 +257,7 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
             };
             let Some(c) = credited else { continue };
-            let best = self.tables.available[end]
-                .iter()
-                .map(|&b| self.q.options[end_row + b])
-                .fold(f64::NEG_INFINITY, f64::max);
-            let target = rewards[j] + params.gamma.powi((k - j) as i32) * best;
+            let target = reward + self.gamma_powers[k - j] * best;
             let cell = &mut self.q.options[self.view.observe(s) * n + c];
             *cell += params.alpha * (target - *cell);
         }
@@ -275,6 +284,7 @@ impl SegmentReward {
 }
 
 /// The index of the largest value; the lowest index among ties, 0 when all are NaN.
+#[inline]
 pub(crate) fn argmax(row: &[f64]) -> usize {
     let mut best = 0;
     for (i, &v) in row.iter().enumerate().skip(1) {
@@ -296,8 +306,16 @@ pub(crate) fn best_of(candidates: &[usize], row: &[f64]) -> usize {
     best
 }
 
+/// The largest value of a non-empty row; comparisons skip NaN unless all are NaN.
+#[inline]
 fn max_of(row: &[f64]) -> f64 {
-    row.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    let mut m = row[0];
+    for &v in &row[1..] {
+        if v > m || m.is_nan() {
+            m = v;
+        }
+    }
+    m
 }
 
 #[cfg(test)]

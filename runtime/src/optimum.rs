@@ -87,7 +87,8 @@ pub fn solve(
     config: SolveConfig,
 ) -> Result<Optimum, Error> {
     let layout = Layout::new(grid, regions)?;
-    if !(config.damping > 0.0 && config.damping <= 1.0) || !(config.tolerance > 0.0) {
+    let damping_ok = config.damping > 0.0 && config.damping <= 1.0;
+    if !damping_ok || config.tolerance.is_nan() || config.tolerance <= 0.0 {
         return Err(Error::Config(format!(
             "value iteration needs damping in (0, 1] and tolerance > 0, not {config:?}"
         )));
@@ -228,8 +229,8 @@ impl Layout {
                 for d in 0..4 {
                     let to = dest[d];
                     base[d] = to * self.per_cell;
-                    for j in 0..last {
-                        let nu = self.next_u(j, c, u[j], to);
+                    for (j, &uj) in u.iter().enumerate().take(last) {
+                        let nu = self.next_u(j, c, uj, to);
                         base[d] += nu * self.stride[j];
                         ok[d] &= self.kept(j, to, nu);
                     }

@@ -58,16 +58,24 @@ impl Tables {
             reach.push(r);
         }
         let legs: Vec<Vec<usize>> = spec.options.iter().map(|o| o.sequence.clone()).collect();
-        let mut available = Vec::with_capacity(states);
-        for s in 0..states {
-            let here: Vec<usize> = (0..legs.len()).filter(|&o| init[legs[o][0]][s]).collect();
-            if here.is_empty() {
-                return Err(Error::Spec(format!(
-                    "no option of the set can start in state {:?}",
-                    env.state(s)
-                )));
-            }
-            available.push(here);
+        let available: Vec<Vec<usize>> = (0..states)
+            .map(|s| {
+                legs.iter().enumerate().filter(|(_, l)| init[l[0]][s]).map(|(o, _)| o).collect()
+            })
+            .collect();
+        if let Some(s) = available.iter().position(Vec::is_empty) {
+            let mut row = Vec::new();
+            trace.row_into(s, &mut row);
+            let state: Vec<String> = spec
+                .state_vars
+                .iter()
+                .zip(&row)
+                .map(|(v, x)| format!("{} = {x}", v.name))
+                .collect();
+            return Err(Error::Spec(format!(
+                "no option of the set can start in the state {}",
+                state.join(", ")
+            )));
         }
         let remaining = legs
             .iter()

@@ -1,0 +1,31 @@
+//! Full case-study training runs: O_T1 (7 options) and O_T2 (15 options), 1200 episodes of
+//! 200 choices with the paper's parameters and argmax termination.
+//!
+//! `cargo bench -p hstl-runtime --bench learn -- --warm-up-time 1 --measurement-time 3`
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use hstl_runtime::{GridWorld, Learner, seeded_rng};
+
+fn training(c: &mut Criterion) {
+    let env = GridWorld::default();
+    let mut group = c.benchmark_group("train");
+    group.sample_size(10);
+    for (name, permutations) in [("O_T1", false), ("O_T2", true)] {
+        let spec = common::case_study(permutations, false);
+        let mut seed = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                seed += 1;
+                let mut learner = Learner::new(&spec, &env).expect("the case study is valid");
+                learner.train(&mut seeded_rng(seed), |_, _| {}).steps
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, training);
+criterion_main!(benches);

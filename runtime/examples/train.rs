@@ -1,0 +1,42 @@
+//! Trains the case study once and reports the time, the steps per second and the window
+//! rate of the greedy policy.
+//!
+//! `cargo run --release -p hstl-runtime --example train -- [SEED] [o_t2] [entry]`
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use std::time::Instant;
+
+use hstl_runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
+use hstl_runtime::{GridWorld, Learner, seeded_rng};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let seed: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(1);
+    let spec =
+        common::case_study(args.iter().any(|a| a == "o_t2"), args.iter().any(|a| a == "entry"));
+    let env = GridWorld::default();
+    let t = Instant::now();
+    let mut learner = Learner::new(&spec, &env).expect("the case study is valid");
+    let trained = learner.train(&mut seeded_rng(seed), |_, _| {});
+    let secs = t.elapsed().as_secs_f64();
+    println!(
+        "{} options, seed {seed}: {:.3} s, {} steps, {:.2}M steps/s",
+        spec.options.len(),
+        secs,
+        trained.steps,
+        trained.steps as f64 / secs / 1e6
+    );
+    let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
+    let agent = learner.agent();
+    let report = window_rate(
+        &env,
+        &mut AgentController::new(&agent),
+        &regions,
+        WindowConfig::default(),
+        &mut seeded_rng(seed ^ 0x5eed),
+    )
+    .expect("default config is valid");
+    println!("window rate {:.3}", report.rate);
+}
