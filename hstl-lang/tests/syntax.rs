@@ -1,0 +1,176 @@
+//! Unit tests of the parser's tree shapes and ranges, the checked formulas, the state
+//! evaluator and positions.
+
+use hstl_lang::syntax::{ExprKind, Formula, FormulaKind, Item};
+use hstl_lang::{CFormulaKind, LetKind, LineIndex, check, parse};
+
+/// Parses `spec S { state { x: int in 0..=9, y: int in 0..=9 } <items> }` and returns
+/// the source with the formula of the `let` named `name`.
+fn let_formula(items: &str, name: &str) -> (String, Formula) {
+    let src = format!("spec S {{ state {{ x: int in 0..=9, y: int in 0..=9 }} {items} }}");
+    let parsed = parse(&src);
+    assert!(parsed.diagnostics.is_empty(), "{:?}", parsed.diagnostics);
+    let f = parsed.file.specs[0]
+        .items
+        .iter()
+        .find_map(|i| match i {
+            Item::Let(l) if l.name.name == name => Some(l.formula.clone()),
+            _ => None,
+        })
+        .expect("the let");
+    (src, f)
+}
+
+fn text<'a>(src: &'a str, f: &Formula) -> &'a str {
+    &src[f.range.clone()]
+}
+
+#[test]
+fn nested_formula_ranges_cover_exactly_their_text() {
+    let (src, f) = let_formula("let A = !(x > 1 && always[0..5] (y < 2)) ;", "A");
+    assert_eq!(text(&src, &f), "!(x > 1 && always[0..5] (y < 2))");
+    let FormulaKind::Not(inner) = &f.kind else { panic!("{f:?}") };
+    assert_eq!(text(&src, inner), "(x > 1 && always[0..5] (y < 2))");
+    let FormulaKind::Paren(and) = &inner.kind else { panic!("{inner:?}") };
+    let FormulaKind::And(parts) = &and.kind else { panic!("{and:?}") };
+    assert_eq!(text(&src, &parts[0]), "x > 1");
+    assert_eq!(text(&src, &parts[1]), "always[0..5] (y < 2)");
+    let FormulaKind::Always(Some(iv), body) = &parts[1].kind else { panic!("{:?}", parts[1]) };
+    assert_eq!(&src[iv.range.clone()], "[0..5]");
+    assert_eq!((iv.start.value, iv.end.as_ref().map(|e| e.value)), (0.0, Some(5.0)));
+    assert_eq!(text(&src, body), "(y < 2)");
+}
+
+#[test]
+fn chained_comparison_is_one_node_and_checks_to_a_conjunction() {
+    let (src, f) = let_formula("let A = 3 < x < 9; task always[0..] eventually[0..5] A;", "A");
+    let FormulaKind::Compare { first, rest } = &f.kind else { panic!("{f:?}") };
+    assert_eq!(&src[first.range.clone()], "3");
+    assert_eq!(rest.len(), 2);
+    let checked = check(&src);
+    let CFormulaKind::And(parts) = &checked.specs[0].lets[0].formula.kind else { panic!() };
+    let texts: Vec<&str> = parts.iter().map(|p| &src[p.range.clone()]).collect();
+    assert_eq!(texts, ["3 < x", "x < 9"]);
+}
+
+#[test]
+fn until_binds_tighter_than_and() {
+    let (src, f) =
+        let_formula("let a = x > 1; let b = y > 1; let c = x < 1; let T = a && b until c;", "T");
+    let FormulaKind::And(parts) = &f.kind else { panic!("{f:?}") };
+    assert_eq!(text(&src, &parts[0]), "a");
+    assert!(matches!(parts[1].kind, FormulaKind::Until(..)), "{:?}", parts[1]);
+    assert_eq!(text(&src, &parts[1]), "b until c");
+}
+
+#[test]
+fn prefix_operators_bind_tighter_than_and() {
+    let (src, f) = let_formula("let p = x > 1; let q = y > 1; let T = always[0..5] p && q;", "T");
+    let FormulaKind::And(parts) = &f.kind else { panic!("{f:?}") };
+    assert_eq!(text(&src, &parts[0]), "always[0..5] p");
+    assert!(matches!(parts[0].kind, FormulaKind::Always(..)));
+    assert_eq!(text(&src, &parts[1]), "q");
+}
+
+#[test]
+fn implication_is_right_associative_and_loosest() {
+    let (src, f) = let_formula("let a = x > 1; let T = a || a -> a && a -> a;", "T");
+    let FormulaKind::Implies(l, r) = &f.kind else { panic!("{f:?}") };
+    assert_eq!(text(&src, l), "a || a");
+    assert_eq!(text(&src, r), "a && a -> a");
+    assert!(matches!(r.kind, FormulaKind::Implies(..)));
+}
+
+#[test]
+fn parenthesised_expression_is_a_comparison_and_parenthesised_comparison_a_formula() {
+    let (src, f) = let_formula("let A = (x + 1) > 3;", "A");
+    let FormulaKind::Compare { first, .. } = &f.kind else { panic!("{f:?}") };
+    assert!(matches!(first.kind, ExprKind::Paren(_)));
+    assert_eq!(&src[first.range.clone()], "(x + 1)");
+    let (_, f) = let_formula("let A = (x) > 3;", "A");
+    assert!(matches!(f.kind, FormulaKind::Compare { .. }), "{f:?}");
+    let (src, f) = let_formula("let A = (x > 1);", "A");
+    let FormulaKind::Paren(inner) = &f.kind else { panic!("{f:?}") };
+    assert_eq!(text(&src, inner), "x > 1");
+}
+
+#[test]
+fn ranges_do_not_lex_as_floats_and_macro_spacing_parses() {
+    let (src, f) = let_formula("let A = eventually[0..40] x > - 3 && x > 1e-6;", "A");
+    let FormulaKind::And(parts) = &f.kind else { panic!("{f:?}") };
+    let FormulaKind::Eventually(Some(iv), _) = &parts[0].kind else { panic!() };
+    assert_eq!(&src[iv.start.range.clone()], "0");
+    assert_eq!(iv.end.as_ref().map(|e| e.text.as_str()), Some("40"));
+    let (src2, f2) = let_formula("let A = eventually [ 0 ..= 40 ] x > 3 ;", "A");
+    let FormulaKind::Eventually(Some(iv), _) = &f2.kind else { panic!() };
+    assert!(iv.inclusive);
+    assert_eq!(text(&src2, &f2), "eventually [ 0 ..= 40 ] x > 3");
+}
+
+#[test]
+fn doc_comments_and_comments_are_kept() {
+    let src = "/// The spec.\nspec S { /* block */ state { /// Column.\n x: int in 0..=3 } // line\n //// not a doc\n task true; }";
+    let parsed = parse(src);
+    assert!(parsed.diagnostics.is_empty(), "{:?}", parsed.diagnostics);
+    let spec = &parsed.file.specs[0];
+    assert_eq!(spec.doc.as_ref().map(|d| d.text()), Some("The spec.".to_string()));
+    let Item::State(b) = &spec.items[0] else { panic!() };
+    assert_eq!(b.vars[0].doc.as_ref().map(|d| d.text()), Some("Column.".to_string()));
+    let kinds: Vec<_> =
+        parsed.file.comments.iter().map(|c| (c.kind, &src[c.range.clone()])).collect();
+    use hstl_lang::syntax::CommentKind::*;
+    assert_eq!(
+        kinds,
+        [
+            (Doc, "/// The spec."),
+            (Block, "/* block */"),
+            (Doc, "/// Column."),
+            (Line, "// line"),
+            (Line, "//// not a doc")
+        ]
+    );
+}
+
+#[test]
+fn state_robustness_follows_the_semantics() {
+    let src = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/valid/case_study_ot1.hstl"
+    ))
+    .expect("fixture");
+    let checked = check(&src);
+    let spec = &checked.specs[0];
+    let a = &spec.lets[0];
+    assert_eq!(a.kind, LetKind::State);
+    for (x, y) in [(5.0, 12.0), (0.0, 0.0), (8.0, 13.0)] {
+        let want = [x - 3.0, 9.0 - x, y - 10.0, 14.0 - y].into_iter().fold(f64::INFINITY, f64::min);
+        assert_eq!(spec.state_robustness(&a.formula, &[x, y]), Some(want));
+    }
+    let task = spec.task.as_ref().expect("task");
+    assert_eq!(spec.state_robustness(&task.formula, &[1.0, 1.0]), None);
+    let conj = spec.persistent_conjuncts(&src).expect("persistent");
+    assert_eq!(
+        conj.iter().map(|c| (c.name.as_str(), c.steps)).collect::<Vec<_>>(),
+        [("A", 40), ("B", 40), ("C", 40)]
+    );
+    let incl = src.replace("eventually[0..40] C", "eventually[0..=40] C");
+    let checked = check(&incl);
+    let conj = checked.specs[0].persistent_conjuncts(&incl).expect("persistent");
+    assert_eq!(conj[2].steps, 41);
+}
+
+#[test]
+fn line_index_counts_characters_and_utf16_units() {
+    let src = "ab\n// é😀x\nz";
+    let idx = LineIndex::new(src);
+    let x = src.find('x').expect("x");
+    let p = idx.position(src, x);
+    assert_eq!((p.line, p.column, p.utf16_column), (2, 6, 6));
+    assert_eq!(idx.offset(src, 2, 6), x);
+    assert_eq!(idx.offset_utf16(src, 1, 6), x);
+    let end = idx.position(src, src.len());
+    assert_eq!((end.line, end.column), (3, 2));
+    // Inside a multi-byte character: moved back to its start.
+    let e = src.find('é').expect("é");
+    assert_eq!(idx.position(src, e + 1), idx.position(src, e));
+}
