@@ -6,7 +6,7 @@
 mod walk;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use hstl_robustness::{Evaluator, Formula, Trace, segment::TabularScorer};
+use hstl_robustness::{Evaluator, Formula, OnlineMonitor, Trace, segment::TabularScorer};
 use std::hint::black_box;
 
 fn full_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
@@ -16,6 +16,28 @@ fn full_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
     let mut ev = Evaluator::new();
     for (name, f) in cases {
         g.bench_function(*name, |b| b.iter(|| black_box(ev.signal(f, black_box(trace))[0])));
+    }
+    g.finish();
+}
+
+fn online(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
+    let mut g = c.benchmark_group("online");
+    g.throughput(Throughput::Elements(trace.len() as u64));
+    g.sample_size(10);
+    let (xs, ys) = (trace.column(0), trace.column(1));
+    for (name, f) in cases {
+        g.bench_function(*name, |b| {
+            b.iter(|| {
+                let mut m = OnlineMonitor::new(f, 2);
+                let mut acc = 0.0;
+                for (x, y) in xs.iter().zip(ys) {
+                    if let Ok(Some(v)) = m.push(&[*x, *y]) {
+                        acc += v.value;
+                    }
+                }
+                black_box((acc, m.finish().len()))
+            })
+        });
     }
     g.finish();
 }
@@ -58,6 +80,7 @@ fn benches(c: &mut Criterion) {
         ("F3", walk::f3()),
     ];
     full_signal(c, &trace, &cases);
+    online(c, &trace, &[("F1_w40", walk::f1(40)), ("F3", walk::f3())]);
     step_zero(c, &trace);
     suffix_rewards(c, &mut rng);
 }

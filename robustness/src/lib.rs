@@ -19,6 +19,7 @@ pub mod offline;
 pub mod online;
 pub mod reference;
 pub mod segment;
+mod stream;
 pub mod trace;
 
 pub use formula::{Bound, CmpOp, Expr, Formula, Interval};

@@ -364,15 +364,15 @@ impl Evaluator {
 }
 
 /// A min or a max, with its identity.
-trait Lattice {
+pub(crate) trait Lattice {
     const ID: f64;
     /// `minNum(acc, x)` (or `maxNum`) when `acc` is not NaN, in one instruction: a NaN `x`
     /// fails the comparison and leaves `acc`. Every fold starts at `ID`, so none holds NaN.
     fn acc(acc: f64, x: f64) -> f64;
 }
 
-struct Min;
-struct Max;
+pub(crate) struct Min;
+pub(crate) struct Max;
 
 impl Lattice for Min {
     const ID: f64 = INF;

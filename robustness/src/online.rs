@@ -2,17 +2,19 @@
 //!
 //! For a formula with a finite horizon `H`, `rho(f, t)` depends on `s_t ..= s_{t+H}` only,
 //! so it is final once state `t + H` has arrived: [`OnlineMonitor::push`] returns it then.
-//! The monitor keeps at most about `2 (H + 1)` states per variable, whatever the trace
-//! length, and each verdict costs one evaluation of those `H + 1` states (`O(H)` times the
-//! formula size). [`OnlineMonitor::finish`] ends the trace and returns the steps still
-//! open, with their windows clipped at the end of the trace, exactly as the offline
-//! evaluators clip them.
+//! Each operator is a streaming node (monotonic deques for `always`/`eventually`, the
+//! offline evaluator's block decomposition run forwards for `until`), so a push costs
+//! amortised `O(1)` per operator and the monitor holds `O(H)` values per operator plus the
+//! last `H` states, whatever the trace length. [`OnlineMonitor::finish`] ends the trace and
+//! returns the steps still open, evaluated offline on those last states with their windows
+//! clipped at the end of the trace, exactly as the offline evaluators clip them.
 //!
 //! For a formula with an unbounded operator no verdict is final before the trace ends: a
 //! later state can still change `rho(f, t)`. [`OnlineMonitor::push`] then returns nothing,
 //! the monitor keeps every state, and [`OnlineMonitor::provisional`] gives the value the
 //! first open step would have if the trace ended now (it is not a verdict).
 
+use crate::stream::Node;
 use crate::{Formula, TraceError, offline::Evaluator};
 
 /// The final robustness of the trace at one step.
@@ -31,6 +33,8 @@ pub struct Verdict {
 pub struct OnlineMonitor {
     formula: Formula,
     horizon: Option<usize>,
+    /// The streaming operators of a bounded formula.
+    nodes: Option<Node>,
     columns: Vec<Vec<f64>>,
     /// The length of every column (kept apart so a formula over no variable works).
     len: usize,
@@ -47,6 +51,7 @@ impl OnlineMonitor {
         OnlineMonitor {
             formula: formula.clone(),
             horizon: formula.horizon(),
+            nodes: Node::build(formula),
             columns: vec![Vec::new(); vars],
             len: 0,
             start: 0,
@@ -79,13 +84,11 @@ impl OnlineMonitor {
             c.push(*v);
         }
         self.len += 1;
-        let Some(h) = self.horizon else { return Ok(None) };
+        let (Some(h), Some(nodes)) = (self.horizon, &mut self.nodes) else { return Ok(None) };
+        nodes.push(state);
+        // Every node emits one value per state once warmed up: at most one verdict here.
+        let Some(value) = nodes.pop() else { return Ok(None) };
         let window = h.saturating_add(1);
-        if self.buffered() < window {
-            return Ok(None);
-        }
-        let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
-        let value = self.eval.robustness_of_columns(&self.formula, &cols, window);
         let verdict = Verdict { step: self.first_step, value };
         self.start += 1;
         self.first_step += 1;
@@ -129,6 +132,7 @@ impl OnlineMonitor {
         self.len = 0;
         self.start = 0;
         self.first_step = 0;
+        self.nodes = Node::build(&self.formula);
         out
     }
 
