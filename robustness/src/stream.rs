@@ -239,7 +239,7 @@ impl Until {
         self.fv.push_back(f);
         self.gv.push_back(g);
         // Forwards through the current block: the until over its prefix.
-        if j % len == 0 {
+        if j.is_multiple_of(len) {
             self.pf = INF;
             self.pu = NEG_INF;
         }
@@ -280,7 +280,7 @@ impl Until {
             head = self.a_deque.front().map_or(INF, |&(_, v)| v);
         }
         let i = s - self.base;
-        let tail = if s % len == 0 {
+        let tail = if s.is_multiple_of(len) {
             self.su[i]
         } else {
             Max::acc(self.su[i], Min::acc(self.sf[i], self.p[j - self.base]))
