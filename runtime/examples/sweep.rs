@@ -2,7 +2,8 @@
 //! termination) on two threads and reports the window rate, W/W*, training time and the
 //! O_T2 vs O_T1 reward difference.
 //!
-//! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES]`
+//! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES] [VARIANT]`
+//! (VARIANT, such as `O_T2 argmax`, runs that variant alone; EPISODES `-` keeps 1200).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -57,6 +58,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let seeds: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20);
     let episodes: Option<usize> = args.get(2).and_then(|a| a.parse().ok());
+    let only = args.get(3);
     let env = GridWorld::default();
     let spec = common::case_study(false, false);
     let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
@@ -89,6 +91,9 @@ fn main() {
         (false, true, "O_T1 entry"),
         (true, true, "O_T2 entry"),
     ] {
+        if only.is_some_and(|o| o != name) {
+            continue;
+        }
         let outcomes: Vec<Outcome> = std::thread::scope(|scope| {
             let handles: Vec<_> = (0..2u64)
                 .map(|w| {
@@ -123,6 +128,9 @@ fn main() {
             st / s / 1e6
         );
         tails.push(tr);
+    }
+    if tails.len() < 4 {
+        return;
     }
     let diff = |a: f64, b: f64| 100.0 * (b - a) / a.abs();
     println!(

@@ -141,7 +141,8 @@ impl RegionTable {
         offline::robustness(&self.task, &t)
     }
 
-    /// `psi(t)` for every step of a rollout through `states`.
+    /// `psi(t)` for every step of a rollout through `states` (an index past the table
+    /// lies in no region).
     pub fn psi(&self, states: &[usize]) -> Vec<bool> {
         let mut tau = self.horizons.clone();
         states
@@ -149,7 +150,11 @@ impl RegionTable {
             .map(|&s| {
                 let mut kept = true;
                 for (j, t) in tau.iter_mut().enumerate() {
-                    *t = if self.holds[j][s] { 0 } else { (*t + 1).min(self.horizons[j]) };
+                    *t = if self.holds[j].get(s).copied().unwrap_or(false) {
+                        0
+                    } else {
+                        (*t + 1).min(self.horizons[j])
+                    };
                     kept &= *t < self.horizons[j];
                 }
                 kept
@@ -171,16 +176,32 @@ impl Controller for AgentController<'_> {
     }
 
     fn act(&mut self, s: usize) -> Decision {
-        let (o, leg, _) = *self.running.get_or_insert((self.agent.options[s], 0, 0));
-        let p = self.agent.legs[o][leg];
-        Decision { action: self.agent.flat[p][s], option: o, leg }
+        let agent = self.agent;
+        let chosen = agent.options.get(s).copied().unwrap_or(0);
+        let (o, leg, _) = *self.running.get_or_insert((chosen, 0, 0));
+        // An agent that does not fit the state (hand-built, or another environment) takes
+        // no valid action, which leaves the state unchanged, instead of panicking.
+        let action = agent
+            .legs
+            .get(o)
+            .and_then(|l| l.get(leg))
+            .and_then(|&p| agent.flat.get(p)?.get(s).copied())
+            .unwrap_or(usize::MAX);
+        Decision { action, option: o, leg }
     }
 
     fn observe(&mut self, next: usize) {
         let Some((o, leg, steps)) = self.running else { return };
-        let p = self.agent.legs[o][leg];
-        self.running = if self.agent.terminate[p][next] || steps + 1 >= self.agent.max_steps {
-            (leg + 1 < self.agent.legs[o].len()).then_some((o, leg + 1, 0))
+        let agent = self.agent;
+        let legs = agent.legs.get(o).map_or(0, Vec::len);
+        let done = agent
+            .legs
+            .get(o)
+            .and_then(|l| l.get(leg))
+            .and_then(|&p| agent.terminate.get(p)?.get(next).copied())
+            .unwrap_or(true);
+        self.running = if done || steps + 1 >= agent.max_steps {
+            (leg + 1 < legs).then_some((o, leg + 1, 0))
         } else {
             Some((o, leg, steps + 1))
         };
@@ -191,6 +212,9 @@ impl EntryCycle {
     /// The cycle through `regions` on `grid`, in region order.
     pub fn new(grid: &crate::GridWorld, regions: &RegionTable) -> Result<EntryCycle, Error> {
         let width = grid.width();
+        if regions.holds.iter().any(|h| h.len() != grid.width() * grid.height()) {
+            return Err(Error::Config("the regions were not computed on this grid".into()));
+        }
         let targets: Vec<Vec<(usize, usize)>> = regions
             .holds
             .iter()
@@ -225,7 +249,7 @@ impl Controller for EntryCycle {
     }
 
     fn observe(&mut self, next: usize) {
-        if self.holds[self.phase][next] {
+        if self.holds[self.phase].get(next).copied().unwrap_or(false) {
             self.phase = (self.phase + 1) % self.holds.len();
         }
     }
@@ -282,6 +306,12 @@ pub fn window_rate<E: Env, C: Controller>(
     if config.starts == 0 || config.burn_in >= config.steps {
         return Err(Error::Config(format!(
             "the window rate needs starts > 0 and burn_in < steps, not {config:?}"
+        )));
+    }
+    if regions.holds.iter().any(|h| h.len() != env.num_states()) {
+        return Err(Error::Config(format!(
+            "the regions were not computed on this {} environment",
+            env.name()
         )));
     }
     let mut per_rollout = Vec::with_capacity(config.starts);

@@ -299,7 +299,8 @@ impl OptimalController<'_> {
     fn update_tau(&mut self, s: usize) {
         let l = &self.optimum.layout;
         for (j, t) in self.tau.iter_mut().enumerate() {
-            *t = if l.inside[j][s] { 0 } else { (*t + 1).min(l.n[j]) };
+            *t =
+                if l.inside[j].get(s).copied().unwrap_or(false) { 0 } else { (*t + 1).min(l.n[j]) };
         }
     }
 }
@@ -311,6 +312,10 @@ impl Controller for OptimalController<'_> {
     }
 
     fn act(&mut self, s: usize) -> Decision {
+        if s >= self.optimum.layout.cells {
+            // Not a cell of the solved grid: take no valid action.
+            return Decision { action: usize::MAX, option: 0, leg: 0 };
+        }
         if self.fresh {
             // The start state counts as visited for the regions it lies in.
             let l = &self.optimum.layout;

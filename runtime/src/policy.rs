@@ -206,8 +206,8 @@ impl Policy {
     }
 
     /// The document as pretty-printed JSON.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).unwrap_or_default()
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string_pretty(self).map_err(|e| Error::Policy(e.to_string()))
     }
 
     /// Reads a document; the error says what is wrong and where.

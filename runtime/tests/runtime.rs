@@ -148,7 +148,7 @@ fn policy_json_round_trips_bit_for_bit() {
     q.options[3] = -0.0;
     let learner = learner.with_tables(q.clone()).unwrap();
     let policy = Policy::new(&learner);
-    let text = policy.to_json();
+    let text = policy.to_json().unwrap();
     let back = Policy::from_json(&text).unwrap();
     assert_eq!(back, policy);
     assert_eq!(bits(&back.q_tables().unwrap()), bits(&q));
@@ -177,7 +177,8 @@ fn policy_json_round_trips_bit_for_bit() {
 fn bad_policy_documents_say_what_is_wrong() {
     let env = GridWorld::default();
     let learner = Learner::new(&small(false, false), &env).unwrap();
-    let good: serde_json::Value = serde_json::from_str(&Policy::new(&learner).to_json()).unwrap();
+    let good: serde_json::Value =
+        serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap();
     type Break = fn(&mut serde_json::Value);
     let cases: [(&str, Break); 6] = [
         ("missing field `spec`", |d| {
