@@ -6,7 +6,7 @@
 //! windows are clipped at the end of the trace, an empty `always` window is `+inf`, an
 //! empty `eventually` or `until` window is `-inf`.
 //!
-//! - [`reference`] follows the semantics table literally; it is the test oracle.
+//! - [`reference`](mod@reference) follows the semantics table literally; it is the test oracle.
 //! - [`offline`] computes whole signals fast, and the robustness at step 0 from the
 //!   formula's horizon alone.
 //! - [`online`] monitors a trace fed one state at a time.

@@ -12,10 +12,12 @@
 //! The results equal [`reference`](crate::reference) exactly: min and max are selections,
 //! never arithmetic, so no rounding can differ. Minimum and maximum follow IEEE 754
 //! `minNum`/`maxNum` as Rust's [`f64::min`] and [`f64::max`] do, and as the reference does:
-//! a NaN operand is ignored. A NaN therefore appears in a signal only where an atom
-//! evaluates to NaN (`sqrt(-1)`, `inf - inf`, a variable the trace lacks) and reaches the
-//! output through `!` or `->`; `always`, `eventually`, `&&` and `||` skip it, as if the
-//! sample were not there. The one thing not pinned is the sign of a zero (`min(0, -0)`).
+//! a NaN operand is skipped. NaN comes only from atoms (`sqrt(-1)`, `inf - inf`, a variable
+//! the trace lacks); `!` keeps it, `->` keeps it only when both sides are NaN, and `&&`,
+//! `||`, `always`, `eventually` and `until` skip it as if the sample were not there (an
+//! all-NaN window gives the empty window's `+inf` or `-inf`). Infinite samples stay exact:
+//! `x > 3` with `x = inf` is `inf`. The one thing not pinned is the sign of a zero
+//! (`min(0, -0)`): the tests compare with `==`, under which `0 == -0`.
 
 use crate::{Bound, CmpOp, Expr, Formula, Interval, Trace};
 

@@ -2,6 +2,12 @@
 //!
 //! It is slow on purpose (every operator re-reads its whole window) and exists to be
 //! obviously right. The fast evaluators are tested against it.
+//!
+//! NaN policy: min and max are Rust's [`f64::min`] and [`f64::max`] (IEEE `minNum` and
+//! `maxNum`): a NaN operand is skipped. `&&`, `||` and the temporal operators fold from
+//! `+inf` or `-inf`, so they never give NaN; `!` keeps a NaN, and `->` gives NaN only when
+//! both sides are NaN. NaN itself comes only from atoms (`sqrt(-1)`, `inf - inf`, a
+//! variable the trace lacks).
 
 use crate::{Formula, Trace};
 

@@ -1,7 +1,7 @@
 //! Rewards of option executions: the task's robustness over a segment of states, and
 //! over every suffix of a segment.
 //!
-//! The semantics are those of [`reference::segment_reward`](crate::reference::segment_reward).
+//! The semantics are those of [`reference::segment_reward`].
 //! Suffix rewards come from one signal over the whole segment: `rho(f, t)` depends only on
 //! the states from `t` to the end, and every suffix ends where the segment ends, so the
 //! robustness at step 0 of the suffix from `i` is the segment's `rho(f, i)`, windows
