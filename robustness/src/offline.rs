@@ -224,6 +224,16 @@ impl Evaluator {
         let mut tmp = self.take_chunk();
         let tmp_s = &mut tmp[..out.len()];
         for g in gs {
+            // `x op c` folds straight in: no pass through `tmp`.
+            if let Some((col, c, x_minus_c)) = simple_atom(g, cols) {
+                let col = &col[lo..lo + out.len()];
+                if x_minus_c {
+                    out.iter_mut().zip(col).for_each(|(a, x)| *a = L::acc(*a, *x - c));
+                } else {
+                    out.iter_mut().zip(col).for_each(|(a, x)| *a = L::acc(*a, c - *x));
+                }
+                continue;
+            }
             self.state_chunk(g, cols, lo, tmp_s);
             out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = L::acc(*a, *b));
         }
@@ -365,6 +375,19 @@ impl Evaluator {
     }
 }
 
+/// For an atom `x op c` or `c op x` over a variable the trace has: the column, `c`, and
+/// whether the robustness is `x - c` (else `c - x`).
+fn simple_atom<'a>(f: &Formula, cols: &[&'a [f64]]) -> Option<(&'a [f64], f64, bool)> {
+    let Formula::Cmp { lhs, op, rhs } = f else { return None };
+    let (var, c, var_left) = match (lhs, rhs) {
+        (Expr::Var(i), Expr::Const(c)) => (*i, *c, true),
+        (Expr::Const(c), Expr::Var(i)) => (*i, *c, false),
+        _ => return None,
+    };
+    let x_minus_c = matches!(op, CmpOp::Gt | CmpOp::Ge) == var_left;
+    Some((cols.get(var)?, c, x_minus_c))
+}
+
 /// A min or a max, with its identity.
 pub(crate) trait Lattice {
     const ID: f64;
@@ -483,10 +506,27 @@ fn van_herk<L: Lattice>(
     pre.truncate(n);
     suf.resize(n, 0.0);
     suf.truncate(n);
-    // Prefix folds run forwards and suffix folds backwards inside each block; the two
-    // chains are independent, so one loop runs both. (Running four blocks side by side
-    // measured slower: the strided indexing costs more than the latency it hides.)
+    // Prefix folds run forwards and suffix folds backwards inside each block. Each fold is
+    // a dependency chain, so two blocks run side by side: four independent chains.
     let mut b0 = 0;
+    while b0 + 2 * len <= n {
+        let (x0, x1) = buf[b0..b0 + 2 * len].split_at(len);
+        let (p0, p1) = pre[b0..b0 + 2 * len].split_at_mut(len);
+        let (s0, s1) = suf[b0..b0 + 2 * len].split_at_mut(len);
+        let (mut pa0, mut pa1, mut sa0, mut sa1) = (L::ID, L::ID, L::ID, L::ID);
+        for j in 0..len {
+            let k = len - 1 - j;
+            pa0 = L::acc(pa0, x0[j]);
+            p0[j] = pa0;
+            pa1 = L::acc(pa1, x1[j]);
+            p1[j] = pa1;
+            sa0 = L::acc(sa0, x0[k]);
+            s0[k] = sa0;
+            sa1 = L::acc(sa1, x1[k]);
+            s1[k] = sa1;
+        }
+        b0 += 2 * len;
+    }
     while b0 < n {
         let b1 = (b0 + len).min(n);
         let (x, p, s) = (&buf[b0..b1], &mut pre[b0..b1], &mut suf[b0..b1]);
