@@ -9,6 +9,8 @@ use crate::{PictureError, Result};
 
 /// Curves longer than this are thinned (after smoothing) to keep the SVG small.
 const MAX_POINTS: usize = 2000;
+/// Rewards beyond this size are refused: the axis arithmetic would overflow.
+const LIMIT: f64 = 1e300;
 const WIDTH: u32 = 900;
 const HEIGHT: u32 = 540;
 
@@ -27,7 +29,7 @@ struct Stat {
 /// Seeds may have different lengths: each episode is summarised over the seeds that reached
 /// it. Non-finite rewards (NaN, infinities) are skipped, their number is noted in the
 /// legend, and an episode with no finite value leaves a gap. Errors when there are no seeds,
-/// every seed is empty, or no reward is finite.
+/// every seed is empty, no reward is finite, or a reward is beyond ±1e300.
 pub fn learning_curve(title: &str, seeds: &[Vec<f64>], smooth: usize) -> Result<String> {
     if seeds.is_empty() {
         return Err(PictureError::new("a learning curve needs at least one seed"));
@@ -42,6 +44,17 @@ pub fn learning_curve(title: &str, seeds: &[Vec<f64>], smooth: usize) -> Result<
         return Err(PictureError::new(format!(
             "no reward is finite (all {total} values are NaN or infinite)"
         )));
+    }
+    for (s, seed) in seeds.iter().enumerate() {
+        if let Some((e, v)) =
+            seed.iter().enumerate().find(|(_, v)| v.is_finite() && v.abs() > LIMIT)
+        {
+            return Err(PictureError::new(format!(
+                "reward {v:e} in episode {} of seed {} is too large to draw (beyond ±{LIMIT:e})",
+                e + 1,
+                s + 1
+            )));
+        }
     }
     let window = smooth.max(1);
     let smoothed: Vec<Vec<Option<f64>>> =
@@ -150,7 +163,17 @@ fn moving_average(seed: &[f64], window: usize) -> Vec<Option<f64>> {
                 count -= 1;
             }
         }
-        out.push((count > 0).then(|| sum / count as f64));
+        let mean = match count {
+            0 => None,
+            // The running sum can overflow for huge rewards: average term by term instead.
+            _ if !sum.is_finite() => {
+                let from = (i + 1).saturating_sub(window);
+                let finite = seed[from..=i].iter().filter(|v| v.is_finite());
+                Some(finite.map(|v| v / count as f64).sum())
+            }
+            _ => Some(sum / count as f64),
+        };
+        out.push(mean);
     }
     out
 }
@@ -191,18 +214,31 @@ mod tests {
 
     #[test]
     fn moving_average_matches_a_direct_mean_and_skips_non_finite() {
-        let seed = [1.0, f64::NAN, 3.0, 5.0, f64::INFINITY, f64::NAN, f64::NAN, 7.0];
-        let window = 3;
-        let got = moving_average(&seed, window);
-        for (i, value) in got.iter().enumerate() {
-            let from = (i + 1).saturating_sub(window);
-            let finite: Vec<f64> =
-                seed[from..=i].iter().copied().filter(|v| v.is_finite()).collect();
-            let expected =
-                (!finite.is_empty()).then(|| finite.iter().sum::<f64>() / finite.len() as f64);
-            match (value, expected) {
-                (Some(a), Some(b)) => assert!((a - b).abs() < 1e-12, "episode {i}: {a} vs {b}"),
-                (a, b) => assert_eq!(a.is_none(), b.is_none(), "episode {i}"),
+        let big = 1e308;
+        let seeds: [&[f64]; 2] = [
+            &[1.0, f64::NAN, 3.0, 5.0, f64::INFINITY, f64::NAN, f64::NAN, 7.0],
+            // Sums of these overflow although every mean is finite.
+            &[big, big, big, -big, big, big],
+        ];
+        for seed in seeds {
+            let window = 3;
+            let got = moving_average(seed, window);
+            for (i, value) in got.iter().enumerate() {
+                let from = (i + 1).saturating_sub(window);
+                let finite: Vec<f64> =
+                    seed[from..=i].iter().copied().filter(|v| v.is_finite()).collect();
+                let n = finite.len() as f64;
+                let expected =
+                    (!finite.is_empty()).then(|| finite.iter().map(|v| v / n).sum::<f64>());
+                match (value, expected) {
+                    (Some(a), Some(b)) => {
+                        assert!(
+                            (a - b).abs() <= 1e-12 * b.abs().max(1.0),
+                            "episode {i}: {a} vs {b}"
+                        )
+                    }
+                    (a, b) => assert_eq!(a.is_none(), b.is_none(), "episode {i}"),
+                }
             }
         }
     }

@@ -434,3 +434,26 @@ fn the_same_input_gives_the_same_picture() {
         assert_eq!(flat_policy(&grid, "Same", &cells, &terminate).expect("draws"), first);
     }
 }
+
+#[test]
+fn extreme_rewards_still_draw() {
+    let big = 1e300;
+    let cases = [
+        vec![vec![big, -big, big]],
+        vec![vec![big, big], vec![big / 2.0, big]],
+        vec![vec![1e-300, 2e-300, 3e-300]],
+        vec![vec![5e-324, 0.0]],
+        vec![vec![1e15, 1e15 + 1.0]],
+        vec![vec![-big; 3]],
+    ];
+    for seeds in cases {
+        let svg = learning_curve("Extreme", &seeds, 2).unwrap_or_else(|e| panic!("{seeds:?}: {e}"));
+        parse(&svg);
+    }
+    let error =
+        learning_curve("Too big", &[vec![0.0], vec![1.0, -f64::MAX]], 2).expect_err("refused");
+    assert_eq!(
+        error.to_string(),
+        "reward -1.7976931348623157e308 in episode 2 of seed 2 is too large to draw (beyond ±1e300)"
+    );
+}
