@@ -3,7 +3,7 @@
 use plotters::element::EmptyElement;
 use plotters::prelude::*;
 
-use crate::draw::{FONT, LABEL_SIZE, TITLE_SIZE, clean_text, draw_err};
+use crate::draw::{FONT, LABEL_SIZE, TITLE_SIZE, draw_err, title_text};
 use crate::palette::{CURVE, GRID_LINE, INK};
 use crate::{PictureError, Result};
 
@@ -87,7 +87,7 @@ pub fn learning_curve(title: &str, seeds: &[Vec<f64>], smooth: usize) -> Result<
         let root = SVGBackend::with_string(&mut svg, (WIDTH, HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(clean_text(title), (FONT, TITLE_SIZE, FontStyle::Bold).into_font().color(&INK))
+            .caption(title_text(title), (FONT, TITLE_SIZE, FontStyle::Bold).into_font().color(&INK))
             .margin(18)
             .x_label_area_size(56)
             .y_label_area_size(84)

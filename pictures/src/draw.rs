@@ -20,6 +20,8 @@ pub(crate) const LEGEND_ROW: i32 = 24;
 pub(crate) const LEGEND_MARK: i32 = 30;
 /// Longest label shown in full; longer ones are cut to keep the legend narrow.
 const MAX_LABEL_CHARS: usize = 40;
+/// Longest title shown in full.
+const MAX_TITLE_CHARS: usize = 150;
 /// The font family of every text.
 pub(crate) const FONT: &str = "sans-serif";
 
@@ -68,11 +70,21 @@ pub(crate) fn clean_text(text: &str) -> String {
 }
 
 /// Cuts long labels so one odd name cannot make the picture very wide.
-fn shorten(text: &str) -> String {
-    if text.chars().count() <= MAX_LABEL_CHARS {
+pub(crate) fn shorten(text: &str) -> String {
+    shorten_to(text, MAX_LABEL_CHARS)
+}
+
+/// The title as drawn: printable, and cut so that a huge title cannot make a huge picture.
+pub(crate) fn title_text(title: &str) -> String {
+    shorten_to(&clean_text(title), MAX_TITLE_CHARS)
+}
+
+/// Cuts `text` to at most `limit` characters, marking the cut with an ellipsis.
+fn shorten_to(text: &str, limit: usize) -> String {
+    if text.chars().count() <= limit {
         return text.to_owned();
     }
-    let mut short: String = text.chars().take(MAX_LABEL_CHARS - 1).collect();
+    let mut short: String = text.chars().take(limit - 1).collect();
     short.push('…');
     short
 }

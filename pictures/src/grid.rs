@@ -8,7 +8,7 @@ use plotters::style::text_anchor::{HPos, VPos};
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, REGION_ALPHA, clean_text, draw_arrow, draw_cased_line,
     draw_end, draw_err, draw_legend, draw_start, draw_terminate, draw_text, draw_title,
-    legend_size, text_style, text_width,
+    legend_size, shorten, text_style, text_width, title_text,
 };
 use crate::palette::{GRID_LINE, INK, REGION, option_color};
 use crate::{Action, Cell, Grid, MAX_GRID_SIDE, PictureError, Result};
@@ -363,7 +363,8 @@ fn render(
     let grid_w = cell * grid.width as i32;
     let grid_h = cell * grid.height as i32;
     let (legend_w, legend_h) = legend_size(heading, legend);
-    let title_w = text_width(title, crate::draw::TITLE_SIZE) + 32;
+    let title = title_text(title);
+    let title_w = text_width(&title, crate::draw::TITLE_SIZE) + 32;
     let width = (LEFT + grid_w + GAP + legend_w + RIGHT).max(title_w);
     let height = (TOP + grid_h + BOTTOM).max(TOP + legend_h + 16);
     let mut svg = String::new();
@@ -371,7 +372,7 @@ fn render(
         let area =
             SVGBackend::with_string(&mut svg, (width as u32, height as u32)).into_drawing_area();
         area.fill(&WHITE).map_err(draw_err)?;
-        draw_title(&area, title, width / 2)?;
+        draw_title(&area, &title, width / 2)?;
         for region in &grid.regions {
             let cells: BTreeSet<(i64, i64)> = region.cells.iter().copied().collect();
             for &(x, y) in &cells {
@@ -440,7 +441,7 @@ fn draw_region(area: &Area<'_>, canvas: &Canvas, name: &str, cells: &[(i64, i64)
             (ax.min(x), bx.max(x), ay.min(y), by.max(y))
         });
     let (mid_x, mid_y) = ((min_x + max_x) as f64 / 2.0, (min_y + max_y) as f64 / 2.0);
-    let name = clean_text(name);
+    let name = shorten(&clean_text(name));
     let chars = name.chars().count().max(1) as f64;
     let (at, box_w, box_h) = if set.contains(&(mid_x.round() as i64, mid_y.round() as i64))
         && is_full_box(&set, (min_x, max_x, min_y, max_y))

@@ -457,3 +457,22 @@ fn extreme_rewards_still_draw() {
         "reward -1.7976931348623157e308 in episode 2 of seed 2 is too large to draw (beyond ±1e300)"
     );
 }
+
+#[test]
+fn huge_titles_and_names_are_cut() {
+    let long = "x".repeat(100_000);
+    let grid = Grid { width: 2, height: 1, regions: vec![region(&long, &[(0, 0)])] };
+    let choices = vec![((1, 0), long.clone())];
+    let pictures = [
+        options_policy(&grid, &long, &choices, &[]).expect("draws"),
+        learning_curve(&long, &[vec![1.0]], 1).expect("draws"),
+    ];
+    for svg in &pictures {
+        let doc = parse(svg);
+        let width: f64 =
+            doc.root_element().attribute("width").expect("width").parse().expect("number");
+        assert!(width < 5000.0, "{width}");
+        let longest = texts(&doc).iter().map(|t| t.chars().count()).max().unwrap_or(0);
+        assert!(longest < 1000, "{longest}");
+    }
+}
