@@ -55,7 +55,10 @@ pub(crate) struct LegendEntry {
 
 impl LegendEntry {
     pub(crate) fn new(mark: Mark, label: impl AsRef<str>) -> Self {
-        Self { mark, label: shorten(&clean_text(label.as_ref())) }
+        let label = label.as_ref();
+        // An option without a name would leave a bare swatch; say so instead.
+        let label = if label.trim().is_empty() { "(no name)" } else { label };
+        Self { mark, label: shorten(&clean_text(label)) }
     }
 }
 

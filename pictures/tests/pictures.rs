@@ -476,3 +476,10 @@ fn huge_titles_and_names_are_cut() {
         assert!(longest < 1000, "{longest}");
     }
 }
+
+#[test]
+fn an_option_without_a_name_is_listed_as_such() {
+    let svg =
+        options_policy(&small_grid(), "Blank", &[((0, 0), String::new())], &[]).expect("draws");
+    assert!(has_text(&parse(&svg), "(no name)"));
+}
