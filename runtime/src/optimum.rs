@@ -215,6 +215,8 @@ impl Layout {
         let q = (1.0 - self.p) / 3.0;
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         let mut u = vec![0usize; k];
+        let maximise = self.p >= q;
+        let mut w = [(); 4].map(|_| vec![0.0f32; self.n[last]]);
         for (ci, out_cell) in out.chunks_mut(self.per_cell).enumerate() {
             let c = first + ci;
             let dest = self.dest[c];
@@ -238,28 +240,42 @@ impl Layout {
                 let own: usize = (0..last).map(|j| u[j] * self.stride[j]).sum();
                 let nk = self.n[last];
                 let in_c = self.inside[last][c];
-                for uk in 0..len[last] {
-                    let mut w = [0.0f32; 4];
-                    for d in 0..4 {
-                        let to = dest[d];
-                        let in_to = self.inside[last][to];
-                        let nu = if in_to || in_c { 0 } else { (uk + 1).min(nk - 1) };
-                        let kept = ok[d] && (in_to || nu + 1 < nk);
-                        w[d] = kept as u8 as f32 + values[base[d] + nu];
-                    }
-                    let sum = w[0] + w[1] + w[2] + w[3];
-                    let best = if self.p >= q {
-                        w[0].max(w[1]).max(w[2]).max(w[3])
+                let m = len[last];
+                // Per direction, the value of arriving: one slice per direction, filled
+                // with straight-line loops the compiler vectorises.
+                for d in 0..4 {
+                    let to = dest[d];
+                    let in_to = self.inside[last][to];
+                    let wd = &mut w[d][..m];
+                    if in_to || in_c {
+                        // u_k resets: every entry reads the same target.
+                        let kept = ok[d] && (in_to || 1 < nk);
+                        wd.fill(kept as u8 as f32 + values[base[d]]);
                     } else {
-                        w[0].min(w[1]).min(w[2]).min(w[3])
+                        // u_k advances by one, capped at N_k - 1 (expired).
+                        let bonus = ok[d] as u8 as f32;
+                        let src = &values[base[d]..base[d] + nk];
+                        for (uk, x) in wd.iter_mut().enumerate() {
+                            let nu = (uk + 1).min(nk - 1);
+                            *x = if nu + 1 < nk { bonus } else { 0.0 } + src[nu];
+                        }
+                    }
+                }
+                let old_row = &values[c * self.per_cell + own..][..m];
+                let out_row = &mut out_cell[own..][..m];
+                let (wa, wb, wc, wd) = (&w[0][..m], &w[1][..m], &w[2][..m], &w[3][..m]);
+                for i in 0..m {
+                    let sum = wa[i] + wb[i] + wc[i] + wd[i];
+                    let best = if maximise {
+                        wa[i].max(wb[i]).max(wc[i]).max(wd[i])
+                    } else {
+                        wa[i].min(wb[i]).min(wc[i]).min(wd[i])
                     };
                     let tv = q * sum + (self.p - q) * best;
-                    let i = own + uk;
-                    let old = values[c * self.per_cell + i];
-                    let diff = tv - old;
+                    let diff = tv - old_row[i];
                     lo = lo.min(diff);
                     hi = hi.max(diff);
-                    out_cell[i] = old + beta * diff - shift;
+                    out_row[i] = old_row[i] + beta * diff - shift;
                 }
                 // Odometer over the prefix dimensions.
                 let mut done = true;

@@ -6,7 +6,8 @@
 //! state, `primitives` with each one's `terminate` set as a list of states. Beyond the
 //! contract the document holds `max_steps` and `q_tables`, so that training can continue:
 //! every Q-value is stored as the 16 hex digits of its IEEE-754 bits, which reload bit for
-//! bit, infinities and NaNs included.
+//! bit, infinities and NaNs included. Readers ignore fields they do not know, as "at
+//! least" in the contract asks.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -34,7 +35,6 @@ pub struct Agent {
 
 /// The `policy.json` document.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct Policy {
     /// The spec's name.
     pub spec: String,
@@ -60,7 +60,6 @@ pub struct Policy {
 
 /// The environment part of `policy.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct EnvInfo {
     /// The environment's name.
     pub name: String,
@@ -70,7 +69,6 @@ pub struct EnvInfo {
 
 /// A member of the options set in `policy.json`.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct OptionInfo {
     /// The option's name.
     pub name: String,
@@ -80,7 +78,6 @@ pub struct OptionInfo {
 
 /// A primitive option in `policy.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct PrimitiveInfo {
     /// The option's name.
     pub name: String,
@@ -90,7 +87,6 @@ pub struct PrimitiveInfo {
 
 /// One row of a policy table: in `state`, choose `choice`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct Entry {
     /// The state, as a map from variable name to value.
     pub state: Map<String, Value>,
@@ -100,7 +96,6 @@ pub struct Entry {
 
 /// The Q-tables in `policy.json`; each value is the 16 hex digits of its `f64` bits.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct QTablesDoc {
     /// Per primitive option, its table in state-major order (`s * actions + a`).
     pub flat: BTreeMap<String, Vec<String>>,

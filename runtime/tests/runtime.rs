@@ -282,3 +282,37 @@ fn greedy_rollouts_follow_option_legs() {
         }
     }
 }
+
+#[test]
+fn persistent_regions_are_read_off_the_task() {
+    use hstl_runtime::robustness::{Bound, CmpOp, Interval};
+    use hstl_runtime::spec::persistent_regions;
+    let r = common::cmp(0, CmpOp::Gt, 3.0);
+    let ev = |start, end| Formula::Eventually(Interval { start, end }, Box::new(r.clone()));
+    let always = |f: Formula| Formula::Always(Interval::ALL, Box::new(f));
+    // (task, the N_j read off it, or None when the task has another form)
+    let cases = [
+        (always(ev(0, Bound::Exclusive(40))), Some(vec![40])),
+        (always(ev(0, Bound::Inclusive(40))), Some(vec![41])),
+        (
+            always(Formula::And(vec![ev(0, Bound::Exclusive(5)), ev(0, Bound::Inclusive(7))])),
+            Some(vec![5, 8]),
+        ),
+        (always(ev(1, Bound::Exclusive(40))), None),
+        (always(ev(0, Bound::Unbounded)), None),
+        (always(Formula::Or(vec![ev(0, Bound::Exclusive(5))])), None),
+        (ev(0, Bound::Exclusive(40)), None),
+        (
+            Formula::Always(
+                Interval { start: 0, end: Bound::Exclusive(9) },
+                Box::new(ev(0, Bound::Exclusive(4))),
+            ),
+            None,
+        ),
+    ];
+    for (task, want) in cases {
+        let got =
+            persistent_regions(&task).map(|rs| rs.into_iter().map(|(_, n)| n).collect::<Vec<_>>());
+        assert_eq!(got, want, "{task:?}");
+    }
+}
