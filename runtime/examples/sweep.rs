@@ -3,7 +3,8 @@
 //! O_T2 vs O_T1 reward difference.
 //!
 //! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES] [VARIANT]`
-//! (VARIANT, such as `O_T2 argmax`, runs that variant alone; EPISODES `-` keeps 1200).
+//! (VARIANT, such as `O_T2 argmax`, runs that variant alone; EPISODES `-` keeps 1200;
+//! SEEDS 0 stops after the optimum and the hand-written cycle).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -84,6 +85,9 @@ fn main() {
     let c = window_rate(&env, &mut cycle, &regions, WindowConfig::default(), &mut rng)
         .expect("valid config");
     println!("nearest-cell entry cycle A->B->C: {:.4} (W/W* {:.3})", c.rate, c.rate / w_star);
+    if seeds == 0 {
+        return;
+    }
     let mut tails = Vec::new();
     for (permutations, entry, name) in [
         (false, false, "O_T1 argmax"),
