@@ -1,0 +1,110 @@
+//! The macro's work as plain functions over `proc_macro2` tokens, so it runs (and is
+//! tested and benchmarked) outside the compiler.
+
+pub mod codegen;
+pub mod report;
+pub mod source;
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use hstl_lang::{Checked, Diagnostic, Severity};
+use proc_macro2::{Span, TokenStream, TokenTree};
+use quote::quote;
+
+use report::Target;
+use source::Source;
+
+/// Expands the body of `hstl! { ... }`: either hstl items, or `include "path"` naming a
+/// file relative to `CARGO_MANIFEST_DIR`.
+pub fn expand(input: TokenStream) -> TokenStream {
+    match include_path(&input) {
+        Some(Ok((path, spans))) => expand_file(&path, spans),
+        Some(Err(e)) => e.to_compile_error(),
+        None => expand_tokens(input),
+    }
+}
+
+/// Expands hstl items given as tokens.
+pub fn expand_tokens(input: TokenStream) -> TokenStream {
+    let source = Source::from_tokens(input);
+    let checked = hstl_lang::check(&source.text);
+    emit(&Target::Tokens(&source), &source.text, &checked, TokenStream::new())
+}
+
+/// Expands the hstl file at `path` (relative to `CARGO_MANIFEST_DIR`), reporting at
+/// `spans` (the `include "..."` tokens).
+pub fn expand_file(path: &str, spans: (Span, Span)) -> TokenStream {
+    let full = resolve(path);
+    let text = match std::fs::read_to_string(&full) {
+        Ok(t) => t,
+        Err(e) => {
+            let msg = format!("cannot read `{}`: {e}", full.display());
+            return report::spanned_error(spans.0, spans.1, &msg).to_compile_error();
+        }
+    };
+    let checked = hstl_lang::check(&text);
+    // Ties the crate to the file, so cargo rebuilds when it changes.
+    let abs = full.to_string_lossy().into_owned();
+    let track = quote!(
+        const _: &str = ::core::include_str!(#abs);
+    );
+    emit(&Target::File { path, text: &text, spans }, &text, &checked, track)
+}
+
+fn emit(target: &Target, text: &str, checked: &Checked, mut out: TokenStream) -> TokenStream {
+    let mut seen = HashSet::new();
+    for spec in &checked.specs {
+        if !seen.insert(codegen::module_name(spec)) {
+            continue;
+        }
+        let complete = !checked
+            .diagnostics
+            .iter()
+            .any(|d| d.severity == Severity::Error && overlaps(d, &spec.range));
+        out.extend(codegen::spec_module(spec, text, complete));
+    }
+    out.extend(report::warnings(target, &checked.diagnostics));
+    if let Some(e) = report::errors(target, &checked.diagnostics) {
+        let errors = e.to_compile_error();
+        out.extend(quote!({ #errors }));
+    }
+    out
+}
+
+fn overlaps(d: &Diagnostic, range: &std::ops::Range<usize>) -> bool {
+    d.range.start < range.end && range.start <= d.range.end
+}
+
+/// `include "path"` (with an optional `;`): the path and the spans to report at.
+fn include_path(input: &TokenStream) -> Option<syn::Result<(String, (Span, Span))>> {
+    let tts: Vec<TokenTree> = input.clone().into_iter().collect();
+    let (kw, rest) = tts.split_first()?;
+    let TokenTree::Ident(kw) = kw else { return None };
+    if kw != "include" {
+        return None;
+    }
+    let first = kw.span();
+    let err =
+        |span: Span| report::spanned_error(first, span, "expected `include \"path/to/spec.hstl\"`");
+    let lit = match rest {
+        [TokenTree::Literal(l)] => l,
+        [TokenTree::Literal(l), TokenTree::Punct(p)] if p.as_char() == ';' => l,
+        _ => return Some(Err(err(rest.last().map_or(first, TokenTree::span)))),
+    };
+    match syn::parse2::<syn::LitStr>(TokenTree::Literal(lit.clone()).into()) {
+        Ok(s) => Some(Ok((s.value(), (first, lit.span())))),
+        Err(_) => Some(Err(err(lit.span()))),
+    }
+}
+
+fn resolve(path: &str) -> PathBuf {
+    let p = Path::new(path);
+    if p.is_absolute() {
+        return p.to_path_buf();
+    }
+    match std::env::var_os("CARGO_MANIFEST_DIR") {
+        Some(dir) => Path::new(&dir).join(p),
+        None => p.to_path_buf(),
+    }
+}
