@@ -1,10 +1,15 @@
-//! Scratch.
+//! Scratch: times parse and check of a file.
 fn main() {
-    let path = std::env::args().nth(1).unwrap();
-    let src = std::fs::read_to_string(&path).unwrap();
-    let c = hstl_lang::check(&src);
-    if std::env::args().nth(2).is_some() {
-        println!("{:#?}", c.specs);
+    let path = std::env::args().nth(1).unwrap_or_default();
+    let src = std::fs::read_to_string(&path).unwrap_or_default();
+    let t = std::time::Instant::now();
+    for _ in 0..10 {
+        std::hint::black_box(hstl_lang::parse(&src));
     }
-    print!("{}", hstl_lang::render_plain(&path, &src, &c.diagnostics));
+    eprintln!("parse {:?}", t.elapsed() / 10);
+    let t = std::time::Instant::now();
+    for _ in 0..10 {
+        std::hint::black_box(hstl_lang::check(&src));
+    }
+    eprintln!("check {:?}", t.elapsed() / 10);
 }

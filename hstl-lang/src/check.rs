@@ -14,6 +14,10 @@ pub const MAX_DIAGNOSTICS: usize = 200;
 /// The finite-domain checks enumerate at most this many states.
 pub const MAX_DOMAIN_STATES: u64 = 1_000_000;
 
+/// The finite-domain checks evaluate at most this many formulas (states times the
+/// formulas and lets evaluated per state).
+pub const MAX_DOMAIN_WORK: u64 = 20_000_000;
+
 /// The expanded options set may hold at most this many options.
 pub const MAX_OPTIONS: u64 = 10_000;
 
@@ -1352,6 +1356,27 @@ impl Cx<'_> {
             }
         }
         let mut ev = StateEvaluator::new(out, &roots);
+        // Bound the time spent: each state evaluates the lets the regions need.
+        let work = size.saturating_mul((ev.needed_lets() + roots.len()) as u64);
+        if work > MAX_DOMAIN_WORK {
+            let r =
+                out.state_vars[0].range.start..out.state_vars[out.state_vars.len() - 1].range.end;
+            self.push(
+                Diagnostic::new(
+                    "HSTL022",
+                    r,
+                    format!(
+                        "the finite-domain checks would evaluate {} formulas ({} states, {} lets), more than {}; they are skipped",
+                        thousands(work),
+                        thousands(size),
+                        ev.needed_lets(),
+                        thousands(MAX_DOMAIN_WORK)
+                    ),
+                )
+                .with_help("shrink the `int` ranges, or shorten the chains of lets the regions use"),
+            );
+            return;
+        }
         let n = size as usize;
         let states = |k: usize| -> Vec<f64> {
             let mut s = vec![0.0; out.state_vars.len()];

@@ -447,6 +447,11 @@ impl<'a> StateEvaluator<'a> {
         StateEvaluator { spec, needed, values: vec![f64::NAN; spec.lets.len()] }
     }
 
+    /// How many lets [`StateEvaluator::load`] computes per valuation.
+    pub fn needed_lets(&self) -> usize {
+        self.needed.len()
+    }
+
     /// Computes the needed lets on `valuation`.
     pub fn load(&mut self, valuation: &[f64]) {
         for k in 0..self.needed.len() {

@@ -260,8 +260,9 @@ Fix: add parentheses: `(a until b) until c` or `a until (b until c)`.",
         severity: W,
         summary: "the declared domain is too large to enumerate",
         explanation: "The finite-domain checks (HSTL018, HSTL020, HSTL102, HSTL103, argmax \
-termination sets) enumerate every state of the declared `int` domain, up to 1,000,000 states. \
-Beyond that they are skipped, and tabular learning would be slow anyway.\n\n\
+termination sets) enumerate every state of the declared `int` domain, up to 1,000,000 states \
+and 20,000,000 formula evaluations (states times the lets the regions use). Beyond that they \
+are skipped, and tabular learning would be slow anyway.\n\n\
 Example:\n    state { x: int in 0..=9999, y: int in 0..=9999 }\n\n\
 Fix: shrink the ranges, or accept that those checks are skipped.",
     },

@@ -1,22 +1,57 @@
 //! The hstl language: grammar, syntax tree, name resolution, checks and the checked spec.
 //!
-//! Parsing and checking never fail: they return what they could build together with a
-//! list of plain-data [`Diagnostic`]s. This crate knows nothing of miette, LSP or proc macros.
+//! # Pipeline
+//! 1. [`parse`] (module [`parser`]): a small lexer records every comment and token; a
+//!    balanced-delimiter scanner splits the file into spec headers and items (an item ends
+//!    at a `;` or a closing `}` at depth 0, or where the next item keyword starts); pest
+//!    (`grammar.pest`) parses each piece on its own. A piece that does not parse gives one
+//!    `HSTL001` at the exact position with what was expected in words, and is skipped, so
+//!    one broken item never hides errors in the others. The result is a [`syntax::File`]
+//!    with a byte range on every node and name, doc comments on the nodes they document,
+//!    and every comment's range (for a formatter).
+//! 2. [`check()`] (module [`check`]): resolves names (state variables and `let`s share one
+//!    namespace, options have their own), detects `let` cycles, classifies lets (state or
+//!    temporal), checks options, the options set and learning parameters, and runs the
+//!    finite-domain checks by enumerating the declared `int` domain (up to
+//!    1,000,000 states). It builds one [`CheckedSpec`] per spec: names resolved to indices,
+//!    defaults filled in, the options set expanded.
+//! 3. Diagnostics are plain data ([`Diagnostic`]); [`render_plain`] renders them like
+//!    rustc, [`LineIndex`] converts byte offsets to lines and columns (characters and
+//!    UTF-16), and [`codes`] explains every code.
+//!
+//! # Invariants
+//! - [`parse`] and [`check()`] never fail and never panic, whatever the input: problems
+//!   are diagnostics. Every diagnostic range lies on char boundaries inside the source.
+//! - Syntax trees stay shallow: brackets nested more than [`parser::MAX_NESTING`] deep and
+//!   formulas taller than [`parser::MAX_HEIGHT`] are reported, so later recursive passes
+//!   cannot exhaust the stack. Chains of lets are walked iteratively.
+//! - Diagnostics are sorted by position, deduplicated and capped at
+//!   [`check::MAX_DIAGNOSTICS`] per file; one `HSTL024` says how many more there were.
+//! - A [`CheckedSpec`] is always returned for a spec whose header parsed; where a part did
+//!   not check it holds [`CFormulaKind::Invalid`] / [`CExprKind::Invalid`], and an error
+//!   was reported. The finite-domain checks run only on specs without errors.
+//! - Messages have no trailing period; codes are stable (see [`codes::CODES`]).
+//!
+//! # Regions
+//! The warnings `HSTL102`/`HSTL103` concern *regions*: a state formula that an option
+//! reaches (its `reach`, or the `let` its name names), or the `Rj` of a task of the form
+//! `always[0..] (eventually[0..N1] R1 && ... )`. They are reported at the `let`'s name
+//! (or at the formula when it is written inline).
+//!
+//! This crate knows nothing of miette, LSP, syn or proc macros: each edge converts.
 
+pub mod check;
+pub mod checked;
 pub mod codes;
 pub mod diagnostic;
 pub mod parser;
+pub mod position;
+pub mod render;
 pub mod syntax;
-
-pub use diagnostic::{Diagnostic, Label, Severity};
-pub use parser::{Parsed, parse};
-pub mod check;
-pub mod checked;
 
 pub use check::{Checked, check};
 pub use checked::*;
-pub mod position;
-pub mod render;
-
+pub use diagnostic::{Diagnostic, Label, Severity};
+pub use parser::{Parsed, parse};
 pub use position::{LineIndex, Position};
 pub use render::render_plain;

@@ -389,8 +389,11 @@ impl Splitter<'_, '_> {
             Ok(mut pairs) => {
                 let entry = pairs.next()?;
                 let inner = entry.into_inner().find(|p| p.as_rule() != Rule::EOI)?;
-                let mut b =
-                    Builder { offset: range.start, ends: self.ends, diagnostics: Vec::new() };
+                let mut b = Builder {
+                    offset: range.start,
+                    ends: &self.ends[a..b],
+                    diagnostics: Vec::new(),
+                };
                 match b.item(inner) {
                     Ok(item) => {
                         self.diagnostics.append(&mut b.diagnostics);
