@@ -213,10 +213,11 @@ impl Layout {
         let k = self.n.len();
         let last = k - 1;
         let q = (1.0 - self.p) / 3.0;
-        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         let mut u = vec![0usize; k];
         let maximise = self.p >= q;
         let mut w = [(); 4].map(|_| vec![0.0f32; self.n[last]]);
+        let mut diffs = vec![0.0f32; self.n[last]];
+        let (mut lo8, mut hi8) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
         for (ci, out_cell) in out.chunks_mut(self.per_cell).enumerate() {
             let c = first + ci;
             let dest = self.dest[c];
@@ -252,13 +253,15 @@ impl Layout {
                         let kept = ok[d] && (in_to || 1 < nk);
                         wd.fill(kept as u8 as f32 + values[base[d]]);
                     } else {
-                        // u_k advances by one, capped at N_k - 1 (expired).
+                        // u_k advances by one, capped at N_k - 1 (expired): entry `uk` reads
+                        // `uk + 1`, and keeps its windows while that is below N_k - 1.
                         let bonus = ok[d] as u8 as f32;
                         let src = &values[base[d]..base[d] + nk];
-                        for (uk, x) in wd.iter_mut().enumerate() {
-                            let nu = (uk + 1).min(nk - 1);
-                            *x = if nu + 1 < nk { bonus } else { 0.0 } + src[nu];
+                        let split = nk.saturating_sub(2);
+                        for (x, &v) in wd[..split].iter_mut().zip(&src[1..]) {
+                            *x = bonus + v;
                         }
+                        wd[split..].fill(src[nk - 1]);
                     }
                 }
                 let old_row = &values[c * self.per_cell + own..][..m];
@@ -273,9 +276,20 @@ impl Layout {
                     };
                     let tv = q * sum + (self.p - q) * best;
                     let diff = tv - old_row[i];
-                    lo = lo.min(diff);
-                    hi = hi.max(diff);
+                    diffs[i] = diff;
                     out_row[i] = old_row[i] + beta * diff - shift;
+                }
+                // Eight lanes, so that the reduction vectorises.
+                let (chunks, rest) = diffs[..m].as_chunks::<8>();
+                for chunk in chunks {
+                    for l in 0..8 {
+                        lo8[l] = if chunk[l] < lo8[l] { chunk[l] } else { lo8[l] };
+                        hi8[l] = if chunk[l] > hi8[l] { chunk[l] } else { hi8[l] };
+                    }
+                }
+                for &d in rest {
+                    lo8[0] = lo8[0].min(d);
+                    hi8[0] = hi8[0].max(d);
                 }
                 // Odometer over the prefix dimensions.
                 let mut done = true;
@@ -294,6 +308,8 @@ impl Layout {
                 }
             }
         }
+        let lo = lo8.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = hi8.iter().copied().fold(f32::NEG_INFINITY, f32::max);
         (lo, hi)
     }
 
