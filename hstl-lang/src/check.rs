@@ -714,11 +714,7 @@ impl Cx<'_> {
 
     /// Where a formula stops being a state formula: the temporal node, or a let reference
     /// to a temporal let (with that let's name range).
-    fn temporal_site(
-        &self,
-        f: &CFormula,
-        lets: &[LetInfo],
-    ) -> Option<(Range<usize>, Option<(Range<usize>, String)>)> {
+    fn temporal_site(&self, f: &CFormula, lets: &[LetInfo]) -> Option<TemporalSite> {
         match &f.kind {
             CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
                 Some((f.range.clone(), None))
@@ -980,11 +976,11 @@ impl Cx<'_> {
             Some((OptionsKind::Sequences(legs), r))
             | Some((OptionsKind::Permutations(legs), r)) => {
                 let perm = matches!(item.map(|i| &i.kind), Some(OptionsKind::Permutations(_)));
-                if let Some(base) = resolve(self, legs) {
-                    if self.set_size_ok(base.len(), perm, r.clone()) {
-                        for seq in expand(&base, perm) {
-                            set.push(make(seq, r.clone()));
-                        }
+                if let Some(base) = resolve(self, legs)
+                    && self.set_size_ok(base.len(), perm, r.clone())
+                {
+                    for seq in expand(&base, perm) {
+                        set.push(make(seq, r.clone()));
                     }
                 }
             }
@@ -1288,18 +1284,20 @@ impl Cx<'_> {
             }
         }
         while let Some(i) = stack.pop() {
-            if let Some(l) = out.lets.get_mut(i) {
-                if !l.used {
-                    l.used = true;
-                    let f = l.formula.clone();
-                    push_refs(&f, &mut stack);
-                }
+            if let Some(l) = out.lets.get_mut(i)
+                && !l.used
+            {
+                l.used = true;
+                let f = l.formula.clone();
+                push_refs(&f, &mut stack);
             }
         }
     }
 
     /// The checks that enumerate the declared `int` domain: empty and full regions,
     /// states where no option can start, and gaps inside sequences.
+    // `k` numbers a state and indexes several per-option tables at once.
+    #[allow(clippy::needless_range_loop)]
     fn finite_domain(
         &mut self,
         out: &CheckedSpec,
@@ -1507,13 +1505,16 @@ fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);
     }
     out
 }
+
+/// Where a formula stops being a state formula, and the temporal let it goes through.
+type TemporalSite = (Range<usize>, Option<(Range<usize>, String)>);
 
 fn value_range(v: &ParamValue) -> Range<usize> {
     match v {

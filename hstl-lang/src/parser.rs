@@ -429,10 +429,11 @@ impl Splitter<'_, '_> {
                 attempts.expected_tokens().iter().map(ToString::to_string).collect();
             expected.extend(describe_tokens(tokens));
         }
-        if expected.is_empty() && far == loc {
-            if let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant {
-                expected.extend(positives.iter().filter_map(|r| rule_words(*r)).map(String::from));
-            }
+        if expected.is_empty()
+            && far == loc
+            && let pest::error::ErrorVariant::ParsingError { positives, .. } = &e.variant
+        {
+            expected.extend(positives.iter().filter_map(|r| rule_words(*r)).map(String::from));
         }
         let mut seen = std::collections::BTreeSet::new();
         expected.retain(|w| seen.insert(w.clone()));
@@ -474,7 +475,7 @@ fn describe_tokens(tokens: Vec<String>) -> Vec<String> {
     const NOISE: [&str; 8] = ["/*", "//", "\u{feff}", ".", "e", "E", "BUILTIN_RULE", "+"];
     let mut set: std::collections::BTreeSet<String> = tokens
         .into_iter()
-        .filter(|t| !t.trim().is_empty() && !(t.len() == 4 && &t[1..3] == ".."))
+        .filter(|t| !(t.trim().is_empty() || t.len() == 4 && t.get(1..3) == Some("..")))
         .collect();
     // `+` alone is the exponent sign of a number; as an operator it comes with `*` and `/`.
     if set.contains("*") {
