@@ -40,6 +40,8 @@ pub struct Learner<'e, E: Env> {
     q: QTables,
     /// `gamma_powers[i]`: the options gamma to the power `i`, grown on demand.
     gamma_powers: Vec<f64>,
+    /// Every state by index, so that a step does not rebuild its state from the index.
+    states: Vec<E::State>,
 }
 
 /// The learned values, enough to continue training.
@@ -105,7 +107,17 @@ impl<'e, E: Env> Learner<'e, E> {
             choices: 0,
         };
         let reward = SegmentReward { scorer: TabularScorer::new(&spec.task, &tables.trace) };
-        Ok(Learner { env, spec: spec.clone(), tables, view, reward, q, gamma_powers: vec![1.0] })
+        let states = (0..tables.states).filter_map(|s| env.state(s)).collect();
+        Ok(Learner {
+            env,
+            spec: spec.clone(),
+            tables,
+            view,
+            reward,
+            q,
+            gamma_powers: vec![1.0],
+            states,
+        })
     }
 
     /// Continues from earlier Q-tables (for instance from a loaded `policy.json`).
@@ -205,8 +217,8 @@ impl<'e, E: Env> Learner<'e, E> {
                 } else {
                     argmax(&self.q.flat[p][s * actions..][..actions])
                 };
-                let next = match self.env.state(s) {
-                    Some(state) => self.env.index(&self.env.step(&state, a, rng)),
+                let next = match self.states.get(s) {
+                    Some(state) => self.env.index(&self.env.step(state, a, rng)),
                     None => s,
                 };
                 self.update_flat(s, a, next);
