@@ -77,6 +77,17 @@ impl Tables {
                 state.join(", ")
             )));
         }
+        for (o, seq) in spec.options.iter().zip(&legs) {
+            for pair in seq.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                if (0..states).any(|s| term[a][s] && !init[b][s]) {
+                    return Err(Error::Spec(format!(
+                        "in option {}, {} can terminate outside the initiation set of {}",
+                        o.name, spec.primitives[a].name, spec.primitives[b].name
+                    )));
+                }
+            }
+        }
         let remaining = legs
             .iter()
             .map(|seq| {

@@ -107,12 +107,39 @@ fn bad_environments_are_errors() {
     }
     let params = serde_json::json!({ "width": 15, "height": "15", "p": 0.7 });
     assert!(GridWorld::from_params(&params).is_err());
+    // Evaluation and value-iteration settings.
+    let env = GridWorld::default();
+    let spec = small(false, false);
+    let table = RegionTable::new(&spec, &env).unwrap();
+    let agent = Learner::new(&spec, &env).unwrap().agent();
+    for config in [
+        WindowConfig { starts: 0, ..WindowConfig::default() },
+        WindowConfig { burn_in: 2000, ..WindowConfig::default() },
+    ] {
+        let mut c = AgentController::new(&agent);
+        assert!(window_rate(&env, &mut c, &table, config, &mut seeded_rng(0)).is_err());
+    }
+    let other = GridWorld::new(5, 5, 0.7).unwrap();
+    let mut c = AgentController::new(&agent);
+    assert!(
+        window_rate(&other, &mut c, &table, WindowConfig::default(), &mut seeded_rng(0)).is_err()
+    );
+    for config in [
+        SolveConfig { damping: 0.0, ..SolveConfig::default() },
+        SolveConfig { tolerance: f64::NAN, ..SolveConfig::default() },
+    ] {
+        assert!(solve(&env, &table, config).is_err());
+    }
+    assert!(solve(&other, &table, SolveConfig::default()).is_err());
+    let mut no_regions = spec.clone();
+    no_regions.regions.clear();
+    assert!(RegionTable::new(&no_regions, &env).is_err());
 }
 
 #[test]
 fn bad_specs_are_errors() {
     type Break = fn(&mut TaskSpec);
-    let cases: [(&str, Break); 9] = [
+    let cases: [(&str, Break); 10] = [
         ("is not a variable of environment", |s| s.state_vars[0].name = "z".into()),
         ("no finite int range", |s| s.state_vars[1].domain = None),
         ("outside its declared domain", |s| s.state_vars[0].domain = Some(0..=9)),
@@ -124,6 +151,9 @@ fn bad_specs_are_errors() {
         ("flat gamma", |s| s.learn.flat.gamma = 1.5),
         ("episodes must be > 0", |s| s.learn.episodes = 0),
         ("the regions do not match", |s| s.regions[0].horizon = 30),
+        ("A can terminate outside the initiation set of B", |s| {
+            s.primitives[1].init = common::cmp(0, hstl_runtime::robustness::CmpOp::Gt, 7.0)
+        }),
     ];
     let env = GridWorld::default();
     for (want, change) in cases {
