@@ -25,6 +25,9 @@ const INF: f64 = f64::INFINITY;
 const NEG_INF: f64 = f64::NEG_INFINITY;
 /// Samples per chunk for state formulas: a handful of chunk buffers stay in L1.
 const CHUNK: usize = 512;
+/// The least number of steps per piece of a bounded temporal formula: its buffers stay
+/// in L2.
+const PIECE: usize = 8192;
 
 /// A reusable evaluator: keeps its buffers between calls, so repeated evaluation (the RL
 /// reward pattern) allocates nothing once warmed up.
@@ -112,7 +115,38 @@ impl Evaluator {
     }
 
     /// The signal of `f` over the first `n` steps, in a buffer from the pool.
+    ///
+    /// A temporal formula with a finite horizon `H` is evaluated in pieces of `C` steps:
+    /// `rho(t)` reads only `t ..= t + H`, so each piece needs the `H` steps after it and
+    /// nothing else, and its windows are clipped only where the trace really ends. Every
+    /// buffer then stays in cache; the overlap costs `H / C` extra work.
     fn eval(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
+        let piece = match f.horizon() {
+            Some(h) if !f.is_state_formula() => PIECE.max(h.saturating_mul(16)),
+            _ => usize::MAX,
+        };
+        if n / 2 <= piece {
+            return self.eval_whole(f, cols, n);
+        }
+        let h = f.horizon().unwrap_or(0);
+        let mut out = self.take(n);
+        let mut sub: Vec<&[f64]> = Vec::with_capacity(cols.len());
+        let mut lo = 0;
+        while lo < n {
+            let hi = (lo + piece).min(n);
+            let end = hi.saturating_add(h).min(n);
+            sub.clear();
+            sub.extend(cols.iter().map(|c| &c[lo..end]));
+            let v = self.eval_whole(f, &sub, end - lo);
+            out[lo..hi].copy_from_slice(&v[..hi - lo]);
+            self.pool.push(v);
+            lo = hi;
+        }
+        out
+    }
+
+    /// [`Evaluator::eval`] in one piece.
+    fn eval_whole(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
         if f.is_state_formula() {
             let mut out = self.take(n);
             let mut lo = 0;
