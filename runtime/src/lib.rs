@@ -3,7 +3,7 @@
 //!
 //! - [`spec`]: the plain data a checked spec lowers into ([`TaskSpec`]) and the [`Spec`]
 //!   trait generated code implements.
-//! - [`env`]: the [`Env`] trait (gymnasium conventions) and the [`GridWorld`] of the paper.
+//! - [`env`](mod@env): the [`Env`] trait (gymnasium conventions) and the [`GridWorld`] of the paper.
 //! - [`learn`]: Algorithm 1: flat Q-learning per primitive option, options Q-learning with
 //!   intra-option updates, seeded and bit-for-bit reproducible.
 //! - [`policy`]: greedy policies and the `policy.json` document.
