@@ -9,7 +9,7 @@
 //!    one broken item never hides errors in the others. The result is a [`syntax::File`]
 //!    with a byte range on every node and name, doc comments on the nodes they document,
 //!    and every comment's range (for a formatter).
-//! 2. [`check()`] (module [`check`]): resolves names (state variables and `let`s share one
+//! 2. [`check()`] (module [`check`](mod@check)): resolves names (state variables and `let`s share one
 //!    namespace, options have their own), detects `let` cycles, classifies lets (state or
 //!    temporal), checks options, the options set and learning parameters, and runs the
 //!    finite-domain checks by enumerating the declared `int` domain (up to

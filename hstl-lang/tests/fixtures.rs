@@ -187,3 +187,21 @@ fn diagnostics_are_deduplicated_and_capped() {
         d.iter().map(|d| (d.range.start, d.range.end, d.code, d.message.clone())).collect();
     assert_eq!(unique.len(), d.len());
 }
+
+#[test]
+fn every_code_written_in_the_sources_is_in_the_table() {
+    let src_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut found = BTreeSet::new();
+    for entry in std::fs::read_dir(&src_dir).expect("src").filter_map(Result::ok) {
+        let text = std::fs::read_to_string(entry.path()).unwrap_or_default();
+        for (i, _) in text.match_indices("\"HSTL") {
+            if let Some(code) = text.get(i + 1..i + 8) {
+                found.insert(code.to_string());
+            }
+        }
+    }
+    assert!(found.len() >= 20, "{found:?}");
+    for code in found {
+        assert!(codes::lookup(&code).is_some(), "{code} is emitted but not in codes::CODES");
+    }
+}
