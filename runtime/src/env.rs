@@ -107,14 +107,14 @@ impl GridWorld {
 
     /// Where `action` leads from `cell` without slipping; off the grid stays in place.
     pub fn intended(&self, cell: Cell, action: usize) -> Cell {
-        let Cell { x, y } = cell;
-        match action {
-            0 if y + 1 < self.height => Cell { x, y: y + 1 },
-            1 if y > 0 => Cell { x, y: y - 1 },
-            2 if x > 0 => Cell { x: x - 1, y },
-            3 if x + 1 < self.width => Cell { x: x + 1, y },
-            _ => cell,
-        }
+        // Only one coordinate changes, so clamping it to the grid is staying in place;
+        // written without branches because slips make the action unpredictable.
+        const DX: [isize; 4] = [0, 0, -1, 1];
+        const DY: [isize; 4] = [1, -1, 0, 0];
+        let Some((&dx, &dy)) = DX.get(action).zip(DY.get(action)) else { return cell };
+        let x = cell.x.saturating_add_signed(dx).min(self.width - 1);
+        let y = cell.y.saturating_add_signed(dy).min(self.height - 1);
+        Cell { x, y }
     }
 }
 
@@ -171,14 +171,11 @@ impl Env for GridWorld {
         }
         // One uniform draw decides both whether the robot slips and where: below `p` it
         // takes the chosen action, the rest of [0, 1) splits evenly over the other three.
+        // Computed without branches: the slip is a coin flip the CPU cannot predict.
         let u = rng.random::<f64>();
-        let taken = if u < self.p {
-            action
-        } else {
-            let k = (((u - self.p) / (1.0 - self.p)) * 3.0) as usize;
-            let k = k.min(2);
-            if k >= action { k + 1 } else { k }
-        };
+        let k = (((u - self.p) / (1.0 - self.p) * 3.0) as usize).min(2);
+        let other = k + usize::from(k >= action);
+        let taken = if u < self.p { action } else { other };
         self.intended(*state, taken)
     }
 }
