@@ -100,7 +100,15 @@ impl Evaluator {
     }
 
     fn take(&mut self, n: usize) -> Vec<f64> {
-        let mut v = self.pool.pop().unwrap_or_default();
+        // The shortest buffer that is long enough, else the longest: growing a buffer's
+        // length writes zeros, so big buffers are kept for big requests.
+        let fit =
+            self.pool.iter().enumerate().filter(|(_, v)| v.len() >= n).min_by_key(|(_, v)| v.len());
+        let pick = fit.or_else(|| self.pool.iter().enumerate().max_by_key(|(_, v)| v.len()));
+        let mut v = match pick.map(|(i, _)| i) {
+            Some(i) => self.pool.swap_remove(i),
+            None => Vec::new(),
+        };
         // Every operator overwrites its whole output, so stale values may stay.
         if v.len() < n {
             v.resize(n, 0.0);
