@@ -142,7 +142,7 @@ impl<'a> Gen<'a> {
             quote! {
                 // An integral value inside the i64 range, or nothing.
                 fn int(v: f64) -> ::core::option::Option<i64> {
-                    if v.fract() == 0.0 && v >= -9_223_372_036_854_775_808.0 && v < 9_223_372_036_854_775_808.0 {
+                    if v.fract() == 0.0 && (-9_223_372_036_854_775_808.0..9_223_372_036_854_775_808.0).contains(&v) {
                         ::core::option::Option::Some(v as i64)
                     } else {
                         ::core::option::Option::None

@@ -66,8 +66,8 @@ fn emit(target: &Target, text: &str, checked: &Checked, mut out: TokenStream) ->
     }
     out.extend(report::warnings(target, &checked.diagnostics));
     if let Some(e) = report::errors(target, &checked.diagnostics) {
-        let errors = e.to_compile_error();
-        out.extend(quote!({ #errors }));
+        // `compile_error! { ... }` with braces: valid in item position without a `;`.
+        out.extend(e.to_compile_error());
     }
     out
 }
