@@ -523,14 +523,17 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         Rule::ident => "a name",
         Rule::number | Rule::neg_number => "a number",
         Rule::doc => "a doc comment",
-        Rule::formula | Rule::or_f | Rule::and_f | Rule::until_f | Rule::unary => "a formula",
+        Rule::formula => "a formula",
         Rule::paren_f => "a formula",
-        Rule::comparison | Rule::expr | Rule::term | Rule::factor => "an expression",
+        Rule::comparison | Rule::expr => "an expression",
         Rule::cmp_op => "a comparison operator",
         Rule::add_op | Rule::mul_op => "an arithmetic operator",
         Rule::implies_op => "`->`",
         Rule::until_op => "`until`",
-        Rule::prefix_op | Rule::not_op => "`!`",
+        Rule::not_op => "`!`",
+        Rule::or_op => "`||`",
+        Rule::and_op => "`&&`",
+        Rule::neg_op => "`-`",
         Rule::always_op => "`always`",
         Rule::eventually_op => "`eventually`",
         Rule::interval => "an interval such as `[0..40]`",
@@ -610,6 +613,10 @@ struct Builder<'t> {
 }
 
 type Res<T> = Result<T, Fail>;
+
+/// An operand of a product, with the operator before it (`None` for the first) and its
+/// height.
+type Factor = (Option<BinOp>, (Expr, usize));
 
 impl Builder<'_> {
     fn range(&self, p: &Pair<'_, Rule>) -> Range<usize> {
@@ -866,233 +873,306 @@ impl Builder<'_> {
         Interval { start, end: it.next(), inclusive, range }
     }
 
-    /// Builds a formula and returns it with its height.
+    /// Builds a formula from a `formula` pair (a flat sequence of prefix operators,
+    /// operands and infix operators) and returns it with its height.
     fn formula(&mut self, p: Pair<'_, Rule>) -> Res<(Formula, usize)> {
         let range = self.range(&p);
-        let rule = p.as_rule();
-        let mut inner: Vec<Pair<'_, Rule>> = p.into_inner().collect();
-        let built = match rule {
-            Rule::formula => {
-                let rhs = if inner.len() >= 3 { inner.pop() } else { None };
-                let first = inner.into_iter().next().ok_or_else(|| self.internal(range.clone()))?;
-                let (lhs, h1) = self.formula(first)?;
-                match rhs {
-                    Some(r) => {
-                        let (rhs, h2) = self.formula(r)?;
-                        (
-                            Formula {
-                                kind: FormulaKind::Implies(Box::new(lhs), Box::new(rhs)),
-                                range: range.clone(),
-                            },
-                            h1.max(h2) + 1,
-                        )
+        // Operands (each with its prefix operators) and the infix operators between them.
+        let mut operands: Vec<(Formula, usize)> = Vec::new();
+        let mut ops: Vec<Pair<'_, Rule>> = Vec::new();
+        let mut prefixes: Vec<Pair<'_, Rule>> = Vec::new();
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::not_op | Rule::always_op | Rule::eventually_op => {
+                    if prefixes.len() >= MAX_HEIGHT {
+                        return Err(self.too_tall(range));
                     }
-                    None => (lhs, h1),
+                    prefixes.push(c);
                 }
-            }
-            Rule::or_f | Rule::and_f => {
-                let mut parts = Vec::new();
-                let mut h = 0;
-                for c in inner {
-                    let (f, hc) = self.formula(c)?;
-                    h = h.max(hc);
-                    parts.push(f);
-                }
-                if parts.len() == 1 {
-                    (parts.pop().ok_or_else(|| self.internal(range.clone()))?, h)
-                } else {
-                    let kind = if rule == Rule::or_f {
-                        FormulaKind::Or(parts)
-                    } else {
-                        FormulaKind::And(parts)
-                    };
-                    (Formula { kind, range: range.clone() }, h + 1)
-                }
-            }
-            Rule::until_f => {
-                let mut it = inner.into_iter();
-                let first = it.next().ok_or_else(|| self.internal(range.clone()))?;
-                let (mut acc, mut h) = self.formula(first)?;
-                let mut count = 0;
-                while let (Some(op), Some(rhs)) = (it.next(), it.next()) {
-                    count += 1;
-                    let op_range = self.range(&op);
-                    if count == 2 {
-                        self.diagnostics.push(
-                            Diagnostic::new(
-                                "HSTL021",
-                                op_range.clone(),
-                                "`until` is not chainable",
-                            )
-                            .with_label(acc.range.clone(), "this is already an `until` formula")
-                            .with_help(
-                                "add parentheses: `(a until b) until c` or `a until (b until c)`",
-                            ),
-                        );
-                    }
-                    let interval = op.into_inner().find(|c| c.as_rule() == Rule::interval);
-                    let interval = interval.map(|i| self.interval(i));
-                    let (rhs, hr) = self.formula(rhs)?;
-                    let r = acc.range.start..rhs.range.end;
-                    h = h.max(hr) + 1;
-                    acc = Formula {
-                        kind: FormulaKind::Until(Box::new(acc), interval, Box::new(rhs)),
-                        range: r,
-                    };
-                }
-                (acc, h)
-            }
-            Rule::unary => {
-                let first = inner.remove(0);
-                match first.as_rule() {
-                    Rule::prefix_op => {
-                        let op = first
-                            .into_inner()
-                            .next()
-                            .ok_or_else(|| self.internal(range.clone()))?;
-                        let operand = inner.pop().ok_or_else(|| self.internal(range.clone()))?;
-                        let (f, h) = self.formula(operand)?;
-                        let f = Box::new(f);
+                Rule::implies_op | Rule::or_op | Rule::and_op | Rule::until_op => ops.push(c),
+                _ => {
+                    let (mut f, mut h) = self.primary(c)?;
+                    for op in prefixes.drain(..).rev() {
+                        let r = self.range(&op).start..f.range.end;
+                        let interval =
+                            op.clone().into_inner().find(|c| c.as_rule() == Rule::interval);
+                        let interval = interval.map(|i| self.interval(i));
+                        let b = Box::new(f);
                         let kind = match op.as_rule() {
-                            Rule::not_op => FormulaKind::Not(f),
-                            Rule::always_op => {
-                                let i = op.into_inner().find(|c| c.as_rule() == Rule::interval);
-                                FormulaKind::Always(i.map(|i| self.interval(i)), f)
-                            }
-                            _ => {
-                                let i = op.into_inner().find(|c| c.as_rule() == Rule::interval);
-                                FormulaKind::Eventually(i.map(|i| self.interval(i)), f)
-                            }
+                            Rule::not_op => FormulaKind::Not(b),
+                            Rule::always_op => FormulaKind::Always(interval, b),
+                            _ => FormulaKind::Eventually(interval, b),
                         };
-                        (Formula { kind, range: range.clone() }, h + 1)
+                        f = Formula { kind, range: r };
+                        h += 1;
                     }
-                    Rule::comparison => {
-                        let mut it = first.into_inner();
-                        let e0 = it.next().ok_or_else(|| self.internal(range.clone()))?;
-                        let (first_e, mut h) = self.expr(e0)?;
-                        let mut rest = Vec::new();
-                        while let (Some(op), Some(e)) = (it.next(), it.next()) {
-                            let cmp = match op.as_str() {
-                                "<" => CmpOp::Lt,
-                                "<=" => CmpOp::Le,
-                                ">" => CmpOp::Gt,
-                                ">=" => CmpOp::Ge,
-                                "==" => CmpOp::Eq,
-                                _ => CmpOp::Ne,
-                            };
-                            let (e, he) = self.expr(e)?;
-                            h = h.max(he);
-                            rest.push((cmp, self.range(&op), e));
-                        }
-                        (
-                            Formula {
-                                kind: FormulaKind::Compare { first: first_e, rest },
-                                range: range.clone(),
-                            },
-                            h + 1,
-                        )
-                    }
-                    Rule::k_true => (Formula { kind: FormulaKind::True, range: range.clone() }, 1),
-                    Rule::k_false => {
-                        (Formula { kind: FormulaKind::False, range: range.clone() }, 1)
-                    }
-                    Rule::paren_f => {
-                        let f = first
-                            .into_inner()
-                            .next()
-                            .ok_or_else(|| self.internal(range.clone()))?;
-                        let (f, h) = self.formula(f)?;
-                        (
-                            Formula { kind: FormulaKind::Paren(Box::new(f)), range: range.clone() },
-                            h + 1,
-                        )
-                    }
-                    _ => (
-                        Formula {
-                            kind: FormulaKind::Name(ident(&first, self.offset)),
-                            range: range.clone(),
-                        },
-                        1,
-                    ),
-                }
-            }
-            _ => return Err(self.internal(range)),
-        };
-        if built.1 > MAX_HEIGHT {
-            return Err(self.too_tall(range));
-        }
-        Ok(built)
-    }
-
-    /// Builds an expression and returns it with its height.
-    fn expr(&mut self, p: Pair<'_, Rule>) -> Res<(Expr, usize)> {
-        let range = self.range(&p);
-        let rule = p.as_rule();
-        let built = match rule {
-            Rule::expr | Rule::term => {
-                let mut it = p.into_inner();
-                let first = it.next().ok_or_else(|| self.internal(range.clone()))?;
-                let (mut acc, mut h) = self.expr(first)?;
-                while let (Some(op), Some(rhs)) = (it.next(), it.next()) {
-                    let bop = match op.as_str().trim() {
-                        "+" => BinOp::Add,
-                        "*" => BinOp::Mul,
-                        "/" => BinOp::Div,
-                        _ => BinOp::Sub,
-                    };
-                    let (rhs, hr) = self.expr(rhs)?;
-                    h = h.max(hr) + 1;
                     if h > MAX_HEIGHT {
                         return Err(self.too_tall(range));
                     }
-                    let r = acc.range.start..rhs.range.end;
-                    acc = Expr {
-                        kind: ExprKind::Binary(bop, Box::new(acc), Box::new(rhs)),
-                        range: r,
-                    };
-                }
-                (acc, h)
-            }
-            Rule::factor => {
-                let c = p.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
-                match c.as_rule() {
-                    Rule::number => {
-                        (Expr { kind: ExprKind::Number(self.number(&c)), range: range.clone() }, 1)
-                    }
-                    Rule::ident => (
-                        Expr { kind: ExprKind::Name(ident(&c, self.offset)), range: range.clone() },
-                        1,
-                    ),
-                    Rule::neg => {
-                        let f =
-                            c.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
-                        let (e, h) = self.expr(f)?;
-                        (Expr { kind: ExprKind::Neg(Box::new(e)), range: range.clone() }, h + 1)
-                    }
-                    Rule::paren_e => {
-                        let f =
-                            c.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
-                        let (e, h) = self.expr(f)?;
-                        (Expr { kind: ExprKind::Paren(Box::new(e)), range: range.clone() }, h + 1)
-                    }
-                    _ => {
-                        let mut it = c.into_inner();
-                        let func = it.next().ok_or_else(|| self.internal(range.clone()))?;
-                        let func = if func.as_str() == "abs" { Func::Abs } else { Func::Sqrt };
-                        let arg = it.next().ok_or_else(|| self.internal(range.clone()))?;
-                        let (e, h) = self.expr(arg)?;
-                        (
-                            Expr { kind: ExprKind::Call(func, Box::new(e)), range: range.clone() },
-                            h + 1,
-                        )
-                    }
+                    operands.push((f, h));
                 }
             }
-            _ => return Err(self.internal(range)),
-        };
-        if built.1 > MAX_HEIGHT {
-            return Err(self.too_tall(range));
         }
-        Ok(built)
+        if operands.len() != ops.len() + 1 {
+            return Err(self.internal(range));
+        }
+        // Split at `->` (loosest, right-associative), then `||`, then `&&`, then `until`.
+        let mut segments: Vec<(Formula, usize)> = Vec::new();
+        let mut operands = operands.into_iter();
+        let mut group: Vec<(Formula, usize)> = operands.next().into_iter().collect();
+        let mut group_ops: Vec<Pair<'_, Rule>> = Vec::new();
+        for (op, rhs) in ops.into_iter().zip(operands) {
+            if op.as_rule() == Rule::implies_op {
+                segments.push(
+                    self.disjunction(std::mem::take(&mut group), std::mem::take(&mut group_ops))?,
+                );
+            } else {
+                group_ops.push(op);
+            }
+            group.push(rhs);
+        }
+        segments.push(self.disjunction(group, group_ops)?);
+        let (mut acc, mut h) = segments.pop().ok_or_else(|| self.internal(range.clone()))?;
+        while let Some((lhs, hl)) = segments.pop() {
+            h = h.max(hl) + 1;
+            if h > MAX_HEIGHT {
+                return Err(self.too_tall(range));
+            }
+            let r = lhs.range.start..acc.range.end;
+            acc = Formula { kind: FormulaKind::Implies(Box::new(lhs), Box::new(acc)), range: r };
+        }
+        Ok((acc, h))
+    }
+
+    /// Operands joined by `||`, `&&` and `until` (no `->`).
+    fn disjunction(
+        &mut self,
+        operands: Vec<(Formula, usize)>,
+        ops: Vec<Pair<'_, Rule>>,
+    ) -> Res<(Formula, usize)> {
+        // Group by `||`, each group by `&&`, each of those by `until`.
+        let mut ors: Vec<Vec<Vec<(Formula, usize)>>> = vec![vec![Vec::new()]];
+        let mut untils: Vec<Vec<Vec<Pair<'_, Rule>>>> = vec![vec![Vec::new()]];
+        let mut operands = operands.into_iter();
+        if let Some(first) = operands.next() {
+            ors[0][0].push(first);
+        }
+        for (op, rhs) in ops.into_iter().zip(operands) {
+            match op.as_rule() {
+                Rule::or_op => {
+                    ors.push(vec![Vec::new()]);
+                    untils.push(vec![Vec::new()]);
+                }
+                Rule::and_op => {
+                    if let (Some(o), Some(u)) = (ors.last_mut(), untils.last_mut()) {
+                        o.push(Vec::new());
+                        u.push(Vec::new());
+                    }
+                }
+                _ => {
+                    if let Some(u) = untils.last_mut().and_then(|u| u.last_mut()) {
+                        u.push(op);
+                    }
+                }
+            }
+            if let Some(chain) = ors.last_mut().and_then(|o| o.last_mut()) {
+                chain.push(rhs);
+            }
+        }
+        let mut or_parts = Vec::new();
+        for (ands, and_ops) in ors.into_iter().zip(untils) {
+            let mut and_parts = Vec::new();
+            for (chain, until_ops) in ands.into_iter().zip(and_ops) {
+                and_parts.push(self.until_chain(chain, until_ops)?);
+            }
+            or_parts.push(self.nary(and_parts, false)?);
+        }
+        self.nary(or_parts, true)
+    }
+
+    /// `a until b` (a longer chain is reported as HSTL021 and built from the left).
+    fn until_chain(
+        &mut self,
+        chain: Vec<(Formula, usize)>,
+        ops: Vec<Pair<'_, Rule>>,
+    ) -> Res<(Formula, usize)> {
+        let mut chain = chain.into_iter();
+        let (mut acc, mut h) = chain.next().ok_or(Fail(Diagnostic::new(
+            "HSTL001",
+            0..0,
+            "could not read this formula",
+        )))?;
+        for (count, (op, (rhs, hr))) in ops.into_iter().zip(chain).enumerate() {
+            let op_range = self.range(&op);
+            if count == 1 {
+                self.diagnostics.push(
+                    Diagnostic::new("HSTL021", op_range, "`until` is not chainable")
+                        .with_label(acc.range.clone(), "this is already an `until` formula")
+                        .with_help(
+                            "add parentheses: `(a until b) until c` or `a until (b until c)`",
+                        ),
+                );
+            }
+            let interval = op.into_inner().find(|c| c.as_rule() == Rule::interval);
+            let interval = interval.map(|i| self.interval(i));
+            h = h.max(hr) + 1;
+            if h > MAX_HEIGHT {
+                return Err(self.too_tall(acc.range.start..rhs.range.end));
+            }
+            let r = acc.range.start..rhs.range.end;
+            acc = Formula {
+                kind: FormulaKind::Until(Box::new(acc), interval, Box::new(rhs)),
+                range: r,
+            };
+        }
+        Ok((acc, h))
+    }
+
+    /// One operand, or an `Or`/`And` node over two or more.
+    fn nary(&self, mut parts: Vec<(Formula, usize)>, or: bool) -> Res<(Formula, usize)> {
+        if parts.len() == 1 {
+            return parts.pop().ok_or_else(|| self.internal(0..0));
+        }
+        let h = parts.iter().map(|p| p.1).max().unwrap_or(0) + 1;
+        let r = match (parts.first(), parts.last()) {
+            (Some(a), Some(b)) => a.0.range.start..b.0.range.end,
+            _ => return Err(self.internal(0..0)),
+        };
+        let fs = parts.into_iter().map(|p| p.0).collect();
+        let kind = if or { FormulaKind::Or(fs) } else { FormulaKind::And(fs) };
+        Ok((Formula { kind, range: r }, h))
+    }
+
+    /// An operand of a formula: `true`, `false`, a name, a comparison or `( formula )`.
+    fn primary(&mut self, p: Pair<'_, Rule>) -> Res<(Formula, usize)> {
+        let range = self.range(&p);
+        match p.as_rule() {
+            Rule::k_true => Ok((Formula { kind: FormulaKind::True, range }, 1)),
+            Rule::k_false => Ok((Formula { kind: FormulaKind::False, range }, 1)),
+            Rule::ident => {
+                Ok((Formula { kind: FormulaKind::Name(ident(&p, self.offset)), range }, 1))
+            }
+            Rule::paren_f => {
+                let f = p.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
+                let (f, h) = self.formula(f)?;
+                Ok((Formula { kind: FormulaKind::Paren(Box::new(f)), range }, h + 1))
+            }
+            Rule::comparison => {
+                let mut it = p.into_inner();
+                let e0 = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                let (first, mut h) = self.expr(e0)?;
+                let mut rest = Vec::new();
+                while let (Some(op), Some(e)) = (it.next(), it.next()) {
+                    let cmp = match op.as_str() {
+                        "<" => CmpOp::Lt,
+                        "<=" => CmpOp::Le,
+                        ">" => CmpOp::Gt,
+                        ">=" => CmpOp::Ge,
+                        "==" => CmpOp::Eq,
+                        _ => CmpOp::Ne,
+                    };
+                    let (e, he) = self.expr(e)?;
+                    h = h.max(he);
+                    rest.push((cmp, self.range(&op), e));
+                }
+                Ok((Formula { kind: FormulaKind::Compare { first, rest }, range }, h + 1))
+            }
+            _ => Err(self.internal(range)),
+        }
+    }
+
+    /// Builds an expression from an `expr` pair (prefix `-`, operands and `+ - * /`) and
+    /// returns it with its height.
+    fn expr(&mut self, p: Pair<'_, Rule>) -> Res<(Expr, usize)> {
+        let range = self.range(&p);
+        // Terms joined by `+`/`-`; each term is operands joined by `*`/`/`.
+        let mut sums: Vec<(Option<BinOp>, Vec<Factor>)> = vec![(None, Vec::new())];
+        let mut negs: Vec<usize> = Vec::new();
+        let mut pending: Option<BinOp> = None;
+        for c in p.into_inner() {
+            match c.as_rule() {
+                Rule::neg_op => {
+                    if negs.len() >= MAX_HEIGHT {
+                        return Err(self.too_tall(range));
+                    }
+                    negs.push(self.range(&c).start);
+                }
+                Rule::add_op => {
+                    let op = if c.as_str().starts_with('+') { BinOp::Add } else { BinOp::Sub };
+                    sums.push((Some(op), Vec::new()));
+                }
+                Rule::mul_op => {
+                    pending = Some(if c.as_str() == "*" { BinOp::Mul } else { BinOp::Div });
+                }
+                _ => {
+                    let (mut e, mut h) = self.operand(c)?;
+                    for start in negs.drain(..).rev() {
+                        let r = start..e.range.end;
+                        e = Expr { kind: ExprKind::Neg(Box::new(e)), range: r };
+                        h += 1;
+                    }
+                    if let Some(last) = sums.last_mut() {
+                        last.1.push((pending.take(), (e, h)));
+                    }
+                }
+            }
+        }
+        let mut acc: Option<(Expr, usize)> = None;
+        for (add, factors) in sums {
+            let mut term: Option<(Expr, usize)> = None;
+            for (mul, (e, h)) in factors {
+                term = Some(match (term, mul) {
+                    (Some((a, ha)), Some(op)) => self.binary(op, a, ha, e, h, &range)?,
+                    _ => (e, h),
+                });
+            }
+            let Some((t, ht)) = term else { return Err(self.internal(range)) };
+            acc = Some(match (acc, add) {
+                (Some((a, ha)), Some(op)) => self.binary(op, a, ha, t, ht, &range)?,
+                _ => (t, ht),
+            });
+        }
+        acc.ok_or_else(|| self.internal(range))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn binary(
+        &self,
+        op: BinOp,
+        a: Expr,
+        ha: usize,
+        b: Expr,
+        hb: usize,
+        whole: &Range<usize>,
+    ) -> Res<(Expr, usize)> {
+        let h = ha.max(hb) + 1;
+        if h > MAX_HEIGHT {
+            return Err(self.too_tall(whole.clone()));
+        }
+        let r = a.range.start..b.range.end;
+        Ok((Expr { kind: ExprKind::Binary(op, Box::new(a), Box::new(b)), range: r }, h))
+    }
+
+    /// An operand of an expression: a number, a name, `( expr )` or a call.
+    fn operand(&mut self, c: Pair<'_, Rule>) -> Res<(Expr, usize)> {
+        let range = self.range(&c);
+        match c.as_rule() {
+            Rule::number => Ok((Expr { kind: ExprKind::Number(self.number(&c)), range }, 1)),
+            Rule::ident => Ok((Expr { kind: ExprKind::Name(ident(&c, self.offset)), range }, 1)),
+            Rule::paren_e => {
+                let f = c.into_inner().next().ok_or_else(|| self.internal(range.clone()))?;
+                let (e, h) = self.expr(f)?;
+                Ok((Expr { kind: ExprKind::Paren(Box::new(e)), range }, h + 1))
+            }
+            Rule::call => {
+                let mut it = c.into_inner();
+                let func = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                let func = if func.as_str() == "abs" { Func::Abs } else { Func::Sqrt };
+                let arg = it.next().ok_or_else(|| self.internal(range.clone()))?;
+                let (e, h) = self.expr(arg)?;
+                Ok((Expr { kind: ExprKind::Call(func, Box::new(e)), range }, h + 1))
+            }
+            _ => Err(self.internal(range)),
+        }
     }
 }
