@@ -319,11 +319,27 @@ impl<'a> Gen<'a> {
         let rt =
             if lets.to_string() == "super" { quote!(super::super::rt) } else { quote!(super::rt) };
         let empty = lit_f64(self.empty_value(f, &mut Vec::new()));
-        let mut body = Body { g: self, lets, rt: &rt, stmts: Vec::new(), uses_state: false, n: 0 };
+        let mut body = Body {
+            g: self,
+            lets,
+            rt: &rt,
+            stmts: Vec::new(),
+            uses_state: false,
+            uses_t: false,
+            n: 0,
+        };
         let signal = body.signal(f);
         let stmts = &body.stmts;
         let at = if self.spec.is_state_formula(f) {
-            let mut b = Body { g: self, lets, rt: &rt, stmts: Vec::new(), uses_state: false, n: 0 };
+            let mut b = Body {
+                g: self,
+                lets,
+                rt: &rt,
+                stmts: Vec::new(),
+                uses_state: false,
+                uses_t: false,
+                n: 0,
+            };
             let p = b.point(f);
             let arg = if b.uses_state { quote!(s) } else { quote!(_s) };
             quote! {
@@ -347,7 +363,6 @@ impl<'a> Gen<'a> {
 
                 /// Robustness at every step of the trace.
                 pub fn signal(trace: &[#state]) -> ::std::vec::Vec<f64> {
-                    let n = trace.len();
                     #(#stmts)*
                     #signal
                 }
@@ -628,6 +643,7 @@ struct Body<'g, 'a> {
     rt: &'g TokenStream,
     stmts: Vec<TokenStream>,
     uses_state: bool,
+    uses_t: bool,
     n: usize,
 }
 
@@ -646,16 +662,18 @@ impl Body<'_, '_> {
                 self.temporal(f)
             }
             _ => {
-                let before = self.uses_state;
-                self.uses_state = false;
+                let before = (self.uses_state, self.uses_t);
+                (self.uses_state, self.uses_t) = (false, false);
                 let p = self.point(f);
-                let used = self.uses_state;
-                self.uses_state = before;
-                if used {
-                    quote!(trace.iter().enumerate().map(|(t, s)| { let _ = t; #p }).collect::<::std::vec::Vec<f64>>())
-                } else {
-                    quote!((0..n).map(|t| { let _ = t; #p }).collect::<::std::vec::Vec<f64>>())
-                }
+                let used = (self.uses_state, self.uses_t);
+                (self.uses_state, self.uses_t) = before;
+                let map = match used {
+                    (true, true) => quote!(trace.iter().enumerate().map(|(t, s)| #p)),
+                    (true, false) => quote!(trace.iter().map(|s| #p)),
+                    (false, true) => quote!((0..trace.len()).map(|t| #p)),
+                    (false, false) => quote!(trace.iter().map(|_| #p)),
+                };
+                quote!(#map.collect::<::std::vec::Vec<f64>>())
             }
         }
     }
@@ -712,6 +730,7 @@ impl Body<'_, '_> {
                     self.n += 1;
                     self.stmts
                         .push(quote!(let #v: ::std::vec::Vec<f64> = #lets::#name::signal(trace);));
+                    self.uses_t = true;
                     quote!(#v[t])
                 }
             }
@@ -741,6 +760,7 @@ impl Body<'_, '_> {
             }
             CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
                 let v = self.temporal(f);
+                self.uses_t = true;
                 quote!(#v[t])
             }
         }

@@ -108,3 +108,99 @@ fn resolve(path: &str) -> PathBuf {
         None => p.to_path_buf(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proc_macro2::Delimiter;
+
+    /// Generated code laid out one statement or item per line, for readable snapshots.
+    fn pretty(tokens: TokenStream) -> String {
+        fn walk(tokens: TokenStream, depth: usize, out: &mut String) {
+            let pad = |out: &mut String, depth: usize| {
+                if out.ends_with('\n') {
+                    out.push_str(&"    ".repeat(depth));
+                }
+            };
+            for tt in tokens {
+                pad(out, depth);
+                match tt {
+                    TokenTree::Group(g) if g.delimiter() == Delimiter::Brace => {
+                        out.push_str("{\n");
+                        walk(g.stream(), depth + 1, out);
+                        if !out.ends_with('\n') {
+                            out.push('\n');
+                        }
+                        out.push_str(&"    ".repeat(depth));
+                        out.push_str("}\n");
+                    }
+                    TokenTree::Punct(p) if p.as_char() == ';' => out.push_str(";\n"),
+                    TokenTree::Punct(p)
+                        if p.as_char() == ',' && depth > 0 && out.ends_with("}\n") =>
+                    {
+                        out.pop();
+                        out.push_str(",\n");
+                    }
+                    TokenTree::Punct(p) if p.spacing() == proc_macro2::Spacing::Joint => {
+                        out.push(p.as_char())
+                    }
+                    other => {
+                        out.push_str(&other.to_string());
+                        out.push(' ');
+                    }
+                }
+            }
+        }
+        let mut out = String::new();
+        walk(tokens, 0, &mut out);
+        out.lines().map(str::trim_end).collect::<Vec<_>>().join("\n")
+    }
+
+    #[test]
+    fn case_study_expansion() {
+        let text = include_str!("../../specs/case_study.hstl");
+        let tokens: TokenStream = text.parse().expect("the case study lexes as Rust tokens");
+        insta::assert_snapshot!(pretty(expand_tokens(tokens)));
+    }
+
+    #[test]
+    fn errors_and_best_effort_code_come_together() {
+        let tokens: TokenStream =
+            "spec S { state { x: float } let A = x > 1; let B = x < ; task A; }"
+                .parse()
+                .expect("lexes");
+        let out = expand_tokens(tokens).to_string();
+        // One error, and the parts that checked are still generated.
+        assert_eq!(out.matches("compile_error").count(), 1, "{out}");
+        assert!(out.contains("pub mod s"), "{out}");
+        assert!(out.contains("pub struct State"), "{out}");
+        assert!(out.contains("pub mod a"), "{out}");
+        assert!(!out.contains("impl :: hstl :: runtime :: Spec"), "{out}");
+    }
+
+    #[test]
+    fn include_forms() {
+        let ok: TokenStream = "include \"specs/case_study.hstl\";".parse().expect("lexes");
+        assert!(matches!(include_path(&ok), Some(Ok((p, _))) if p == "specs/case_study.hstl"));
+        for bad in ["include", "include x", "include \"a\" \"b\""] {
+            let tokens: TokenStream = bad.parse().expect("lexes");
+            assert!(matches!(include_path(&tokens), Some(Err(_))), "{bad}");
+        }
+        let items: TokenStream = "spec include {}".parse().expect("lexes");
+        assert!(include_path(&items).is_none());
+        let missing = expand_file("no/such/file.hstl", (Span::call_site(), Span::call_site()));
+        assert!(missing.to_string().contains("cannot read"), "{missing}");
+    }
+
+    #[test]
+    fn warnings_become_deprecated_uses() {
+        let tokens: TokenStream =
+            "spec S { state { x: float } let A = x > 1; let Spare = x < 0; task A; }"
+                .parse()
+                .expect("lexes");
+        let out = expand_tokens(tokens).to_string();
+        assert!(!out.contains("compile_error"), "{out}");
+        assert_eq!(out.matches("deprecated").count(), 1, "{out}");
+        assert!(out.contains("unused `let` `Spare`"), "{out}");
+    }
+}
