@@ -90,6 +90,18 @@ pub enum Formula {
     Until(Interval, Box<Formula>, Box<Formula>),
 }
 
+/// A [`Formula`] or [`Expr`] printed in hstl syntax with the given variable names.
+///
+/// Made by [`Formula::display_with`] and [`Expr::display_with`]. A variable without a name
+/// prints as `v<index>`. Parentheses appear where precedence needs them and around nested
+/// operators of the same level, so the text parses back to the same tree. Infinite
+/// constants print as `1e999` (which reads back as infinity) and NaN as `(0 / 0)`.
+#[derive(Clone, Copy, Debug)]
+pub struct Display<'a, T> {
+    item: &'a T,
+    names: &'a [&'a str],
+}
+
 impl Expr {
     /// The value of the expression on one sample, `state[i]` being variable `i`.
     ///
@@ -226,18 +238,6 @@ impl fmt::Display for Interval {
             Bound::Inclusive(b) => write!(f, "[{}..={}]", self.start, b),
         }
     }
-}
-
-/// A [`Formula`] or [`Expr`] printed in hstl syntax with the given variable names.
-///
-/// Made by [`Formula::display_with`] and [`Expr::display_with`]. A variable without a name
-/// prints as `v<index>`. Parentheses appear where precedence needs them and around nested
-/// operators of the same level, so the text parses back to the same tree. Infinite
-/// constants print as `1e999` (which reads back as infinity) and NaN as `(0 / 0)`.
-#[derive(Clone, Copy, Debug)]
-pub struct Display<'a, T> {
-    item: &'a T,
-    names: &'a [&'a str],
 }
 
 impl Formula {

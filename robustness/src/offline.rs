@@ -48,6 +48,33 @@ pub struct Evaluator {
     scratch_c: Vec<f64>,
 }
 
+/// A min or a max, with its identity.
+pub(crate) trait Lattice {
+    const ID: f64;
+    /// `minNum(acc, x)` (or `maxNum`) when `acc` is not NaN, in one instruction: a NaN `x`
+    /// fails the comparison and leaves `acc`. Every fold starts at `ID`, so none holds NaN.
+    fn acc(acc: f64, x: f64) -> f64;
+}
+
+pub(crate) struct Min;
+pub(crate) struct Max;
+
+impl Lattice for Min {
+    const ID: f64 = INF;
+    #[inline(always)]
+    fn acc(acc: f64, x: f64) -> f64 {
+        if x < acc { x } else { acc }
+    }
+}
+
+impl Lattice for Max {
+    const ID: f64 = NEG_INF;
+    #[inline(always)]
+    fn acc(acc: f64, x: f64) -> f64 {
+        if x > acc { x } else { acc }
+    }
+}
+
 /// The full robustness signal of `f` on `trace`: `rho(f, t)` for every step `t`.
 pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
     let mut e = Evaluator::new();
@@ -435,33 +462,6 @@ fn simple_atom<'a>(f: &Formula, cols: &[&'a [f64]]) -> Option<(&'a [f64], f64, b
     };
     let x_minus_c = matches!(op, CmpOp::Gt | CmpOp::Ge) == var_left;
     Some((cols.get(var)?, c, x_minus_c))
-}
-
-/// A min or a max, with its identity.
-pub(crate) trait Lattice {
-    const ID: f64;
-    /// `minNum(acc, x)` (or `maxNum`) when `acc` is not NaN, in one instruction: a NaN `x`
-    /// fails the comparison and leaves `acc`. Every fold starts at `ID`, so none holds NaN.
-    fn acc(acc: f64, x: f64) -> f64;
-}
-
-pub(crate) struct Min;
-pub(crate) struct Max;
-
-impl Lattice for Min {
-    const ID: f64 = INF;
-    #[inline(always)]
-    fn acc(acc: f64, x: f64) -> f64 {
-        if x < acc { x } else { acc }
-    }
-}
-
-impl Lattice for Max {
-    const ID: f64 = NEG_INF;
-    #[inline(always)]
-    fn acc(acc: f64, x: f64) -> f64 {
-        if x > acc { x } else { acc }
-    }
 }
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {
