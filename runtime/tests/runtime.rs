@@ -346,3 +346,40 @@ fn persistent_regions_are_read_off_the_task() {
         assert_eq!(got, want, "{task:?}");
     }
 }
+
+#[test]
+fn option_rewards_follow_the_reference_segment_semantics() {
+    use hstl_runtime::robustness::Trace;
+    use hstl_runtime::robustness::reference::segment_reward;
+    use hstl_runtime::robustness::segment::TabularScorer;
+    // The learner's rewards come from the fast scorer; hold it against the reference on
+    // random walks of the case study, short (under the horizon) and long (past it).
+    let env = GridWorld::default();
+    let spec = common::case_study(false, false);
+    let mut states = Trace::new(2);
+    for s in 0..env.num_states() {
+        let c = env.state(s).unwrap();
+        states.push(&[c.x as f64, c.y as f64]).unwrap();
+    }
+    let mut scorer = TabularScorer::new(&spec.task, &states);
+    let mut rng = seeded_rng(11);
+    let mut out = Vec::new();
+    for len in [2, 7, 39, 40, 41, 90] {
+        let mut walk = vec![env.index(&env.reset(&mut rng))];
+        while walk.len() < len {
+            let c = env.state(*walk.last().unwrap()).unwrap();
+            walk.push(env.index(&env.step(&c, (walk.len() * 7) % 4, &mut rng)));
+        }
+        scorer.suffix_rewards(&walk, &mut out);
+        assert_eq!(out.len(), len);
+        for (j, &got) in out.iter().enumerate() {
+            let mut seg = Trace::new(2);
+            for &s in &walk[j..] {
+                let c = env.state(s).unwrap();
+                seg.push(&[c.x as f64, c.y as f64]).unwrap();
+            }
+            assert_eq!(got, segment_reward(&spec.task, &seg), "length {len}, suffix {j}");
+        }
+        assert_eq!(scorer.reward(&walk), out[0]);
+    }
+}
