@@ -40,6 +40,11 @@
 //!
 //! This crate knows nothing of miette, LSP, syn or proc macros: each edge converts.
 
+// pest is built without `std`: its per-call native stack probe cost a fifth of the parse
+// time, and the parser bounds recursion itself (bracket nesting, formula height). The
+// generated parser then names `crate::alloc`.
+extern crate alloc;
+
 pub mod check;
 pub mod checked;
 pub mod codes;

@@ -63,7 +63,20 @@ pub fn parse(src: &str) -> Parsed {
     let toks = lex(src, &mut comments, &mut diagnostics);
     let mut specs = Vec::new();
     let ends: Vec<usize> = toks.iter().map(|t| t.end).collect();
-    let mut p = Splitter { src, toks: &toks, ends: &ends, i: 0, diagnostics: &mut diagnostics };
+    let deep_comments = diagnostics
+        .iter()
+        .filter(|d| d.message.starts_with("block comments nested"))
+        .filter_map(|d| comments.iter().find(|c| c.range.start == d.range.start))
+        .map(|c| c.range.clone())
+        .collect();
+    let mut p = Splitter {
+        src,
+        deep_comments,
+        toks: &toks,
+        ends: &ends,
+        i: 0,
+        diagnostics: &mut diagnostics,
+    };
     while p.i < toks.len() {
         if let Some(spec) = p.spec() {
             specs.push(spec);
@@ -93,9 +106,11 @@ fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> V
             comments.push(Comment { kind, range: start..i });
         } else if b[i..].starts_with(b"/*") {
             let mut depth = 0usize;
+            let mut deepest = 0usize;
             while i < b.len() {
                 if b[i..].starts_with(b"/*") {
                     depth += 1;
+                    deepest = deepest.max(depth);
                     i += 2;
                 } else if b[i..].starts_with(b"*/") {
                     depth -= 1;
@@ -113,6 +128,14 @@ fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> V
                     Diagnostic::new("HSTL001", start..start + 2, "unterminated block comment")
                         .with_help("close it with `*/`"),
                 );
+            }
+            if deepest > MAX_NESTING {
+                // pest parses nested comments recursively: keep such text away from it.
+                diags.push(Diagnostic::new(
+                    "HSTL001",
+                    start..start + 2,
+                    format!("block comments nested too deeply (more than {MAX_NESTING} levels)"),
+                ));
             }
             comments.push(Comment { kind: CommentKind::Block, range: start..i });
         } else if c.is_ascii_alphabetic() || c == b'_' {
@@ -163,6 +186,7 @@ const ITEM_KEYWORDS: [&str; 6] = ["let", "task", "option", "state", "learn", "sp
 
 struct Splitter<'a, 'd> {
     src: &'a str,
+    deep_comments: Vec<Range<usize>>,
     toks: &'a [Tok],
     ends: &'a [usize],
     i: usize,
@@ -221,7 +245,12 @@ impl Splitter<'_, '_> {
         let mut doc = None;
         let mut name =
             Ident { name: String::new(), range: self.toks[spec_kw].start..self.toks[spec_kw].end };
-        match HstlParser::parse(Rule::spec_head, &self.src[head_range.clone()]) {
+        let head = if self.has_deep_comment(&head_range) {
+            Err(None)
+        } else {
+            HstlParser::parse(Rule::spec_head, &self.src[head_range.clone()]).map_err(Some)
+        };
+        match head {
             Ok(mut pairs) => {
                 let mut docs = Vec::new();
                 if let Some(head) = pairs.next() {
@@ -235,7 +264,8 @@ impl Splitter<'_, '_> {
                 }
                 doc = make_doc(docs, head_range.start);
             }
-            Err(e) => {
+            Err(None) => {}
+            Err(Some(e)) => {
                 let text = &self.src[head_range.clone()];
                 let e = reparse_with_detail(Rule::spec_head, text).unwrap_or(e);
                 self.diagnostics.push(self.syntax_error(&e, head_range.clone()));
@@ -362,8 +392,17 @@ impl Splitter<'_, '_> {
         BrokenItem { keyword, names, range: self.toks[a].start..self.toks[b - 1].end }
     }
 
+    /// Whether a block comment nested too deeply for pest lies inside `range` (it was
+    /// reported by the lexer).
+    fn has_deep_comment(&self, range: &Range<usize>) -> bool {
+        self.deep_comments.iter().any(|c| c.start < range.end && range.start < c.end)
+    }
+
     fn item(&mut self, a: usize, b: usize) -> Option<Item> {
         let range = self.toks[a].start..self.toks[b - 1].end;
+        if self.has_deep_comment(&range) {
+            return None;
+        }
         // Bracket nesting is checked before pest so that deep input cannot exhaust the stack.
         let mut depth = 0usize;
         for k in a..b {

@@ -200,6 +200,8 @@ fn pathological_inputs_are_reported_not_crashed_on() {
                 + "let L3000 = x > 1; task L0;",
         ),
         wrap("/* unterminated".into()),
+        wrap(format!("let A = {}{} x > 1; task A;", "/*".repeat(100_000), "*/".repeat(100_000))),
+        format!("spec {}{} S {{ }}", "/*".repeat(100_000), "*/".repeat(100_000)),
         "{".repeat(100_000),
         "spec".repeat(10_000),
     ];
