@@ -12,8 +12,7 @@
 //! 2. [`check()`] (module [`check`](mod@check)): resolves names (state variables and `let`s share one
 //!    namespace, options have their own), detects `let` cycles, classifies lets (state or
 //!    temporal), checks options, the options set and learning parameters, and runs the
-//!    finite-domain checks by enumerating the declared `int` domain (up to
-//!    1,000,000 states). It builds one [`CheckedSpec`] per spec: names resolved to indices,
+//!    finite-domain checks by enumerating the declared `int` domain. It builds one [`CheckedSpec`] per spec: names resolved to indices,
 //!    defaults filled in, the options set expanded.
 //! 3. Diagnostics are plain data ([`Diagnostic`]); [`render_plain`] renders them like
 //!    rustc, [`LineIndex`] converts byte offsets to lines and columns (characters and
@@ -22,9 +21,15 @@
 //! # Invariants
 //! - [`parse`] and [`check()`] never fail and never panic, whatever the input: problems
 //!   are diagnostics. Every diagnostic range lies on char boundaries inside the source.
-//! - Syntax trees stay shallow: brackets nested more than [`parser::MAX_NESTING`] deep and
-//!   formulas taller than [`parser::MAX_HEIGHT`] are reported, so later recursive passes
-//!   cannot exhaust the stack. Chains of lets are walked iteratively.
+//! - Recursion is bounded: brackets (and block comments) nested more than
+//!   [`parser::MAX_NESTING`] deep and formulas taller than [`parser::MAX_HEIGHT`] are
+//!   reported before pest or any recursive pass sees them; operator chains and prefix
+//!   operators are flat repetitions in the grammar; chains of lets are walked
+//!   iteratively. pest is built without `std`, so this bound, not pest's stack probe, is
+//!   what keeps deep input from exhausting the stack.
+//! - The finite-domain checks enumerate at most [`check::MAX_DOMAIN_STATES`] states and
+//!   [`check::MAX_DOMAIN_WORK`] formula evaluations; beyond that they are skipped with the
+//!   warning `HSTL022`.
 //! - Diagnostics are sorted by position, deduplicated and capped at
 //!   [`check::MAX_DIAGNOSTICS`] per file; one `HSTL024` says how many more there were.
 //! - A [`CheckedSpec`] is always returned for a spec whose header parsed; where a part did
