@@ -915,6 +915,11 @@ impl Builder<'_> {
     /// Builds a formula from a `formula` pair (a flat sequence of prefix operators,
     /// operands and infix operators) and returns it with its height.
     fn formula(&mut self, p: Pair<'_, Rule>) -> Res<(Formula, usize)> {
+        // Fast path for a lone operand, the common case, without the bookkeeping below.
+        let mut kids = p.clone().into_inner();
+        if let (Some(only), None) = (kids.next(), kids.next()) {
+            return self.primary(only);
+        }
         let range = self.range(&p);
         // Operands (each with its prefix operators) and the infix operators between them.
         let mut operands: Vec<(Formula, usize)> = Vec::new();
@@ -1123,6 +1128,11 @@ impl Builder<'_> {
     /// Builds an expression from an `expr` pair (prefix `-`, operands and `+ - * /`) and
     /// returns it with its height.
     fn expr(&mut self, p: Pair<'_, Rule>) -> Res<(Expr, usize)> {
+        // Fast path for a lone operand, the common case.
+        let mut kids = p.clone().into_inner();
+        if let (Some(only), None) = (kids.next(), kids.next()) {
+            return self.operand(only);
+        }
         let range = self.range(&p);
         // Terms joined by `+`/`-`; each term is operands joined by `*`/`/`.
         let mut sums: Vec<(Option<BinOp>, Vec<Factor>)> = vec![(None, Vec::new())];
