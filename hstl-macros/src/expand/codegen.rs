@@ -661,6 +661,34 @@ impl Body<'_, '_> {
             CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
                 self.temporal(f)
             }
+            CFormulaKind::And(v) | CFormulaKind::Or(v)
+                if !v.is_empty() && v.iter().all(|g| self.is_vector(g)) =>
+            {
+                // Fold whole signals in place rather than indexing each at every step.
+                let (neutral, op) = if matches!(f.kind, CFormulaKind::And(_)) {
+                    (quote!(f64::INFINITY), quote!(min))
+                } else {
+                    (quote!(f64::NEG_INFINITY), quote!(max))
+                };
+                let acc = format_ident!("sig{}", self.n);
+                self.n += 1;
+                let first = self.signal(&v[0]);
+                self.stmts.push(quote! {
+                    let mut #acc: ::std::vec::Vec<f64> = #first;
+                    for x in #acc.iter_mut() {
+                        *x = #neutral.#op(*x);
+                    }
+                });
+                for g in &v[1..] {
+                    let c = self.signal(g);
+                    self.stmts.push(quote! {
+                        for (x, y) in #acc.iter_mut().zip(#c) {
+                            *x = x.#op(y);
+                        }
+                    });
+                }
+                quote!(#acc)
+            }
             _ => {
                 let before = (self.uses_state, self.uses_t);
                 (self.uses_state, self.uses_t) = (false, false);
@@ -678,6 +706,19 @@ impl Body<'_, '_> {
         }
     }
 
+    /// Whether `f`'s signal is computed as a whole vector (not step by step).
+    fn is_vector(&self, f: &CFormula) -> bool {
+        match &f.kind {
+            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
+                true
+            }
+            CFormulaKind::Let(i) => {
+                self.g.spec.lets.get(*i).is_some_and(|l| l.kind == LetKind::Temporal)
+            }
+            _ => false,
+        }
+    }
+
     /// A temporal operator: a statement computing its signal; returns the variable.
     fn temporal(&mut self, f: &CFormula) -> TokenStream {
         let v = format_ident!("sig{}", self.n);
@@ -688,7 +729,7 @@ impl Body<'_, '_> {
                 let (s, e) = bounds(iv);
                 {
                     let rt = self.rt;
-                    quote!(#rt::window(&#a, #s, #e, true))
+                    quote!(#rt::window_min(#a, #s, #e))
                 }
             }
             CFormulaKind::Eventually(iv, a) => {
@@ -696,7 +737,7 @@ impl Body<'_, '_> {
                 let (s, e) = bounds(iv);
                 {
                     let rt = self.rt;
-                    quote!(#rt::window(&#a, #s, #e, false))
+                    quote!(#rt::window_max(#a, #s, #e))
                 }
             }
             CFormulaKind::Until(iv, a, b) => {
@@ -821,73 +862,114 @@ impl Body<'_, '_> {
 fn runtime_helpers() -> TokenStream {
     quote! {
         mod rt {
-            /// `min` (or `max`) of `sig` over the window `[t + start, t + end)` clipped to
-            /// the trace, for every `t`; `+inf` (or `-inf`) when empty.
-            pub(super) fn window(sig: &[f64], start: usize, end: usize, min: bool) -> ::std::vec::Vec<f64> {
+            /// `min` of `sig` over the window `[t + start, t + end)` clipped to the trace,
+            /// for every `t`; `+inf` when empty.
+            pub(super) fn window_min(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
+                window(sig, start, end, f64::INFINITY, f64::min)
+            }
+
+            /// `max` of `sig` over the window `[t + start, t + end)` clipped to the trace,
+            /// for every `t`; `-inf` when empty.
+            pub(super) fn window_max(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
+                window(sig, start, end, f64::NEG_INFINITY, f64::max)
+            }
+
+            /// Sliding windows by van Herk / Gil-Werman: per-block prefix and suffix folds,
+            /// three passes whatever the width, reusing the input as the prefix buffer.
+            /// Folding from `neutral` with `f64::min` or `f64::max` skips NaN as the
+            /// reference evaluator does.
+            #[inline(always)]
+            fn window(
+                mut sig: ::std::vec::Vec<f64>,
+                start: usize,
+                end: usize,
+                neutral: f64,
+                op: fn(f64, f64) -> f64,
+            ) -> ::std::vec::Vec<f64> {
                 let n = sig.len();
-                let (neutral, better): (f64, fn(f64, f64) -> bool) = if min {
-                    (f64::INFINITY, |a, b| a <= b)
-                } else {
-                    (f64::NEG_INFINITY, |a, b| a >= b)
-                };
-                let val = |u: usize| if sig[u].is_nan() { neutral } else { sig[u] };
-                let mut out = ::std::vec![neutral; n];
                 if end <= start {
-                    return out;
+                    sig.fill(neutral);
+                    return sig;
                 }
-                let width = end - start;
-                // best[u]: the extreme of the window [u, u + width) clipped to the trace.
-                let mut best = ::std::vec![neutral; n];
-                if width >= n {
+                let w = end - start;
+                if w >= n {
+                    // Every window runs to the end: suffix folds, shifted by `start`.
                     let mut acc = neutral;
-                    for u in (0..n).rev() {
-                        if better(val(u), acc) {
-                            acc = val(u);
-                        }
-                        best[u] = acc;
+                    for x in sig.iter_mut().rev() {
+                        acc = op(acc, *x);
+                        *x = acc;
                     }
-                } else {
-                    let mut deque = ::std::collections::VecDeque::with_capacity(width + 1);
-                    for u in (0..n).rev() {
-                        let x = val(u);
-                        while deque.back().is_some_and(|&b: &usize| better(x, val(b))) {
-                            deque.pop_back();
-                        }
-                        deque.push_back(u);
-                        while deque.front().is_some_and(|&f: &usize| f >= u + width) {
-                            deque.pop_front();
-                        }
-                        best[u] = deque.front().map_or(neutral, |&f| val(f));
+                    for t in 0..n {
+                        sig[t] = match t.checked_add(start) {
+                            ::core::option::Option::Some(l) if l < n => sig[l],
+                            _ => neutral,
+                        };
                     }
+                    return sig;
                 }
-                for (t, o) in out.iter_mut().enumerate() {
-                    if let ::core::option::Option::Some(&b) = best.get(t.saturating_add(start)) {
-                        *o = b;
+                // suf[u]: the fold from u to the end of its block of w steps.
+                let mut suf = ::std::vec![neutral; n];
+                let mut b = 0;
+                while b < n {
+                    let e = (b + w).min(n);
+                    let mut acc = neutral;
+                    for u in (b..e).rev() {
+                        acc = op(acc, sig[u]);
+                        suf[u] = acc;
                     }
+                    b = e;
                 }
-                out
+                // tail[k]: the fold over n - w + k .. n, for the windows the trace clips.
+                let mut tail = ::std::vec![neutral; w + 1];
+                for k in (0..w).rev() {
+                    tail[k] = op(tail[k + 1], sig[n - w + k]);
+                }
+                // sig becomes pre[u]: the fold from the start of u's block to u.
+                let mut b = 0;
+                while b < n {
+                    let e = (b + w).min(n);
+                    let mut acc = neutral;
+                    for x in &mut sig[b..e] {
+                        acc = op(acc, *x);
+                        *x = acc;
+                    }
+                    b = e;
+                }
+                // Step t reads suf at t + start >= t, so the result can overwrite suf.
+                for t in 0..n {
+                    let l = t.saturating_add(start);
+                    suf[t] = if l >= n {
+                        neutral
+                    } else if l + w <= n {
+                        op(suf[l], sig[l + w - 1])
+                    } else {
+                        tail[l + w - n]
+                    };
+                }
+                suf
             }
 
             /// `f until[start..end) g` at every step.
             pub(super) fn until(f: &[f64], g: &[f64], start: usize, end: usize) -> ::std::vec::Vec<f64> {
                 let n = f.len().min(g.len());
-                let fv = |u: usize| if f[u].is_nan() { f64::INFINITY } else { f[u] };
-                let gv = |u: usize| if g[u].is_nan() { f64::INFINITY } else { g[u] };
                 let mut out = ::std::vec![f64::NEG_INFINITY; n];
                 if end <= start {
                     return out;
                 }
+                // A NaN operand is skipped by min, as in the reference evaluator.
+                let fv = |u: usize| f64::INFINITY.min(f[u]);
+                let gv = |u: usize| f64::INFINITY.min(g[u]);
                 if end == usize::MAX {
-                    // v[u]: best over u' >= u of min(g(u'), min f over [u, u')).
+                    // v[u]: the best over u' >= u of min(g(u'), min f over [u, u')).
                     let mut v = ::std::vec![f64::NEG_INFINITY; n + 1];
                     for u in (0..n).rev() {
                         v[u] = gv(u).max(fv(u).min(v[u + 1]));
                     }
-                    let prefix = window(&f[..n], 0, start, true);
+                    let before = window_min(f[..n].to_vec(), 0, start);
                     for (t, o) in out.iter_mut().enumerate() {
                         let u = t.saturating_add(start);
                         if u < n {
-                            *o = if start == 0 { v[u] } else { prefix[t].min(v[u]) };
+                            *o = before[t].min(v[u]);
                         }
                     }
                 } else {
