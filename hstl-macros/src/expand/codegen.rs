@@ -865,26 +865,71 @@ fn runtime_helpers() -> TokenStream {
             /// `min` of `sig` over the window `[t + start, t + end)` clipped to the trace,
             /// for every `t`; `+inf` when empty.
             pub(super) fn window_min(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
-                window(sig, start, end, f64::INFINITY, f64::min)
+                if sig.iter().any(|x| x.is_nan()) {
+                    window(sig, start, end, f64::INFINITY, f64::min)
+                } else {
+                    window(sig, start, end, f64::INFINITY, |a: f64, b: f64| if b < a { b } else { a })
+                }
             }
 
             /// `max` of `sig` over the window `[t + start, t + end)` clipped to the trace,
             /// for every `t`; `-inf` when empty.
             pub(super) fn window_max(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
-                window(sig, start, end, f64::NEG_INFINITY, f64::max)
+                if sig.iter().any(|x| x.is_nan()) {
+                    window(sig, start, end, f64::NEG_INFINITY, f64::max)
+                } else {
+                    window(sig, start, end, f64::NEG_INFINITY, |a: f64, b: f64| if b > a { b } else { a })
+                }
+            }
+
+            /// Folds every block of `w` steps of `buf` in place, forward (prefix folds) or
+            /// backward (suffix folds); four blocks at a time so the folds overlap.
+            #[inline(always)]
+            fn scan<F: Fn(f64, f64) -> f64 + Copy>(buf: &mut [f64], w: usize, neutral: f64, op: F, backward: bool) {
+                let n = buf.len();
+                let groups = n / w / 4;
+                for gi in 0..groups {
+                    let base = gi * 4 * w;
+                    let mut acc = [neutral; 4];
+                    for j in 0..w {
+                        let j = if backward { w - 1 - j } else { j };
+                        for (k, a) in acc.iter_mut().enumerate() {
+                            let u = base + k * w + j;
+                            *a = op(*a, buf[u]);
+                            buf[u] = *a;
+                        }
+                    }
+                }
+                let mut b = groups * 4 * w;
+                while b < n {
+                    let e = (b + w).min(n);
+                    let mut acc = neutral;
+                    if backward {
+                        for x in buf[b..e].iter_mut().rev() {
+                            acc = op(acc, *x);
+                            *x = acc;
+                        }
+                    } else {
+                        for x in &mut buf[b..e] {
+                            acc = op(acc, *x);
+                            *x = acc;
+                        }
+                    }
+                    b = e;
+                }
             }
 
             /// Sliding windows by van Herk / Gil-Werman: per-block prefix and suffix folds,
-            /// three passes whatever the width, reusing the input as the prefix buffer.
+            /// a few passes whatever the width, reusing the input as the prefix buffer.
             /// Folding from `neutral` with `f64::min` or `f64::max` skips NaN as the
             /// reference evaluator does.
             #[inline(always)]
-            fn window(
+            fn window<F: Fn(f64, f64) -> f64 + Copy>(
                 mut sig: ::std::vec::Vec<f64>,
                 start: usize,
                 end: usize,
                 neutral: f64,
-                op: fn(f64, f64) -> f64,
+                op: F,
             ) -> ::std::vec::Vec<f64> {
                 let n = sig.len();
                 if end <= start {
@@ -907,44 +952,31 @@ fn runtime_helpers() -> TokenStream {
                     }
                     return sig;
                 }
-                // suf[u]: the fold from u to the end of its block of w steps.
-                let mut suf = ::std::vec![neutral; n];
-                let mut b = 0;
-                while b < n {
-                    let e = (b + w).min(n);
-                    let mut acc = neutral;
-                    for u in (b..e).rev() {
-                        acc = op(acc, sig[u]);
-                        suf[u] = acc;
-                    }
-                    b = e;
-                }
                 // tail[k]: the fold over n - w + k .. n, for the windows the trace clips.
                 let mut tail = ::std::vec![neutral; w + 1];
                 for k in (0..w).rev() {
                     tail[k] = op(tail[k + 1], sig[n - w + k]);
                 }
-                // sig becomes pre[u]: the fold from the start of u's block to u.
-                let mut b = 0;
-                while b < n {
-                    let e = (b + w).min(n);
-                    let mut acc = neutral;
-                    for x in &mut sig[b..e] {
-                        acc = op(acc, *x);
-                        *x = acc;
+                // suf[u]: the fold from u to the end of its block; sig becomes the prefix
+                // folds from the start of each block.
+                let mut suf = sig.clone();
+                scan(&mut suf, w, neutral, op, true);
+                scan(&mut sig, w, neutral, op, false);
+                // Step t reads suf at t + start >= t, so the result can overwrite suf. Steps
+                // before `full` see whole windows; the rest are clipped by the trace's end.
+                let full = (n - w + 1).saturating_sub(start);
+                if start == 0 {
+                    for (x, y) in suf[..full].iter_mut().zip(&sig[w - 1..]) {
+                        *x = op(*x, *y);
                     }
-                    b = e;
+                } else {
+                    for t in 0..full {
+                        suf[t] = op(suf[t + start], sig[t + start + w - 1]);
+                    }
                 }
-                // Step t reads suf at t + start >= t, so the result can overwrite suf.
-                for t in 0..n {
+                for t in full..n {
                     let l = t.saturating_add(start);
-                    suf[t] = if l >= n {
-                        neutral
-                    } else if l + w <= n {
-                        op(suf[l], sig[l + w - 1])
-                    } else {
-                        tail[l + w - n]
-                    };
+                    suf[t] = if l >= n { neutral } else { tail[l + w - n] };
                 }
                 suf
             }
