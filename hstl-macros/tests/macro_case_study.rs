@@ -107,3 +107,21 @@ fn spec_trait_gives_a_valid_task_spec() {
     let inline = inline::Inline.task_spec();
     inline.validate().expect("the inline spec is a valid runtime spec");
 }
+
+#[test]
+fn training_the_case_study_takes_a_few_lines() {
+    use hstl::runtime::{GridWorld, Learner, Spec, seeded_rng};
+    let mut spec = surveillance::Surveillance.task_spec();
+    spec.learn.episodes = 3;
+    spec.learn.choices = 5;
+    let env = GridWorld::default();
+    let train = |seed| {
+        let mut learner = Learner::new(&spec, &env).expect("the case study fits the grid world");
+        let trained = learner.train(&mut seeded_rng(seed), |_, _| {});
+        (trained.curve, learner.q().clone())
+    };
+    let (curve, q) = train(7);
+    assert_eq!(curve.len(), 3);
+    // The same seed gives the same tables, bit for bit.
+    assert_eq!((curve, q), train(7));
+}
