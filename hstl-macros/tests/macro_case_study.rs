@@ -125,3 +125,34 @@ fn training_the_case_study_takes_a_few_lines() {
     // The same seed gives the same tables, bit for bit.
     assert_eq!((curve, q), train(7));
 }
+
+hstl! {
+    /// Names that could clash with generated items or Rust keywords.
+    spec State {
+        state { type: int in 0..=1, s: int in 0..=3, t: int in 0..=2 }
+        let fn = r#type > 0 && s < 2;
+        let Lets = eventually[0..3] fn;
+        task always[0..] (Lets || t > 1);
+        option fn;
+    }
+}
+
+#[test]
+fn awkward_names_still_compile() {
+    use hstl::runtime::Spec;
+    let states = [state::State { r#type: 1, s: 1, t: 0 }, state::State { r#type: 0, s: 3, t: 2 }];
+    assert_eq!(state::lets::r#fn::at(&states[0]), 1.0);
+    let f = state::task::formula();
+    let trace = trace_from(&states.map(|s| s.values().to_vec()));
+    assert_eq!(state::task::signal(&states), reference::signal(&f, &trace));
+    assert_eq!(state::StateSpec.task_spec().name, "State");
+    assert_eq!(state::Primitive::ALL.map(state::Primitive::name), ["fn"]);
+}
+
+fn trace_from(rows: &[Vec<f64>]) -> Trace {
+    let mut t = Trace::new(rows.first().map_or(0, Vec::len));
+    for r in rows {
+        t.push(r).expect("rows have the same width");
+    }
+    t
+}

@@ -513,7 +513,12 @@ impl<'a> Gen<'a> {
         if !self.valid(&task.formula) {
             return TokenStream::new();
         }
-        let ty = ident(&camel_case(&self.spec.name));
+        // The unit struct is named after the spec, unless that names another item here.
+        let camel = camel_case(&self.spec.name);
+        let ty = match camel.as_str() {
+            "State" | "Primitive" | "Options" => format_ident!("{}Spec", camel),
+            _ => ident(&camel),
+        };
         let name = &self.spec.name;
         let lets = quote!(lets);
         let vars = self.spec.state_vars.iter().map(|v| {

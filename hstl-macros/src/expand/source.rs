@@ -112,7 +112,11 @@ impl Builder {
                 }
                 self.glue = p.spacing() == Spacing::Joint;
             }
-            TokenTree::Ident(i) => self.push(&i.to_string(), i.span()),
+            TokenTree::Ident(i) => {
+                // `r#type` names `type`: hstl has no raw identifiers and few keywords.
+                let name = i.to_string();
+                self.push(name.strip_prefix("r#").unwrap_or(&name), i.span());
+            }
             TokenTree::Literal(l) => self.push(&l.to_string(), l.span()),
         }
     }
@@ -194,6 +198,7 @@ mod tests {
             ("a & & b", "a & & b", vec!["a", "&", "&", "b"]),
             ("x > -3", "x > - 3", vec!["x", ">", "-", "3"]),
             ("x>-3", "x >- 3", vec!["x", ">-", "3"]),
+            ("r#type > 1", "type > 1", vec!["type", ">", "1"]),
         ];
         for (input, text, entries) in cases {
             let src = source(input);
