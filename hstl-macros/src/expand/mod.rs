@@ -193,6 +193,18 @@ mod tests {
     }
 
     #[test]
+    fn included_file_errors_name_path_line_and_column() {
+        let path = std::env::temp_dir().join(format!("hstl-macros-{}.hstl", std::process::id()));
+        std::fs::write(&path, "spec S {\n    state { x: float }\n    task always Goal;\n}\n")
+            .expect("temp file");
+        let shown = path.display().to_string();
+        let out = expand_file(&shown, (Span::call_site(), Span::call_site())).to_string();
+        std::fs::remove_file(&path).ok();
+        assert!(out.contains(&format!("{shown}:3:17: unknown name `Goal` [HSTL002]")), "{out}");
+        assert!(out.contains("include_str"), "{out}");
+    }
+
+    #[test]
     fn warnings_become_deprecated_uses() {
         let tokens: TokenStream =
             "spec S { state { x: float } let A = x > 1; let Spare = x < 0; task A; }"
