@@ -887,17 +887,16 @@ fn runtime_helpers() -> TokenStream {
                 }
             }
 
-            /// Folds every block of `w` steps of `buf` in place, forward (prefix folds) or
-            /// backward (suffix folds); four blocks at a time so the folds overlap.
+            /// Folds every block of `w` steps of `buf` in place from the block's start
+            /// (prefix folds); four blocks at a time so the folds overlap.
             #[inline(always)]
-            fn scan<F: Fn(f64, f64) -> f64 + Copy>(buf: &mut [f64], w: usize, neutral: f64, op: F, backward: bool) {
+            fn scan<F: Fn(f64, f64) -> f64 + Copy>(buf: &mut [f64], w: usize, neutral: f64, op: F) {
                 let n = buf.len();
                 let groups = n / w / 4;
                 for gi in 0..groups {
                     let base = gi * 4 * w;
                     let mut acc = [neutral; 4];
                     for j in 0..w {
-                        let j = if backward { w - 1 - j } else { j };
                         for (k, a) in acc.iter_mut().enumerate() {
                             let u = base + k * w + j;
                             *a = op(*a, buf[u]);
@@ -909,16 +908,38 @@ fn runtime_helpers() -> TokenStream {
                 while b < n {
                     let e = (b + w).min(n);
                     let mut acc = neutral;
-                    if backward {
-                        for x in buf[b..e].iter_mut().rev() {
-                            acc = op(acc, *x);
-                            *x = acc;
+                    for x in &mut buf[b..e] {
+                        acc = op(acc, *x);
+                        *x = acc;
+                    }
+                    b = e;
+                }
+            }
+
+            /// `dst[u]`: the fold of `src` from `u` to the end of its block of `w` steps; four
+            /// blocks at a time so the folds overlap.
+            #[inline(always)]
+            fn suffix_folds<F: Fn(f64, f64) -> f64 + Copy>(src: &[f64], dst: &mut [f64], w: usize, neutral: f64, op: F) {
+                let n = src.len().min(dst.len());
+                let groups = n / w / 4;
+                for gi in 0..groups {
+                    let base = gi * 4 * w;
+                    let mut acc = [neutral; 4];
+                    for j in (0..w).rev() {
+                        for (k, a) in acc.iter_mut().enumerate() {
+                            let u = base + k * w + j;
+                            *a = op(*a, src[u]);
+                            dst[u] = *a;
                         }
-                    } else {
-                        for x in &mut buf[b..e] {
-                            acc = op(acc, *x);
-                            *x = acc;
-                        }
+                    }
+                }
+                let mut b = groups * 4 * w;
+                while b < n {
+                    let e = (b + w).min(n);
+                    let mut acc = neutral;
+                    for u in (b..e).rev() {
+                        acc = op(acc, src[u]);
+                        dst[u] = acc;
                     }
                     b = e;
                 }
@@ -964,9 +985,9 @@ fn runtime_helpers() -> TokenStream {
                 }
                 // suf[u]: the fold from u to the end of its block; sig becomes the prefix
                 // folds from the start of each block.
-                let mut suf = sig.clone();
-                scan(&mut suf, w, neutral, op, true);
-                scan(&mut sig, w, neutral, op, false);
+                let mut suf = ::std::vec![neutral; n];
+                suffix_folds(&sig, &mut suf, w, neutral, op);
+                scan(&mut sig, w, neutral, op);
                 // Step t reads suf at t + start >= t, so the result can overwrite suf. Steps
                 // before `full` see whole windows; the rest are clipped by the trace's end.
                 let full = (n - w + 1).saturating_sub(start);
