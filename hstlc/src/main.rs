@@ -1,1 +1,74 @@
-fn main() {}
+//! `hstlc`: the hstl command line.
+//!
+//! Exit status: 0 when the command succeeded (warnings allowed), 1 when the input has
+//! errors, 2 when the command could not run (a missing file, a bad flag).
+
+mod check;
+mod cli_error;
+mod explain;
+mod render;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::cli_error::CliError;
+
+/// Check, monitor and learn from hstl task specs.
+#[derive(Parser, Debug)]
+#[command(name = "hstlc", version, about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Check spec files and print their diagnostics.
+    Check(check::CheckArgs),
+    /// Print the long explanation of a diagnostic code, such as HSTL003.
+    Explain(explain::ExplainArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // clap prints help and version to stdout with status 0, usage errors with 2.
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    let result = match cli.command {
+        Command::Check(args) => check::run(&args),
+        Command::Explain(args) => explain::run(&args),
+    };
+    match result {
+        Ok(status) => status.into(),
+        Err(e) => {
+            eprintln!("{}", render::cli_error(&e));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// How a command that ran went.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// Nothing wrong (warnings allowed).
+    Clean,
+    /// The input has errors.
+    Errors,
+}
+
+impl From<Status> for ExitCode {
+    fn from(s: Status) -> ExitCode {
+        match s {
+            Status::Clean => ExitCode::SUCCESS,
+            Status::Errors => ExitCode::from(1),
+        }
+    }
+}
+
+/// The result of a command: a status, or an error that kept it from running.
+pub type CmdResult = Result<Status, CliError>;

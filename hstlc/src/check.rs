@@ -1,0 +1,87 @@
+//! `hstlc check`: diagnostics of spec files in four formats.
+
+use std::io::{IsTerminal, Read};
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use hstl::lang::{Diagnostic, Severity};
+
+use crate::cli_error::CliError;
+use crate::{CmdResult, Status, render};
+
+/// Arguments of `hstlc check`.
+#[derive(Args, Debug)]
+pub struct CheckArgs {
+    /// Spec files to check; `-` reads standard input.
+    #[arg(required = true, value_name = "FILE")]
+    pub files: Vec<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Full)]
+    pub format: Format,
+    /// The name to report for standard input.
+    #[arg(long, value_name = "NAME", default_value = "<stdin>")]
+    pub stdin_filename: String,
+}
+
+/// How `check` prints diagnostics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    /// Rendered with the source and carets (colour only on a terminal).
+    Full,
+    /// One line each: `path:line:col: CODE message`.
+    Concise,
+    /// One JSON array of objects.
+    Json,
+    /// SARIF 2.1.0.
+    Sarif,
+}
+
+/// One checked input: its name, text and diagnostics.
+pub struct Checked {
+    /// The path, or the `--stdin-filename` name.
+    pub name: String,
+    /// The source text.
+    pub source: String,
+    /// Everything the front end found, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Runs `hstlc check`.
+pub fn run(args: &CheckArgs) -> CmdResult {
+    // Read every input first: an unreadable file stops the run before anything prints.
+    let inputs = args
+        .files
+        .iter()
+        .map(|path| read_input(path, &args.stdin_filename))
+        .collect::<Result<Vec<_>, _>>()?;
+    let checked: Vec<Checked> = inputs
+        .into_iter()
+        .map(|(name, source)| {
+            let diagnostics = hstl::lang::check(&source).diagnostics;
+            Checked { name, source, diagnostics }
+        })
+        .collect();
+    let out = match args.format {
+        Format::Full => render::full(&checked, std::io::stdout().is_terminal()),
+        Format::Concise => render::concise(&checked),
+        Format::Json => render::json(&checked),
+        Format::Sarif => render::sarif(&checked),
+    };
+    print!("{out}");
+    let errors = checked.iter().flat_map(|c| &c.diagnostics).any(|d| d.severity == Severity::Error);
+    Ok(if errors { Status::Errors } else { Status::Clean })
+}
+
+/// Reads a file, or standard input for `-`, and names it for reports.
+pub fn read_input(path: &Path, stdin_name: &str) -> Result<(String, String), CliError> {
+    if path == Path::new("-") {
+        let mut text = String::new();
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|source| CliError::Read { path: PathBuf::from(stdin_name), source })?;
+        return Ok((stdin_name.to_string(), text));
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+    Ok((path.display().to_string(), text))
+}

@@ -1,0 +1,75 @@
+//! Errors that keep a command from running (exit status 2).
+
+use std::fmt;
+use std::path::PathBuf;
+
+/// Why a command could not run.
+#[derive(Debug)]
+pub enum CliError {
+    /// A file could not be read.
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// A file could not be written.
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The reason.
+        source: std::io::Error,
+    },
+    /// Any other problem, with what to do about it.
+    Other {
+        /// What is wrong.
+        message: String,
+        /// How to fix it.
+        help: Option<String>,
+    },
+}
+
+impl CliError {
+    /// An error with a message and a hint.
+    pub fn new(message: impl Into<String>, help: impl Into<Option<String>>) -> CliError {
+        CliError::Other { message: message.into(), help: help.into() }
+    }
+
+    /// How to fix it, where one fits.
+    pub fn help(&self) -> Option<String> {
+        match self {
+            CliError::Read { source, .. } if source.kind() == std::io::ErrorKind::NotFound => {
+                Some("check the path; use `-` to read standard input".into())
+            }
+            CliError::Read { .. } | CliError::Write { .. } => None,
+            CliError::Other { help, .. } => help.clone(),
+        }
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Read { path, source } => {
+                write!(f, "cannot read `{}`: {}", path.display(), io_reason(source))
+            }
+            CliError::Write { path, source } => {
+                write!(f, "cannot write `{}`: {}", path.display(), io_reason(source))
+            }
+            CliError::Other { message, .. } => f.write_str(message),
+        }
+    }
+}
+
+impl std::error::Error for CliError {}
+
+/// The OS reason in lower case, without the "(os error N)" tail.
+fn io_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    let text = text.split(" (os error").next().unwrap_or(&text).to_string();
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => text,
+    }
+}
