@@ -12,7 +12,7 @@
 //!
 //! ```
 //! let src = "spec S { state { x: int in 0..=9 } let Goal = x > 6; task eventually[0..5] Goal;
-//!            option Goal; options {Goal}; }";
+//!            option Goal; options { Goal } }";
 //! let checked = hstl::lang::check(src);
 //! assert!(!checked.has_errors());
 //! let spec = hstl::lower::task_spec(&checked.specs[0], src).unwrap();
