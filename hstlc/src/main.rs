@@ -6,7 +6,9 @@
 mod check;
 mod cli_error;
 mod explain;
+mod monitor;
 mod render;
+mod trace_csv;
 
 use std::process::ExitCode;
 
@@ -28,6 +30,8 @@ enum Command {
     Check(check::CheckArgs),
     /// Print the long explanation of a diagnostic code, such as HSTL003.
     Explain(explain::ExplainArgs),
+    /// Score a trace (CSV) against the task or a `let`.
+    Monitor(monitor::MonitorArgs),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +46,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check(args) => check::run(&args),
         Command::Explain(args) => explain::run(&args),
+        Command::Monitor(args) => monitor::run(&args),
     };
     match result {
         Ok(status) => status.into(),

@@ -1,0 +1,158 @@
+//! The command line's contract, one snapshot per case: exit status, standard output and
+//! standard error of `hstlc` run in `tests/cli/` on the fixtures there.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+/// A case: its snapshot name, the arguments, and what standard input holds.
+struct Case {
+    name: &'static str,
+    args: &'static [&'static str],
+    stdin: &'static str,
+}
+
+const fn case(name: &'static str, args: &'static [&'static str]) -> Case {
+    Case { name, args, stdin: "" }
+}
+
+const CASES: &[Case] = &[
+    // check
+    case("check_clean", &["check", "surveillance.hstl"]),
+    case("check_warnings_exit_0", &["check", "warnings.hstl"]),
+    case("check_errors_full", &["check", "errors.hstl"]),
+    case("check_errors_concise", &["check", "--format", "concise", "errors.hstl"]),
+    case("check_errors_json", &["check", "--format", "json", "errors.hstl"]),
+    case("check_errors_sarif", &["check", "--format", "sarif", "errors.hstl"]),
+    case("check_many_files", &["check", "--format", "concise", "warnings.hstl", "errors.hstl"]),
+    Case {
+        name: "check_stdin",
+        args: &["check", "--format", "concise", "--stdin-filename", "piped.hstl", "-"],
+        stdin: "spec S { state { x: int in 0..=3 } task x > ; }",
+    },
+    case("check_missing_file", &["check", "surveillance.hstl", "nowhere.hstl"]),
+    case("check_bad_format", &["check", "--format", "xml", "errors.hstl"]),
+    case("check_no_files", &["check"]),
+    // explain
+    case("explain_code", &["explain", "HSTL003"]),
+    case("explain_lowercase", &["explain", "hstl101"]),
+    case("explain_unknown", &["explain", "HSTL999"]),
+    // monitor
+    case("monitor_task", &["monitor", "surveillance.hstl", "--trace", "trace.csv"]),
+    case("monitor_signal", &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--signal"]),
+    case(
+        "monitor_let_signal",
+        &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "A", "--signal"],
+    ),
+    case("monitor_infinite", &["monitor", "surveillance.hstl", "--trace", "infinite.csv"]),
+    case(
+        "monitor_unknown_formula",
+        &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "Nope"],
+    ),
+    case(
+        "monitor_missing_column",
+        &["monitor", "surveillance.hstl", "--trace", "missing_column.csv"],
+    ),
+    case("monitor_not_a_number", &["monitor", "surveillance.hstl", "--trace", "not_a_number.csv"]),
+    case("monitor_ragged_row", &["monitor", "surveillance.hstl", "--trace", "ragged.csv"]),
+    case("monitor_empty_file", &["monitor", "surveillance.hstl", "--trace", "empty.csv"]),
+    case("monitor_header_only", &["monitor", "surveillance.hstl", "--trace", "header_only.csv"]),
+    case("monitor_missing_trace", &["monitor", "surveillance.hstl", "--trace", "nowhere.csv"]),
+    case("monitor_spec_errors", &["monitor", "errors.hstl", "--trace", "trace.csv"]),
+    case("monitor_two_specs", &["monitor", "two_specs.hstl", "--trace", "x.csv"]),
+    case(
+        "monitor_pick_spec",
+        &["monitor", "two_specs.hstl", "--spec", "Second", "--trace", "x.csv"],
+    ),
+    case(
+        "monitor_unknown_spec",
+        &["monitor", "two_specs.hstl", "--spec", "Third", "--trace", "x.csv"],
+    ),
+    Case {
+        name: "monitor_trace_on_stdin",
+        args: &["monitor", "two_specs.hstl", "--spec", "First", "--trace", "-", "--signal"],
+        stdin: "x\n0\n9\n1\n",
+    },
+];
+
+#[test]
+fn cli_cases() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli");
+    let mut settings = insta::Settings::clone_current();
+    settings.set_snapshot_path("snapshots/cli");
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| {
+        for case in CASES {
+            let mut child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+                .args(case.args)
+                .current_dir(dir)
+                .env_remove("NO_COLOR")
+                .env_remove("CLICOLOR_FORCE")
+                .stdin(Stdio::piped())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("hstlc starts");
+            child.stdin.take().expect("piped").write_all(case.stdin.as_bytes()).expect("stdin");
+            let out = child.wait_with_output().expect("hstlc ends");
+            let status = out.status.code().map_or("killed".to_string(), |c| c.to_string());
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            insta::assert_snapshot!(
+                case.name,
+                format!(
+                    "$ hstlc {}\nexit: {status}\n--- stdout\n{stdout}--- stderr\n{stderr}",
+                    case.args.join(" ")
+                )
+            );
+        }
+    });
+}
+
+/// Colour codes belong on terminals only: piped output has none.
+#[test]
+fn piped_output_has_no_colour() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli");
+    let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["check", "errors.hstl"])
+        .current_dir(dir)
+        .output()
+        .expect("hstlc runs");
+    assert!(!out.stdout.contains(&0x1b), "escape codes in piped output");
+    assert_eq!(out.status.code(), Some(1));
+}
+
+/// The machine formats parse, and hold the fields the contract names.
+#[test]
+fn json_and_sarif_are_valid() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli");
+    let run = |format: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+            .args(["check", "--format", format, "errors.hstl", "warnings.hstl"])
+            .current_dir(dir)
+            .output()
+            .expect("hstlc runs");
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("valid JSON")
+    };
+    let json = run("json");
+    let items = json.as_array().expect("an array");
+    assert!(items.len() >= 4);
+    for item in items {
+        for key in [
+            "file",
+            "severity",
+            "code",
+            "message",
+            "line",
+            "column",
+            "end_line",
+            "end_column",
+            "help",
+        ] {
+            assert!(item.get(key).is_some(), "missing `{key}` in {item}");
+        }
+        assert!(matches!(item["severity"].as_str(), Some("error" | "warning")));
+    }
+    let sarif = run("sarif");
+    assert_eq!(sarif["version"], "2.1.0");
+    assert_eq!(sarif["runs"][0]["results"].as_array().map(Vec::len), Some(items.len()));
+}
