@@ -1,19 +1,26 @@
-//! Trains the case study over many seeds for four variants (O_T1/O_T2 x argmax/entry
-//! termination) on two threads and reports the window rate, W/W*, training time and the
-//! O_T2 vs O_T1 reward difference.
+//! Trains the case study over many seeds for five variants (O_T1/O_T2 x argmax/entry
+//! termination, and `memory`: options {A, B, C} with `memory: 8` and `reward: window`) on
+//! two threads and reports the window rate, W/W*, training time, the window rate of the
+//! learned legs driven through the fixed cycle A -> B -> C, and the O_T2 vs O_T1 reward
+//! difference.
 //!
 //! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES] [VARIANT]`
-//! (VARIANT, such as `O_T2 argmax`, runs that variant alone; EPISODES `-` keeps 1200;
-//! SEEDS 0 stops after the optimum and the hand-written cycle).
+//! (VARIANT, such as `O_T2 argmax` or `memory`, runs that variant alone; EPISODES `-` keeps
+//! 1200; SEEDS 0 stops after the optimum and the hand-written cycle).
+//!
+//! The memory variant's figures: `cargo run --release -p hstl-runtime --example sweep -- 20 -
+//! memory`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
 
 use std::time::Instant;
 
-use hstl_runtime::eval::{AgentController, EntryCycle, RegionTable, WindowConfig, window_rate};
+use hstl_runtime::eval::{
+    AgentController, EntryCycle, LegCycle, RegionTable, WindowConfig, window_rate,
+};
 use hstl_runtime::optimum::{SolveConfig, solve};
-use hstl_runtime::{GridWorld, Learner, seeded_rng};
+use hstl_runtime::{GridWorld, Learner, TaskSpec, seeded_rng};
 
 /// What one training run measured.
 #[derive(Clone, Debug)]
@@ -22,10 +29,19 @@ struct Outcome {
     secs: f64,
     tail_reward: f64,
     steps: u64,
+    legs: f64,
 }
 
-fn run(permutations: bool, entry: bool, seed: u64, episodes: Option<usize>) -> Outcome {
-    let mut spec = common::case_study(permutations, entry);
+/// The spec of a variant by name.
+fn variant(name: &str) -> TaskSpec {
+    match name {
+        "memory" => common::case_study_memory(),
+        _ => common::case_study(name.starts_with("O_T2"), name.ends_with("entry")),
+    }
+}
+
+fn run(name: &str, seed: u64, episodes: Option<usize>) -> Outcome {
+    let mut spec = variant(name);
     if let Some(e) = episodes {
         spec.learn.episodes = e;
     }
@@ -46,12 +62,16 @@ fn run(permutations: bool, entry: bool, seed: u64, episodes: Option<usize>) -> O
         &mut eval_rng,
     )
     .expect("default window config is valid");
+    let mut legs = LegCycle::new(&agent, vec![0, 1, 2]).expect("three primitives");
+    let legs = window_rate(&env, &mut legs, &regions, WindowConfig::default(), &mut eval_rng)
+        .expect("default window config is valid");
     let tail = &trained.curve[trained.curve.len().saturating_sub(100)..];
     Outcome {
         rate: report.rate,
         secs,
         tail_reward: tail.iter().sum::<f64>() / tail.len() as f64,
         steps: trained.steps,
+        legs: legs.rate,
     }
 }
 
@@ -89,12 +109,7 @@ fn main() {
         return;
     }
     let mut tails = Vec::new();
-    for (permutations, entry, name) in [
-        (false, false, "O_T1 argmax"),
-        (true, false, "O_T2 argmax"),
-        (false, true, "O_T1 entry"),
-        (true, true, "O_T2 entry"),
-    ] {
+    for name in ["O_T1 argmax", "O_T2 argmax", "O_T1 entry", "O_T2 entry", "memory"] {
         if only.is_some_and(|o| o != name) {
             continue;
         }
@@ -104,7 +119,7 @@ fn main() {
                     scope.spawn(move || {
                         (0..seeds)
                             .filter(|s| s % 2 == w)
-                            .map(|s| (s, run(permutations, entry, s, episodes)))
+                            .map(|s| (s, run(name, s, episodes)))
                             .collect::<Vec<_>>()
                     })
                 })
@@ -126,12 +141,18 @@ fn main() {
         let (s, slo, shi) = stat(&|o| o.secs);
         let (tr, _, _) = stat(&|o| o.tail_reward);
         let (st, _, _) = stat(&|o| o.steps as f64);
+        let (lg, llo, lhi) = stat(&|o| o.legs);
+        let sd = (outcomes.iter().map(|o| (o.rate - r).powi(2)).sum::<f64>()
+            / (outcomes.len().max(2) - 1) as f64)
+            .sqrt();
         println!(
-            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}",
+            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}, sd {sd:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}, learned legs through A->B->C {lg:.3} ({llo:.3}-{lhi:.3})",
             r / w_star,
             st / s / 1e6
         );
-        tails.push(tr);
+        if name != "memory" {
+            tails.push(tr);
+        }
     }
     if tails.len() < 4 {
         return;

@@ -1,7 +1,8 @@
 //! Trains the case study once and reports the time, the steps per second and the window
 //! rate of the greedy policy.
 //!
-//! `cargo run --release -p hstl-runtime --example train -- [SEED] [o_t2] [entry]`
+//! `cargo run --release -p hstl-runtime --example train -- [SEED] [o_t2] [entry] [memory]`
+//! (`memory`: the fourth variant, options {A, B, C} with `memory: 8` and `reward: window`)
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -14,8 +15,12 @@ use hstl_runtime::{GridWorld, Learner, seeded_rng};
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let seed: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(1);
-    let spec =
-        common::case_study(args.iter().any(|a| a == "o_t2"), args.iter().any(|a| a == "entry"));
+    let has = |flag: &str| args.iter().any(|a| a == flag);
+    let spec = if has("memory") {
+        common::case_study_memory()
+    } else {
+        common::case_study(has("o_t2"), has("entry"))
+    };
     let env = GridWorld::default();
     let t = Instant::now();
     let mut learner = Learner::new(&spec, &env).expect("the case study is valid");

@@ -77,11 +77,27 @@ pub struct RegionTable {
 }
 
 /// A greedy [`Agent`] executing options: the options policy picks an option where none
-/// runs, its legs follow their flat policies greedily.
+/// runs, its legs follow their flat policies greedily. An agent with memory has its
+/// counters tracked along the run (from the first state after each reset), and picks on
+/// the state and buckets.
 #[derive(Clone, Debug)]
 pub struct AgentController<'a> {
     agent: &'a Agent,
     running: Option<(usize, usize, usize)>,
+    tau: Vec<usize>,
+    fresh: bool,
+}
+
+/// The learned legs driven through a fixed cycle of primitive options: run the flat
+/// policy of each primitive in turn until it terminates (or is cut off), then the next.
+/// With the nearest-cell [`EntryCycle`] it separates how good the legs are from how good
+/// the options policy's choices are.
+#[derive(Clone, Debug)]
+pub struct LegCycle<'a> {
+    agent: &'a Agent,
+    cycle: Vec<usize>,
+    phase: usize,
+    steps: usize,
 }
 
 /// The hand-written "nearest-cell entry cycle" on a [`crate::GridWorld`]: visit the regions in
@@ -166,19 +182,38 @@ impl RegionTable {
 impl<'a> AgentController<'a> {
     /// A controller following `agent`.
     pub fn new(agent: &'a Agent) -> AgentController<'a> {
-        AgentController { agent, running: None }
+        AgentController { agent, running: None, tau: Vec::new(), fresh: true }
+    }
+
+    /// The counters `tau_j` of an agent with memory, as of the last state seen (empty
+    /// without memory or before the first step).
+    pub fn tau(&self) -> &[usize] {
+        &self.tau
     }
 }
 
 impl Controller for AgentController<'_> {
     fn reset(&mut self) {
         self.running = None;
+        self.fresh = true;
+        self.tau.clear();
     }
 
     fn act(&mut self, s: usize) -> Decision {
         let agent = self.agent;
-        let chosen = agent.options.get(s).copied().unwrap_or(0);
-        let (o, leg, _) = *self.running.get_or_insert((chosen, 0, 0));
+        if self.fresh {
+            if let Some(m) = &agent.memory {
+                m.start(s, &mut self.tau);
+            }
+            self.fresh = false;
+        }
+        let (o, leg, _) = match self.running {
+            Some(r) => r,
+            None => {
+                let obs = agent.observation(s, &self.tau);
+                *self.running.insert((agent.options.get(obs).copied().unwrap_or(0), 0, 0))
+            }
+        };
         // An agent that does not fit the state (hand-built, or another environment) takes
         // no valid action, which leaves the state unchanged, instead of panicking.
         let action = agent
@@ -191,8 +226,13 @@ impl Controller for AgentController<'_> {
     }
 
     fn observe(&mut self, next: usize) {
-        let Some((o, leg, steps)) = self.running else { return };
         let agent = self.agent;
+        if let Some(m) = &agent.memory
+            && !self.fresh
+        {
+            m.step(next, &mut self.tau);
+        }
+        let Some((o, leg, steps)) = self.running else { return };
         let legs = agent.legs.get(o).map_or(0, Vec::len);
         let done = agent
             .legs
@@ -205,6 +245,44 @@ impl Controller for AgentController<'_> {
         } else {
             Some((o, leg, steps + 1))
         };
+    }
+}
+
+impl<'a> LegCycle<'a> {
+    /// The cycle through the primitive options `cycle` (indices into `agent.flat`), in
+    /// order, starting with the first after each reset. Fails for an empty cycle or an
+    /// index the agent lacks.
+    pub fn new(agent: &'a Agent, cycle: Vec<usize>) -> Result<LegCycle<'a>, Error> {
+        if cycle.is_empty() || cycle.iter().any(|&p| p >= agent.flat.len()) {
+            return Err(Error::Config(format!(
+                "a leg cycle needs primitive indices below {}, not {cycle:?}",
+                agent.flat.len()
+            )));
+        }
+        Ok(LegCycle { agent, cycle, phase: 0, steps: 0 })
+    }
+}
+
+impl Controller for LegCycle<'_> {
+    fn reset(&mut self) {
+        self.phase = 0;
+        self.steps = 0;
+    }
+
+    fn act(&mut self, s: usize) -> Decision {
+        let p = self.cycle[self.phase];
+        let action = self.agent.flat[p].get(s).copied().unwrap_or(usize::MAX);
+        Decision { action, option: p, leg: 0 }
+    }
+
+    fn observe(&mut self, next: usize) {
+        let p = self.cycle[self.phase];
+        self.steps += 1;
+        let done = self.agent.terminate[p].get(next).copied().unwrap_or(true);
+        if done || self.steps >= self.agent.max_steps {
+            self.phase = (self.phase + 1) % self.cycle.len();
+            self.steps = 0;
+        }
     }
 }
 

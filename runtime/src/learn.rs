@@ -17,6 +17,16 @@
 //! before this execution's updates; a later update of a cell that an earlier one changed
 //! (a state visited twice) starts from the changed value.
 //!
+//! **Memory and the window reward** (LANGUAGE.md, "Persistent tasks beyond the paper";
+//! see [`crate::memory`]). With `memory: B > 0` the options table is indexed by the
+//! observation `state * (B + 1)^k + code(buckets)` instead of the state. The counters
+//! `tau_j` start with each episode and are updated after every primitive step; the
+//! observation at every position of an option's trajectory is recorded, so that each
+//! suffix update uses the memory of its own start, and the bootstrap uses the state and
+//! memory at termination. With `reward: window` an option run from `s_i` to `s_k` earns
+//! `sum_{j=1..k-i} gamma^(j-1) psi(i + j)` (options gamma) instead of the segment
+//! robustness, and each suffix the same sum over its own steps.
+//!
 //! **Options.** An option runs at least one step; a leg stops at the first `s'` in its
 //! termination set, or is cut off after `max_steps` steps. Exploration is epsilon-greedy
 //! at both levels with linear decay and a floor: the flat epsilon decays per primitive
@@ -25,9 +35,13 @@
 use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
+use crate::memory::Memory;
 use crate::spec::{Intra, LearnParams, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
+
+/// At most this many options Q-values (observations times options).
+const MAX_OPTION_VALUES: usize = 1 << 27;
 
 /// Trains one spec on one environment.
 #[derive(Clone, Debug)]
@@ -35,9 +49,12 @@ pub struct Learner<'e, E: Env> {
     env: &'e E,
     spec: TaskSpec,
     tables: Tables,
-    view: StateView,
-    reward: SegmentReward,
+    /// The counters and buckets, when the spec sets `memory` or `reward: window`.
+    memory: Option<Memory>,
+    reward: Reward,
     q: QTables,
+    /// `tau_j` of the running episode.
+    tau: Vec<usize>,
     /// `gamma_powers[i]`: the options gamma to the power `i`, grown on demand.
     gamma_powers: Vec<f64>,
     /// Every state by index, so that a step does not rebuild its state from the index.
@@ -66,18 +83,13 @@ pub struct Trained {
     pub steps: u64,
 }
 
-/// What the options policy observes: the state index today. Issue 7 adds a memory of
-/// recently visited regions here.
+/// How an option execution and its suffixes are rewarded.
 #[derive(Clone, Debug)]
-struct StateView {
-    states: usize,
-}
-
-/// How an option execution and its suffixes are rewarded: the task's segment robustness
-/// today.
-#[derive(Clone, Debug)]
-struct SegmentReward {
-    scorer: TabularScorer,
+enum Reward {
+    /// The task's robustness over the segment (the paper's).
+    Segment(Box<TabularScorer>),
+    /// The discounted count of steps whose windows are kept.
+    Window,
 }
 
 /// The trajectory of one option execution.
@@ -87,34 +99,53 @@ struct Run {
     states: Vec<usize>,
     /// Position in `states` where each leg starts.
     leg_starts: Vec<usize>,
+    /// The options policy's observation at each position (the state without memory).
+    obs: Vec<usize>,
+    /// `psi` at each position (empty without counters).
+    psi: Vec<bool>,
 }
 
 impl<'e, E: Env> Learner<'e, E> {
     /// A learner with zeroed Q-tables. Fails when the spec is invalid, does not fit `env`,
     /// or some state has no available option.
     pub fn new(spec: &TaskSpec, env: &'e E) -> Result<Learner<'e, E>, Error> {
-        if spec.learn.memory > 0 || spec.learn.reward == RewardKind::Window {
-            return Err(Error::Config(
-                "memory and reward: window are not implemented by this learner yet".into(),
-            ));
-        }
         let tables = Tables::new(spec, env)?;
-        let view = StateView { states: tables.states };
+        let memory = Memory::of_spec(spec, env)?;
+        let values = memory.as_ref().map_or(1, Memory::values);
+        let size = tables
+            .states
+            .checked_mul(values)
+            .and_then(|v| v.checked_mul(tables.legs.len()))
+            .filter(|&v| v <= MAX_OPTION_VALUES);
+        let Some(size) = size else {
+            return Err(Error::Config(format!(
+                "{} states with {values} memory values and {} options need more than \
+                 {MAX_OPTION_VALUES} options Q-values; lower memory",
+                tables.states,
+                tables.legs.len()
+            )));
+        };
         let q = QTables {
             flat: vec![vec![0.0; tables.states * tables.actions]; tables.reach.len()],
-            options: vec![0.0; view.size() * tables.legs.len()],
+            options: vec![0.0; size],
             steps: 0,
             choices: 0,
         };
-        let reward = SegmentReward { scorer: TabularScorer::new(&spec.task, &tables.trace) };
+        let reward = match spec.learn.reward {
+            RewardKind::Segment => {
+                Reward::Segment(Box::new(TabularScorer::new(&spec.task, &tables.trace)))
+            }
+            RewardKind::Window => Reward::Window,
+        };
         let states = (0..tables.states).filter_map(|s| env.state(s)).collect();
         Ok(Learner {
             env,
             spec: spec.clone(),
             tables,
-            view,
+            memory,
             reward,
             q,
+            tau: Vec::new(),
             gamma_powers: vec![1.0],
             states,
         })
@@ -148,9 +179,14 @@ impl<'e, E: Env> Learner<'e, E> {
         &self.q
     }
 
+    /// The memory the options policy observes, when the spec sets `memory: B > 0`.
+    pub fn memory(&self) -> Option<&Memory> {
+        self.memory.as_ref().filter(|m| m.buckets > 0)
+    }
+
     /// The greedy policies of the current Q-tables.
     pub fn agent(&self) -> crate::Agent {
-        crate::Agent::from_q(&self.tables, &self.q, self.spec.learn.max_steps)
+        crate::Agent::from_q(&self.tables, &self.q, self.spec.learn.max_steps, self.memory())
     }
 
     /// The learner's per-state tables (crate-internal).
@@ -176,16 +212,33 @@ impl<'e, E: Env> Learner<'e, E> {
     fn episode(&mut self, rng: &mut Rng, run: &mut Run, rewards: &mut Vec<f64>) -> f64 {
         let start = self.env.reset(rng);
         let mut s = self.env.index(&start);
+        self.begin(s);
         let mut total = 0.0;
         for _ in 0..self.spec.learn.choices {
             let o = self.choose_option(s, rng);
             self.run_option(o, s, rng, run);
-            self.reward.suffix_rewards(&run.states, rewards);
+            self.suffix_rewards(run, rewards);
             total += rewards[0];
             self.update_options(o, run, rewards);
             s = *run.states.last().unwrap_or(&s);
         }
         total
+    }
+
+    /// Starts an episode in state `s`: the counters take their start values.
+    fn begin(&mut self, s: usize) {
+        if let Some(m) = &self.memory {
+            m.start(s, &mut self.tau);
+        }
+    }
+
+    /// What the options policy observes in state `s` with the current counters.
+    #[inline]
+    fn observe(&self, s: usize) -> usize {
+        match &self.memory {
+            Some(m) if m.buckets > 0 => m.observation(s, &self.tau),
+            _ => s,
+        }
     }
 
     fn choose_option(&mut self, s: usize, rng: &mut Rng) -> usize {
@@ -196,7 +249,7 @@ impl<'e, E: Env> Learner<'e, E> {
             return available[rng.random_range(0..available.len())];
         }
         let n = self.tables.legs.len();
-        let row = &self.q.options[self.view.observe(s) * n..][..n];
+        let row = &self.q.options[self.observe(s) * n..][..n];
         best_of(available, row)
     }
 
@@ -205,7 +258,13 @@ impl<'e, E: Env> Learner<'e, E> {
         let actions = self.tables.actions;
         run.states.clear();
         run.leg_starts.clear();
+        run.obs.clear();
+        run.psi.clear();
         run.states.push(s);
+        run.obs.push(self.observe(s));
+        if let Some(m) = &self.memory {
+            run.psi.push(m.kept(&self.tau));
+        }
         for l in 0..self.tables.legs[o].len() {
             let p = self.tables.legs[o][l];
             run.leg_starts.push(run.states.len() - 1);
@@ -223,6 +282,11 @@ impl<'e, E: Env> Learner<'e, E> {
                 };
                 self.update_flat(s, a, next);
                 run.states.push(next);
+                if let Some(m) = &self.memory {
+                    m.step(next, &mut self.tau);
+                    run.psi.push(m.kept(&self.tau));
+                }
+                run.obs.push(self.observe(next));
                 s = next;
                 if self.tables.term[p][next] {
                     break;
@@ -246,7 +310,7 @@ impl<'e, E: Env> Learner<'e, E> {
         let params = self.spec.learn.options;
         let k = run.states.len() - 1;
         let end = run.states[k];
-        let end_row = self.view.observe(end) * n;
+        let end_row = run.obs[k] * n;
         // Every suffix bootstraps from the same end state, read before any update so that
         // the order of the updates below changes only their shared cells.
         let best = self.tables.available[end]
@@ -270,28 +334,31 @@ impl<'e, E: Env> Learner<'e, E> {
             };
             let Some(c) = credited else { continue };
             let target = reward + self.gamma_powers[k - j] * best;
-            let cell = &mut self.q.options[self.view.observe(s) * n + c];
+            let cell = &mut self.q.options[run.obs[j] * n + c];
             *cell += params.alpha * (target - *cell);
         }
     }
 }
 
-impl StateView {
-    /// The number of distinct observations.
-    fn size(&self) -> usize {
-        self.states
-    }
-
-    /// What the options policy sees in state `s`.
-    fn observe(&self, s: usize) -> usize {
-        s
-    }
-}
-
-impl SegmentReward {
-    /// `out[j]`: the reward of the suffix `states[j..]`.
-    fn suffix_rewards(&mut self, states: &[usize], out: &mut Vec<f64>) {
-        self.scorer.suffix_rewards(states, out);
+impl<E: Env> Learner<'_, E> {
+    /// `out[j]`: the reward of the suffix of `run` from position `j` (`out[k] = 0` for the
+    /// window reward).
+    fn suffix_rewards(&mut self, run: &Run, out: &mut Vec<f64>) {
+        match &mut self.reward {
+            Reward::Segment(scorer) => scorer.suffix_rewards(&run.states, out),
+            Reward::Window => {
+                // R_j = psi(j + 1) + gamma R_{j+1}, R_k = 0: the sum over the suffix's steps
+                // of gamma^(m-1) psi(j + m).
+                let gamma = self.spec.learn.options.gamma;
+                let k = run.states.len() - 1;
+                out.clear();
+                out.resize(k + 1, 0.0);
+                for j in (0..k).rev() {
+                    let psi = if run.psi[j + 1] { 1.0 } else { 0.0 };
+                    out[j] = psi + gamma * out[j + 1];
+                }
+            }
+        }
     }
 }
 
@@ -400,8 +467,9 @@ mod tests {
         let mut rng = seeded_rng(0);
         let mut run = Run::default();
         let mut rewards = Vec::new();
+        learner.begin(s);
         learner.run_option(o, s, &mut rng, &mut run);
-        learner.reward.suffix_rewards(&run.states, &mut rewards);
+        learner.suffix_rewards(&run, &mut rewards);
         learner.update_options(o, &run, &rewards);
         (run, rewards)
     }

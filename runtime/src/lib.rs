@@ -6,6 +6,8 @@
 //! - [`env`](mod@env): the [`Env`] trait (gymnasium conventions) and the [`GridWorld`] of the paper.
 //! - [`learn`]: Algorithm 1: flat Q-learning per primitive option, options Q-learning with
 //!   intra-option updates, seeded and bit-for-bit reproducible.
+//! - [`memory`]: the counters and buckets of `memory: B` and the step signal of
+//!   `reward: window` (beyond the paper).
 //! - [`policy`]: greedy policies and the `policy.json` document.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
 //! - [`optimum`]: the exact optimal window rate by relative value iteration.
@@ -16,6 +18,7 @@ pub mod env;
 mod error;
 pub mod eval;
 pub mod learn;
+pub mod memory;
 pub mod optimum;
 pub mod policy;
 pub mod spec;
@@ -25,6 +28,7 @@ pub use env::{Env, GridWorld};
 pub use error::Error;
 pub use hstl_robustness as robustness;
 pub use learn::{Learner, QTables, Trained};
+pub use memory::Memory;
 pub use policy::{Agent, Policy};
 pub use spec::{
     CombinedOption, Intra, LearnParams, LevelParams, PrimitiveOption, Region, RewardKind, Spec,

@@ -8,6 +8,14 @@
 //! every Q-value is stored as the 16 hex digits of its IEEE-754 bits, which reload bit for
 //! bit, infinities and NaNs included. Readers ignore fields they do not know, as "at
 //! least" in the contract asks.
+//!
+//! **contract, with `memory: B`**: the document also holds `"memory": {"regions": [NAME...],
+//! "horizons": [N...], "buckets": B}`, and each `options_policy` entry holds `"memory":
+//! [b_1, ...]` beside `"state"`: one entry per state and memory value that can be observed
+//! there (inside region `j`, `b_j` is 0). Beyond the contract, `memory.states` lists the
+//! states of each region, so that a replay can track the counters without the spec.
+//!
+//! The JSON is indented down to the entries; each entry, state and table is on one line.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -15,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use crate::learn::{argmax, best_of};
+use crate::memory::Memory;
 use crate::tables::Tables;
 use crate::{Env, Error, Learner, QTables};
 
@@ -23,7 +32,9 @@ use crate::{Env, Error, Learner, QTables};
 pub struct Agent {
     /// `legs[o]`: the primitives option `o` runs, in order.
     pub legs: Vec<Vec<usize>>,
-    /// `options[s]`: the option the options policy picks in state `s`.
+    /// `options[obs]`: the option the options policy picks on observing `obs`: the state
+    /// index without memory, `s * memory.values() + code` with it. An observation that
+    /// cannot occur (a bucket other than 0 inside its region) holds `usize::MAX`.
     pub options: Vec<usize>,
     /// `flat[p][s]`: the action primitive `p` takes in state `s`.
     pub flat: Vec<Vec<usize>>,
@@ -31,6 +42,8 @@ pub struct Agent {
     pub terminate: Vec<Vec<bool>>,
     /// Steps after which a leg is cut off.
     pub max_steps: usize,
+    /// The memory the options policy observes (`memory: B > 0`), or `None`.
+    pub memory: Option<Memory>,
 }
 
 /// The `policy.json` document.
@@ -48,7 +61,10 @@ pub struct Policy {
     pub options: Vec<OptionInfo>,
     /// The primitive options and their termination sets.
     pub primitives: Vec<PrimitiveInfo>,
-    /// The greedy option in every state.
+    /// The memory the options policy observes, for a spec with `memory: B > 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory: Option<MemoryDoc>,
+    /// The greedy option in every state (and every memory value there, with memory).
     pub options_policy: Vec<Entry>,
     /// For every primitive option, the greedy action in every state.
     pub flat_policies: BTreeMap<String, Vec<Entry>>,
@@ -85,11 +101,27 @@ pub struct PrimitiveInfo {
     pub terminate: Vec<Map<String, Value>>,
 }
 
-/// One row of a policy table: in `state`, choose `choice`.
+/// The memory part of `policy.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MemoryDoc {
+    /// The region names, in conjunct order.
+    pub regions: Vec<String>,
+    /// `N_j` of each region.
+    pub horizons: Vec<usize>,
+    /// `B`.
+    pub buckets: usize,
+    /// The states where each region holds.
+    pub states: Vec<Vec<Map<String, Value>>>,
+}
+
+/// One row of a policy table: in `state` (with `memory`), choose `choice`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Entry {
     /// The state, as a map from variable name to value.
     pub state: Map<String, Value>,
+    /// The buckets `[b_1, ...]` of an options-policy entry with memory.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory: Option<Vec<usize>>,
     /// The chosen option or action.
     pub choice: String,
 }
@@ -108,10 +140,23 @@ pub struct QTablesDoc {
 }
 
 impl Agent {
-    pub(crate) fn from_q(tables: &Tables, q: &QTables, max_steps: usize) -> Agent {
+    pub(crate) fn from_q(
+        tables: &Tables,
+        q: &QTables,
+        max_steps: usize,
+        memory: Option<&Memory>,
+    ) -> Agent {
         let (n, a) = (tables.legs.len(), tables.actions);
-        let options = (0..tables.states)
-            .map(|s| best_of(&tables.available[s], &q.options[s * n..][..n]))
+        let values = memory.map_or(1, Memory::values);
+        let options = (0..tables.states * values)
+            .map(|obs| {
+                let s = obs / values;
+                if memory.is_some_and(|m| !m.consistent(s, obs % values)) {
+                    usize::MAX
+                } else {
+                    best_of(&tables.available[s], &q.options[obs * n..][..n])
+                }
+            })
             .collect();
         let flat = q
             .flat
@@ -124,7 +169,13 @@ impl Agent {
             flat,
             terminate: tables.term.clone(),
             max_steps,
+            memory: memory.cloned(),
         }
+    }
+
+    /// The observation of state `s` with counters `tau` (ignored without memory).
+    pub fn observation(&self, s: usize, tau: &[usize]) -> usize {
+        self.memory.as_ref().map_or(s, |m| m.observation(s, tau))
     }
 }
 
@@ -160,12 +211,29 @@ impl Policy {
                     .collect(),
             })
             .collect();
+        let memory = agent.memory.as_ref();
+        let values = memory.map_or(1, Memory::values);
         let options_policy = agent
             .options
             .iter()
             .enumerate()
-            .map(|(s, &o)| Entry { state: states[s].clone(), choice: spec.options[o].name.clone() })
+            .filter(|&(_, &o)| o != usize::MAX)
+            .map(|(obs, &o)| Entry {
+                state: states[obs / values].clone(),
+                memory: memory.map(|m| m.decode(obs % values)),
+                choice: spec.options[o].name.clone(),
+            })
             .collect();
+        let memory = memory.map(|m| MemoryDoc {
+            regions: m.regions.clone(),
+            horizons: m.horizons.clone(),
+            buckets: m.buckets,
+            states: m
+                .holds
+                .iter()
+                .map(|h| (0..states.len()).filter(|&s| h[s]).map(|s| states[s].clone()).collect())
+                .collect(),
+        });
         let flat_policies = agent
             .flat
             .iter()
@@ -174,7 +242,11 @@ impl Policy {
                 let entries = row
                     .iter()
                     .enumerate()
-                    .map(|(s, &a)| Entry { state: states[s].clone(), choice: actions[a].clone() })
+                    .map(|(s, &a)| Entry {
+                        state: states[s].clone(),
+                        memory: None,
+                        choice: actions[a].clone(),
+                    })
                     .collect();
                 (prim(p), entries)
             })
@@ -193,6 +265,7 @@ impl Policy {
             actions,
             options,
             primitives,
+            memory,
             options_policy,
             flat_policies,
             max_steps: agent.max_steps,
@@ -274,7 +347,11 @@ impl Policy {
                 o.sequence.iter().map(|p| prim_index(p)).collect::<Result<Vec<usize>, Error>>()
             })
             .collect::<Result<Vec<Vec<usize>>, _>>()?;
-        let options = fill(n, &self.options_policy, "options_policy", &lookup, |c| {
+        let memory = match &self.memory {
+            None => None,
+            Some(doc) => Some(self.memory_of(doc, n, &lookup)?),
+        };
+        let options = fill_options(n, memory.as_ref(), &self.options_policy, &lookup, |c| {
             self.options.iter().position(|o| o.name == c)
         })?;
         let mut flat = Vec::new();
@@ -293,7 +370,90 @@ impl Policy {
             }
             terminate.push(t);
         }
-        Ok(Agent { legs, options, flat, terminate, max_steps: self.max_steps })
+        Ok(Agent { legs, options, flat, terminate, max_steps: self.max_steps, memory })
+    }
+
+    /// The memory of the document's `memory` part.
+    fn memory_of(
+        &self,
+        doc: &MemoryDoc,
+        n: usize,
+        lookup: &impl Fn(&Map<String, Value>, &str) -> Result<usize, Error>,
+    ) -> Result<Memory, Error> {
+        if doc.buckets == 0 {
+            return Err(Error::Policy("memory.buckets is 0; a memory policy has B > 0".into()));
+        }
+        if doc.states.len() != doc.regions.len() {
+            return Err(Error::Policy(format!(
+                "memory names {} regions but lists the states of {}",
+                doc.regions.len(),
+                doc.states.len()
+            )));
+        }
+        let mut holds = Vec::with_capacity(doc.states.len());
+        for (name, states) in doc.regions.iter().zip(&doc.states) {
+            let mut h = vec![false; n];
+            for state in states {
+                h[lookup(state, &format!("memory.states of region {name}"))?] = true;
+            }
+            holds.push(h);
+        }
+        Memory::new(doc.regions.clone(), doc.horizons.clone(), doc.buckets, holds)
+            .map_err(|e| Error::Policy(format!("memory: {e}")))
+    }
+
+    /// The options-policy entries of one memory slice, one per state: in each state, the
+    /// entry whose buckets are `memory`, with `b_j` read as 0 in the states of region `j`
+    /// (where no other value occurs). Without memory, `memory` must be empty and the
+    /// slice is the whole options policy. Fails when `memory` does not have one bucket in
+    /// `0..=B` per region.
+    pub fn options_slice(&self, memory: &[usize]) -> Result<Vec<Entry>, Error> {
+        let Some(doc) = &self.memory else {
+            if memory.is_empty() {
+                return Ok(self.options_policy.clone());
+            }
+            return Err(Error::Config(
+                "the policy has no memory; ask for the slice [] instead".into(),
+            ));
+        };
+        if memory.len() != doc.regions.len() || memory.iter().any(|&b| b > doc.buckets) {
+            return Err(Error::Config(format!(
+                "the memory slice {memory:?} needs one bucket in 0..={} for each of the \
+                 regions {}",
+                doc.buckets,
+                doc.regions.join(", ")
+            )));
+        }
+        let inside: Vec<std::collections::HashSet<Vec<(String, u64)>>> =
+            doc.states.iter().map(|states| states.iter().map(key).collect()).collect();
+        Ok(self
+            .options_policy
+            .iter()
+            .filter(|e| {
+                let k = key(&e.state);
+                let want = memory
+                    .iter()
+                    .zip(&inside)
+                    .map(|(&b, set)| if set.contains(&k) { 0 } else { b });
+                e.memory.as_ref().is_some_and(|m| m.iter().copied().eq(want))
+            })
+            .cloned()
+            .collect())
+    }
+
+    /// The slices to draw a memory policy by (see [`Policy::options_slice`]): one per
+    /// memory value `v` in `0..=B`, every region's bucket set to `v`, labelled as
+    /// `"b = [v, v, ...]"`; without memory, the one slice `[]` labelled `""`.
+    pub fn memory_slices(&self) -> Vec<(String, Vec<usize>)> {
+        match &self.memory {
+            None => vec![(String::new(), Vec::new())],
+            Some(doc) => (0..=doc.buckets)
+                .map(|v| {
+                    let b = vec![v; doc.regions.len()];
+                    (format!("b = {b:?}"), b)
+                })
+                .collect(),
+        }
     }
 }
 
@@ -322,6 +482,59 @@ fn key(state: &Map<String, Value>) -> Vec<(String, u64)> {
         .iter()
         .map(|(k, v)| (k.clone(), v.as_f64().map_or(u64::MAX, |f| (f + 0.0).to_bits())))
         .collect()
+}
+
+/// The options table from policy entries, indexed by observation: every state (with
+/// every memory value that can occur there) must be covered.
+fn fill_options(
+    n: usize,
+    memory: Option<&Memory>,
+    entries: &[Entry],
+    lookup: &impl Fn(&Map<String, Value>, &str) -> Result<usize, Error>,
+    choice: impl Fn(&str) -> Option<usize>,
+) -> Result<Vec<usize>, Error> {
+    let Some(m) = memory else {
+        if entries.iter().any(|e| e.memory.is_some()) {
+            return Err(Error::Policy(
+                "options_policy has an entry with memory, but the document has no memory part"
+                    .into(),
+            ));
+        }
+        return fill(n, entries, "options_policy", lookup, choice);
+    };
+    let values = m.values();
+    let mut out = vec![usize::MAX; n * values];
+    for e in entries {
+        let s = lookup(&e.state, "options_policy")?;
+        let Some(b) = &e.memory else {
+            return Err(Error::Policy(format!(
+                "options_policy has an entry for state {} without memory; a memory policy \
+                 gives [b_1, ...] in each entry",
+                Value::Object(e.state.clone())
+            )));
+        };
+        let code = m.code_of_buckets(b).filter(|&c| m.consistent(s, c)).ok_or_else(|| {
+            Error::Policy(format!(
+                "options_policy gives state {} the memory {b:?}, which is not {} buckets in \
+                 0..={} with 0 for the regions the state lies in",
+                Value::Object(e.state.clone()),
+                m.len(),
+                m.buckets
+            ))
+        })?;
+        out[s * values + code] = choice(&e.choice)
+            .ok_or_else(|| Error::Policy(format!("options_policy chooses unknown {}", e.choice)))?;
+    }
+    if let Some(obs) = (0..out.len())
+        .find(|&obs| out[obs] == usize::MAX && m.consistent(obs / values, obs % values))
+    {
+        return Err(Error::Policy(format!(
+            "options_policy does not cover state index {} with memory {:?}",
+            obs / values,
+            m.decode(obs % values)
+        )));
+    }
+    Ok(out)
 }
 
 /// A per-state table from policy entries; every state must be covered exactly once.

@@ -112,3 +112,25 @@ pub fn case_study(permutations: bool, entry: bool) -> TaskSpec {
             .collect(),
     }
 }
+
+/// The fourth variant, beyond the paper (LANGUAGE.md, "Persistent tasks beyond the
+/// paper"): options `{A, B, C}`, each with `init: !R` and `terminate: R`, `memory: 8`,
+/// `reward: window`, options `{gamma: 0.98, alpha: 0.1}`, the rest as in Table II.
+pub fn case_study_memory() -> TaskSpec {
+    let mut spec = case_study(false, true);
+    for p in &mut spec.primitives {
+        p.init = Formula::Not(Box::new(p.reach.clone()));
+    }
+    spec.options = spec
+        .primitives
+        .iter()
+        .enumerate()
+        .map(|(i, p)| CombinedOption { name: p.name.clone(), sequence: vec![i] })
+        .collect();
+    spec.name = "SurveillanceMemory".into();
+    spec.learn.memory = 8;
+    spec.learn.reward = hstl_runtime::RewardKind::Window;
+    spec.learn.options.gamma = 0.98;
+    spec.learn.options.alpha = 0.1;
+    spec
+}
