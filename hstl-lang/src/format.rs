@@ -1,0 +1,437 @@
+//! The formatter: one canonical layout for a spec file.
+//!
+//! [`format`] re-emits the tokens of the file in their order and changes only the space
+//! between them, so the formatted text parses to the same checked spec (up to byte
+//! ranges). The layout:
+//! - one item per line, indented by four spaces per level; a spec's items at level 1;
+//! - `state { ... }`, long-form `option Name { ... }` and `learn { ... }` one entry per
+//!   line, with a trailing comma; nested `learn` groups (`flat: { ... }`) and
+//!   `options { ... }` lists on one line, without a trailing comma;
+//! - one space between tokens, none inside brackets, before `,` `;` `:`, around `..` and
+//!   `..=`, after a prefix `!` or `-`, between `abs`/`sqrt`/`sequences`/`permutations`
+//!   and `(`, or between `always`/`eventually`/`until` and their interval;
+//! - one blank line between specs; blank lines between items, entries and comments are
+//!   kept (several become one), none after an opening or before a closing brace;
+//! - every comment is kept, in its place: a comment that followed a token on its line
+//!   stays there (after one space), one on a line of its own stays on a line of its own,
+//!   indented like what follows it; trailing white space is dropped from line comments
+//!   (not from doc comments, whose text is part of the checked spec).
+//!
+//! Long formulas are not wrapped. A file with syntax errors is not formatted: [`format`]
+//! returns the parser's diagnostics instead.
+
+use std::collections::{HashMap, HashSet};
+
+use crate::diagnostic::Diagnostic;
+use crate::parser::parse;
+use crate::syntax::{File, Item, OptionsKind, Param, ParamValue};
+
+/// One level of indentation.
+pub const INDENT: &str = "    ";
+
+/// Formats a source text in the canonical layout.
+///
+/// Returns every diagnostic of [`parse`] when it reports an error (a file with syntax
+/// errors is left to its author); otherwise the formatted text, which ends with one
+/// newline (an empty or blank input gives an empty text). Formatting is idempotent:
+/// formatting the result again gives the same text.
+pub fn format(src: &str) -> Result<String, Vec<Diagnostic>> {
+    let parsed = parse(src);
+    if parsed.diagnostics.iter().any(Diagnostic::is_error) {
+        return Err(parsed.diagnostics);
+    }
+    let toks = lex(src);
+    let plan = Plan::new(&parsed.file, &toks, src);
+    Ok(emit(src, &toks, &plan))
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Word,
+    Number,
+    Punct,
+    Doc,
+    LineComment,
+    BlockComment,
+    Other,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Tok {
+    kind: Kind,
+    start: usize,
+    end: usize,
+}
+
+impl Tok {
+    fn is_comment(self) -> bool {
+        matches!(self.kind, Kind::LineComment | Kind::BlockComment)
+    }
+}
+
+/// The same tokens as the parser's lexer, with comments as tokens.
+fn lex(src: &str) -> Vec<Tok> {
+    let b = src.as_bytes();
+    let mut toks = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i];
+        let start = i;
+        let kind = if c.is_ascii_whitespace() {
+            i += 1;
+            continue;
+        } else if b[i..].starts_with(b"//") {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+            if b[start..].starts_with(b"///") && !b[start..].starts_with(b"////") {
+                Kind::Doc
+            } else {
+                Kind::LineComment
+            }
+        } else if b[i..].starts_with(b"/*") {
+            let mut depth = 0usize;
+            while i < b.len() {
+                if b[i..].starts_with(b"/*") {
+                    depth += 1;
+                    i += 2;
+                } else if b[i..].starts_with(b"*/") {
+                    depth -= 1;
+                    i += 2;
+                    if depth == 0 {
+                        break;
+                    }
+                } else {
+                    i += 1;
+                }
+            }
+            if depth > 0 {
+                i = b.len();
+            }
+            Kind::BlockComment
+        } else if c.is_ascii_alphabetic() || c == b'_' {
+            while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
+                i += 1;
+            }
+            Kind::Word
+        } else if c.is_ascii_digit() {
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+            if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
+                i += 1;
+                while i < b.len() && b[i].is_ascii_digit() {
+                    i += 1;
+                }
+            }
+            if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+                let mut j = i + 1;
+                if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
+                    j += 1;
+                }
+                if j < b.len() && b[j].is_ascii_digit() {
+                    i = j;
+                    while i < b.len() && b[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                }
+            }
+            Kind::Number
+        } else if c.is_ascii() {
+            let ops: [&[u8]; 10] =
+                [b"..=", b"..", b"->", b"&&", b"||", b"<=", b">=", b"==", b"!=", b"::"];
+            i += ops.iter().find(|op| b[i..].starts_with(op)).map_or(1, |op| op.len());
+            Kind::Punct
+        } else {
+            i += src[i..].chars().next().map_or(1, char::len_utf8);
+            Kind::Other
+        };
+        toks.push(Tok { kind, start, end: i });
+    }
+    toks
+}
+
+/// A token that starts a line.
+#[derive(Clone, Copy, Debug)]
+struct Break {
+    /// Indentation level of the token.
+    indent: usize,
+    /// Indentation level of comments on their own lines just before it.
+    comment_indent: usize,
+    /// Whether a blank line in the source before it is kept.
+    blank_ok: bool,
+    /// Whether a blank line always precedes it (a spec after another).
+    blank: bool,
+}
+
+/// Where the layout differs from "one space between tokens".
+#[derive(Default)]
+struct Plan {
+    breaks: HashMap<usize, Break>,
+    /// Trailing commas to drop (token indices).
+    skip: HashSet<usize>,
+    /// Tokens after which a trailing comma is added.
+    comma_after: HashSet<usize>,
+}
+
+impl Plan {
+    fn new(file: &File, toks: &[Tok], src: &str) -> Plan {
+        let mut plan = Plan::default();
+        let text = |k: usize| &src[toks[k].start..toks[k].end];
+        // First token starting at or after `offset`, and the token ending at `offset`.
+        let first_at = |offset: usize| toks.partition_point(|t| t.start < offset);
+        let ending_at = |offset: usize| {
+            let k = toks.partition_point(|t| t.end < offset);
+            (k < toks.len() && toks[k].end == offset).then_some(k)
+        };
+        for (n, spec) in file.specs.iter().enumerate() {
+            plan.node(toks, first_at(spec.range.start), 0, n > 0);
+            for item in &spec.items {
+                plan.node(toks, first_at(item.range().start), 1, false);
+                let (entries, close): (Vec<usize>, usize) = match item {
+                    Item::State(b) => (b.vars.iter().map(|v| v.range.start).collect(), b.range.end),
+                    Item::Option(o) => match &o.fields {
+                        Some(fields) => {
+                            (fields.iter().map(|f| f.range.start).collect(), o.range.end)
+                        }
+                        None => continue,
+                    },
+                    Item::Learn(l) => {
+                        for p in &l.params {
+                            plan.inline_groups(p, &ending_at, &text, toks);
+                        }
+                        (l.params.iter().map(|p| p.range.start).collect(), l.range.end)
+                    }
+                    Item::Options(o) => {
+                        if let OptionsKind::List(_) = o.kind {
+                            plan.drop_trailing_comma(ending_at(o.range.end), &text, toks);
+                        }
+                        continue;
+                    }
+                    Item::Let(_) | Item::Task(_) => continue,
+                };
+                for start in entries {
+                    plan.node(toks, first_at(start), 2, false);
+                }
+                if let Some(close) = ending_at(close) {
+                    plan.breaks.insert(
+                        close,
+                        Break { indent: 1, comment_indent: 2, blank_ok: false, blank: false },
+                    );
+                    // The last code token before the brace: a comma, or the last entry's end.
+                    if let Some(last) = (0..close).rev().find(|&j| !toks[j].is_comment())
+                        && text(last) != ","
+                        && text(last) != "{"
+                    {
+                        plan.comma_after.insert(last);
+                    }
+                }
+            }
+            if let Some(close) = ending_at(spec.range.end).filter(|&k| text(k) == "}") {
+                plan.breaks.insert(
+                    close,
+                    Break { indent: 0, comment_indent: 1, blank_ok: false, blank: false },
+                );
+            }
+        }
+        plan
+    }
+
+    /// Breaks before the doc lines of a node starting at token `k` and before its first
+    /// code token.
+    fn node(&mut self, toks: &[Tok], mut k: usize, indent: usize, blank: bool) {
+        let mut first = true;
+        while k < toks.len() {
+            let t = toks[k];
+            if t.is_comment() {
+                k += 1;
+                continue;
+            }
+            let b = Break { indent, comment_indent: indent, blank_ok: true, blank: blank && first };
+            self.breaks.insert(k, b);
+            first = false;
+            if t.kind != Kind::Doc {
+                break;
+            }
+            k += 1;
+        }
+    }
+
+    /// Nested `{ ... }` groups of a learn parameter stay on one line without a trailing
+    /// comma.
+    fn inline_groups<'s>(
+        &mut self,
+        p: &Param,
+        ending_at: &dyn Fn(usize) -> Option<usize>,
+        text: &dyn Fn(usize) -> &'s str,
+        toks: &[Tok],
+    ) {
+        if let ParamValue::Group(ps, range) = &p.value {
+            self.drop_trailing_comma(ending_at(range.end), text, toks);
+            for q in ps {
+                self.inline_groups(q, ending_at, text, toks);
+            }
+        }
+    }
+
+    /// Drops the comma before the closing brace at token `close`, if there is one.
+    fn drop_trailing_comma<'s>(
+        &mut self,
+        close: Option<usize>,
+        text: &dyn Fn(usize) -> &'s str,
+        toks: &[Tok],
+    ) {
+        if let Some(close) = close
+            && let Some(last) = (0..close).rev().find(|&j| !toks[j].is_comment())
+            && text(last) == ","
+        {
+            self.skip.insert(last);
+        }
+    }
+}
+
+/// Whether a `-` after token `prev` is a prefix minus.
+fn minus_is_prefix(src: &str, prev: Option<Tok>) -> bool {
+    match prev {
+        None => true,
+        Some(p) => {
+            let text = &src[p.start..p.end];
+            match p.kind {
+                Kind::Number => false,
+                Kind::Word => matches!(text, "always" | "eventually" | "until" | "in"),
+                _ => text != ")",
+            }
+        }
+    }
+}
+
+/// The space between two code tokens on one line.
+fn spacing(a: &str, prefix_minus: bool, b: &str) -> &'static str {
+    if matches!(b, "," | ";" | ")" | "]" | ":" | ".." | "..=")
+        || matches!(a, "(" | "[" | ".." | "..=" | "!")
+        || (a == "-" && prefix_minus)
+        || (b == "(" && matches!(a, "abs" | "sqrt" | "sequences" | "permutations"))
+        || (b == "[" && matches!(a, "always" | "eventually" | "until"))
+    {
+        ""
+    } else {
+        " "
+    }
+}
+
+fn emit(src: &str, toks: &[Tok], plan: &Plan) -> String {
+    let mut out = String::with_capacity(src.len() + src.len() / 8);
+    let newlines = |a: usize, b: usize| src[a..b].bytes().filter(|&c| c == b'\n').count();
+    let mut prev: Option<Tok> = None;
+    let mut prev_prefix_minus = false;
+    let mut last_end = 0usize;
+    let mut indent = 0usize;
+    let mut pending_newline = false;
+    for (k, &t) in toks.iter().enumerate() {
+        if plan.skip.contains(&k) {
+            last_end = t.end;
+            continue;
+        }
+        let text = &src[t.start..t.end];
+        let gap = newlines(last_end, t.start);
+        if t.is_comment() {
+            let own_line = out.is_empty() || gap > 0;
+            if out.is_empty() {
+            } else if own_line || pending_newline {
+                let next = (k + 1..toks.len()).find(|&j| !toks[j].is_comment());
+                let level = match next {
+                    None => 0,
+                    Some(j) => plan.breaks.get(&j).map_or(indent + 1, |b| b.comment_indent),
+                };
+                let blank = own_line && gap >= 2 && !out.ends_with('{');
+                newline(&mut out, blank, level);
+            } else {
+                out.push(' ');
+            }
+            if t.kind == Kind::LineComment {
+                out.push_str(text.trim_end());
+                pending_newline = true;
+            } else {
+                out.push_str(text);
+                let next_start = toks.get(k + 1).map_or(src.len(), |n| n.start);
+                pending_newline = newlines(t.end, next_start) > 0;
+            }
+            last_end = t.end;
+            continue;
+        }
+        if let Some(b) = plan.breaks.get(&k) {
+            if !out.is_empty() {
+                let blank = b.blank || (b.blank_ok && gap >= 2 && !out.ends_with('{'));
+                newline(&mut out, blank, b.indent);
+            }
+            indent = b.indent;
+        } else if pending_newline || t.kind == Kind::Doc {
+            newline(&mut out, false, indent + 1);
+        } else if let Some(p) = prev {
+            out.push_str(spacing(&src[p.start..p.end], prev_prefix_minus, text));
+        }
+        if t.kind == Kind::Doc {
+            // Verbatim: its text, trailing white space included, is the item's doc string.
+            out.push_str(text);
+            pending_newline = true;
+        } else {
+            out.push_str(text);
+            pending_newline = false;
+        }
+        prev_prefix_minus = text == "-" && minus_is_prefix(src, prev);
+        prev = Some(t);
+        if plan.comma_after.contains(&k) {
+            out.push(',');
+            prev = Some(Tok { kind: Kind::Punct, start: 0, end: 0 });
+        }
+        last_end = t.end;
+    }
+    if !out.is_empty() {
+        out.push('\n');
+    }
+    out
+}
+
+fn newline(out: &mut String, blank: bool, level: usize) {
+    while out.ends_with(' ') {
+        out.pop();
+    }
+    out.push('\n');
+    if blank {
+        out.push('\n');
+    }
+    for _ in 0..level {
+        out.push_str(INDENT);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spaces_operators_and_brackets() {
+        let src = "spec S{state{x:int in 0..=9,y:float}let A=x>3&&-x<-(y-1)||!(abs(x)>=2);\
+                   task always[0..]eventually[0..=4]A;}";
+        let out = format(src).unwrap();
+        assert_eq!(
+            out,
+            "spec S {\n    state {\n        x: int in 0..=9,\n        y: float,\n    }\n    \
+             let A = x > 3 && -x < -(y - 1) || !(abs(x) >= 2);\n    \
+             task always[0..] eventually[0..=4] A;\n}\n"
+        );
+        assert_eq!(format(&out).unwrap(), out);
+    }
+
+    #[test]
+    fn refuses_syntax_errors() {
+        let err = format("spec S { let A = ; }").unwrap_err();
+        assert!(err.iter().any(|d| d.code == "HSTL001"));
+    }
+
+    #[test]
+    fn empty_input_stays_empty() {
+        assert_eq!(format("").unwrap(), "");
+        assert_eq!(format("  \n\n").unwrap(), "");
+    }
+}
