@@ -53,8 +53,14 @@ pub struct Learner<'e, E: Env> {
     memory: Option<Memory>,
     reward: Reward,
     q: QTables,
+    /// The fast form of `memory` that the steps update.
+    counters: Option<Counters>,
     /// `tau_j` of the running episode.
     tau: Vec<usize>,
+    /// The memory code of `tau` (0 without memory).
+    code: usize,
+    /// Memory values the options policy tells apart (1 without memory).
+    values: usize,
     /// `gamma_powers[i]`: the options gamma to the power `i`, grown on demand.
     gamma_powers: Vec<f64>,
     /// Every state by index, so that a step does not rebuild its state from the index.
@@ -81,6 +87,52 @@ pub struct Trained {
     pub curve: Vec<f64>,
     /// Primitive steps taken in this call.
     pub steps: u64,
+}
+
+/// The counters' dynamics laid out for the inner loop: one row of region membership per
+/// state, and each bucket already multiplied by its digit's weight.
+#[derive(Clone, Debug)]
+struct Counters {
+    /// `inside[s * k + j]`: region `j` holds in state `s`.
+    inside: Vec<bool>,
+    horizons: Vec<usize>,
+    /// `digit[j][tau]`: the bucket of `tau` times `(B + 1)^(k - 1 - j)`; all 0 when `B = 0`.
+    digit: Vec<Vec<usize>>,
+}
+
+impl Counters {
+    fn new(m: &Memory) -> Counters {
+        let k = m.len();
+        let inside = (0..m.states()).flat_map(|s| (0..k).map(move |j| m.holds(j, s))).collect();
+        let digit = (0..k)
+            .map(|j| {
+                let weight =
+                    if m.buckets == 0 { 0 } else { (m.buckets + 1).pow((k - 1 - j) as u32) };
+                (0..=m.horizons[j]).map(|t| m.bucket(j, t) * weight).collect()
+            })
+            .collect();
+        Counters { inside, horizons: m.horizons.clone(), digit }
+    }
+
+    /// The code of `tau`.
+    fn code(&self, tau: &[usize]) -> usize {
+        tau.iter().zip(&self.digit).map(|(&t, d)| d[t]).sum()
+    }
+
+    /// Moves the counters on to state `next`; returns `psi` and the new code.
+    #[inline]
+    fn step(&self, next: usize, tau: &mut [usize]) -> (bool, usize) {
+        let k = tau.len();
+        let row = &self.inside[next * k..][..k];
+        let (mut kept, mut code) = (true, 0);
+        for (j, t) in tau.iter_mut().enumerate() {
+            let n = self.horizons[j];
+            *t = if row[j] { 0 } else { (*t + 1).min(n) };
+            kept &= *t < n;
+            code += self.digit[j][*t];
+        }
+        (kept, code)
+    }
 }
 
 /// How an option execution and its suffixes are rewarded.
@@ -142,10 +194,13 @@ impl<'e, E: Env> Learner<'e, E> {
             env,
             spec: spec.clone(),
             tables,
+            counters: memory.as_ref().map(Counters::new),
             memory,
             reward,
             q,
             tau: Vec::new(),
+            code: 0,
+            values,
             gamma_powers: vec![1.0],
             states,
         })
@@ -227,18 +282,16 @@ impl<'e, E: Env> Learner<'e, E> {
 
     /// Starts an episode in state `s`: the counters take their start values.
     fn begin(&mut self, s: usize) {
-        if let Some(m) = &self.memory {
+        if let (Some(m), Some(c)) = (&self.memory, &self.counters) {
             m.start(s, &mut self.tau);
+            self.code = c.code(&self.tau);
         }
     }
 
     /// What the options policy observes in state `s` with the current counters.
     #[inline]
     fn observe(&self, s: usize) -> usize {
-        match &self.memory {
-            Some(m) if m.buckets > 0 => m.observation(s, &self.tau),
-            _ => s,
-        }
+        s * self.values + self.code
     }
 
     fn choose_option(&mut self, s: usize, rng: &mut Rng) -> usize {
@@ -265,6 +318,7 @@ impl<'e, E: Env> Learner<'e, E> {
         if let Some(m) = &self.memory {
             run.psi.push(m.kept(&self.tau));
         }
+        let counters = self.counters.take();
         for l in 0..self.tables.legs[o].len() {
             let p = self.tables.legs[o][l];
             run.leg_starts.push(run.states.len() - 1);
@@ -282,9 +336,10 @@ impl<'e, E: Env> Learner<'e, E> {
                 };
                 self.update_flat(s, a, next);
                 run.states.push(next);
-                if let Some(m) = &self.memory {
-                    m.step(next, &mut self.tau);
-                    run.psi.push(m.kept(&self.tau));
+                if let Some(c) = &counters {
+                    let (kept, code) = c.step(next, &mut self.tau);
+                    self.code = code;
+                    run.psi.push(kept);
                 }
                 run.obs.push(self.observe(next));
                 s = next;
@@ -293,6 +348,7 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
             }
         }
+        self.counters = counters;
     }
 
     fn update_flat(&mut self, s: usize, a: usize, next: usize) {
@@ -494,6 +550,110 @@ mod tests {
                 assert_eq!(q[j * 2 + 1 - credited[j]], 0.0, "{intra:?} suffix {j}");
             }
         }
+    }
+
+    /// The line again with a persistent task `always[0..] (eventually[0..6] x < 1 &&
+    /// eventually[0..6] x > 3)`, `memory: 2`, `reward: window`, options gamma 0.5 and alpha
+    /// 0.5; options Right (reach and stop at `x > 3`, start where `x < 4`) and Left (reach
+    /// and stop at `x < 1`, start where `x > 0`).
+    fn persistent_line() -> TaskSpec {
+        let (r1, r2) = (x(CmpOp::Lt, 1.0), x(CmpOp::Gt, 3.0));
+        let window = Interval { start: 0, end: Bound::Exclusive(6) };
+        let ev = |r: &Formula| Formula::Eventually(window, Box::new(r.clone()));
+        let prim = |name: &str, reach: &Formula, init| PrimitiveOption {
+            name: name.into(),
+            reach: reach.clone(),
+            init,
+            terminate: Terminate::Formula(reach.clone()),
+        };
+        let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
+        spec.task = Formula::Always(Interval::ALL, Box::new(Formula::And(vec![ev(&r1), ev(&r2)])));
+        spec.primitives =
+            vec![prim("Right", &r2, x(CmpOp::Lt, 4.0)), prim("Left", &r1, x(CmpOp::Gt, 0.0))];
+        spec.options = vec![
+            CombinedOption { name: "Right".into(), sequence: vec![0] },
+            CombinedOption { name: "Left".into(), sequence: vec![1] },
+        ];
+        spec.regions = spec.regions_from_task().unwrap();
+        spec.learn.memory = 2;
+        spec.learn.reward = RewardKind::Window;
+        spec.learn.options.gamma = 0.5;
+        spec
+    }
+
+    #[test]
+    fn window_rewards_and_memory_updates_match_a_hand_computed_example() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let spec = persistent_line();
+        let mut learner = Learner::new(&spec, &env).unwrap();
+        // Right's flat policy goes Right (3), Left's goes Left (2); Q(obs 1, Right) = 2:
+        // the bootstrap at the end of the second run below (x = 0, b = [0, 1]).
+        let mut q = learner.q().clone();
+        for s in 0..5 {
+            q.flat[0][s * 4 + 3] = 10.0;
+            q.flat[1][s * 4 + 2] = 10.0;
+        }
+        q.options[2] = 2.0;
+        let mut learner = learner.with_tables(q).unwrap();
+        let mut rng = seeded_rng(0);
+        let (mut run, mut rewards) = (Run::default(), Vec::new());
+        // Run 1: Right from x = 0, where R1 holds: tau = (0, N) = (0, 6).
+        learner.begin(0);
+        learner.run_option(0, 0, &mut rng, &mut run);
+        learner.suffix_rewards(&run, &mut rewards);
+        assert_eq!(run.states, [0, 1, 2, 3, 4]);
+        // tau: (0,6) (1,6) (2,6) (3,6) (4,0); buckets floor(2 tau / 6), 2 when expired:
+        // (0,2) (0,2) (0,2) (1,2) (1,0); obs = x * 9 + 3 b_1 + b_2.
+        assert_eq!(run.obs, [2, 11, 20, 32, 39]);
+        assert_eq!(run.psi, [false, false, false, false, true]);
+        // R_j = sum_{m=1..4-j} 0.5^(m-1) psi(j + m).
+        assert_eq!(rewards, [0.125, 0.25, 0.5, 1.0, 0.0]);
+        learner.update_options(0, &run, &rewards);
+        // Q(39, Left) = 0 at the end (only Left can start at x = 4): alpha R_j.
+        for (j, &obs) in run.obs[..4].iter().enumerate() {
+            assert_eq!(learner.q().options[obs * 2], 0.5 * rewards[j], "run 1, suffix {j}");
+        }
+        // Run 2: Left from x = 4, the memory carried over: tau (4,0) (5,1) (6,2) (6,3) (0,4).
+        learner.run_option(1, 4, &mut rng, &mut run);
+        learner.suffix_rewards(&run, &mut rewards);
+        assert_eq!(run.states, [4, 3, 2, 1, 0]);
+        assert_eq!(run.obs, [39, 30, 24, 16, 1]);
+        assert_eq!(run.psi, [true, true, false, false, true]);
+        assert_eq!(rewards, [1.125, 0.25, 0.5, 1.0, 0.0]);
+        learner.update_options(1, &run, &rewards);
+        // Each suffix from its own state and memory, bootstrapping from (x = 0, b = [0, 1]):
+        // alpha (R_j + 0.5^(4-j) * 2).
+        let want = [0.625, 0.25, 0.5, 1.0];
+        for (j, &obs) in run.obs[..4].iter().enumerate() {
+            assert_eq!(learner.q().options[obs * 2 + 1], want[j], "run 2, suffix {j}");
+        }
+        // The greedy agent sees the same observations.
+        let agent = learner.agent();
+        assert_eq!(agent.options.len(), 5 * 9);
+        assert_eq!(agent.options[39], 1);
+        // Inside R1 (x = 0) b_1 is 0: codes with b_1 > 0 cannot occur there.
+        assert_eq!(agent.options[3], usize::MAX);
+    }
+
+    #[test]
+    fn without_memory_the_window_reward_sees_the_state_alone() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let mut spec = persistent_line();
+        spec.learn.memory = 0;
+        let mut learner = Learner::new(&spec, &env).unwrap();
+        assert_eq!(learner.q().options.len(), 5 * 2);
+        assert!(learner.memory().is_none());
+        let mut q = learner.q().clone();
+        for s in 0..5 {
+            q.flat[0][s * 4 + 3] = 10.0;
+        }
+        learner = learner.with_tables(q).unwrap();
+        let (mut run, mut rewards) = (Run::default(), Vec::new());
+        learner.begin(0);
+        learner.run_option(0, 0, &mut seeded_rng(0), &mut run);
+        learner.suffix_rewards(&run, &mut rewards);
+        assert_eq!(run.obs, [0, 1, 2, 3, 4]);
+        assert_eq!(rewards, [0.125, 0.25, 0.5, 1.0, 0.0]);
     }
 
     #[test]

@@ -383,3 +383,167 @@ fn option_rewards_follow_the_reference_segment_semantics() {
         assert_eq!(scorer.reward(&walk), out[0]);
     }
 }
+
+/// The memory variant (options {A, B, C}, `memory: 8`, `reward: window`), cut down.
+fn small_memory() -> TaskSpec {
+    let mut spec = common::case_study_memory();
+    spec.learn.episodes = 6;
+    spec.learn.choices = 20;
+    spec
+}
+
+#[test]
+fn memory_training_is_deterministic() {
+    let env = GridWorld::default();
+    let spec = small_memory();
+    let a = train(&spec, &env, 7);
+    assert_eq!(a.options.len(), 225 * 729 * 3);
+    assert_eq!(bits(&a), bits(&train(&spec, &env, 7)));
+    assert_ne!(bits(&a), bits(&train(&spec, &env, 8)));
+    // The memory changes what is learned: without it the options table is per state.
+    let mut flat = spec.clone();
+    flat.learn.memory = 0;
+    assert_eq!(train(&flat, &env, 7).options.len(), 225 * 3);
+}
+
+#[test]
+fn memory_policy_json_round_trips_bit_for_bit() {
+    let env = GridWorld::default();
+    let spec = small_memory();
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(5), |_, _| {});
+    let policy = Policy::new(&learner);
+    let text = policy.to_json().unwrap();
+    let back = Policy::from_json(&text).unwrap();
+    assert_eq!(back, policy);
+    assert_eq!(bits(&back.q_tables().unwrap()), bits(learner.q()));
+    let agent = back.agent(&env).unwrap();
+    assert_eq!(agent, learner.agent());
+    assert_eq!(agent.memory.as_ref().map(|m| m.buckets), Some(8));
+    // The contract: the memory part, and one entry per state and memory value that can
+    // occur there (b_j = 0 inside region j: A and C have 15 cells, B 9).
+    let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(doc["memory"]["regions"], serde_json::json!(["A", "B", "C"]));
+    assert_eq!(doc["memory"]["horizons"], serde_json::json!([40, 40, 40]));
+    assert_eq!(doc["memory"]["buckets"], 8);
+    let entries = doc["options_policy"].as_array().unwrap();
+    assert_eq!(entries.len(), (225 - 39) * 729 + 39 * 81);
+    let in_a =
+        entries.iter().find(|e| e["state"] == serde_json::json!({ "x": 5, "y": 12 })).unwrap();
+    assert_eq!(in_a["memory"][0], 0);
+    assert!(entries.iter().all(|e| e["memory"].as_array().is_some_and(|m| m.len() == 3)));
+    // With `init: !A`, no entry chooses the region the state lies in.
+    assert!(entries.iter().filter(|e| e["memory"][0] == 0).all(|e| {
+        let (x, y) = (e["state"]["x"].as_i64().unwrap(), e["state"]["y"].as_i64().unwrap());
+        !(3 < x && x < 9 && 10 < y && y < 14) || e["choice"] != "A"
+    }));
+    // Flat policies carry no memory.
+    assert!(doc["flat_policies"]["A"][0].get("memory").is_none());
+    // Each entry on one line.
+    assert!(text.contains(r#"{"state": {"x": 0, "y": 0}, "memory": [8, 8, 8], "choice": "#));
+    // Training continues from the reloaded tables.
+    let resumed = Learner::new(&spec, &env).unwrap().with_tables(back.q_tables().unwrap()).unwrap();
+    assert_eq!(bits(resumed.q()), bits(learner.q()));
+}
+
+#[test]
+fn memory_slices_pick_one_entry_per_state() {
+    let env = GridWorld::default();
+    let mut spec = small_memory();
+    spec.learn.memory = 2;
+    let learner = Learner::new(&spec, &env).unwrap();
+    let policy = Policy::new(&learner);
+    let slices = policy.memory_slices();
+    assert_eq!(slices.len(), 3);
+    assert_eq!(slices[2], ("b = [2, 2, 2]".to_string(), vec![2, 2, 2]));
+    for (_, b) in &slices {
+        let slice = policy.options_slice(b).unwrap();
+        assert_eq!(slice.len(), 225, "{b:?}");
+        let inside_b = slice.iter().find(|e| e.state["x"] == 3 && e.state["y"] == 3).unwrap();
+        assert_eq!(inside_b.memory, Some(vec![b[0], 0, b[2]]));
+    }
+    let err = policy.options_slice(&[3, 0, 0]).unwrap_err().to_string();
+    assert!(err.contains("one bucket in 0..=2 for each of the regions A, B, C"), "{err}");
+    // Without memory the one slice is the whole options policy.
+    let plain = Policy::new(&Learner::new(&small(false, false), &env).unwrap());
+    assert_eq!(plain.memory_slices(), [(String::new(), vec![])]);
+    assert_eq!(plain.options_slice(&[]).unwrap(), plain.options_policy);
+    assert!(plain.options_slice(&[1]).is_err());
+}
+
+#[test]
+fn bad_memory_policy_documents_say_what_is_wrong() {
+    let env = GridWorld::default();
+    let mut spec = small_memory();
+    spec.learn.memory = 2;
+    let learner = Learner::new(&spec, &env).unwrap();
+    let good: serde_json::Value =
+        serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap();
+    type Break = fn(&mut serde_json::Value);
+    let cases: [(&str, Break); 7] = [
+        ("without memory; a memory policy gives", |d| {
+            d["options_policy"][0].as_object_mut().unwrap().remove("memory");
+        }),
+        ("which is not 3 buckets in 0..=2", |d| d["options_policy"][0]["memory"][1] = 3.into()),
+        ("which is not 3 buckets in 0..=2", |d| {
+            d["options_policy"][0]["memory"].as_array_mut().unwrap().pop();
+        }),
+        ("does not cover state index 0 with memory [0, 0, 0]", |d| {
+            d["options_policy"].as_array_mut().unwrap().remove(0);
+        }),
+        ("memory.buckets is 0", |d| d["memory"]["buckets"] = 0.into()),
+        ("memory names 3 regions but lists the states of 2", |d| {
+            d["memory"]["states"].as_array_mut().unwrap().pop();
+        }),
+        ("entry with memory, but the document has no memory part", |d| {
+            d.as_object_mut().unwrap().remove("memory");
+        }),
+    ];
+    for (want, change) in cases {
+        let mut doc = good.clone();
+        change(&mut doc);
+        let err = Policy::from_json(&doc.to_string()).and_then(|p| p.agent(&env)).unwrap_err();
+        assert!(err.to_string().contains(want), "{want}: {err}");
+    }
+}
+
+#[test]
+fn memory_agents_replay_their_counters() {
+    use hstl_runtime::eval::Controller;
+    let env = GridWorld::default();
+    let spec = small_memory();
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(4), |_, _| {});
+    let agent = learner.agent();
+    let memory = agent.memory.clone().unwrap();
+    let mut controller = AgentController::new(&agent);
+    let steps = rollout(&env, &mut controller, 7 * 15 + 5, 400, &mut seeded_rng(6));
+    // Replay the counters by hand: every new option is the greedy one on (state, buckets).
+    let mut tau = Vec::new();
+    memory.start(steps[0].state, &mut tau);
+    let mut new_option = true;
+    for (i, step) in steps.iter().enumerate() {
+        if i > 0 {
+            memory.step(step.state, &mut tau);
+            let prev = steps[i - 1].decision;
+            let p = agent.legs[prev.option][prev.leg];
+            new_option = agent.terminate[p][step.state];
+        }
+        if new_option {
+            assert_eq!(step.decision.option, agent.options[memory.observation(step.state, &tau)]);
+        }
+    }
+    // Reset forgets the counters.
+    assert_eq!(controller.tau().len(), 3);
+    controller.reset();
+    assert!(controller.tau().is_empty());
+    // The window rate of a reloaded memory policy is the learner's, draw for draw.
+    let regions = RegionTable::new(&spec, &env).unwrap();
+    let config = WindowConfig { starts: 3, steps: 300, burn_in: 50 };
+    let rate = |a: &hstl_runtime::Agent| {
+        window_rate(&env, &mut AgentController::new(a), &regions, config, &mut seeded_rng(1))
+            .unwrap()
+    };
+    let back = Policy::from_json(&Policy::new(&learner).to_json().unwrap()).unwrap();
+    assert_eq!(rate(&back.agent(&env).unwrap()), rate(&agent));
+}
