@@ -585,7 +585,7 @@ mod tests {
     fn window_rewards_and_memory_updates_match_a_hand_computed_example() {
         let env = GridWorld::new(5, 1, 1.0).unwrap();
         let spec = persistent_line();
-        let mut learner = Learner::new(&spec, &env).unwrap();
+        let learner = Learner::new(&spec, &env).unwrap();
         // Right's flat policy goes Right (3), Left's goes Left (2); Q(obs 1, Right) = 2:
         // the bootstrap at the end of the second run below (x = 0, b = [0, 1]).
         let mut q = learner.q().clone();
