@@ -3,12 +3,17 @@
 //! Exit status: 0 when the command succeeded (warnings allowed), 1 when the input has
 //! errors, 2 when the command could not run (a missing file, a bad flag).
 
+mod artifacts;
 mod check;
 mod cli_error;
+mod eval;
 mod explain;
 mod monitor;
 mod render;
+mod spec_file;
+mod study;
 mod trace_csv;
+mod train;
 
 use std::process::ExitCode;
 
@@ -32,6 +37,12 @@ enum Command {
     Explain(explain::ExplainArgs),
     /// Score a trace (CSV) against the task or a `let`.
     Monitor(monitor::MonitorArgs),
+    /// Learn a hierarchical policy for a spec; write policy.json, curve.csv and pictures.
+    Train(train::TrainArgs),
+    /// Replay a trained policy.json and report how well it keeps the task.
+    Eval(eval::EvalArgs),
+    /// Train several specs over many seeds and compare them (the paper's case study).
+    Study(study::StudyArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +58,9 @@ fn main() -> ExitCode {
         Command::Check(args) => check::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Monitor(args) => monitor::run(&args),
+        Command::Train(args) => train::run(&args),
+        Command::Eval(args) => eval::run(&args),
+        Command::Study(args) => study::run(&args),
     };
     match result {
         Ok(status) => status.into(),

@@ -5,16 +5,15 @@
 //! run: an unreadable file, a malformed trace, an unknown `--formula` or `--spec`. On 1 and 2
 //! nothing is printed to standard output.
 
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 use clap::Args;
-use hstl::lang::CheckedSpec;
 use hstl::robustness::offline;
 
-use crate::check::{Checked, read_input};
+use crate::check::read_input;
 use crate::cli_error::CliError;
-use crate::{CmdResult, Status, render, trace_csv};
+use crate::{CmdResult, Status, spec_file, trace_csv};
 
 /// Arguments of `hstlc monitor`.
 #[derive(Args, Debug)]
@@ -45,16 +44,11 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             Some("pass at least one of them as a file".to_string()),
         ));
     }
-    let (name, source) = read_input(&args.spec, "<stdin>")?;
-    let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
-    let checked = hstl::lang::check(&source);
-    if checked.has_errors() {
-        let file = Checked { name, source, diagnostics: checked.diagnostics };
-        let report = render::full(std::slice::from_ref(&file), std::io::stderr().is_terminal());
-        eprint!("{report}");
+    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
         return Ok(Status::Errors);
-    }
-    let spec = pick_spec(&checked.specs, args.spec_name.as_deref(), &name)?;
+    };
+    let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
+    let (spec, name) = (&loaded.spec, &loaded.file);
     let formula = match &args.formula {
         None => hstl::lower::task(spec),
         Some(let_name) => hstl::lower::let_formula(spec, let_name),
@@ -89,31 +83,5 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             Err(CliError::Write { path: PathBuf::from("<stdout>"), source: e })
         }
         _ => Ok(Status::Clean),
-    }
-}
-
-/// The spec named `wanted`, or the only one in the file.
-fn pick_spec<'a>(
-    specs: &'a [CheckedSpec],
-    wanted: Option<&str>,
-    file: &str,
-) -> Result<&'a CheckedSpec, CliError> {
-    let names = || specs.iter().map(|s| format!("`{}`", s.name)).collect::<Vec<_>>().join(", ");
-    match (wanted, specs) {
-        (None, [only]) => Ok(only),
-        (None, []) => Err(CliError::new(
-            format!("{file}: the file holds no spec"),
-            Some("write `spec Name { ... }` in it".to_string()),
-        )),
-        (None, _) => Err(CliError::new(
-            format!("{file}: the file holds {} specs", specs.len()),
-            Some(format!("pick one with `--spec NAME`: {}", names())),
-        )),
-        (Some(w), _) => specs.iter().find(|s| s.name == w).ok_or_else(|| {
-            CliError::new(
-                format!("{file}: no spec named `{w}`"),
-                Some(format!("the file holds {}", names())),
-            )
-        }),
     }
 }

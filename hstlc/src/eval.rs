@@ -1,0 +1,181 @@
+//! `hstlc eval`: replay a trained policy and report how well it keeps the task.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use hstl::robustness::offline;
+use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
+use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
+
+use crate::check::read_input;
+use crate::cli_error::CliError;
+use crate::train::env_words;
+use crate::{CmdResult, Status};
+
+/// Arguments of `hstlc eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// The `policy.json` that `hstlc train` wrote.
+    #[arg(value_name = "POLICY.json")]
+    pub policy: PathBuf,
+    /// Greedy runs, each from a random start.
+    #[arg(long, default_value_t = 100)]
+    pub starts: usize,
+    /// Steps per run.
+    #[arg(long, default_value_t = 2000)]
+    pub steps: usize,
+    /// Steps at the start of each run that the window rate does not count.
+    #[arg(long, default_value_t = 100)]
+    pub burn_in: usize,
+    /// The seed of the random starts and slips.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Skip the optimum W* (value iteration takes a few seconds).
+    #[arg(long)]
+    pub no_optimum: bool,
+}
+
+/// Runs `hstlc eval`.
+pub fn run(args: &EvalArgs) -> CmdResult {
+    let (name, text) = read_input(&args.policy, "<stdin>")?;
+    let bad = |message: String, help: &str| {
+        CliError::new(format!("{name}: {message}"), Some(help.to_string()))
+    };
+    let policy = Policy::from_json(&text)
+        .map_err(|e| bad(e.to_string(), "pass the policy.json that `hstlc train` wrote"))?;
+    let spec = spec_of(&text, &policy.spec)
+        .map_err(|m| bad(m, "train the policy again with `hstlc train`"))?;
+    if policy.env.name != "gridworld" {
+        return Err(bad(
+            format!("unknown environment `{}`", policy.env.name),
+            "this hstlc replays `gridworld` policies",
+        ));
+    }
+    let env = GridWorld::from_params(&policy.env.params)
+        .map_err(|e| bad(e.to_string(), "the `env` entry must hold the grid world's parameters"))?;
+    let agent = policy
+        .agent(&env)
+        .map_err(|e| bad(e.to_string(), "the policy does not fit its environment"))?;
+    let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
+    let mut rng = seeded_rng(args.seed);
+    println!(
+        "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
+        spec.name,
+        env_words(&env),
+        spec.options.len(),
+        args.starts,
+        args.steps,
+        args.seed
+    );
+    if spec.regions.is_empty() {
+        // Not a persistent task: the task's robustness over each run is the measure.
+        if args.starts == 0 || args.steps == 0 {
+            return Err(CliError::new("`--starts` and `--steps` must be at least 1", None));
+        }
+        let mut controller = AgentController::new(&agent);
+        let mut values = Vec::with_capacity(args.starts);
+        for _ in 0..args.starts {
+            let start = env.index(&env.reset(&mut rng));
+            let states: Vec<usize> = rollout(&env, &mut controller, start, args.steps, &mut rng)
+                .iter()
+                .map(|s| s.state)
+                .collect();
+            values.push(robustness_of_run(&spec, &env, &states)?);
+        }
+        print_robustness(&values);
+        return Ok(Status::Clean);
+    }
+    let regions = RegionTable::new(&spec, &env).map_err(|e| CliError::new(e.to_string(), None))?;
+    let report = window_rate(&env, &mut AgentController::new(&agent), &regions, config, &mut rng)
+        .map_err(|e| {
+        CliError::new(
+            e.to_string(),
+            Some("use --burn-in smaller than --steps, and --starts > 0".into()),
+        )
+    })?;
+    let (lo, hi) = range(&report.per_rollout);
+    println!(
+        "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
+        report.rate,
+        args.burn_in,
+        spec.regions
+            .iter()
+            .map(|r| format!("{} within {}", r.name, r.horizon))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    print_robustness(&report.robustness);
+    if !args.no_optimum {
+        let start = Instant::now();
+        let optimum = solve(&env, &regions, SolveConfig::default())
+            .map_err(|e| CliError::new(e.to_string(), None))?;
+        println!(
+            "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
+            optimum.gain,
+            optimum.lower,
+            optimum.upper,
+            start.elapsed().as_secs_f64(),
+            if optimum.converged { "" } else { ", not converged" },
+            report.rate / optimum.gain
+        );
+    }
+    Ok(Status::Clean)
+}
+
+/// The spec that `policy.json` was trained from, checked and lowered again.
+pub fn spec_of(policy_text: &str, expected: &str) -> Result<TaskSpec, String> {
+    let value: serde_json::Value = serde_json::from_str(policy_text).map_err(|e| e.to_string())?;
+    let Some(source) = value.get("spec_source").and_then(|s| s.as_str()) else {
+        return Err("it has no `spec_source` entry with the spec it was trained on".into());
+    };
+    let checked = hstl::lang::check(source);
+    if checked.has_errors() {
+        return Err("its `spec_source` does not check; run `hstlc check` on the spec".into());
+    }
+    let spec = checked
+        .specs
+        .iter()
+        .find(|s| s.name == expected)
+        .ok_or_else(|| format!("its `spec_source` has no spec named `{expected}`"))?;
+    hstl::lower::task_spec(spec, source).map_err(|e| e.to_string())
+}
+
+fn robustness_of_run(spec: &TaskSpec, env: &GridWorld, states: &[usize]) -> Result<f64, CliError> {
+    let env_vars = env.state_vars();
+    let mut columns = vec![Vec::with_capacity(states.len()); spec.state_vars.len()];
+    let mut row = Vec::new();
+    for &s in states {
+        let state = env
+            .state(s)
+            .ok_or_else(|| CliError::new(format!("state {s} is not on the grid"), None))?;
+        env.valuation(&state, &mut row);
+        for (col, var) in columns.iter_mut().zip(&spec.state_vars) {
+            let i = env_vars.iter().position(|e| *e == var.name).ok_or_else(|| {
+                CliError::new(
+                    format!("state variable `{}` is not the environment's", var.name),
+                    None,
+                )
+            })?;
+            col.push(row[i]);
+        }
+    }
+    let trace = hstl::robustness::Trace::from_columns(columns)
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    Ok(offline::robustness(&spec.task, &trace))
+}
+
+fn print_robustness(values: &[f64]) {
+    let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
+    let (lo, hi) = range(values);
+    let satisfied = values.iter().filter(|&&v| v > 0.0).count();
+    println!(
+        "  task robustness over each run: mean {mean:.3}, min {lo:.3}, max {hi:.3}; satisfied in {satisfied} of {} runs",
+        values.len()
+    );
+}
+
+fn range(values: &[f64]) -> (f64, f64) {
+    values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)))
+}

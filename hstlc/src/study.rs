@@ -1,0 +1,257 @@
+//! `hstlc study`: train several specs over many seeds, compare them, and write each one's
+//! pictures. The paper's case study is `scripts/case-study`, which runs this on the four
+//! variants in `examples/specs/`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use hstl::runtime::eval::RegionTable;
+use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::{GridWorld, Intra, Region, TaskSpec, seeded_rng};
+
+use crate::artifacts::{self, OutFile};
+use crate::cli_error::CliError;
+use crate::train::{self, PICTURE_SEED, env_words, tail_mean};
+use crate::{CmdResult, Status, spec_file};
+
+/// Arguments of `hstlc study`.
+#[derive(Args, Debug)]
+pub struct StudyArgs {
+    /// The spec files to train and compare; the first is the baseline of the reward
+    /// comparison.
+    #[arg(required = true, value_name = "SPEC")]
+    pub specs: Vec<PathBuf>,
+    /// Seeds per spec: 0, 1, ... N-1.
+    #[arg(long, default_value_t = 20)]
+    pub seeds: u64,
+    /// Training episodes (overrides each spec's `learn { episodes }`).
+    #[arg(long, value_name = "N")]
+    pub episodes: Option<usize>,
+    /// Also train each spec with the other `intra` crediting rule, and report both.
+    #[arg(long)]
+    pub both_intra: bool,
+    /// Skip the optimum W* (value iteration takes a few seconds per region set).
+    #[arg(long)]
+    pub no_optimum: bool,
+    /// Worker threads (default: every core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// The folder for each spec's policy (first seed), curves and pictures.
+    #[arg(long, value_name = "DIR", default_value = "out/study")]
+    pub out: PathBuf,
+}
+
+/// What one training run measured.
+#[derive(Clone, Debug)]
+struct RunResult {
+    secs: f64,
+    steps: u64,
+    tail_reward: f64,
+    window: Option<f64>,
+    curve: Vec<f64>,
+}
+
+/// Runs `hstlc study`.
+pub fn run(args: &StudyArgs) -> CmdResult {
+    if args.seeds == 0 {
+        return Err(CliError::new("`--seeds` must be at least 1", None));
+    }
+    // Check every spec before the long part starts.
+    let mut loaded = Vec::new();
+    for path in &args.specs {
+        let Some(l) = spec_file::load(path, None)? else { return Ok(Status::Errors) };
+        let mut spec = l.task_spec()?;
+        if let Some(e) = args.episodes {
+            spec.learn.episodes = e.max(1);
+        }
+        loaded.push((path.clone(), l, spec));
+    }
+    let env = GridWorld::default();
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
+        .max(1);
+    println!(
+        "study: {} specs x {} seeds on {}, {threads} threads",
+        loaded.len(),
+        args.seeds,
+        env_words(&env)
+    );
+    let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
+    let mut baseline: Option<(String, f64)> = None;
+    for (path, l, spec) in &loaded {
+        let results = run_seeds(spec, &env, args.seeds, threads, &l.file)?;
+        let w_star = if args.no_optimum || spec.regions.is_empty() {
+            None
+        } else {
+            Some(optimum(&mut optima, spec, &env)?)
+        };
+        let label = path.file_name().map_or(l.file.clone(), |n| n.to_string_lossy().into_owned());
+        println!();
+        println!(
+            "{label}: `{}`, {} options, intra: {}, {} seeds x {} episodes x {} choices",
+            spec.name,
+            spec.options.len(),
+            intra_word(spec.learn.intra),
+            args.seeds,
+            spec.learn.episodes,
+            spec.learn.choices
+        );
+        print_table(&results, w_star);
+        let reward = mean(&results.iter().map(|r| r.tail_reward).collect::<Vec<_>>());
+        match &baseline {
+            None => baseline = Some((label.clone(), reward)),
+            Some((base, b)) => println!(
+                "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
+                100.0 * (reward - b) / b.abs()
+            ),
+        }
+        if args.both_intra {
+            let mut other = spec.clone();
+            other.learn.intra = match spec.learn.intra {
+                Intra::Paper => Intra::Remaining,
+                Intra::Remaining => Intra::Paper,
+            };
+            let alt = run_seeds(&other, &env, args.seeds, threads, &l.file)?;
+            println!("  with intra: {} instead:", intra_word(other.learn.intra));
+            print_table(&alt, w_star);
+        }
+        let dir = args.out.join(stem(path));
+        write_outputs(&dir, spec, &env, l, &results)?;
+        println!("  wrote {}", dir.display());
+    }
+    Ok(Status::Clean)
+}
+
+/// Trains `spec` for seeds `0..seeds` on `threads` workers; results in seed order.
+fn run_seeds(
+    spec: &TaskSpec,
+    env: &GridWorld,
+    seeds: u64,
+    threads: usize,
+    file: &str,
+) -> Result<Vec<RunResult>, CliError> {
+    let threads = threads.min(seeds as usize).max(1) as u64;
+    let mut all: Vec<(u64, Result<RunResult, CliError>)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|w| {
+                scope.spawn(move || {
+                    (0..seeds)
+                        .filter(|s| s % threads == w)
+                        .map(|seed| (seed, one_run(spec, env, seed, file)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        workers.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    });
+    if all.len() as u64 != seeds {
+        return Err(CliError::new("a training thread failed", None));
+    }
+    all.sort_by_key(|(seed, _)| *seed);
+    all.into_iter().map(|(_, r)| r).collect()
+}
+
+fn one_run(spec: &TaskSpec, env: &GridWorld, seed: u64, file: &str) -> Result<RunResult, CliError> {
+    let outcome = train::train(spec, env, seed, file, |_, _| {})?;
+    let window = train::window_report(spec, env, &outcome.agent, seed)?.map(|(rate, _)| rate);
+    Ok(RunResult {
+        secs: outcome.secs,
+        steps: outcome.steps,
+        tail_reward: tail_mean(&outcome.curve, 100),
+        window,
+        curve: outcome.curve,
+    })
+}
+
+/// W* for the spec's regions, solved once per distinct region set.
+fn optimum(
+    cache: &mut Vec<(Vec<Region>, f64)>,
+    spec: &TaskSpec,
+    env: &GridWorld,
+) -> Result<f64, CliError> {
+    if let Some((_, w)) = cache.iter().find(|(r, _)| *r == spec.regions) {
+        return Ok(*w);
+    }
+    let regions = RegionTable::new(spec, env).map_err(|e| CliError::new(e.to_string(), None))?;
+    let start = Instant::now();
+    let o = solve(env, &regions, SolveConfig::default())
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    println!(
+        "optimum for regions {}: W* = {:.4} (value iteration, {} sweeps, {:.1} s{})",
+        spec.regions.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
+        o.gain,
+        o.iterations,
+        start.elapsed().as_secs_f64(),
+        if o.converged { "" } else { ", not converged" }
+    );
+    cache.push((spec.regions.clone(), o.gain));
+    Ok(o.gain)
+}
+
+fn print_table(results: &[RunResult], w_star: Option<f64>) {
+    let row = |name: &str, values: Vec<f64>, digits: usize| {
+        let (lo, hi) = range(&values);
+        println!("  {name:<34} {:>9.digits$} {:>9.digits$} {:>9.digits$}", mean(&values), lo, hi);
+    };
+    println!("  {:<34} {:>9} {:>9} {:>9}", "", "mean", "min", "max");
+    row("training time (s)", results.iter().map(|r| r.secs).collect(), 3);
+    row(
+        "primitive steps/s (millions)",
+        results.iter().map(|r| r.steps as f64 / r.secs.max(1e-9) / 1e6).collect(),
+        2,
+    );
+    row("reward per episode (last 100)", results.iter().map(|r| r.tail_reward).collect(), 2);
+    let windows: Vec<f64> = results.iter().filter_map(|r| r.window).collect();
+    if windows.len() == results.len() {
+        row("window rate W", windows.clone(), 3);
+        if let Some(w) = w_star {
+            row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3);
+        }
+    }
+}
+
+/// The first seed's policy, curve and pictures, and the learning curves of all seeds.
+fn write_outputs(
+    dir: &Path,
+    spec: &TaskSpec,
+    env: &GridWorld,
+    loaded: &spec_file::LoadedSpec,
+    results: &[RunResult],
+) -> Result<(), CliError> {
+    // Train seed 0 again for its agent: training is deterministic, so this is the same
+    // policy the table measured.
+    let outcome = train::train(spec, env, 0, &loaded.file, |_, _| {})?;
+    let mut files = vec![
+        OutFile::text("policy.json", train::policy_json(&outcome.policy, &loaded.source, 0)?),
+        OutFile::text("curve.csv", artifacts::curve_csv(&outcome.curve)),
+    ];
+    let mut rng = seeded_rng(PICTURE_SEED);
+    files.extend(artifacts::agent_pictures(spec, env, &outcome.agent, &mut rng)?);
+    let curves: Vec<Vec<f64>> = results.iter().map(|r| r.curve.clone()).collect();
+    files.push(artifacts::curve_picture(
+        &format!("Learning curve of {} over {} seeds", spec.name, curves.len()),
+        &curves,
+    )?);
+    artifacts::write_all(dir, &files).map(|_| ())
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem().map_or("spec".into(), |s| artifacts::file_safe(&s.to_string_lossy()))
+}
+
+fn intra_word(i: Intra) -> &'static str {
+    match i {
+        Intra::Paper => "paper",
+        Intra::Remaining => "remaining",
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+fn range(v: &[f64]) -> (f64, f64) {
+    v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)))
+}
