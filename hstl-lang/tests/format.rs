@@ -149,7 +149,8 @@ fn every_fixture_and_example_formats_faithfully() {
 #[test]
 fn valid_fixtures_snapshot() {
     for (name, src) in all_specs() {
-        if name.starts_with("invalid/") {
+        // Examples come and go with other work: only the fixtures are snapshotted.
+        if !name.starts_with("valid/") {
             continue;
         }
         let out = format(&src).unwrap_or_else(|d| panic!("{name}: {d:?}"));

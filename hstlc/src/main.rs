@@ -8,6 +8,8 @@ mod check;
 mod cli_error;
 mod eval;
 mod explain;
+mod fmt;
+mod lsp;
 mod monitor;
 mod render;
 mod spec_file;
@@ -35,6 +37,10 @@ enum Command {
     Check(check::CheckArgs),
     /// Print the long explanation of a diagnostic code, such as HSTL003.
     Explain(explain::ExplainArgs),
+    /// Print spec files in the canonical layout (or check or rewrite them).
+    Fmt(fmt::FmtArgs),
+    /// Run the language server on standard input and output.
+    Lsp,
     /// Score a trace (CSV) against the task or a `let`.
     Monitor(monitor::MonitorArgs),
     /// Learn a hierarchical policy for a spec; write policy.json, curve.csv and pictures.
@@ -57,6 +63,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check(args) => check::run(&args),
         Command::Explain(args) => explain::run(&args),
+        Command::Fmt(args) => fmt::run(&args),
+        Command::Lsp => lsp::run(),
         Command::Monitor(args) => monitor::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Eval(args) => eval::run(&args),

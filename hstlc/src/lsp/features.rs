@@ -1,0 +1,822 @@
+//! What the server answers, computed from one [`Analysis`] of a document: diagnostics,
+//! hover, definition, references, document symbols, completion and formatting.
+
+use std::ops::Range;
+
+use hstl::lang::check::MAX_DOMAIN_STATES;
+use hstl::lang::syntax::{
+    self, CmpOp, Expr, ExprKind, FieldValue, Formula, FormulaKind, Interval, Item, OptionsKind,
+    Spec,
+};
+use hstl::lang::{CheckedSpec, Domain, LetKind, Severity, StateEvaluator};
+use lsp_types::{
+    CompletionItem, CompletionItemKind, DiagnosticRelatedInformation, DiagnosticSeverity,
+    DocumentSymbol, Hover, HoverContents, Location, MarkupContent, MarkupKind, NumberOrString,
+    Position, SymbolKind, TextEdit, Uri,
+};
+
+use super::convert::{Converter, Encoding};
+
+/// What a name refers to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SymKind {
+    /// A state variable.
+    Var,
+    /// A `let`.
+    Let,
+    /// A primitive option.
+    Option,
+}
+
+/// A name of one spec.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Symbol {
+    /// Index of the spec in the syntax tree.
+    pub spec: usize,
+    /// What it names.
+    pub kind: SymKind,
+    /// The name.
+    pub name: String,
+}
+
+/// One place where a name is written.
+#[derive(Clone, Debug)]
+pub struct Occurrence {
+    /// Byte range of the name.
+    pub range: Range<usize>,
+    /// What it refers to.
+    pub symbol: Symbol,
+    /// Whether this is where it is declared.
+    pub decl: bool,
+}
+
+/// Everything the server knows about one version of a document.
+pub struct Analysis {
+    /// The text.
+    pub text: String,
+    /// Parse and check results.
+    pub checked: hstl::lang::Checked,
+    /// Every name occurrence, sorted by start.
+    pub occurrences: Vec<Occurrence>,
+    /// Position conversion for this text.
+    pub conv: Converter,
+}
+
+impl Analysis {
+    /// Checks `text` and indexes its names.
+    pub fn new(text: String, enc: Encoding) -> Self {
+        let checked = hstl::lang::check(&text);
+        let mut occurrences = Vec::new();
+        for (i, spec) in checked.file.specs.iter().enumerate() {
+            index_spec(i, spec, &mut occurrences);
+        }
+        occurrences.sort_by_key(|o| (o.range.start, !o.decl));
+        let conv = Converter::new(&text, enc);
+        Analysis { text, checked, occurrences, conv }
+    }
+
+    fn occurrences_at(&self, offset: usize) -> impl Iterator<Item = &Occurrence> {
+        let first = self.occurrences.partition_point(|o| o.range.end < offset);
+        self.occurrences[first..]
+            .iter()
+            .take_while(move |o| o.range.start <= offset)
+            .filter(move |o| o.range.start <= offset && offset <= o.range.end)
+    }
+
+    /// The declaration of a symbol (its first one).
+    fn declaration(&self, symbol: &Symbol) -> Option<&Occurrence> {
+        self.occurrences.iter().find(|o| o.decl && &o.symbol == symbol)
+    }
+
+    /// The checked spec of syntax spec `i`.
+    fn checked_spec(&self, i: usize) -> Option<&CheckedSpec> {
+        let spec = self.checked.file.specs.get(i)?;
+        self.checked.specs.iter().find(|c| c.name_range == spec.name.range && !c.name.is_empty())
+    }
+
+    /// The symbol the cursor is on: for a name that is both an option's declaration and
+    /// a reference to the `let` it reaches (`option A;`), the `let`.
+    fn symbol_at(&self, offset: usize) -> Option<&Occurrence> {
+        let all: Vec<&Occurrence> = self.occurrences_at(offset).collect();
+        all.iter().find(|o| !o.decl).or(all.first()).copied()
+    }
+}
+
+/// Records the names of one spec.
+fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
+    let mut vars = Vec::new();
+    let mut lets = Vec::new();
+    for item in &spec.items {
+        match item {
+            Item::State(b) => vars.extend(b.vars.iter().map(|v| v.name.name.clone())),
+            Item::Let(l) => lets.push(l.name.name.clone()),
+            _ => {}
+        }
+    }
+    let sym = |kind, name: &str| Symbol { spec: spec_i, kind, name: name.to_string() };
+    let mut push = |range: Range<usize>, kind, name: &str, decl| {
+        out.push(Occurrence { range, symbol: sym(kind, name), decl });
+    };
+    // A name in formula position names a let; in expression position a variable. Either
+    // falls back to the other namespace, which they share, so that navigation still
+    // works on a spec with a kind error.
+    let resolve = |name: &str, formula: bool| {
+        let (is_let, is_var) = (lets.iter().any(|l| l == name), vars.iter().any(|v| v == name));
+        match (formula, is_let, is_var) {
+            (true, true, _) | (false, true, false) => Some(SymKind::Let),
+            (_, _, true) => Some(SymKind::Var),
+            _ => None,
+        }
+    };
+    let mut names: Vec<(Range<usize>, String, bool)> = Vec::new();
+    for item in &spec.items {
+        match item {
+            Item::State(b) => {
+                for v in &b.vars {
+                    push(v.name.range.clone(), SymKind::Var, &v.name.name, true);
+                }
+            }
+            Item::Let(l) => {
+                push(l.name.range.clone(), SymKind::Let, &l.name.name, true);
+                formula_names(&l.formula, &mut names);
+            }
+            Item::Task(t) => formula_names(&t.formula, &mut names),
+            Item::Option(o) => {
+                push(o.name.range.clone(), SymKind::Option, &o.name.name, true);
+                match &o.fields {
+                    // `option A;` reaches the let `A`.
+                    None if lets.contains(&o.name.name) => {
+                        push(o.name.range.clone(), SymKind::Let, &o.name.name, false);
+                    }
+                    None => {}
+                    Some(fields) => {
+                        for f in fields {
+                            if let FieldValue::Formula(g) = &f.value {
+                                formula_names(g, &mut names);
+                            }
+                        }
+                    }
+                }
+            }
+            Item::Options(o) => {
+                let idents: Vec<&syntax::Ident> = match &o.kind {
+                    OptionsKind::List(seqs) => seqs.iter().flat_map(|s| &s.legs).collect(),
+                    OptionsKind::Sequences(v) | OptionsKind::Permutations(v) => v.iter().collect(),
+                };
+                for id in idents {
+                    push(id.range.clone(), SymKind::Option, &id.name, false);
+                }
+            }
+            Item::Learn(_) => {}
+        }
+    }
+    for (range, name, formula) in names {
+        if let Some(kind) = resolve(&name, formula) {
+            push(range, kind, &name, false);
+        }
+    }
+}
+
+/// Every name in a formula: `(range, name, in formula position)`.
+fn formula_names(f: &Formula, out: &mut Vec<(Range<usize>, String, bool)>) {
+    match &f.kind {
+        FormulaKind::True | FormulaKind::False => {}
+        FormulaKind::Name(id) => out.push((id.range.clone(), id.name.clone(), true)),
+        FormulaKind::Compare { first, rest } => {
+            expr_names(first, out);
+            for (_, _, e) in rest {
+                expr_names(e, out);
+            }
+        }
+        FormulaKind::Not(a)
+        | FormulaKind::Always(_, a)
+        | FormulaKind::Eventually(_, a)
+        | FormulaKind::Paren(a) => formula_names(a, out),
+        FormulaKind::Until(a, _, b) | FormulaKind::Implies(a, b) => {
+            formula_names(a, out);
+            formula_names(b, out);
+        }
+        FormulaKind::And(v) | FormulaKind::Or(v) => v.iter().for_each(|g| formula_names(g, out)),
+    }
+}
+
+fn expr_names(e: &Expr, out: &mut Vec<(Range<usize>, String, bool)>) {
+    match &e.kind {
+        ExprKind::Number(_) => {}
+        ExprKind::Name(id) => out.push((id.range.clone(), id.name.clone(), false)),
+        ExprKind::Neg(a) | ExprKind::Call(_, a) | ExprKind::Paren(a) => expr_names(a, out),
+        ExprKind::Binary(_, a, b) => {
+            expr_names(a, out);
+            expr_names(b, out);
+        }
+    }
+}
+
+/// The diagnostics of `hstlc check`, converted: code, severity, help appended to the
+/// message, labels as related information.
+pub fn diagnostics(a: &Analysis, uri: &Uri) -> Vec<lsp_types::Diagnostic> {
+    a.checked
+        .diagnostics
+        .iter()
+        .map(|d| {
+            let related: Vec<DiagnosticRelatedInformation> = d
+                .labels
+                .iter()
+                .map(|l| DiagnosticRelatedInformation {
+                    location: Location { uri: uri.clone(), range: a.conv.range(&a.text, &l.range) },
+                    message: l.message.clone(),
+                })
+                .collect();
+            let message = match &d.help {
+                Some(help) => format!("{}\nhelp: {help}", d.message),
+                None => d.message.clone(),
+            };
+            lsp_types::Diagnostic {
+                range: a.conv.range(&a.text, &d.range),
+                severity: Some(match d.severity {
+                    Severity::Error => DiagnosticSeverity::ERROR,
+                    Severity::Warning => DiagnosticSeverity::WARNING,
+                }),
+                code: Some(NumberOrString::String(d.code.to_string())),
+                source: Some("hstlc".to_string()),
+                message,
+                related_information: (!related.is_empty()).then_some(related),
+                ..lsp_types::Diagnostic::default()
+            }
+        })
+        .collect()
+}
+
+/// Hover text: for a name, what it is; for an operator, its robustness meaning and its
+/// interval in words.
+pub fn hover(a: &Analysis, pos: Position) -> Option<Hover> {
+    let offset = a.conv.offset(&a.text, pos);
+    let (range, text) = match a.symbol_at(offset) {
+        Some(o) => (o.range.clone(), symbol_hover(a, &o.symbol)?),
+        None => operator_hover(a, offset)?,
+    };
+    Some(Hover {
+        contents: HoverContents::Markup(MarkupContent { kind: MarkupKind::Markdown, value: text }),
+        range: Some(a.conv.range(&a.text, &range)),
+    })
+}
+
+fn snippet(text: &str, r: &Range<usize>) -> String {
+    text.get(r.clone()).unwrap_or("").split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
+    let spec = a.checked.file.specs.get(s.spec)?;
+    let checked = a.checked_spec(s.spec);
+    let mut out = String::new();
+    match s.kind {
+        SymKind::Var => {
+            let v = spec.items.iter().find_map(|i| match i {
+                Item::State(b) => b.vars.iter().find(|v| v.name.name == s.name),
+                _ => None,
+            })?;
+            let start = v.name.range.start;
+            out.push_str(&format!(
+                "```hstl\n{}\n```\nstate variable",
+                snippet(&a.text, &(start..v.range.end))
+            ));
+            if let Some(d) = &v.doc {
+                out.push_str(&format!("\n\n{}", d.text()));
+            }
+        }
+        SymKind::Let => {
+            let l = spec.items.iter().find_map(|i| match i {
+                Item::Let(l) if l.name.name == s.name => Some(l),
+                _ => None,
+            })?;
+            out.push_str(&format!(
+                "```hstl\nlet {} = {};\n```\n",
+                l.name.name,
+                snippet(&a.text, &l.formula.range)
+            ));
+            let info = checked.and_then(|c| c.lets.iter().find(|i| i.name == s.name));
+            if let (Some(c), Some(info)) = (checked, info) {
+                match info.kind {
+                    LetKind::State => out.push_str("state formula (a region)"),
+                    LetKind::Temporal => out.push_str("temporal formula"),
+                }
+                if !info.used {
+                    out.push_str(", not used by the task or an option");
+                }
+                if info.kind == LetKind::State {
+                    match count_states(c, &info.formula) {
+                        Some(Ok((n, total))) => out.push_str(&format!(
+                            "\n\nholds (robustness > 0) in {n} of the {total} states of the declared domain"
+                        )),
+                        Some(Err(total)) => out.push_str(&format!(
+                            "\n\nthe declared domain has {total} states: too many to count where it holds"
+                        )),
+                        None => {}
+                    }
+                }
+            }
+            if let Some(d) = &l.doc {
+                out.push_str(&format!("\n\n{}", d.text()));
+            }
+        }
+        SymKind::Option => {
+            let o = spec.items.iter().find_map(|i| match i {
+                Item::Option(o) if o.name.name == s.name => Some(o),
+                _ => None,
+            })?;
+            out.push_str(&format!("**option {}** (primitive)\n", o.name.name));
+            let field = |name: &str| {
+                o.fields.as_ref().and_then(|fs| fs.iter().find(|f| f.name.name == name)).map(|f| {
+                    match &f.value {
+                        FieldValue::Argmax(_) => "argmax".to_string(),
+                        FieldValue::Formula(g) => snippet(&a.text, &g.range),
+                    }
+                })
+            };
+            let reach = field("reach").unwrap_or_else(|| o.name.name.clone());
+            out.push_str(&format!(
+                "- reach: `{reach}` (flat reward: its robustness after each step)\n"
+            ));
+            match field("init") {
+                Some(init) => out.push_str(&format!("- init: `{init}`\n")),
+                None => out.push_str("- init: `true` (default: may start anywhere)\n"),
+            }
+            match field("terminate") {
+                Some(t) if t != "argmax" => out.push_str(&format!("- terminate: `{t}`\n")),
+                _ => out.push_str(&format!(
+                    "- terminate: `argmax` (where the robustness of `{reach}` is largest over the declared domain)\n"
+                )),
+            }
+            if let Some(c) = checked
+                && let Some(p) = c.primitives.iter().position(|p| p.name == s.name)
+            {
+                let seqs: Vec<String> = c
+                    .options
+                    .iter()
+                    .filter(|o| o.sequence.contains(&p))
+                    .map(|o| {
+                        let legs: Vec<&str> = o
+                            .sequence
+                            .iter()
+                            .filter_map(|&k| c.primitives.get(k))
+                            .map(|p| p.name.as_str())
+                            .collect();
+                        format!("`[{}]`", legs.join(", "))
+                    })
+                    .collect();
+                if seqs.is_empty() {
+                    out.push_str("- in no sequence of the options set\n");
+                } else {
+                    out.push_str(&format!(
+                        "- sequences of the options set with it: {}\n",
+                        seqs.join(", ")
+                    ));
+                }
+            }
+            if let Some(d) = &o.doc {
+                out.push_str(&format!("\n{}", d.text()));
+            }
+        }
+    }
+    Some(out)
+}
+
+/// `(states where f has robustness > 0, states of the domain)`; `Err(total)` when the
+/// domain is too large to enumerate; `None` without a finite `int` domain or when `f`
+/// cannot be evaluated.
+fn count_states(spec: &CheckedSpec, f: &hstl::lang::CFormula) -> Option<Result<(u64, u64), u64>> {
+    let total = spec.domain_size()?;
+    if total > MAX_DOMAIN_STATES {
+        return Some(Err(total));
+    }
+    if !spec.is_state_formula(f) {
+        return None;
+    }
+    let bounds: Vec<(i64, i64)> = spec
+        .state_vars
+        .iter()
+        .map(|v| match v.domain {
+            Domain::Int { lo, hi } => Some((lo, hi)),
+            _ => None,
+        })
+        .collect::<Option<_>>()?;
+    let mut ev = StateEvaluator::new(spec, &[f]);
+    let mut values: Vec<i64> = bounds.iter().map(|b| b.0).collect();
+    let mut s: Vec<f64> = values.iter().map(|&v| v as f64).collect();
+    let mut n = 0;
+    for _ in 0..total {
+        ev.load(&s);
+        let r = ev.robustness(f, &s);
+        if r.is_nan() {
+            return None;
+        }
+        n += u64::from(r > 0.0);
+        // Next valuation, last variable fastest.
+        for k in (0..values.len()).rev() {
+            if values[k] < bounds[k].1 {
+                values[k] += 1;
+                s[k] = values[k] as f64;
+                break;
+            }
+            values[k] = bounds[k].0;
+            s[k] = values[k] as f64;
+        }
+    }
+    Some(Ok((n, total)))
+}
+
+/// The operator whose token(s) cover `offset`, with its hover text.
+fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)> {
+    let mut found = None;
+    for spec in &a.checked.file.specs {
+        for item in &spec.items {
+            let mut formulas: Vec<&Formula> = Vec::new();
+            match item {
+                Item::Let(l) => formulas.push(&l.formula),
+                Item::Task(t) => formulas.push(&t.formula),
+                Item::Option(o) => {
+                    for f in o.fields.iter().flatten() {
+                        if let FieldValue::Formula(g) = &f.value {
+                            formulas.push(g);
+                        }
+                    }
+                }
+                _ => {}
+            }
+            for f in formulas {
+                if f.range.start <= offset && offset <= f.range.end {
+                    find_operator(&a.text, f, offset, &mut found);
+                }
+            }
+        }
+    }
+    found
+}
+
+fn find_operator(text: &str, f: &Formula, at: usize, found: &mut Option<(Range<usize>, String)>) {
+    if found.is_some() || at < f.range.start || at > f.range.end {
+        return;
+    }
+    let kw_end = |start: usize, kw: &str| start + kw.len();
+    let hit = |r: &Range<usize>| r.start <= at && at <= r.end;
+    match &f.kind {
+        FormulaKind::Always(iv, g) | FormulaKind::Eventually(iv, g) => {
+            let always = matches!(f.kind, FormulaKind::Always(..));
+            let kw = if always { "always" } else { "eventually" };
+            let span =
+                f.range.start..iv.as_ref().map_or(kw_end(f.range.start, kw), |i| i.range.end);
+            if hit(&span) {
+                let meaning = if always {
+                    "the minimum of the operand's robustness over the window (`+inf` if the window is empty): positive when the operand holds at every step of it"
+                } else {
+                    "the maximum of the operand's robustness over the window (`-inf` if the window is empty): positive when the operand holds at some step of it"
+                };
+                *found =
+                    Some((span, format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref()))));
+                return;
+            }
+            find_operator(text, g, at, found);
+        }
+        FormulaKind::Until(l, iv, r) => {
+            let span = l.range.end..r.range.start;
+            if hit(&span) && text.get(span.clone()).is_some_and(|s| s.contains("until")) {
+                let start = span.start + text[span.clone()].find("until").unwrap_or(0);
+                let end = iv.as_ref().map_or(start + "until".len(), |i| i.range.end);
+                *found = Some((
+                    start..end,
+                    format!(
+                        "**until**: `f until[I] g` is the maximum, over the steps `t'` of the window, of the minimum of `g`'s robustness at `t'` and `f`'s robustness at every step from now up to (not including) `t'`: positive when `g` holds at some step of the window and `f` holds until then.\n\n{}",
+                        window_words(iv.as_ref())
+                    ),
+                ));
+                return;
+            }
+            find_operator(text, l, at, found);
+            find_operator(text, r, at, found);
+        }
+        FormulaKind::And(v) | FormulaKind::Or(v) => {
+            let and = matches!(f.kind, FormulaKind::And(_));
+            for w in v.windows(2) {
+                let span = w[0].range.end..w[1].range.start;
+                if hit(&span) {
+                    let op = if and { "&&" } else { "||" };
+                    let start =
+                        span.start + text.get(span.clone()).and_then(|s| s.find(op)).unwrap_or(0);
+                    let meaning = if and {
+                        "**&&** (and): the minimum of the operands' robustness: positive when every operand holds."
+                    } else {
+                        "**||** (or): the maximum of the operands' robustness: positive when some operand holds."
+                    };
+                    *found = Some((start..start + 2, meaning.to_string()));
+                    return;
+                }
+            }
+            v.iter().for_each(|g| find_operator(text, g, at, found));
+        }
+        FormulaKind::Implies(l, r) => {
+            let span = l.range.end..r.range.start;
+            if hit(&span) {
+                let start =
+                    span.start + text.get(span.clone()).and_then(|s| s.find("->")).unwrap_or(0);
+                *found = Some((
+                    start..start + 2,
+                    "**->** (implies): `f -> g` is `!f || g`: the maximum of minus `f`'s robustness and `g`'s robustness.".to_string(),
+                ));
+                return;
+            }
+            find_operator(text, l, at, found);
+            find_operator(text, r, at, found);
+        }
+        FormulaKind::Not(g) => {
+            let span = f.range.start..f.range.start + 1;
+            if hit(&span) && at < span.end {
+                *found = Some((span, "**!** (not): minus the operand's robustness.".to_string()));
+                return;
+            }
+            find_operator(text, g, at, found);
+        }
+        FormulaKind::Paren(g) => find_operator(text, g, at, found),
+        FormulaKind::Compare { rest, .. } => {
+            for (op, r, _) in rest {
+                if hit(r) {
+                    let meaning = match op {
+                        CmpOp::Lt | CmpOp::Le => format!(
+                            "**{}**: `e1 {} e2` has robustness `e2 - e1`: how far `e1` is below `e2`.",
+                            op.as_str(),
+                            op.as_str()
+                        ),
+                        CmpOp::Gt | CmpOp::Ge => format!(
+                            "**{}**: `e1 {} e2` has robustness `e1 - e2`: how far `e1` is above `e2`.",
+                            op.as_str(),
+                            op.as_str()
+                        ),
+                        CmpOp::Eq | CmpOp::Ne => format!(
+                            "**{}** has no robustness and is rejected; use a band such as `abs(x - 3) < 0.5`.",
+                            op.as_str()
+                        ),
+                    };
+                    *found = Some((r.clone(), meaning));
+                    return;
+                }
+            }
+        }
+        FormulaKind::True | FormulaKind::False | FormulaKind::Name(_) => {}
+    }
+}
+
+/// A time interval in words.
+fn window_words(iv: Option<&Interval>) -> String {
+    let Some(iv) = iv else {
+        return "No interval, so `[0..]`: the window runs from the current step to the end of the trace.".to_string();
+    };
+    let a = iv.start.as_integer();
+    let b = iv.end.as_ref().and_then(|e| e.as_integer());
+    match (a, b, iv.end.is_some(), iv.inclusive) {
+        (Some(a), _, false, _) => {
+            format!("Interval `[{a}..]`: the window runs from {} to the end of the trace.", step(a))
+        }
+        (Some(a), Some(b), true, false) if b > a => format!(
+            "Interval `[{a}..{b}]`: the window is {} to {} ({} steps; step `t+{b}` excluded), clipped at the end of the trace.",
+            step(a),
+            step(b - 1),
+            b - a
+        ),
+        (Some(a), Some(b), true, true) if b >= a => format!(
+            "Interval `[{a}..={b}]`: the window is {} to {}, both included ({} steps), clipped at the end of the trace.",
+            step(a),
+            step(b),
+            b - a + 1
+        ),
+        _ => "The interval is empty or not made of integers (see the diagnostic).".to_string(),
+    }
+}
+
+fn step(k: u64) -> String {
+    if k == 0 { "the current step `t`".to_string() } else { format!("step `t+{k}`") }
+}
+
+/// Where the symbol at `pos` is declared.
+pub fn definition(a: &Analysis, pos: Position) -> Option<lsp_types::Range> {
+    let offset = a.conv.offset(&a.text, pos);
+    let o = a.symbol_at(offset)?;
+    let d = a.declaration(&o.symbol)?;
+    Some(a.conv.range(&a.text, &d.range))
+}
+
+/// Every occurrence of the symbol at `pos`.
+pub fn references(a: &Analysis, pos: Position, include_declaration: bool) -> Vec<lsp_types::Range> {
+    let offset = a.conv.offset(&a.text, pos);
+    let Some(o) = a.symbol_at(offset) else { return Vec::new() };
+    a.occurrences
+        .iter()
+        .filter(|x| x.symbol == o.symbol && (include_declaration || !x.decl))
+        .map(|x| a.conv.range(&a.text, &x.range))
+        .collect()
+}
+
+/// The outline: each spec with its state variables, lets, task, options, options set and
+/// learning parameters.
+#[allow(deprecated)] // `DocumentSymbol::deprecated` must be named to build one.
+pub fn symbols(a: &Analysis) -> Vec<DocumentSymbol> {
+    let sym = |name: String,
+               detail: Option<String>,
+               kind,
+               range: &Range<usize>,
+               sel: &Range<usize>,
+               children: Option<Vec<DocumentSymbol>>| DocumentSymbol {
+        name,
+        detail,
+        kind,
+        tags: None,
+        deprecated: None,
+        range: a.conv.range(&a.text, range),
+        selection_range: a.conv.range(&a.text, sel),
+        children,
+    };
+    let mut out = Vec::new();
+    for spec in &a.checked.file.specs {
+        if spec.name.name.is_empty() {
+            continue;
+        }
+        let mut children = Vec::new();
+        for item in &spec.items {
+            match item {
+                Item::State(b) => {
+                    for v in &b.vars {
+                        let detail = snippet(&a.text, &(v.ty_range.start..v.range.end));
+                        children.push(sym(
+                            v.name.name.clone(),
+                            Some(detail),
+                            SymbolKind::FIELD,
+                            &v.range,
+                            &v.name.range,
+                            None,
+                        ));
+                    }
+                }
+                Item::Let(l) => children.push(sym(
+                    l.name.name.clone(),
+                    Some(snippet(&a.text, &l.formula.range)),
+                    SymbolKind::CONSTANT,
+                    &l.range,
+                    &l.name.range,
+                    None,
+                )),
+                Item::Task(t) => children.push(sym(
+                    "task".into(),
+                    Some(snippet(&a.text, &t.formula.range)),
+                    SymbolKind::EVENT,
+                    &t.range,
+                    &t.keyword_range,
+                    None,
+                )),
+                Item::Option(o) => children.push(sym(
+                    o.name.name.clone(),
+                    Some("option".into()),
+                    SymbolKind::METHOD,
+                    &o.range,
+                    &o.name.range,
+                    None,
+                )),
+                Item::Options(o) => {
+                    let sel = o.range.start..o.range.start + "options".len();
+                    children.push(sym(
+                        "options".into(),
+                        Some(snippet(&a.text, &o.range)),
+                        SymbolKind::ENUM,
+                        &o.range,
+                        &sel,
+                        None,
+                    ));
+                }
+                Item::Learn(l) => {
+                    let sel = l.range.start..l.range.start + "learn".len();
+                    children.push(sym(
+                        "learn".into(),
+                        None,
+                        SymbolKind::PROPERTY,
+                        &l.range,
+                        &sel,
+                        None,
+                    ));
+                }
+            }
+        }
+        out.push(sym(
+            spec.name.name.clone(),
+            Some("spec".into()),
+            SymbolKind::MODULE,
+            &spec.range,
+            &spec.name.range,
+            Some(children),
+        ));
+    }
+    out
+}
+
+/// Keywords of the language, offered by completion.
+pub const KEYWORDS: [&str; 22] = [
+    "spec",
+    "state",
+    "int",
+    "float",
+    "in",
+    "let",
+    "task",
+    "option",
+    "options",
+    "sequences",
+    "permutations",
+    "learn",
+    "always",
+    "eventually",
+    "until",
+    "true",
+    "false",
+    "abs",
+    "sqrt",
+    "argmax",
+    "reach",
+    "init",
+];
+
+/// Keywords, then the names of the spec the cursor is in (variables, lets, options;
+/// also those declared by items that do not parse yet).
+pub fn completion(a: &Analysis, pos: Position) -> Vec<CompletionItem> {
+    let offset = a.conv.offset(&a.text, pos);
+    let mut items: Vec<CompletionItem> = KEYWORDS
+        .iter()
+        .chain(["terminate"].iter())
+        .map(|k| CompletionItem {
+            label: (*k).to_string(),
+            kind: Some(CompletionItemKind::KEYWORD),
+            ..CompletionItem::default()
+        })
+        .collect();
+    let specs = &a.checked.file.specs;
+    let inside: Vec<usize> = (0..specs.len())
+        .filter(|&i| specs[i].range.start <= offset && offset <= specs[i].range.end)
+        .collect();
+    let mut seen = std::collections::HashSet::new();
+    for o in &a.occurrences {
+        if !o.decl || !(inside.is_empty() || inside.contains(&o.symbol.spec)) {
+            continue;
+        }
+        if !seen.insert((o.symbol.kind, o.symbol.name.clone())) {
+            continue;
+        }
+        let (kind, detail) = match o.symbol.kind {
+            SymKind::Var => (CompletionItemKind::VARIABLE, "state variable"),
+            SymKind::Let => (CompletionItemKind::CONSTANT, "let"),
+            SymKind::Option => (CompletionItemKind::METHOD, "option"),
+        };
+        items.push(CompletionItem {
+            label: o.symbol.name.clone(),
+            kind: Some(kind),
+            detail: Some(detail.to_string()),
+            ..CompletionItem::default()
+        });
+    }
+    for &i in &inside {
+        for b in &specs[i].broken {
+            for name in &b.names {
+                if seen.insert((SymKind::Let, name.clone())) {
+                    items.push(CompletionItem {
+                        label: name.clone(),
+                        kind: Some(CompletionItemKind::TEXT),
+                        detail: Some("declared by an item that does not parse yet".into()),
+                        ..CompletionItem::default()
+                    });
+                }
+            }
+        }
+    }
+    items
+}
+
+/// The edits that give the canonical layout (none when it is already canonical), or why
+/// the text cannot be formatted.
+pub fn format(a: &Analysis) -> Result<Vec<TextEdit>, String> {
+    match hstl::lang::format(&a.text) {
+        Ok(formatted) if formatted == a.text => Ok(Vec::new()),
+        Ok(formatted) => Ok(vec![TextEdit {
+            range: a.conv.range(&a.text, &(0..a.text.len())),
+            new_text: formatted,
+        }]),
+        Err(diags) => {
+            let first = diags.iter().find(|d| d.is_error()).or(diags.first());
+            Err(match first {
+                Some(d) => {
+                    let p = a.conv.position(&a.text, d.range.start);
+                    format!(
+                        "cannot format: syntax error at line {}, column {}: {}",
+                        p.line + 1,
+                        p.character + 1,
+                        d.message
+                    )
+                }
+                None => "cannot format: the file has syntax errors".to_string(),
+            })
+        }
+    }
+}

@@ -1,0 +1,350 @@
+//! In-process protocol tests: a client talks to [`super::serve`] over
+//! `Connection::memory()`.
+
+use std::path::Path;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use hstl::lang::LineIndex;
+use lsp_server::{Connection, Message, Notification, Request, RequestId, ResponseError};
+use serde_json::{Value, json};
+
+const URI: &str = "file:///tmp/spec.hstl";
+
+/// A spec with a missing `;` after `let B = ...` (HSTL001 after `x > 3`) and a
+/// duplicate `let` (HSTL003 with a related location).
+const BROKEN: &str = "spec S {
+    state { x: int in 0..=4, y: int in 0..=2 }
+    let A = x > 1 && y < 2;
+    let A = x < 3;
+    let B = x > 3
+    let C = y > 0;
+    task always[0..10] eventually[0..=3] A;
+}
+";
+
+const FIXED: &str = "/// A spec.
+spec S {
+    state { x: int in 0..=4, y: int in 0..=2 }
+    /// Where x is large and y small.
+    let A = x > 1 && y < 2;
+    let B = x > 3;
+    task always[0..10] (eventually[0..=3] A || B);
+    option A;
+    option B { reach: B, init: x < 5, terminate: B }
+    options sequences(A, B);
+}
+";
+
+/// A response, split for the asserts.
+#[derive(Debug)]
+struct Reply {
+    result: Option<Value>,
+    error: Option<ResponseError>,
+}
+
+struct Client {
+    conn: Connection,
+    server: Option<JoinHandle<Result<(), String>>>,
+    next_id: i32,
+    notifications: Vec<Notification>,
+}
+
+impl Client {
+    /// Starts a server and initialises it; returns the client and the `initialize` result.
+    fn start(capabilities: Value) -> (Client, Value) {
+        let (client, server) = Connection::memory();
+        let handle = std::thread::spawn(move || super::serve(&server));
+        let mut c =
+            Client { conn: client, server: Some(handle), next_id: 0, notifications: vec![] };
+        let init = c.request("initialize", json!({ "capabilities": capabilities }));
+        let result = init.result.expect("initialize succeeds");
+        c.notify("initialized", json!({}));
+        (c, result)
+    }
+
+    fn request(&mut self, method: &str, params: Value) -> Reply {
+        self.next_id += 1;
+        let id = RequestId::from(self.next_id);
+        let req = Request { id: id.clone(), method: method.into(), params };
+        self.conn.sender.send(Message::Request(req)).expect("server is up");
+        loop {
+            match self.recv() {
+                Message::Response(r) if r.id == id => {
+                    return match r.response_result {
+                        Ok(v) => Reply { result: Some(v), error: None },
+                        Err(e) => Reply { result: None, error: Some(e) },
+                    };
+                }
+                Message::Notification(n) => self.notifications.push(n),
+                other => panic!("unexpected message {other:?}"),
+            }
+        }
+    }
+
+    fn notify(&self, method: &str, params: Value) {
+        let n = Notification { method: method.into(), params };
+        self.conn.sender.send(Message::Notification(n)).expect("server is up");
+    }
+
+    fn recv(&self) -> Message {
+        self.conn.receiver.recv_timeout(Duration::from_secs(20)).expect("the server answers")
+    }
+
+    /// The next `publishDiagnostics` for the document.
+    fn diagnostics(&mut self) -> Vec<Value> {
+        let n = if self.notifications.is_empty() {
+            match self.recv() {
+                Message::Notification(n) => n,
+                other => panic!("expected a notification, got {other:?}"),
+            }
+        } else {
+            self.notifications.remove(0)
+        };
+        assert_eq!(n.method, "textDocument/publishDiagnostics");
+        assert_eq!(n.params["uri"], URI);
+        n.params["diagnostics"].as_array().cloned().unwrap_or_default()
+    }
+
+    fn open(&mut self, text: &str) -> Vec<Value> {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": URI, "languageId": "hstl", "version": 1, "text": text } }),
+        );
+        self.diagnostics()
+    }
+
+    fn change(&mut self, version: i32, text: &str) -> Vec<Value> {
+        self.notify(
+            "textDocument/didChange",
+            json!({ "textDocument": { "uri": URI, "version": version }, "contentChanges": [{ "text": text }] }),
+        );
+        self.diagnostics()
+    }
+
+    fn at(&mut self, method: &str, line: u32, character: u32) -> Reply {
+        self.request(
+            method,
+            json!({ "textDocument": { "uri": URI }, "position": { "line": line, "character": character }, "context": { "includeDeclaration": true } }),
+        )
+    }
+
+    fn shutdown(mut self) {
+        let r = self.request("shutdown", Value::Null);
+        assert!(r.error.is_none(), "{r:?}");
+        self.notify("exit", Value::Null);
+        let result = self.server.take().map(|h| h.join().expect("server thread ends"));
+        assert_eq!(result, Some(Ok(())));
+    }
+}
+
+/// `(line, character)` (0-based) of the first occurrence of `needle` in `text`, plus `skip`.
+fn pos_of(text: &str, needle: &str, nth: usize, skip: u32) -> (u32, u32) {
+    let at = text.match_indices(needle).nth(nth).expect("needle in text").0;
+    let p = LineIndex::new(text).position(text, at);
+    ((p.line - 1) as u32, p.utf16_column as u32 + skip)
+}
+
+fn lsp_range(text: &str, r: &std::ops::Range<usize>) -> Value {
+    let index = LineIndex::new(text);
+    let (a, b) = (index.position(text, r.start), index.position(text, r.end));
+    json!({
+        "start": { "line": a.line - 1, "character": a.utf16_column },
+        "end": { "line": b.line - 1, "character": b.utf16_column },
+    })
+}
+
+#[test]
+fn a_session_from_initialize_to_shutdown() {
+    let (mut c, init) = Client::start(json!({}));
+    assert_eq!(init["capabilities"]["positionEncoding"], "utf-16");
+    assert_eq!(init["capabilities"]["textDocumentSync"], 1);
+    assert_eq!(init["capabilities"]["hoverProvider"], true);
+
+    // Open: exactly the diagnostics of `check`, with codes and related locations.
+    let diags = c.open(BROKEN);
+    let expected = hstl::lang::check(BROKEN).diagnostics;
+    assert_eq!(diags.len(), expected.len(), "{diags:#?}");
+    for (got, want) in diags.iter().zip(&expected) {
+        assert_eq!(got["code"], want.code);
+        assert_eq!(got["range"], lsp_range(BROKEN, &want.range));
+        assert!(got["message"].as_str().unwrap().starts_with(&want.message));
+    }
+    let syntax = diags.iter().find(|d| d["code"] == "HSTL001").expect("syntax error");
+    // Reported where the `;` is missing: right after `x > 3`.
+    let (line, col) = pos_of(BROKEN, "x > 3\n", 0, 5);
+    assert_eq!(syntax["range"]["start"], json!({ "line": line, "character": col }));
+    assert_eq!(syntax["severity"], 1);
+    let dup = diags.iter().find(|d| d["code"] == "HSTL003").expect("duplicate let");
+    let related = &dup["relatedInformation"][0];
+    assert_eq!(related["location"]["uri"], URI);
+    let (line, col) = pos_of(BROKEN, "A", 0, 0);
+    assert_eq!(related["location"]["range"]["start"], json!({ "line": line, "character": col }));
+
+    // Change to a fixed text: the diagnostics clear.
+    assert_eq!(c.change(2, FIXED), Vec::<Value>::new());
+
+    // Hover on `always`: the meaning and the interval in words.
+    let (line, col) = pos_of(FIXED, "always", 0, 2);
+    let hover = c.at("textDocument/hover", line, col);
+    let text = hover.result.as_ref().unwrap()["contents"]["value"].as_str().unwrap().to_string();
+    assert!(text.contains("minimum"), "{text}");
+    assert!(text.contains("`t+9`") && text.contains("10 steps"), "{text}");
+    // On `eventually[0..=3]`: inclusive interval.
+    let (line, col) = pos_of(FIXED, "eventually", 0, 1);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("maximum") && text.contains("4 steps"), "{text}");
+    // On `&&`.
+    let (line, col) = pos_of(FIXED, "&&", 0, 1);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("minimum"), "{text}");
+    // On the let A: its definition and how many of the 15 states satisfy it
+    // (x in 2..=4 and y in 0..=1: 6 states).
+    let (line, col) = pos_of(FIXED, "A =", 0, 0);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("let A = x > 1 && y < 2;"), "{text}");
+    assert!(text.contains("in 6 of the 15 states"), "{text}");
+    assert!(text.contains("Where x is large and y small."), "{text}");
+    // On option B: sequence, init, terminate.
+    let (line, col) = pos_of(FIXED, "option B", 0, 7);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("init: `x < 5`") && text.contains("terminate: `B`"), "{text}");
+    assert!(text.contains("`[A, B]`"), "{text}");
+    // On blank space: nothing.
+    let r = c.at("textDocument/hover", 0, 0);
+    assert_eq!(r.result, Some(Value::Null));
+
+    // Definition of `A` in the task: the let's name. From `option A;`, also the let.
+    let decl = pos_of(FIXED, "A =", 0, 0);
+    let decl = json!({ "line": decl.0, "character": decl.1 });
+    let (line, col) = pos_of(FIXED, "A ||", 0, 0);
+    let def = c.at("textDocument/definition", line, col).result.unwrap();
+    assert_eq!(def["uri"], URI);
+    assert_eq!(def["range"]["start"], decl);
+    let (line, col) = pos_of(FIXED, "option A", 0, 7);
+    assert_eq!(c.at("textDocument/definition", line, col).result.unwrap()["range"]["start"], decl);
+    // Definition of the option B in `sequences(A, B)`: the option's name.
+    let (line, col) = pos_of(FIXED, "B);", 1, 0);
+    let def = c.at("textDocument/definition", line, col).result.unwrap();
+    let want = pos_of(FIXED, "B {", 0, 0);
+    assert_eq!(def["range"]["start"], json!({ "line": want.0, "character": want.1 }));
+    // A state variable.
+    let (line, col) = pos_of(FIXED, "y < 2", 0, 0);
+    let def = c.at("textDocument/definition", line, col).result.unwrap();
+    let want = pos_of(FIXED, "y: int", 0, 0);
+    assert_eq!(def["range"]["start"], json!({ "line": want.0, "character": want.1 }));
+
+    // References of the let B: declaration, task, `reach`, `terminate`.
+    let (line, col) = pos_of(FIXED, "B =", 0, 0);
+    let refs = c.at("textDocument/references", line, col).result.unwrap();
+    assert_eq!(refs.as_array().map(Vec::len), Some(4), "{refs:#}");
+
+    // Document symbols: the spec with its items.
+    let r = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": URI } }));
+    let syms = r.result.unwrap();
+    assert_eq!(syms[0]["name"], "S");
+    let names: Vec<&str> =
+        syms[0]["children"].as_array().unwrap().iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(names, ["x", "y", "A", "B", "task", "A", "B", "options"]);
+
+    // Completion: keywords and the names in scope.
+    let r = c.request(
+        "textDocument/completion",
+        json!({ "textDocument": { "uri": URI }, "position": { "line": 6, "character": 10 } }),
+    );
+    let labels: Vec<String> = r
+        .result
+        .unwrap()
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|i| i["label"].as_str().map(String::from))
+        .collect();
+    for want in ["always", "eventually", "x", "y", "A", "B"] {
+        assert!(labels.iter().any(|l| l == want), "{want} missing from {labels:?}");
+    }
+
+    // Formatting: one edit to the canonical text.
+    let r = c.request(
+        "textDocument/formatting",
+        json!({ "textDocument": { "uri": URI }, "options": { "tabSize": 4, "insertSpaces": true } }),
+    );
+    let edits = r.result.unwrap();
+    assert_eq!(edits[0]["newText"], hstl::lang::format(FIXED).unwrap());
+    assert_eq!(edits[0]["range"]["start"], json!({ "line": 0, "character": 0 }));
+
+    // A malformed request: an error response, and the server goes on.
+    let r = c.request("textDocument/hover", json!({ "textDocument": 42 }));
+    assert_eq!(r.error.as_ref().map(|e| e.code), Some(lsp_server::ErrorCode::InvalidParams as i32));
+    let r = c.request("textDocument/frobnicate", json!({}));
+    assert_eq!(r.error.map(|e| e.code), Some(lsp_server::ErrorCode::MethodNotFound as i32));
+    let r = c.at("textDocument/hover", 99, 0);
+    assert!(r.error.is_none());
+    // A malformed notification is ignored.
+    c.notify("textDocument/didChange", json!({ "nonsense": true }));
+    // Formatting a file with syntax errors fails with a message and changes nothing.
+    c.change(3, BROKEN);
+    let r = c.request("textDocument/formatting", json!({ "textDocument": { "uri": URI }, "options": { "tabSize": 4, "insertSpaces": true } }));
+    let e = r.error.expect("formatting refuses");
+    assert!(e.message.contains("syntax error at line 5, column 18"), "{}", e.message);
+
+    // Close: the diagnostics clear.
+    c.notify("textDocument/didClose", json!({ "textDocument": { "uri": URI } }));
+    assert_eq!(c.diagnostics(), Vec::<Value>::new());
+    c.shutdown();
+}
+
+#[test]
+fn utf8_is_used_when_offered() {
+    let (mut c, init) =
+        Client::start(json!({ "general": { "positionEncodings": ["utf-8", "utf-16"] } }));
+    assert_eq!(init["capabilities"]["positionEncoding"], "utf-8");
+    let text =
+        "spec S {\n    state { x: int in 0..=3 }\n    /* é𝛼 */ let A = x > 1;\n    task B;\n}\n";
+    let diags = c.open(text);
+    let unknown = diags.iter().find(|d| d["code"] == "HSTL002").expect("unknown name B");
+    // `    task B;`: B at byte 9 of line 3.
+    assert_eq!(unknown["range"]["start"], json!({ "line": 3, "character": 9 }));
+    // Hover on `A` after the multi-byte comment: byte column 21.
+    let r = c.at("textDocument/hover", 2, 21);
+    let text = r.result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("let A = x > 1;"), "{text}");
+    c.shutdown();
+}
+
+/// Every invalid fixture: the published diagnostics are `check`'s, positions in UTF-16.
+#[test]
+fn diagnostics_match_check_on_every_invalid_fixture() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hstl-lang/tests/fixtures/invalid");
+    let mut files: Vec<_> =
+        std::fs::read_dir(&dir).unwrap().filter_map(Result::ok).map(|e| e.path()).collect();
+    files.sort();
+    assert!(files.len() > 20);
+    let (mut c, _) = Client::start(json!({}));
+    let mut version = 1;
+    c.open("");
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        version += 1;
+        let got = c.change(version, &text);
+        let want = hstl::lang::check(&text).diagnostics;
+        assert_eq!(got.len(), want.len(), "{}", path.display());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!(g["code"], w.code, "{}", path.display());
+            assert_eq!(g["range"], lsp_range(&text, &w.range), "{}", path.display());
+            let sev = if w.is_error() { 1 } else { 2 };
+            assert_eq!(g["severity"], sev);
+            assert_eq!(
+                g["relatedInformation"].as_array().map_or(0, Vec::len),
+                w.labels.len(),
+                "{}",
+                path.display()
+            );
+        }
+    }
+    c.shutdown();
+}
