@@ -31,6 +31,17 @@ impl OutFile {
 pub fn write_all(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
     std::fs::create_dir_all(dir)
         .map_err(|source| CliError::Write { path: dir.to_path_buf(), source })?;
+    // A rename can only fail on a target we can see now (a folder in the way): refuse
+    // before anything is written, so the renames below all go through.
+    for file in files {
+        let target = dir.join(&file.name);
+        if target.is_dir() {
+            return Err(CliError::new(
+                format!("cannot write `{}`: a folder of that name is in the way", target.display()),
+                Some("move the folder away or choose another `--out`".to_string()),
+            ));
+        }
+    }
     let mut temps: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
     let cleanup = |temps: &[(PathBuf, PathBuf)]| {
         for (tmp, _) in temps {

@@ -61,7 +61,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     let mut loaded = Vec::new();
     for path in &args.specs {
         let Some(l) = spec_file::load(path, None)? else { return Ok(Status::Errors) };
-        let mut spec = l.task_spec()?;
+        let mut spec = l.trainable()?;
         if let Some(e) = args.episodes {
             spec.learn.episodes = e.max(1);
         }

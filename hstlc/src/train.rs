@@ -61,7 +61,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
         return Ok(Status::Errors);
     };
-    let mut spec = loaded.task_spec()?;
+    let mut spec = loaded.trainable()?;
     if let Some(e) = args.episodes {
         if e == 0 {
             return Err(CliError::new("`--episodes` must be at least 1", None));

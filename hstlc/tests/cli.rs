@@ -72,6 +72,15 @@ const CASES: &[Case] = &[
         args: &["monitor", "two_specs.hstl", "--spec", "First", "--trace", "-", "--signal"],
         stdin: "x\n0\n9\n1\n",
     },
+    // train and eval: the errors (successful runs are in tests/train_eval.rs)
+    case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
+    case("train_float_state", &["train", "float_state.hstl", "--out", "unused"]),
+    case("train_unknown_env", &["train", "small.hstl", "--env", "mars", "--out", "unused"]),
+    case("train_zero_episodes", &["train", "small.hstl", "--episodes", "0", "--out", "unused"]),
+    case("train_spec_errors", &["train", "errors.hstl", "--out", "unused"]),
+    case("eval_not_a_policy", &["eval", "not_a_policy.json"]),
+    case("eval_missing_file", &["eval", "nowhere.json"]),
+    case("study_no_seeds", &["study", "small.hstl", "--seeds", "0"]),
 ];
 
 #[test]

@@ -1,0 +1,119 @@
+//! `hstlc train` and `hstlc eval` end to end on a small spec: the files of the contract,
+//! determinism, and all-or-nothing output.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn hstlc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(args)
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli"))
+        .output()
+        .expect("hstlc runs")
+}
+
+fn train(out: &Path, seed: &str) -> Output {
+    hstlc(&["train", "small.hstl", "--seed", seed, "--out", out.to_str().expect("utf-8 path")])
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn train_writes_the_contract_files_and_eval_replays_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    let o = train(&out, "3");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("20 episodes"), "{stdout}");
+
+    let policy: serde_json::Value =
+        serde_json::from_str(&read(&out.join("policy.json"))).expect("policy.json is JSON");
+    for key in [
+        "spec",
+        "env",
+        "state_vars",
+        "actions",
+        "options",
+        "options_policy",
+        "flat_policies",
+        "primitives",
+    ] {
+        assert!(policy.get(key).is_some(), "policy.json lacks `{key}`");
+    }
+    assert_eq!(policy["spec"], "Small");
+    assert_eq!(policy["state_vars"], serde_json::json!(["x", "y"]));
+    // Every state has a flat choice for each primitive option.
+    for p in ["A", "B"] {
+        assert_eq!(policy["flat_policies"][p].as_array().map(Vec::len), Some(225), "{p}");
+    }
+    let entry = &policy["options_policy"][0];
+    assert!(entry["state"]["x"].is_number() && entry["choice"].is_string(), "{entry}");
+
+    let curve = read(&out.join("curve.csv"));
+    let lines: Vec<&str> = curve.lines().collect();
+    assert_eq!(lines[0], "episode,reward");
+    assert_eq!(lines.len(), 21);
+    assert!(
+        lines[1..].iter().all(|l| l.split(',').nth(1).is_some_and(|r| r.parse::<f64>().is_ok()))
+    );
+
+    for svg in ["flat_A.svg", "flat_B.svg", "options.svg", "run_1.svg", "run_2.svg", "curve.svg"] {
+        assert!(read(&out.join(svg)).contains("<svg"), "{svg} is not an SVG");
+    }
+
+    let policy_path = out.join("policy.json");
+    let e = hstlc(&[
+        "eval",
+        policy_path.to_str().expect("utf-8"),
+        "--starts",
+        "5",
+        "--steps",
+        "300",
+        "--no-optimum",
+    ]);
+    assert_eq!(e.status.code(), Some(0), "{}", String::from_utf8_lossy(&e.stderr));
+    let report = String::from_utf8_lossy(&e.stdout);
+    assert!(report.contains("window rate") && report.contains("task robustness"), "{report}");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_files() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (a, b, c) = (dir.path().join("a"), dir.path().join("b"), dir.path().join("c"));
+    for (out, seed) in [(&a, "7"), (&b, "7"), (&c, "8")] {
+        assert_eq!(train(out, seed).status.code(), Some(0));
+    }
+    for file in ["policy.json", "curve.csv", "options.svg", "run_1.svg"] {
+        assert_eq!(read(&a.join(file)), read(&b.join(file)), "{file} differs between two runs");
+    }
+    assert_ne!(read(&a.join("policy.json")), read(&c.join("policy.json")), "seeds 7 and 8 agree");
+}
+
+#[test]
+fn an_unwritable_output_folder_is_an_error_and_nothing_is_written() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A file where a folder should be: the folder cannot be created.
+    let blocker = dir.path().join("file");
+    std::fs::write(&blocker, "not a folder").expect("write");
+    let o = train(&blocker.join("out"), "1");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("cannot write") && stderr.contains("file/out"), "{stderr}");
+
+    // A folder where one output file should go: nothing at all is written.
+    let out = dir.path().join("partly");
+    std::fs::create_dir_all(out.join("curve.svg")).expect("mkdir");
+    let o = train(&out, "1");
+    assert_eq!(o.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("curve.svg"), "{stderr}");
+    let left: Vec<String> = std::fs::read_dir(&out)
+        .expect("read dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(left, ["curve.svg"], "files were left behind");
+}
