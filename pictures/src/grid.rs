@@ -157,6 +157,41 @@ pub fn options_policy(
     render(grid, title, "Option", &legend, Layers { under: &under, over: &|_, _| Ok(()) })
 }
 
+/// One memory slice of an options policy with memory: a label (such as `b = [0, 4, 8]`)
+/// and the option chosen in each cell for that memory value.
+pub type Slice = (String, Vec<((i64, i64), String)>);
+
+/// Draws an options policy with memory as one [`options_policy`] map per slice, titled
+/// `"{title}, {label}"`. The colours agree across the maps: every map uses `legend_order`
+/// followed by the options the slices choose, in order of first appearance over all
+/// slices.
+///
+/// Errors for no slice, or whatever [`options_policy`] rejects in a slice (the message
+/// names the slice).
+pub fn options_policy_slices(
+    grid: &Grid,
+    title: &str,
+    slices: &[Slice],
+    legend_order: &[String],
+) -> Result<Vec<String>> {
+    if slices.is_empty() {
+        return Err(PictureError::new("no memory slice to draw; give at least one"));
+    }
+    let order = option_order(
+        legend_order,
+        slices.iter().flat_map(|(_, choices)| choices.iter().map(|(_, name)| name.as_str())),
+    );
+    slices
+        .iter()
+        .map(|(label, choices)| {
+            let title =
+                if label.is_empty() { title.to_owned() } else { format!("{title}, {label}") };
+            options_policy(grid, &title, choices, &order)
+                .map_err(|e| PictureError::new(format!("memory slice {label:?}: {}", e.message())))
+        })
+        .collect()
+}
+
 /// Draws a sample run as a path through the cell centres, each segment coloured by the
 /// option running when the move was made, with the start and end marked; colours follow
 /// the order of first appearance in the run.

@@ -3,7 +3,8 @@
 //! The functions take plain data (no learner types) and return a complete SVG document as a
 //! `String`, in the style of Figures 2 and 3 of Li & Belta (2016): flat policies as arrow
 //! fields, the options policy as a coloured map, sample runs as coloured paths and the
-//! learning curve as a mean line over a band of seeds.
+//! learning curve as a mean line over a band of seeds. An options policy with memory is
+//! drawn as one map per memory slice ([`options_policy_slices`]).
 //!
 //! Grid coordinates follow the GridWorld contract: `x` is the column from left to right, `y`
 //! the row from bottom to top, and `(0, 0)` is the bottom-left cell.
@@ -33,7 +34,9 @@ mod palette;
 use std::fmt;
 
 pub use curve::learning_curve;
-pub use grid::{flat_policy, options_policy, sample_run, sample_run_ordered};
+pub use grid::{
+    Slice, flat_policy, options_policy, options_policy_slices, sample_run, sample_run_ordered,
+};
 
 /// The largest grid side that can be drawn; larger grids would give unreadable pictures.
 pub const MAX_GRID_SIDE: usize = 256;

@@ -3,8 +3,8 @@
 use std::collections::{BTreeSet, HashMap};
 
 use hstl_pictures::{
-    Action, Cell, Grid, Region, flat_policy, learning_curve, options_policy, sample_run,
-    sample_run_ordered,
+    Action, Cell, Grid, Region, flat_policy, learning_curve, options_policy, options_policy_slices,
+    sample_run, sample_run_ordered,
 };
 use roxmltree::{Document, Node};
 
@@ -482,4 +482,30 @@ fn an_option_without_a_name_is_listed_as_such() {
     let svg =
         options_policy(&small_grid(), "Blank", &[((0, 0), String::new())], &[]).expect("draws");
     assert!(has_text(&parse(&svg), "(no name)"));
+}
+
+#[test]
+fn memory_slices_are_one_map_each_with_shared_colours() {
+    let grid = small_grid();
+    // Two memory slices: "go B" appears only in the second, "go C" only in the first.
+    let slices = vec![
+        ("b = [0]".to_string(), vec![((0, 0), "go C".to_string()), ((1, 0), "go A".to_string())]),
+        ("b = [1]".to_string(), vec![((0, 0), "go B".to_string()), ((1, 0), "go A".to_string())]),
+    ];
+    let maps = options_policy_slices(&grid, "Options", &slices, &names(&["go A"])).expect("draws");
+    assert_eq!(maps.len(), 2);
+    let colour_of = |svg: &str, name: &str, slice: &[((i64, i64), String)]| {
+        let expected =
+            options_policy(&grid, "x", slice, &names(&["go A", "go C", "go B"])).expect("draws");
+        assert_eq!(rect_fills(&parse(svg)), rect_fills(&parse(&expected)), "{name}");
+    };
+    // Each map is the plain map drawn with the order over all slices.
+    colour_of(&maps[0], "first slice", &slices[0].1);
+    colour_of(&maps[1], "second slice", &slices[1].1);
+    assert!(has_text(&parse(&maps[1]), "Options, b = [1]"));
+    // Errors name the slice; no slice is an error.
+    let bad = vec![("b = [2]".to_string(), vec![((9, 9), "go A".to_string())])];
+    let err = options_policy_slices(&grid, "Options", &bad, &[]).unwrap_err();
+    assert!(err.message().starts_with("memory slice \"b = [2]\": "), "{}", err.message());
+    assert!(options_policy_slices(&grid, "Options", &[], &[]).is_err());
 }
