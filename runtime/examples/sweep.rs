@@ -4,12 +4,14 @@
 //! learned legs driven through the fixed cycle A -> B -> C, and the O_T2 vs O_T1 reward
 //! difference.
 //!
-//! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES] [VARIANT]`
-//! (VARIANT, such as `O_T2 argmax` or `memory`, runs that variant alone; EPISODES `-` keeps
-//! 1200; SEEDS 0 stops after the optimum and the hand-written cycle).
+//! `cargo run --release -p hstl-runtime --example sweep -- [SEEDS] [EPISODES] [VARIANT]
+//! [THREADS]` (VARIANT, such as `O_T2 argmax` or `memory`, runs that variant alone, `all`
+//! runs every one; EPISODES `-` keeps 1200; SEEDS 0 stops after the optimum and the
+//! hand-written cycle; THREADS, 2 by default, trains that many seeds at once: use 1 for
+//! training times on an otherwise idle machine).
 //!
 //! The memory variant's figures: `cargo run --release -p hstl-runtime --example sweep -- 20 -
-//! memory`.
+//! memory 1`. `memory off` is the same spec with `memory: 0` (the window reward alone).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -36,6 +38,11 @@ struct Outcome {
 fn variant(name: &str) -> TaskSpec {
     match name {
         "memory" => common::case_study_memory(),
+        "memory off" => {
+            let mut spec = common::case_study_memory();
+            spec.learn.memory = 0;
+            spec
+        }
         _ => common::case_study(name.starts_with("O_T2"), name.ends_with("entry")),
     }
 }
@@ -79,7 +86,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let seeds: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(20);
     let episodes: Option<usize> = args.get(2).and_then(|a| a.parse().ok());
-    let only = args.get(3);
+    let only = args.get(3).filter(|v| *v != "all");
+    let threads: u64 = args.get(4).and_then(|a| a.parse().ok()).unwrap_or(2).max(1);
     let env = GridWorld::default();
     let spec = common::case_study(false, false);
     let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
@@ -109,16 +117,16 @@ fn main() {
         return;
     }
     let mut tails = Vec::new();
-    for name in ["O_T1 argmax", "O_T2 argmax", "O_T1 entry", "O_T2 entry", "memory"] {
+    for name in ["O_T1 argmax", "O_T2 argmax", "O_T1 entry", "O_T2 entry", "memory", "memory off"] {
         if only.is_some_and(|o| o != name) {
             continue;
         }
         let outcomes: Vec<Outcome> = std::thread::scope(|scope| {
-            let handles: Vec<_> = (0..2u64)
+            let handles: Vec<_> = (0..threads)
                 .map(|w| {
                     scope.spawn(move || {
                         (0..seeds)
-                            .filter(|s| s % 2 == w)
+                            .filter(|s| s % threads == w)
                             .map(|s| (s, run(name, s, episodes)))
                             .collect::<Vec<_>>()
                     })
@@ -150,7 +158,7 @@ fn main() {
             r / w_star,
             st / s / 1e6
         );
-        if name != "memory" {
+        if !name.starts_with("memory") {
             tails.push(tr);
         }
     }
