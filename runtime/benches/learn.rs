@@ -1,6 +1,7 @@
 //! Full case-study training runs: O_T1 (7 options) and O_T2 (15 options), 1200 episodes of
-//! 200 choices with the paper's parameters and argmax termination, seed 1; throughput is
-//! in primitive steps.
+//! 200 choices with the paper's parameters and argmax termination, and the memory variant
+//! (options {A, B, C}, `memory: 8`, `reward: window`), seed 1; throughput is in primitive
+//! steps.
 //!
 //! `cargo bench -p hstl-runtime --bench learn -- --warm-up-time 1 --measurement-time 3`
 
@@ -14,8 +15,11 @@ fn training(c: &mut Criterion) {
     let env = GridWorld::default();
     let mut group = c.benchmark_group("train");
     group.sample_size(10);
-    for (name, permutations) in [("O_T1", false), ("O_T2", true)] {
-        let spec = common::case_study(permutations, false);
+    for name in ["O_T1", "O_T2", "memory"] {
+        let spec = match name {
+            "memory" => common::case_study_memory(),
+            _ => common::case_study(name == "O_T2", false),
+        };
         let train = || {
             let mut learner = Learner::new(&spec, &env).expect("the case study is valid");
             learner.train(&mut seeded_rng(1), |_, _| {}).steps
