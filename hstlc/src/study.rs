@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use hstl::runtime::eval::RegionTable;
 use hstl::runtime::optimum::{SolveConfig, solve};
-use hstl::runtime::{GridWorld, Intra, Region, TaskSpec, seeded_rng};
+use hstl::runtime::{GridWorld, Intra, Region, RewardKind, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutFile};
 use crate::cli_error::CliError;
@@ -79,7 +79,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         env_words(&env)
     );
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
-    let mut baseline: Option<(String, f64)> = None;
+    let mut baseline: Option<(String, f64, RewardKind)> = None;
     for (path, l, spec) in &loaded {
         let results = run_seeds(spec, &env, args.seeds, threads, &l.file)?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
@@ -100,12 +100,18 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         );
         print_table(&results, w_star);
         let reward = mean(&results.iter().map(|r| r.tail_reward).collect::<Vec<_>>());
+        // Rewards compare only under the same options-level reward.
         match &baseline {
-            None => baseline = Some((label.clone(), reward)),
-            Some((base, b)) => println!(
+            None => baseline = Some((label.clone(), reward, spec.learn.reward)),
+            Some((base, b, kind)) if *kind == spec.learn.reward => println!(
                 "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
                 100.0 * (reward - b) / b.abs()
             ),
+            Some((base, _, _)) => {
+                println!(
+                    "  reward not compared with {base}: its options earn another kind of reward"
+                )
+            }
         }
         if args.both_intra {
             let mut other = spec.clone();
