@@ -11,7 +11,8 @@
 //! training times on an otherwise idle machine).
 //!
 //! The memory variant's figures: `cargo run --release -p hstl-runtime --example sweep -- 20 -
-//! memory 1`. `memory off` is the same spec with `memory: 0` (the window reward alone).
+//! memory 1`. `memory off` is the same spec with `memory: 0` (the window reward alone);
+//! `memory flat alpha X` is the same spec with the flat step size X instead of 0.2.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -41,6 +42,11 @@ fn variant(name: &str) -> TaskSpec {
         "memory off" => {
             let mut spec = common::case_study_memory();
             spec.learn.memory = 0;
+            spec
+        }
+        _ if name.starts_with("memory flat alpha ") => {
+            let mut spec = common::case_study_memory();
+            spec.learn.flat.alpha = name["memory flat alpha ".len()..].parse().expect("a number");
             spec
         }
         _ => common::case_study(name.starts_with("O_T2"), name.ends_with("entry")),
@@ -117,7 +123,12 @@ fn main() {
         return;
     }
     let mut tails = Vec::new();
-    for name in ["O_T1 argmax", "O_T2 argmax", "O_T1 entry", "O_T2 entry", "memory", "memory off"] {
+    let mut names =
+        vec!["O_T1 argmax", "O_T2 argmax", "O_T1 entry", "O_T2 entry", "memory", "memory off"];
+    if let Some(o) = only.filter(|o| o.starts_with("memory flat alpha ")) {
+        names.push(o);
+    }
+    for name in names {
         if only.is_some_and(|o| o != name) {
             continue;
         }
