@@ -404,6 +404,16 @@ fn memory_training_is_deterministic() {
     let mut flat = spec.clone();
     flat.learn.memory = 0;
     assert_eq!(train(&flat, &env, 7).options.len(), 225 * 3);
+    // Memory with the paper's segment reward: the options table is per state and memory.
+    let mut segment = spec.clone();
+    segment.learn.reward = hstl_runtime::RewardKind::Segment;
+    segment.learn.memory = 2;
+    let q = train(&segment, &env, 7);
+    assert_eq!(q.options.len(), 225 * 27 * 3);
+    assert_eq!(bits(&q), bits(&train(&segment, &env, 7)));
+    // The window reward is never negative; the segment reward of a region far away is.
+    assert!(a.options.iter().all(|&v| v >= 0.0));
+    assert!(q.options.iter().any(|&v| v < 0.0));
 }
 
 #[test]
