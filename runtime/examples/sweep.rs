@@ -164,9 +164,17 @@ fn main() {
         let sd = (outcomes.iter().map(|o| (o.rate - r).powi(2)).sum::<f64>()
             / (outcomes.len().max(2) - 1) as f64)
             .sqrt();
+        // How much of the spread over seeds the legs explain.
+        let cov = outcomes.iter().map(|o| (o.rate - r) * (o.legs - lg)).sum::<f64>();
+        let var_legs = outcomes.iter().map(|o| (o.legs - lg).powi(2)).sum::<f64>();
+        let var_rate = outcomes.iter().map(|o| (o.rate - r).powi(2)).sum::<f64>();
+        let corr = cov / (var_legs * var_rate).sqrt();
+        let mut secs: Vec<f64> = outcomes.iter().map(|o| o.secs).collect();
+        secs.sort_by(f64::total_cmp);
         println!(
-            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}, sd {sd:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}, learned legs through A->B->C {lg:.3} ({llo:.3}-{lhi:.3})",
+            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}, sd {sd:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}, median {:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}, learned legs through A->B->C {lg:.3} ({llo:.3}-{lhi:.3}), corr(W, legs) {corr:.2}",
             r / w_star,
+            secs[secs.len() / 2],
             st / s / 1e6
         );
         if !name.starts_with("memory") {
