@@ -37,7 +37,8 @@ pub struct StudyArgs {
     /// Worker threads (default: every core).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// The folder for each spec's policy (first seed), curves and pictures.
+    /// The folder for each spec's policy (first seed), curves, pictures and per-seed
+    /// figures (`seeds.csv`).
     #[arg(long, value_name = "DIR", default_value = "out/study")]
     pub out: PathBuf,
 }
@@ -199,9 +200,14 @@ fn optimum(
 fn print_table(results: &[RunResult], w_star: Option<f64>) {
     let row = |name: &str, values: Vec<f64>, digits: usize| {
         let (lo, hi) = range(&values);
-        println!("  {name:<34} {:>9.digits$} {:>9.digits$} {:>9.digits$}", mean(&values), lo, hi);
+        let m = mean(&values);
+        // The sample standard deviation over seeds.
+        let sd = (values.iter().map(|v| (v - m) * (v - m)).sum::<f64>()
+            / (values.len().max(2) - 1) as f64)
+            .sqrt();
+        println!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}");
     };
-    println!("  {:<34} {:>9} {:>9} {:>9}", "", "mean", "min", "max");
+    println!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max");
     row("training time (s)", results.iter().map(|r| r.secs).collect(), 3);
     row(
         "primitive steps/s (millions)",
@@ -218,7 +224,8 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) {
     }
 }
 
-/// The first seed's policy, curve and pictures, and the learning curves of all seeds.
+/// The first seed's policy, curve and pictures, the learning curves of all seeds, and
+/// `seeds.csv` with each seed's figures.
 fn write_outputs(
     dir: &Path,
     spec: &TaskSpec,
@@ -235,6 +242,12 @@ fn write_outputs(
     ];
     let mut rng = seeded_rng(PICTURE_SEED);
     files.extend(artifacts::agent_pictures(spec, env, &outcome.agent, &mut rng)?);
+    let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
+    for (seed, r) in results.iter().enumerate() {
+        let window = r.window.map_or(String::new(), |w| w.to_string());
+        seeds.push_str(&format!("{seed},{},{},{},{window}\n", r.secs, r.steps, r.tail_reward));
+    }
+    files.push(OutFile::text("seeds.csv", seeds));
     let curves: Vec<Vec<f64>> = results.iter().map(|r| r.curve.clone()).collect();
     files.push(artifacts::curve_picture(
         &format!("Learning curve of {} over {} seeds", spec.name, curves.len()),
