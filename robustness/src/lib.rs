@@ -10,11 +10,14 @@
 //! - [`offline`] computes whole signals fast, and the robustness at step 0 from the
 //!   formula's horizon alone.
 //! - [`online`] monitors a trace fed one state at a time.
+//! - [`kernels`] are [`offline`]'s sliding-window, until and piecewise kernels over plain
+//!   slices, for monitors that compute their operand signals themselves.
 //! - [`segment`] scores option executions and all their suffixes for the learner.
 //!
 //! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
 pub mod formula;
+pub mod kernels;
 pub mod offline;
 pub mod online;
 pub mod reference;

@@ -26,7 +26,8 @@
 //! `x > 3` with `x = inf` is `inf`. The one thing not pinned is the sign of a zero
 //! (`min(0, -0)`): the tests compare with `==`, under which `0 == -0`.
 
-use crate::{Bound, CmpOp, Expr, Formula, Interval, Trace};
+use crate::kernels::Kernels;
+use crate::{CmpOp, Expr, Formula, Interval, Trace};
 
 const INF: f64 = f64::INFINITY;
 const NEG_INF: f64 = f64::NEG_INFINITY;
@@ -43,9 +44,7 @@ pub struct Evaluator {
     pool: Vec<Vec<f64>>,
     chunks: Vec<Vec<f64>>,
     result: Vec<f64>,
-    scratch_a: Vec<f64>,
-    scratch_b: Vec<f64>,
-    scratch_c: Vec<f64>,
+    kernels: Kernels,
 }
 
 /// A min or a max, with its identity.
@@ -164,7 +163,7 @@ impl Evaluator {
     /// buffer then stays in cache; the overlap costs `H / C` extra work.
     fn eval(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
         let piece = match f.horizon() {
-            Some(h) if !f.is_state_formula() => PIECE.max(h.saturating_mul(16)),
+            Some(h) if !f.is_state_formula() => piece_len(h),
             _ => usize::MAX,
         };
         if n / 2 <= piece {
@@ -392,63 +391,18 @@ impl Evaluator {
 
     /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, in place.
     fn window<L: Lattice>(&mut self, buf: &mut [f64], i: &Interval) {
-        let n = buf.len();
-        let a = i.start;
-        if i.is_empty() || a >= n {
-            buf.fill(L::ID);
-            return;
-        }
-        let Some(last) = i.last_offset() else {
-            // Unbounded: a suffix fold, then a shift by `a`.
-            suffix_fold::<L>(buf);
-            shift_left::<L>(buf, a);
-            return;
-        };
-        // The window at `t` is `s ..= s + len - 1` with `s = t + a`, clipped at `n`.
-        let len = (last - a).saturating_add(1);
-        if len == 1 {
-            buf.iter_mut().for_each(|v| *v = L::acc(L::ID, *v));
-            shift_left::<L>(buf, a);
-            return;
-        }
-        let len = len.min(n);
-        van_herk::<L>(buf, a, len, &mut self.scratch_a, &mut self.scratch_b);
+        self.kernels.window::<L>(buf, i);
     }
 
     /// `out[t]` becomes `rho(lhs until[i] out, t)` given the two operand signals.
     fn until(&mut self, i: &Interval, lhs: &mut [f64], out: &mut [f64]) {
-        let n = out.len();
-        let a = i.start;
-        if i.is_empty() || a >= n {
-            out.fill(NEG_INF);
-            return;
-        }
-        // rho(t) = min(always[0..a] lhs at t, U(t + a)), where U is `until[0..=len-1]`
-        // (or unbounded) at `t + a`: the `lhs` samples before `t + a` bound every candidate.
-        match i.last_offset() {
-            None => {
-                let mut next = NEG_INF;
-                for (g, f) in out.iter_mut().zip(lhs.iter()).rev() {
-                    next = Max::acc(Min::acc(next, *f), Min::acc(INF, *g));
-                    *g = next;
-                }
-            }
-            // A span past the trace's end is as good as `n`, and cannot overflow.
-            Some(last) => block_until(
-                lhs,
-                out,
-                (last - a).min(n),
-                [&mut self.scratch_a, &mut self.scratch_b, &mut self.scratch_c],
-            ),
-        }
-        if a > 0 {
-            self.window::<Min>(lhs, &Interval { start: 0, end: Bound::Exclusive(a) });
-            for t in 0..n - a {
-                out[t] = Min::acc(lhs[t], out[t + a]);
-            }
-            out[n - a..].fill(NEG_INF);
-        }
+        self.kernels.until(i, lhs, out);
     }
+}
+
+/// The steps per piece of a temporal formula with horizon `h`: its buffers stay in L2.
+pub(crate) fn piece_len(h: usize) -> usize {
+    PIECE.max(h.saturating_mul(16))
 }
 
 /// For an atom `x op c` or `c op x` over a variable the trace has: the column, `c`, and
@@ -469,7 +423,7 @@ fn columns(trace: &Trace) -> Vec<&[f64]> {
 }
 
 /// `buf[t] = buf[t + a]`, and the identity where `t + a` is past the end.
-fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
+pub(crate) fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
     let n = buf.len();
     let a = a.min(n);
     buf.copy_within(a.., 0);
@@ -485,7 +439,7 @@ fn shift_left<L: Lattice>(buf: &mut [f64], a: usize) {
 /// recurrence); in the next block it is `min(lhs[s..block end], p[e])`, where `p[e]` is the
 /// until over the next block's prefix up to `e` (a forward recurrence). Every sample costs
 /// a fixed number of min/max, whatever the span, and no step branches on the data.
-fn block_until(lhs: &[f64], out: &mut [f64], span: usize, scratch: [&mut Vec<f64>; 3]) {
+pub(crate) fn block_until(lhs: &[f64], out: &mut [f64], span: usize, scratch: [&mut Vec<f64>; 3]) {
     let n = out.len();
     let [su, sf, p] = scratch;
     for v in [&mut *su, &mut *sf, &mut *p] {
@@ -532,7 +486,7 @@ fn block_until(lhs: &[f64], out: &mut [f64], span: usize, scratch: [&mut Vec<f64
 
 /// `buf[t]` becomes the fold of `buf[t..]`. (Folding four pieces side by side to break
 /// the dependency chain measured no faster.)
-fn suffix_fold<L: Lattice>(buf: &mut [f64]) {
+pub(crate) fn suffix_fold<L: Lattice>(buf: &mut [f64]) {
     let mut acc = L::ID;
     for v in buf.iter_mut().rev() {
         acc = L::acc(acc, *v);
@@ -542,7 +496,7 @@ fn suffix_fold<L: Lattice>(buf: &mut [f64]) {
 
 /// `buf[t]` becomes the fold of `buf[t + a ..= t + a + len - 1]` (clipped at the end), with
 /// `2 <= len <= n` and `a < n`: van Herk/Gil-Werman over blocks of `len` samples.
-fn van_herk<L: Lattice>(
+pub(crate) fn van_herk<L: Lattice>(
     buf: &mut [f64],
     a: usize,
     len: usize,
