@@ -557,3 +557,33 @@ fn memory_agents_replay_their_counters() {
     let back = Policy::from_json(&Policy::new(&learner).to_json().unwrap()).unwrap();
     assert_eq!(rate(&back.agent(&env).unwrap()), rate(&agent));
 }
+
+#[test]
+fn leg_cycles_run_each_primitive_to_termination_in_turn() {
+    use hstl_runtime::eval::LegCycle;
+    // A deterministic 5 x 1 line: primitive 0 goes Right and stops at x = 4, primitive 1
+    // goes Left and stops at x = 0, primitive 2 stays (Up) and never stops.
+    let env = GridWorld::new(5, 1, 1.0).unwrap();
+    let agent = hstl_runtime::Agent {
+        legs: vec![vec![0], vec![1], vec![2]],
+        options: vec![0; 5],
+        flat: vec![vec![3; 5], vec![2; 5], vec![0; 5]],
+        terminate: vec![
+            (0..5).map(|x| x == 4).collect(),
+            (0..5).map(|x| x == 0).collect(),
+            vec![false; 5],
+        ],
+        max_steps: 3,
+        memory: None,
+    };
+    let mut cycle = LegCycle::new(&agent, vec![0, 1, 2]).unwrap();
+    let steps = rollout(&env, &mut cycle, 2, 14, &mut seeded_rng(0));
+    let states: Vec<usize> = steps.iter().map(|s| s.state).collect();
+    let legs: Vec<usize> = steps.iter().map(|s| s.decision.option).collect();
+    // Right until x = 4; Left cut off after 3 steps at x = 1 (max_steps); the stuck leg cut
+    // off after 3 steps; Right again until x = 4, then Left.
+    assert_eq!(states, [2, 3, 4, 3, 2, 1, 1, 1, 1, 2, 3, 4, 3, 2]);
+    assert_eq!(legs, [0, 0, 1, 1, 1, 2, 2, 2, 0, 0, 0, 1, 1, 1]);
+    assert!(LegCycle::new(&agent, vec![]).is_err());
+    assert!(LegCycle::new(&agent, vec![3]).is_err());
+}
