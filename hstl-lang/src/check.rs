@@ -43,7 +43,13 @@ impl Checked {
 
 /// Parses and checks a source text. Never fails and never panics.
 pub fn check(src: &str) -> Checked {
-    let parsed = parse(src);
+    check_parsed(src, parse(src))
+}
+
+/// Checks a source text that is already parsed: `parsed` must be what [`parse`] gives for
+/// `src` (an editor that re-parses only what changed, see [`crate::incremental`], builds
+/// it without parsing the whole text). Never fails and never panics.
+pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
     let mut diags = parsed.diagnostics;
     let mut specs = Vec::new();
     let mut seen: HashMap<String, Range<usize>> = HashMap::new();

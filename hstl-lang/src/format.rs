@@ -1,6 +1,6 @@
 //! The formatter: one canonical layout for a spec file.
 //!
-//! [`format`] re-emits the tokens of the file in their order and changes only the space
+//! [`format()`] re-emits the tokens of the file in their order and changes only the space
 //! between them, so the formatted text parses to the same checked spec (up to byte
 //! ranges). The layout:
 //! - one item per line, indented by four spaces per level; a spec's items at level 1;
@@ -17,7 +17,7 @@
 //!   indented like what follows it; trailing white space is dropped from line comments
 //!   (not from doc comments, whose text is part of the checked spec).
 //!
-//! Long formulas are not wrapped. A file with syntax errors is not formatted: [`format`]
+//! Long formulas are not wrapped. A file with syntax errors is not formatted: [`format()`]
 //! returns the parser's diagnostics instead.
 
 use std::collections::{HashMap, HashSet};
@@ -46,7 +46,7 @@ pub fn format(src: &str) -> Result<String, Vec<Diagnostic>> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
+pub(crate) enum Kind {
     Word,
     Number,
     Punct,
@@ -57,20 +57,20 @@ enum Kind {
 }
 
 #[derive(Clone, Copy, Debug)]
-struct Tok {
-    kind: Kind,
-    start: usize,
-    end: usize,
+pub(crate) struct Tok {
+    pub(crate) kind: Kind,
+    pub(crate) start: usize,
+    pub(crate) end: usize,
 }
 
 impl Tok {
-    fn is_comment(self) -> bool {
+    pub(crate) fn is_comment(self) -> bool {
         matches!(self.kind, Kind::LineComment | Kind::BlockComment)
     }
 }
 
 /// The same tokens as the parser's lexer, with comments as tokens.
-fn lex(src: &str) -> Vec<Tok> {
+pub(crate) fn lex(src: &str) -> Vec<Tok> {
     let b = src.as_bytes();
     let mut toks = Vec::new();
     let mut i = 0;

@@ -55,12 +55,13 @@ pub mod checked;
 pub mod codes;
 pub mod diagnostic;
 pub mod format;
+pub mod incremental;
 pub mod parser;
 pub mod position;
 pub mod render;
 pub mod syntax;
 
-pub use check::{Checked, check};
+pub use check::{Checked, check, check_parsed};
 pub use checked::*;
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use format::format;

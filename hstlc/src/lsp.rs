@@ -229,8 +229,13 @@ impl Server {
                 if change.range.is_some() {
                     return Err("only full-document changes are supported".into());
                 }
-                self.update(p.text_document.uri.clone(), change.text);
-                p.text_document.uri
+                let uri = p.text_document.uri;
+                let next = match self.documents.remove(&uri) {
+                    Some(prev) => Analysis::update(prev, change.text, self.encoding),
+                    None => Analysis::new(change.text, self.encoding),
+                };
+                self.documents.insert(uri.clone(), next);
+                uri
             }
             DidCloseTextDocument::METHOD => {
                 let p: lsp_types::DidCloseTextDocumentParams =

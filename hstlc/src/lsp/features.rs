@@ -56,6 +56,9 @@ pub struct Analysis {
     pub text: String,
     /// Parse and check results.
     pub checked: hstl::lang::Checked,
+    /// The parser's diagnostics (with `checked.file`, the parse that the next version
+    /// re-parses incrementally).
+    pub parse_diagnostics: Vec<hstl::lang::Diagnostic>,
     /// Every name occurrence, sorted by start.
     pub occurrences: Vec<Occurrence>,
     /// Position conversion for this text.
@@ -65,14 +68,29 @@ pub struct Analysis {
 impl Analysis {
     /// Checks `text` and indexes its names.
     pub fn new(text: String, enc: Encoding) -> Self {
-        let checked = hstl::lang::check(&text);
+        let parsed = hstl::lang::parse(&text);
+        Self::from_parsed(text, parsed, enc)
+    }
+
+    /// The analysis of a new version of the text of `prev`: only the items around the
+    /// change are parsed again (see `hstl_lang::incremental`), then the whole is checked.
+    pub fn update(prev: Analysis, text: String, enc: Encoding) -> Self {
+        let Analysis { text: old, checked, parse_diagnostics, .. } = prev;
+        let prev = hstl::lang::Parsed { file: checked.file, diagnostics: parse_diagnostics };
+        let (parsed, _) = hstl::lang::incremental::reparse(prev, &old, &text);
+        Self::from_parsed(text, parsed, enc)
+    }
+
+    fn from_parsed(text: String, parsed: hstl::lang::Parsed, enc: Encoding) -> Self {
+        let parse_diagnostics = parsed.diagnostics.clone();
+        let checked = hstl::lang::check_parsed(&text, parsed);
         let mut occurrences = Vec::new();
         for (i, spec) in checked.file.specs.iter().enumerate() {
             index_spec(i, spec, &mut occurrences);
         }
         occurrences.sort_by_key(|o| (o.range.start, !o.decl));
         let conv = Converter::new(&text, enc);
-        Analysis { text, checked, occurrences, conv }
+        Analysis { text, checked, parse_diagnostics, occurrences, conv }
     }
 
     fn occurrences_at(&self, offset: usize) -> impl Iterator<Item = &Occurrence> {

@@ -348,3 +348,33 @@ fn diagnostics_match_check_on_every_invalid_fixture() {
     }
     c.shutdown();
 }
+
+/// Typing into an open document (each keystroke re-parses only around the change): the
+/// published diagnostics are `check`'s after every keystroke.
+#[test]
+fn keystrokes_publish_checks_diagnostics() {
+    let (mut c, _) = Client::start(json!({}));
+    c.open(FIXED);
+    let mut text = FIXED.to_string();
+    let mut version = 1;
+    let at = text.find("let B").expect("let B");
+    // Break the line piece by piece, then type it back.
+    let typed = "let D = x < 2 && eventually B;\n    ";
+    for k in 0..=typed.len() {
+        let mut next = FIXED.to_string();
+        next.insert_str(at, &typed[..k]);
+        version += 1;
+        let got = c.change(version, &next);
+        let want = hstl::lang::check(&next).diagnostics;
+        let got: Vec<(String, Value)> = got
+            .iter()
+            .map(|d| (d["code"].as_str().unwrap_or("").to_string(), d["range"].clone()))
+            .collect();
+        let want: Vec<(String, Value)> =
+            want.iter().map(|d| (d.code.to_string(), lsp_range(&next, &d.range))).collect();
+        assert_eq!(got, want, "after typing {:?}", &typed[..k]);
+        text = next;
+    }
+    assert!(text.contains("let D"));
+    c.shutdown();
+}
