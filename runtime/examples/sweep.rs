@@ -25,11 +25,21 @@ use hstl_runtime::eval::{
 use hstl_runtime::optimum::{SolveConfig, solve};
 use hstl_runtime::{GridWorld, Learner, TaskSpec, seeded_rng};
 
+/// Seconds this thread has spent on a CPU (Linux `schedstat`), which a busy machine
+/// inflates less than the wall clock; NaN elsewhere.
+fn cpu_secs() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|t| t.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns / 1e9)
+}
+
 /// What one training run measured.
 #[derive(Clone, Debug)]
 struct Outcome {
     rate: f64,
     secs: f64,
+    cpu: f64,
     tail_reward: f64,
     steps: u64,
     legs: f64,
@@ -61,9 +71,11 @@ fn run(name: &str, seed: u64, episodes: Option<usize>) -> Outcome {
     let env = GridWorld::default();
     let mut rng = seeded_rng(seed);
     let t = Instant::now();
+    let cpu = cpu_secs();
     let mut learner = Learner::new(&spec, &env).expect("the case study is valid");
     let trained = learner.train(&mut rng, |_, _| {});
     let secs = t.elapsed().as_secs_f64();
+    let cpu = cpu_secs() - cpu;
     let agent = learner.agent();
     let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
     let mut eval_rng = seeded_rng(seed ^ 0x5eed);
@@ -82,6 +94,7 @@ fn run(name: &str, seed: u64, episodes: Option<usize>) -> Outcome {
     Outcome {
         rate: report.rate,
         secs,
+        cpu,
         tail_reward: tail.iter().sum::<f64>() / tail.len() as f64,
         steps: trained.steps,
         legs: legs.rate,
@@ -160,6 +173,7 @@ fn main() {
         let (s, slo, shi) = stat(&|o| o.secs);
         let (tr, _, _) = stat(&|o| o.tail_reward);
         let (st, _, _) = stat(&|o| o.steps as f64);
+        let (cpu, cpu_lo, cpu_hi) = stat(&|o| o.cpu);
         let (lg, llo, lhi) = stat(&|o| o.legs);
         let sd = (outcomes.iter().map(|o| (o.rate - r).powi(2)).sum::<f64>()
             / (outcomes.len().max(2) - 1) as f64)
@@ -172,7 +186,7 @@ fn main() {
         let mut secs: Vec<f64> = outcomes.iter().map(|o| o.secs).collect();
         secs.sort_by(f64::total_cmp);
         println!(
-            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}, sd {sd:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}, median {:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}, learned legs through A->B->C {lg:.3} ({llo:.3}-{lhi:.3}), corr(W, legs) {corr:.2}",
+            "{name}: window rate {r:.3} ({rlo:.3}-{rhi:.3}, sd {sd:.3}), W/W* {:.3}, train {s:.2} s ({slo:.2}-{shi:.2}, median {:.2}; on the CPU {cpu:.2} s, {cpu_lo:.2}-{cpu_hi:.2}), {:.2}M steps/s, last-100 reward/episode {tr:.2}, learned legs through A->B->C {lg:.3} ({llo:.3}-{lhi:.3}), corr(W, legs) {corr:.2}",
             r / w_star,
             secs[secs.len() / 2],
             st / s / 1e6
