@@ -191,8 +191,9 @@ fn cells(env: &GridWorld) -> Vec<(i64, i64)> {
         .collect()
 }
 
-/// Every state of `env` as one step of a trace, in the spec's variable order.
-fn state_trace(spec: &TaskSpec, env: &GridWorld) -> Result<Trace, CliError> {
+/// Every state of `env` as one step of a trace (step `s` is state index `s`), in the
+/// spec's variable order.
+pub fn state_trace(spec: &TaskSpec, env: &GridWorld) -> Result<Trace, CliError> {
     let env_vars = env.state_vars();
     let picks = spec
         .state_vars

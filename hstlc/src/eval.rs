@@ -4,11 +4,12 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use hstl::robustness::offline;
+use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
 use hstl::runtime::optimum::{SolveConfig, solve};
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
+use crate::artifacts;
 use crate::check::read_input;
 use crate::cli_error::CliError;
 use crate::train::env_words;
@@ -74,6 +75,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         if args.starts == 0 || args.steps == 0 {
             return Err(CliError::new("`--starts` and `--steps` must be at least 1", None));
         }
+        let all_states = artifacts::state_trace(&spec, &env)?;
         let mut controller = AgentController::new(&agent);
         let mut values = Vec::with_capacity(args.starts);
         for _ in 0..args.starts {
@@ -82,7 +84,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                 .iter()
                 .map(|s| s.state)
                 .collect();
-            values.push(robustness_of_run(&spec, &env, &states)?);
+            values.push(robustness_of_run(&spec, &all_states, &states)?);
         }
         print_robustness(&values);
         return Ok(Status::Clean);
@@ -142,27 +144,15 @@ pub fn spec_of(policy_text: &str, expected: &str) -> Result<TaskSpec, String> {
     hstl::lower::task_spec(spec, source).map_err(|e| e.to_string())
 }
 
-fn robustness_of_run(spec: &TaskSpec, env: &GridWorld, states: &[usize]) -> Result<f64, CliError> {
-    let env_vars = env.state_vars();
-    let mut columns = vec![Vec::with_capacity(states.len()); spec.state_vars.len()];
-    let mut row = Vec::new();
-    for &s in states {
-        let state = env
-            .state(s)
-            .ok_or_else(|| CliError::new(format!("state {s} is not on the grid"), None))?;
-        env.valuation(&state, &mut row);
-        for (col, var) in columns.iter_mut().zip(&spec.state_vars) {
-            let i = env_vars.iter().position(|e| *e == var.name).ok_or_else(|| {
-                CliError::new(
-                    format!("state variable `{}` is not the environment's", var.name),
-                    None,
-                )
-            })?;
-            col.push(row[i]);
-        }
+/// The task's robustness over the states of one run (indices into `states`, the trace of
+/// every state of the environment).
+fn robustness_of_run(spec: &TaskSpec, states: &Trace, run: &[usize]) -> Result<f64, CliError> {
+    let mut trace = Trace::new(states.vars());
+    let mut row = Vec::with_capacity(states.vars());
+    for &s in run {
+        states.row_into(s, &mut row);
+        trace.push(&row).map_err(|e| CliError::new(e.to_string(), None))?;
     }
-    let trace = hstl::robustness::Trace::from_columns(columns)
-        .map_err(|e| CliError::new(e.to_string(), None))?;
     Ok(offline::robustness(&spec.task, &trace))
 }
 

@@ -117,3 +117,17 @@ fn an_unwritable_output_folder_is_an_error_and_nothing_is_written() {
         .collect();
     assert_eq!(left, ["curve.svg"], "files were left behind");
 }
+
+#[test]
+fn eval_scores_other_tasks_by_their_robustness() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("reach");
+    let o = hstlc(&["train", "reach.hstl", "--out", out.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let policy = out.join("policy.json");
+    let e = hstlc(&["eval", policy.to_str().expect("utf-8"), "--starts", "4", "--steps", "60"]);
+    assert_eq!(e.status.code(), Some(0), "{}", String::from_utf8_lossy(&e.stderr));
+    let report = String::from_utf8_lossy(&e.stdout);
+    assert!(report.contains("task robustness over each run"), "{report}");
+    assert!(!report.contains("window rate"), "{report}");
+}
