@@ -1,6 +1,8 @@
 //! What the server answers, computed from one [`Analysis`] of a document: diagnostics,
 //! hover, definition, references, document symbols, completion and formatting.
 
+use std::cell::OnceCell;
+use std::collections::HashSet;
 use std::ops::Range;
 
 use hstl::lang::check::MAX_DOMAIN_STATES;
@@ -59,8 +61,9 @@ pub struct Analysis {
     /// The parser's diagnostics (with `checked.file`, the parse that the next version
     /// re-parses incrementally).
     pub parse_diagnostics: Vec<hstl::lang::Diagnostic>,
-    /// Every name occurrence, sorted by start.
-    pub occurrences: Vec<Occurrence>,
+    /// Every name occurrence, sorted by start; built on the first request that needs it
+    /// (a keystroke only needs the diagnostics).
+    occurrences: OnceCell<Vec<Occurrence>>,
     /// Position conversion for this text.
     pub conv: Converter,
 }
@@ -84,18 +87,26 @@ impl Analysis {
     fn from_parsed(text: String, parsed: hstl::lang::Parsed, enc: Encoding) -> Self {
         let parse_diagnostics = parsed.diagnostics.clone();
         let checked = hstl::lang::check_parsed(&text, parsed);
-        let mut occurrences = Vec::new();
-        for (i, spec) in checked.file.specs.iter().enumerate() {
-            index_spec(i, spec, &mut occurrences);
-        }
-        occurrences.sort_by_key(|o| (o.range.start, !o.decl));
         let conv = Converter::new(&text, enc);
-        Analysis { text, checked, parse_diagnostics, occurrences, conv }
+        Analysis { text, checked, parse_diagnostics, occurrences: OnceCell::new(), conv }
+    }
+
+    /// Every name occurrence, sorted by start.
+    pub fn occurrences(&self) -> &[Occurrence] {
+        self.occurrences.get_or_init(|| {
+            let mut occurrences = Vec::new();
+            for (i, spec) in self.checked.file.specs.iter().enumerate() {
+                index_spec(i, spec, &mut occurrences);
+            }
+            occurrences.sort_by_key(|o| (o.range.start, !o.decl));
+            occurrences
+        })
     }
 
     fn occurrences_at(&self, offset: usize) -> impl Iterator<Item = &Occurrence> {
-        let first = self.occurrences.partition_point(|o| o.range.end < offset);
-        self.occurrences[first..]
+        let all = self.occurrences();
+        let first = all.partition_point(|o| o.range.end < offset);
+        all[first..]
             .iter()
             .take_while(move |o| o.range.start <= offset)
             .filter(move |o| o.range.start <= offset && offset <= o.range.end)
@@ -103,7 +114,7 @@ impl Analysis {
 
     /// The declaration of a symbol (its first one).
     fn declaration(&self, symbol: &Symbol) -> Option<&Occurrence> {
-        self.occurrences.iter().find(|o| o.decl && &o.symbol == symbol)
+        self.occurrences().iter().find(|o| o.decl && &o.symbol == symbol)
     }
 
     /// The checked spec of syntax spec `i`.
@@ -122,12 +133,14 @@ impl Analysis {
 
 /// Records the names of one spec.
 fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
-    let mut vars = Vec::new();
-    let mut lets = Vec::new();
+    let mut vars = HashSet::new();
+    let mut lets = HashSet::new();
     for item in &spec.items {
         match item {
-            Item::State(b) => vars.extend(b.vars.iter().map(|v| v.name.name.clone())),
-            Item::Let(l) => lets.push(l.name.name.clone()),
+            Item::State(b) => vars.extend(b.vars.iter().map(|v| v.name.name.as_str())),
+            Item::Let(l) => {
+                lets.insert(l.name.name.as_str());
+            }
             _ => {}
         }
     }
@@ -139,7 +152,7 @@ fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
     // falls back to the other namespace, which they share, so that navigation still
     // works on a spec with a kind error.
     let resolve = |name: &str, formula: bool| {
-        let (is_let, is_var) = (lets.iter().any(|l| l == name), vars.iter().any(|v| v == name));
+        let (is_let, is_var) = (lets.contains(name), vars.contains(name));
         match (formula, is_let, is_var) {
             (true, true, _) | (false, true, false) => Some(SymKind::Let),
             (_, _, true) => Some(SymKind::Var),
@@ -163,7 +176,7 @@ fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
                 push(o.name.range.clone(), SymKind::Option, &o.name.name, true);
                 match &o.fields {
                     // `option A;` reaches the let `A`.
-                    None if lets.contains(&o.name.name) => {
+                    None if lets.contains(o.name.name.as_str()) => {
                         push(o.name.range.clone(), SymKind::Let, &o.name.name, false);
                     }
                     None => {}
@@ -625,7 +638,7 @@ pub fn definition(a: &Analysis, pos: Position) -> Option<lsp_types::Range> {
 pub fn references(a: &Analysis, pos: Position, include_declaration: bool) -> Vec<lsp_types::Range> {
     let offset = a.conv.offset(&a.text, pos);
     let Some(o) = a.symbol_at(offset) else { return Vec::new() };
-    a.occurrences
+    a.occurrences()
         .iter()
         .filter(|x| x.symbol == o.symbol && (include_declaration || !x.decl))
         .map(|x| a.conv.range(&a.text, &x.range))
@@ -776,7 +789,7 @@ pub fn completion(a: &Analysis, pos: Position) -> Vec<CompletionItem> {
         .filter(|&i| specs[i].range.start <= offset && offset <= specs[i].range.end)
         .collect();
     let mut seen = std::collections::HashSet::new();
-    for o in &a.occurrences {
+    for o in a.occurrences() {
         if !o.decl || !(inside.is_empty() || inside.contains(&o.symbol.spec)) {
             continue;
         }
