@@ -4,7 +4,7 @@
 use std::collections::HashSet;
 
 use hstl_lang::{
-    Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Domain, Interval, LetKind,
+    Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Domain, Interval,
     Terminate, VarType,
 };
 use proc_macro2::{Ident, Literal, Span, TokenStream};
@@ -20,7 +20,6 @@ pub fn spec_module(spec: &CheckedSpec, src: &str, complete: bool) -> TokenStream
     let state = g.state();
     let primitives = g.primitive_enum();
     let options = g.options_enum();
-    let rt = runtime_helpers();
     let lets = g.lets();
     let task = match &spec.task {
         Some(t) if g.valid(&t.formula) => g.monitor(
@@ -46,7 +45,6 @@ pub fn spec_module(spec: &CheckedSpec, src: &str, complete: bool) -> TokenStream
                 #lets
             }
             #spec_impl
-            #rt
         }
     }
 }
@@ -315,41 +313,47 @@ impl<'a> Gen<'a> {
         name: &TokenStream,
     ) -> TokenStream {
         let data = self.formula_data(f, lets);
-        // The helpers live in the spec module, one level above the task, two above a let.
-        let rt =
-            if lets.to_string() == "super" { quote!(super::super::rt) } else { quote!(super::rt) };
         let empty = lit_f64(self.empty_value(f, &mut Vec::new()));
-        let mut body = Body {
-            g: self,
-            lets,
-            rt: &rt,
-            stmts: Vec::new(),
-            uses_state: false,
-            uses_t: false,
-            n: 0,
-        };
-        let signal = body.signal(f);
-        let stmts = &body.stmts;
-        let at = if self.spec.is_state_formula(f) {
-            let mut b = Body {
-                g: self,
-                lets,
-                rt: &rt,
-                stmts: Vec::new(),
-                uses_state: false,
-                uses_t: false,
-                n: 0,
-            };
+        let kernels = quote!(::hstl::robustness::kernels::Kernels);
+        let (at, signal_with, robustness) = if self.spec.is_state_formula(f) {
+            let mut b = Body::new(self, lets);
             let p = b.point(f);
             let arg = if b.uses_state { quote!(s) } else { quote!(_s) };
-            quote! {
+            let at = quote! {
                 /// Robustness on one state (a state formula reads no other).
                 pub fn at(#arg: &#state) -> f64 {
                     #p
                 }
-            }
+            };
+            let signal_with = quote! {
+                /// [`signal`]; a state formula needs no kernels.
+                pub fn signal_with(trace: &[#state], _k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                    trace.iter().map(at).collect()
+                }
+            };
+            let robustness = quote!(trace.first().map_or(#empty, at));
+            (at, signal_with, robustness)
         } else {
-            TokenStream::new()
+            let mut b = Body::new(self, lets);
+            let body = b.block(f);
+            let k = if b.uses_kernels { quote!(k) } else { quote!(_k) };
+            let signal_with = quote! {
+                /// [`signal`] with the caller's kernel buffers: reused over many calls,
+                /// they are allocated once.
+                pub fn signal_with(trace: &[#state], #k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                    #body
+                }
+            };
+            // With a finite horizon `H`, step 0 reads only the first `H + 1` steps.
+            let steps =
+                self.horizon(f).and_then(|h| h.checked_add(1)).map(Literal::usize_unsuffixed);
+            let robustness = match steps {
+                Some(h) => quote! {
+                    signal(&trace[..trace.len().min(#h)]).first().copied().unwrap_or(#empty)
+                },
+                None => quote!(signal(trace).first().copied().unwrap_or(#empty)),
+            };
+            (TokenStream::new(), signal_with, robustness)
         };
         quote! {
             #doc
@@ -363,14 +367,15 @@ impl<'a> Gen<'a> {
 
                 /// Robustness at every step of the trace.
                 pub fn signal(trace: &[#state]) -> ::std::vec::Vec<f64> {
-                    #(#stmts)*
-                    #signal
+                    signal_with(trace, &mut #kernels::new())
                 }
+
+                #signal_with
 
                 /// Robustness of the trace: at step 0 (what the reference evaluator gives
                 /// for an empty trace when it is empty).
                 pub fn robustness(trace: &[#state]) -> f64 {
-                    signal(trace).first().copied().unwrap_or(#empty)
+                    #robustness
                 }
 
                 /// Monitors the formula on states pushed one at a time (the runtime's
@@ -415,6 +420,35 @@ impl<'a> Gen<'a> {
                         Online::new()
                     }
                 }
+            }
+        }
+    }
+
+    /// The formula's horizon as the runtime computes it (`Formula::horizon`): the steps
+    /// after `t` that `rho(f, t)` reads; `None` when unbounded (or past `usize`).
+    fn horizon(&self, f: &CFormula) -> Option<usize> {
+        let end = |iv: &Interval| match iv.end {
+            Bound::Unbounded => None,
+            Bound::Exclusive(b) => usize::try_from(b.saturating_sub(1)).ok(),
+            Bound::Inclusive(b) => usize::try_from(b).ok(),
+        };
+        match &f.kind {
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Cmp(..)
+            | CFormulaKind::Invalid => Some(0),
+            // Lets form no cycle in a valid formula, the only kind generated.
+            CFormulaKind::Let(i) => self.horizon(&self.spec.lets.get(*i)?.formula),
+            CFormulaKind::Not(a) => self.horizon(a),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                v.iter().try_fold(0, |acc, g| self.horizon(g).map(|h| acc.max(h)))
+            }
+            CFormulaKind::Implies(a, b) => Some(self.horizon(a)?.max(self.horizon(b)?)),
+            CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
+                end(iv)?.checked_add(self.horizon(a)?)
+            }
+            CFormulaKind::Until(iv, a, b) => {
+                end(iv)?.checked_add(self.horizon(a)?.max(self.horizon(b)?))
             }
         }
     }
@@ -640,127 +674,206 @@ impl<'a> Gen<'a> {
     }
 }
 
-/// Straight-line code for one formula's signal: temporal operators become statements
-/// over whole signals, everything else an expression at step `t` on state `s`.
+/// Code for one formula's signal over `trace` (a `&[State]`), with the kernels `k` in
+/// scope: one `let` statement per operator. State subformulas become one fused expression
+/// per step, mapped over the trace; the temporal structure goes to the offline evaluator's
+/// kernels (`hstl::robustness::kernels`), piece by piece where the horizon is finite, as
+/// the evaluator itself runs it.
 struct Body<'g, 'a> {
     g: &'g Gen<'a>,
     lets: &'g TokenStream,
-    rt: &'g TokenStream,
+    /// The statements of the block being written (a closure body opens a new one).
     stmts: Vec<TokenStream>,
+    /// The number of `sig<n>` variables so far.
+    vars: usize,
     uses_state: bool,
-    uses_t: bool,
-    n: usize,
+    uses_kernels: bool,
 }
 
-impl Body<'_, '_> {
-    /// An expression of type `Vec<f64>`: the signal of `f` (`n` is the trace length).
-    fn signal(&mut self, f: &CFormula) -> TokenStream {
+/// A signal in generated code: a `let mut` variable, or an expression of type `Vec<f64>`.
+enum Sig {
+    Var(Ident),
+    Expr(TokenStream),
+}
+
+impl Sig {
+    fn tokens(&self) -> TokenStream {
+        match self {
+            Sig::Var(v) => quote!(#v),
+            Sig::Expr(e) => e.clone(),
+        }
+    }
+}
+
+impl<'g, 'a> Body<'g, 'a> {
+    fn new(g: &'g Gen<'a>, lets: &'g TokenStream) -> Body<'g, 'a> {
+        Body { g, lets, stmts: Vec::new(), vars: 0, uses_state: false, uses_kernels: false }
+    }
+
+    /// The statements and the final expression of the signal of `f`.
+    fn block(&mut self, f: &CFormula) -> TokenStream {
+        let sig = self.signal(f, false).tokens();
+        let stmts = std::mem::take(&mut self.stmts);
+        quote!(#(#stmts)* #sig)
+    }
+
+    /// A `let mut` variable holding `sig`.
+    fn var(&mut self, sig: Sig) -> Ident {
+        match sig {
+            Sig::Var(v) => v,
+            Sig::Expr(e) => {
+                let v = format_ident!("sig{}", self.vars);
+                self.vars += 1;
+                self.stmts.push(quote!(let mut #v: ::std::vec::Vec<f64> = #e;));
+                v
+            }
+        }
+    }
+
+    /// The signal of `f` on `trace`. `in_piece` says whether an enclosing formula is
+    /// already evaluated piece by piece.
+    fn signal(&mut self, f: &CFormula, in_piece: bool) -> Sig {
+        if self.g.spec.is_state_formula(f) {
+            return Sig::Expr(self.map(&[f], None));
+        }
+        self.uses_kernels = true;
+        match (&f.kind, in_piece, self.g.horizon(f)) {
+            // A let runs its own pieces.
+            (CFormulaKind::Let(_), ..) | (_, true, _) | (_, false, None) => {
+                self.operator(f, in_piece)
+            }
+            (_, false, Some(h)) => {
+                let outer = std::mem::take(&mut self.stmts);
+                let sig = self.operator(f, true).tokens();
+                let stmts = std::mem::replace(&mut self.stmts, outer);
+                let h = Literal::usize_unsuffixed(h);
+                Sig::Expr(quote! {
+                    ::hstl::robustness::kernels::pieces(trace.len(), #h, |steps| {
+                        let trace = &trace[steps];
+                        #(#stmts)*
+                        #sig
+                    })
+                })
+            }
+        }
+    }
+
+    /// `trace.iter().map(..).collect()`: one expression per step, the state formula `fs[0]`
+    /// alone when `fold` is `None`, else all of `fs` folded from the identity with `min`
+    /// (`Some(true)`) or `max`, which drops NaN.
+    fn map(&mut self, fs: &[&CFormula], fold: Option<bool>) -> TokenStream {
+        let before = self.uses_state;
+        self.uses_state = false;
+        let p = match (fs, fold) {
+            ([f, ..], None) => self.point(f),
+            ([], None) => quote!(f64::NAN),
+            (_, Some(and)) => {
+                let ps: Vec<TokenStream> = fs.iter().map(|g| self.point(g)).collect();
+                if and {
+                    quote!(f64::INFINITY #(.min(#ps))*)
+                } else {
+                    quote!(f64::NEG_INFINITY #(.max(#ps))*)
+                }
+            }
+        };
+        let arg = if self.uses_state { quote!(s) } else { quote!(_) };
+        self.uses_state = before;
+        quote!(trace.iter().map(|#arg| #p).collect::<::std::vec::Vec<f64>>())
+    }
+
+    /// [`Body::signal`] of a formula that is not a state formula, without pieces.
+    fn operator(&mut self, f: &CFormula, in_piece: bool) -> Sig {
+        let kernels = quote!(::hstl::robustness::kernels);
         match &f.kind {
-            CFormulaKind::Let(i)
-                if self.g.spec.lets.get(*i).is_some_and(|l| l.kind == LetKind::Temporal) =>
-            {
+            CFormulaKind::Let(i) => {
                 let lets = self.lets;
                 let name = &self.g.let_names[*i];
-                quote!(#lets::#name::signal(trace))
+                Sig::Expr(quote!(#lets::#name::signal_with(trace, k)))
             }
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                self.temporal(f)
-            }
-            CFormulaKind::And(v) | CFormulaKind::Or(v)
-                if !v.is_empty() && v.iter().all(|g| self.is_vector(g)) =>
-            {
-                // Fold whole signals in place rather than indexing each at every step.
-                let (neutral, op) = if matches!(f.kind, CFormulaKind::And(_)) {
-                    (quote!(f64::INFINITY), quote!(min))
+            CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
+                let a = self.signal(a, in_piece);
+                let v = self.var(a);
+                let iv = interval_data(iv);
+                let op = if matches!(f.kind, CFormulaKind::Always(..)) {
+                    quote!(always)
                 } else {
-                    (quote!(f64::NEG_INFINITY), quote!(max))
+                    quote!(eventually)
                 };
-                let acc = format_ident!("sig{}", self.n);
-                self.n += 1;
-                let first = self.signal(&v[0]);
-                self.stmts.push(quote! {
-                    let mut #acc: ::std::vec::Vec<f64> = #first;
-                    for x in #acc.iter_mut() {
-                        *x = #neutral.#op(*x);
-                    }
-                });
-                for g in &v[1..] {
-                    let c = self.signal(g);
-                    self.stmts.push(quote! {
-                        for (x, y) in #acc.iter_mut().zip(#c) {
-                            *x = x.#op(y);
-                        }
-                    });
-                }
-                quote!(#acc)
-            }
-            _ => {
-                let before = (self.uses_state, self.uses_t);
-                (self.uses_state, self.uses_t) = (false, false);
-                let p = self.point(f);
-                let used = (self.uses_state, self.uses_t);
-                (self.uses_state, self.uses_t) = before;
-                let map = match used {
-                    (true, true) => quote!(trace.iter().enumerate().map(|(t, s)| #p)),
-                    (true, false) => quote!(trace.iter().map(|s| #p)),
-                    (false, true) => quote!((0..trace.len()).map(|t| #p)),
-                    (false, false) => quote!(trace.iter().map(|_| #p)),
-                };
-                quote!(#map.collect::<::std::vec::Vec<f64>>())
-            }
-        }
-    }
-
-    /// Whether `f`'s signal is computed as a whole vector (not step by step).
-    fn is_vector(&self, f: &CFormula) -> bool {
-        match &f.kind {
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                true
-            }
-            CFormulaKind::Let(i) => {
-                self.g.spec.lets.get(*i).is_some_and(|l| l.kind == LetKind::Temporal)
-            }
-            _ => false,
-        }
-    }
-
-    /// A temporal operator: a statement computing its signal; returns the variable.
-    fn temporal(&mut self, f: &CFormula) -> TokenStream {
-        let v = format_ident!("sig{}", self.n);
-        self.n += 1;
-        let value = match &f.kind {
-            CFormulaKind::Always(iv, a) => {
-                let a = self.signal(a);
-                let (s, e) = bounds(iv);
-                {
-                    let rt = self.rt;
-                    quote!(#rt::window_min(#a, #s, #e))
-                }
-            }
-            CFormulaKind::Eventually(iv, a) => {
-                let a = self.signal(a);
-                let (s, e) = bounds(iv);
-                {
-                    let rt = self.rt;
-                    quote!(#rt::window_max(#a, #s, #e))
-                }
+                self.stmts.push(quote!(k.#op(&#iv, &mut #v);));
+                Sig::Var(v)
             }
             CFormulaKind::Until(iv, a, b) => {
-                let a = self.signal(a);
-                let b = self.signal(b);
-                let (s, e) = bounds(iv);
-                {
-                    let rt = self.rt;
-                    quote!(#rt::until(&#a, &#b, #s, #e))
-                }
+                let a = self.signal(a, in_piece);
+                let a = self.var(a);
+                let b = self.signal(b, in_piece);
+                let b = self.var(b);
+                let iv = interval_data(iv);
+                self.stmts.push(quote!(k.until(&#iv, &mut #a, &mut #b);));
+                Sig::Var(b)
             }
-            _ => self.signal(f),
-        };
-        self.stmts.push(quote!(let #v: ::std::vec::Vec<f64> = #value;));
-        quote!(#v)
+            CFormulaKind::Not(a) => {
+                let a = self.signal(a, in_piece);
+                let v = self.var(a);
+                self.stmts.push(quote! {
+                    for x in #v.iter_mut() {
+                        *x = -*x;
+                    }
+                });
+                Sig::Var(v)
+            }
+            CFormulaKind::Implies(a, b) => {
+                let a = self.signal(a, in_piece);
+                let v = self.var(a);
+                let b = self.signal(b, in_piece).tokens();
+                self.stmts.push(quote! {
+                    for (x, y) in #v.iter_mut().zip(&#b) {
+                        *x = (-*x).max(*y);
+                    }
+                });
+                Sig::Var(v)
+            }
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                let and = matches!(f.kind, CFormulaKind::And(_));
+                // The state operands fuse into one expression per step; the others are
+                // folded in whole. Every signal here is NaN-free (a temporal operator's
+                // skips NaN, and the fused operands start from the identity), as
+                // `and_into` and `or_into` ask of their first argument.
+                let (state, temporal): (Vec<&CFormula>, Vec<&CFormula>) =
+                    v.iter().partition(|g| self.g.spec.is_state_formula(g));
+                let mut parts = Vec::new();
+                if !state.is_empty() {
+                    parts.push(Sig::Expr(self.map(&state, Some(and))));
+                }
+                for g in temporal {
+                    let sig = self.signal(g, in_piece);
+                    parts.push(sig);
+                }
+                let mut parts = parts.into_iter();
+                let Some(first) = parts.next() else {
+                    // Not reached: a formula without operands is a state formula.
+                    return Sig::Expr(self.map(&[], Some(and)));
+                };
+                let mut rest = parts.peekable();
+                if rest.peek().is_none() {
+                    return first;
+                }
+                let acc = self.var(first);
+                let fold = if and { quote!(and_into) } else { quote!(or_into) };
+                for sig in rest {
+                    let sig = sig.tokens();
+                    self.stmts.push(quote!(#kernels::#fold(&mut #acc, &#sig);));
+                }
+                Sig::Var(acc)
+            }
+            // State formulas are mapped in `signal`; invalid ones are not generated.
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Cmp(..)
+            | CFormulaKind::Invalid => Sig::Expr(self.map(&[f], None)),
+        }
     }
 
-    /// An `f64` expression: `rho(f, t)`, reading the state `s = &trace[t]`.
+    /// An `f64` expression: `rho(f, t)` of a state formula on the state `s`.
     fn point(&mut self, f: &CFormula) -> TokenStream {
         match &f.kind {
             CFormulaKind::True => quote!(f64::INFINITY),
@@ -768,17 +881,8 @@ impl Body<'_, '_> {
             CFormulaKind::Let(i) => {
                 let lets = self.lets;
                 let name = &self.g.let_names[*i];
-                if self.g.spec.lets.get(*i).is_some_and(|l| l.kind == LetKind::State) {
-                    self.uses_state = true;
-                    quote!(#lets::#name::at(s))
-                } else {
-                    let v = format_ident!("sig{}", self.n);
-                    self.n += 1;
-                    self.stmts
-                        .push(quote!(let #v: ::std::vec::Vec<f64> = #lets::#name::signal(trace);));
-                    self.uses_t = true;
-                    quote!(#v[t])
-                }
+                self.uses_state = true;
+                quote!(#lets::#name::at(s))
             }
             CFormulaKind::Cmp(op, a, b) => {
                 self.uses_state |= reads_state(a) || reads_state(b);
@@ -804,10 +908,9 @@ impl Body<'_, '_> {
                 let (a, b) = (self.point(a), self.point(b));
                 quote!((-(#a)).max(#b))
             }
+            // Not reached: `point` is only asked for state formulas.
             CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                let v = self.temporal(f);
-                self.uses_t = true;
-                quote!(#v[t])
+                quote!(f64::NAN)
             }
         }
     }
@@ -860,212 +963,6 @@ impl Body<'_, '_> {
             }
         }
     }
-}
-
-/// The sliding-window and until helpers the monitors call. They follow the reference
-/// evaluator's NaN policy (min and max skip NaN) by reading NaN as the neutral element.
-fn runtime_helpers() -> TokenStream {
-    quote! {
-        mod rt {
-            /// `min` of `sig` over the window `[t + start, t + end)` clipped to the trace,
-            /// for every `t`; `+inf` when empty.
-            pub(super) fn window_min(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
-                if sig.iter().any(|x| x.is_nan()) {
-                    window(sig, start, end, f64::INFINITY, f64::min)
-                } else {
-                    window(sig, start, end, f64::INFINITY, |a: f64, b: f64| if b < a { b } else { a })
-                }
-            }
-
-            /// `max` of `sig` over the window `[t + start, t + end)` clipped to the trace,
-            /// for every `t`; `-inf` when empty.
-            pub(super) fn window_max(sig: ::std::vec::Vec<f64>, start: usize, end: usize) -> ::std::vec::Vec<f64> {
-                if sig.iter().any(|x| x.is_nan()) {
-                    window(sig, start, end, f64::NEG_INFINITY, f64::max)
-                } else {
-                    window(sig, start, end, f64::NEG_INFINITY, |a: f64, b: f64| if b > a { b } else { a })
-                }
-            }
-
-            /// Folds every block of `w` steps of `buf` in place from the block's start
-            /// (prefix folds); four blocks at a time so the folds overlap.
-            #[inline(always)]
-            fn scan<F: Fn(f64, f64) -> f64 + Copy>(buf: &mut [f64], w: usize, neutral: f64, op: F) {
-                let n = buf.len();
-                let groups = n / w / 4;
-                for gi in 0..groups {
-                    let base = gi * 4 * w;
-                    let mut acc = [neutral; 4];
-                    for j in 0..w {
-                        for (k, a) in acc.iter_mut().enumerate() {
-                            let u = base + k * w + j;
-                            *a = op(*a, buf[u]);
-                            buf[u] = *a;
-                        }
-                    }
-                }
-                let mut b = groups * 4 * w;
-                while b < n {
-                    let e = (b + w).min(n);
-                    let mut acc = neutral;
-                    for x in &mut buf[b..e] {
-                        acc = op(acc, *x);
-                        *x = acc;
-                    }
-                    b = e;
-                }
-            }
-
-            /// `dst[u]`: the fold of `src` from `u` to the end of its block of `w` steps; four
-            /// blocks at a time so the folds overlap.
-            #[inline(always)]
-            fn suffix_folds<F: Fn(f64, f64) -> f64 + Copy>(src: &[f64], dst: &mut [f64], w: usize, neutral: f64, op: F) {
-                let n = src.len().min(dst.len());
-                let groups = n / w / 4;
-                for gi in 0..groups {
-                    let base = gi * 4 * w;
-                    let mut acc = [neutral; 4];
-                    for j in (0..w).rev() {
-                        for (k, a) in acc.iter_mut().enumerate() {
-                            let u = base + k * w + j;
-                            *a = op(*a, src[u]);
-                            dst[u] = *a;
-                        }
-                    }
-                }
-                let mut b = groups * 4 * w;
-                while b < n {
-                    let e = (b + w).min(n);
-                    let mut acc = neutral;
-                    for u in (b..e).rev() {
-                        acc = op(acc, src[u]);
-                        dst[u] = acc;
-                    }
-                    b = e;
-                }
-            }
-
-            /// Sliding windows by van Herk / Gil-Werman: per-block prefix and suffix folds,
-            /// a few passes whatever the width, reusing the input as the prefix buffer.
-            /// Folding from `neutral` with `f64::min` or `f64::max` skips NaN as the
-            /// reference evaluator does.
-            #[inline(always)]
-            fn window<F: Fn(f64, f64) -> f64 + Copy>(
-                mut sig: ::std::vec::Vec<f64>,
-                start: usize,
-                end: usize,
-                neutral: f64,
-                op: F,
-            ) -> ::std::vec::Vec<f64> {
-                let n = sig.len();
-                if end <= start {
-                    sig.fill(neutral);
-                    return sig;
-                }
-                let w = end - start;
-                if w >= n {
-                    // Every window runs to the end: suffix folds, shifted by `start`.
-                    let mut acc = neutral;
-                    for x in sig.iter_mut().rev() {
-                        acc = op(acc, *x);
-                        *x = acc;
-                    }
-                    for t in 0..n {
-                        sig[t] = match t.checked_add(start) {
-                            ::core::option::Option::Some(l) if l < n => sig[l],
-                            _ => neutral,
-                        };
-                    }
-                    return sig;
-                }
-                // tail[k]: the fold over n - w + k .. n, for the windows the trace clips.
-                let mut tail = ::std::vec![neutral; w + 1];
-                for k in (0..w).rev() {
-                    tail[k] = op(tail[k + 1], sig[n - w + k]);
-                }
-                // suf[u]: the fold from u to the end of its block; sig becomes the prefix
-                // folds from the start of each block.
-                let mut suf = ::std::vec![neutral; n];
-                suffix_folds(&sig, &mut suf, w, neutral, op);
-                scan(&mut sig, w, neutral, op);
-                // Step t reads suf at t + start >= t, so the result can overwrite suf. Steps
-                // before `full` see whole windows; the rest are clipped by the trace's end.
-                let full = (n - w + 1).saturating_sub(start);
-                if start == 0 {
-                    for (x, y) in suf[..full].iter_mut().zip(&sig[w - 1..]) {
-                        *x = op(*x, *y);
-                    }
-                } else {
-                    for t in 0..full {
-                        suf[t] = op(suf[t + start], sig[t + start + w - 1]);
-                    }
-                }
-                for t in full..n {
-                    let l = t.saturating_add(start);
-                    suf[t] = if l >= n { neutral } else { tail[l + w - n] };
-                }
-                suf
-            }
-
-            /// `f until[start..end) g` at every step.
-            pub(super) fn until(f: &[f64], g: &[f64], start: usize, end: usize) -> ::std::vec::Vec<f64> {
-                let n = f.len().min(g.len());
-                let mut out = ::std::vec![f64::NEG_INFINITY; n];
-                if end <= start {
-                    return out;
-                }
-                // A NaN operand is skipped by min, as in the reference evaluator.
-                let fv = |u: usize| f64::INFINITY.min(f[u]);
-                let gv = |u: usize| f64::INFINITY.min(g[u]);
-                if end == usize::MAX {
-                    // v[u]: the best over u' >= u of min(g(u'), min f over [u, u')).
-                    let mut v = ::std::vec![f64::NEG_INFINITY; n + 1];
-                    for u in (0..n).rev() {
-                        v[u] = gv(u).max(fv(u).min(v[u + 1]));
-                    }
-                    let before = window_min(f[..n].to_vec(), 0, start);
-                    for (t, o) in out.iter_mut().enumerate() {
-                        let u = t.saturating_add(start);
-                        if u < n {
-                            *o = before[t].min(v[u]);
-                        }
-                    }
-                } else {
-                    for (t, o) in out.iter_mut().enumerate() {
-                        let mut best = f64::NEG_INFINITY;
-                        let mut run = f64::INFINITY;
-                        for u in t..t.saturating_add(end).min(n) {
-                            if u >= t + start {
-                                best = best.max(gv(u).min(run));
-                            }
-                            run = run.min(fv(u));
-                        }
-                        *o = best;
-                    }
-                }
-                out
-            }
-        }
-    }
-}
-
-/// `(start, end)` offsets of an interval, `end` exclusive and `usize::MAX` when unbounded.
-fn bounds(iv: &Interval) -> (TokenStream, TokenStream) {
-    let start = Literal::usize_unsuffixed(usize::try_from(iv.start).unwrap_or(usize::MAX));
-    let end = match iv.end {
-        Bound::Unbounded => quote!(usize::MAX),
-        Bound::Exclusive(b) => {
-            let b = Literal::usize_unsuffixed(usize::try_from(b).unwrap_or(usize::MAX - 1));
-            quote!(#b)
-        }
-        Bound::Inclusive(b) => {
-            let b =
-                usize::try_from(b).unwrap_or(usize::MAX - 1).saturating_add(1).min(usize::MAX - 1);
-            let b = Literal::usize_unsuffixed(b);
-            quote!(#b)
-        }
-    };
-    (quote!(#start), end)
 }
 
 fn interval_data(iv: &Interval) -> TokenStream {

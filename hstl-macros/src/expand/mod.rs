@@ -134,6 +134,18 @@ mod tests {
                         out.push_str(&"    ".repeat(depth));
                         out.push_str("}\n");
                     }
+                    // A call taking a closure with a block body: the block laid out too.
+                    TokenTree::Group(g)
+                        if g.delimiter() == Delimiter::Parenthesis
+                            && closure_block(&g.stream()) =>
+                    {
+                        out.push('(');
+                        walk(g.stream(), depth, out);
+                        if out.ends_with("}\n") {
+                            out.pop();
+                        }
+                        out.push_str(") ");
+                    }
                     TokenTree::Punct(p) if p.as_char() == ';' => out.push_str(";\n"),
                     TokenTree::Punct(p)
                         if p.as_char() == ',' && depth > 0 && out.ends_with("}\n") =>
@@ -150,6 +162,14 @@ mod tests {
                     }
                 }
             }
+        }
+        // Whether the tokens hold a closure with a block body (`|..| { .. }`).
+        fn closure_block(tokens: &TokenStream) -> bool {
+            let tts: Vec<TokenTree> = tokens.clone().into_iter().collect();
+            tts.windows(2).any(|w| {
+                matches!(&w[0], TokenTree::Punct(p) if p.as_char() == '|')
+                    && matches!(&w[1], TokenTree::Group(b) if b.delimiter() == Delimiter::Brace)
+            })
         }
         let mut out = String::new();
         walk(tokens, 0, &mut out);
