@@ -10,7 +10,9 @@
 use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use lsp_server::{Connection, ErrorCode, Message, Notification, Request, Response};
+use std::io::{BufRead, Write as _};
+
+use lsp_server::{Connection, ErrorCode, Message, Notification, Request, RequestId, Response};
 use lsp_types::notification::{
     DidChangeTextDocument, DidCloseTextDocument, DidOpenTextDocument, Notification as _,
     PublishDiagnostics,
@@ -36,17 +38,116 @@ mod tests;
 use convert::Encoding;
 use features::Analysis;
 
-/// Runs the server on standard input and output until the client says `exit`.
+/// Runs the server on standard input and output until the client says `exit`. Exit
+/// status 0 after `shutdown` then `exit`, 1 when the client exits without `shutdown` or
+/// goes away.
 pub fn run() -> CmdResult {
-    let (connection, io_threads) = Connection::stdio();
-    serve(&connection).map_err(|e| CliError::new(format!("language server: {e}"), None))?;
-    drop(connection);
-    io_threads.join().map_err(|e| CliError::new(format!("language server: {e}"), None))?;
-    Ok(Status::Clean)
+    let (server, client) = Connection::memory();
+    let Connection { sender: to_server, receiver: from_server } = client;
+    let inject = server.sender.clone();
+    let writer = std::thread::spawn(move || {
+        let stdout = std::io::stdout();
+        for message in from_server {
+            let mut out = stdout.lock();
+            if message.write(&mut out).and_then(|()| out.flush()).is_err() {
+                eprintln!("hstlc lsp: cannot write to standard output; stopping");
+                break;
+            }
+        }
+    });
+    // Not joined: it may be blocked reading standard input when the server stops.
+    std::thread::spawn(move || {
+        read_stdin(
+            |m| to_server.send(m).is_ok(),
+            |m| {
+                let _ = inject.send(m);
+            },
+        )
+    });
+    let clean = serve(&server).map_err(|e| CliError::new(format!("language server: {e}"), None));
+    drop(server);
+    let _ = writer.join();
+    Ok(if clean? { Status::Clean } else { Status::Errors })
 }
 
-/// Serves one client over `connection`: the handshake, then messages until shutdown.
-pub fn serve(connection: &Connection) -> Result<(), String> {
+/// Reads framed messages from standard input and hands them to the server. A message
+/// that is not valid JSON-RPC is logged and skipped; when it carries an `id`, the client
+/// gets an `InvalidRequest` error response for it.
+fn read_stdin(to_server: impl Fn(Message) -> bool, to_client: impl Fn(Message)) {
+    let stdin = std::io::stdin();
+    let mut input = stdin.lock();
+    loop {
+        let body = match read_frame(&mut input) {
+            Ok(Some(body)) => body,
+            Ok(None) => return,
+            Err(e) => {
+                eprintln!("hstlc lsp: malformed message header: {e}");
+                continue;
+            }
+        };
+        match serde_json::from_slice::<Message>(&body) {
+            Ok(message) => {
+                let exit = matches!(&message, Message::Notification(n) if n.method == "exit");
+                if !to_server(message) || exit {
+                    return;
+                }
+            }
+            Err(e) => {
+                eprintln!("hstlc lsp: malformed message: {e}");
+                let id = serde_json::from_slice::<Value>(&body).ok().and_then(|v| match &v["id"] {
+                    Value::Number(n) => {
+                        n.as_i64().and_then(|n| i32::try_from(n).ok()).map(RequestId::from)
+                    }
+                    Value::String(s) => Some(RequestId::from(s.clone())),
+                    _ => None,
+                });
+                if let Some(id) = id {
+                    let message = format!("invalid request: {e}");
+                    let response = Response::new_err(id, ErrorCode::InvalidRequest as i32, message);
+                    to_client(Message::Response(response));
+                }
+            }
+        }
+    }
+}
+
+/// One frame: headers up to an empty line, then `Content-Length` bytes. `None` at the
+/// end of the input.
+fn read_frame(input: &mut impl BufRead) -> std::io::Result<Option<Vec<u8>>> {
+    let mut length = None;
+    let mut line = String::new();
+    loop {
+        line.clear();
+        if input.read_line(&mut line)? == 0 {
+            return Ok(None);
+        }
+        let header = line.trim_end_matches(['\r', '\n']);
+        if header.is_empty() {
+            if length.is_some() {
+                break;
+            }
+            continue;
+        }
+        if let Some((name, value)) = header.split_once(':')
+            && name.trim().eq_ignore_ascii_case("content-length")
+        {
+            length = value.trim().parse::<usize>().ok();
+            if length.is_none() {
+                return Err(std::io::Error::other(format!(
+                    "bad Content-Length `{}`",
+                    value.trim()
+                )));
+            }
+        }
+    }
+    let mut body = vec![0; length.unwrap_or(0)];
+    input.read_exact(&mut body)?;
+    Ok(Some(body))
+}
+
+/// Serves one client over `connection`: the handshake, then messages until the client
+/// exits. Returns whether it shut down cleanly (`shutdown`, then `exit`).
+pub fn serve(connection: &Connection) -> Result<bool, String> {
     let (id, params) = connection.initialize_start().map_err(|e| e.to_string())?;
     let params: InitializeParams = serde_json::from_value(params).unwrap_or_else(|e| {
         eprintln!("hstlc lsp: initialize: {e}; using default client capabilities");
@@ -77,14 +178,15 @@ pub fn serve(connection: &Connection) -> Result<(), String> {
         match message {
             Message::Request(request) => {
                 if connection.handle_shutdown(&request).map_err(|e| e.to_string())? {
-                    return Ok(());
+                    return Ok(true);
                 }
                 let response = server.answer(request);
                 send(connection, Message::Response(response));
             }
             Message::Notification(n) => {
                 if n.method == "exit" {
-                    return Ok(());
+                    eprintln!("hstlc lsp: exit without shutdown");
+                    return Ok(false);
                 }
                 for out in server.notify(n) {
                     send(connection, Message::Notification(out));
@@ -93,7 +195,7 @@ pub fn serve(connection: &Connection) -> Result<(), String> {
             Message::Response(_) => {}
         }
     }
-    Ok(())
+    Ok(false)
 }
 
 /// The server's state: the open documents and the negotiated position encoding.

@@ -45,7 +45,7 @@ struct Reply {
 
 struct Client {
     conn: Connection,
-    server: Option<JoinHandle<Result<(), String>>>,
+    server: Option<JoinHandle<Result<bool, String>>>,
     next_id: i32,
     notifications: Vec<Notification>,
 }
@@ -134,7 +134,7 @@ impl Client {
         assert!(r.error.is_none(), "{r:?}");
         self.notify("exit", Value::Null);
         let result = self.server.take().map(|h| h.join().expect("server thread ends"));
-        assert_eq!(result, Some(Ok(())));
+        assert_eq!(result, Some(Ok(true)));
     }
 }
 
