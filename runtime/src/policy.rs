@@ -282,6 +282,35 @@ impl Policy {
         String::from_utf8(out).map_err(|e| Error::Policy(e.to_string()))
     }
 
+    /// The document as [`Policy::to_json`] writes it, with `extra` fields (such as the spec's
+    /// source) after the document's own; an extra field may not reuse a document field's
+    /// name.
+    pub fn to_json_with(&self, extra: &[(&str, Value)]) -> Result<String, Error> {
+        #[derive(Serialize)]
+        struct WithExtra<'a> {
+            #[serde(flatten)]
+            policy: &'a Policy,
+            #[serde(flatten)]
+            extra: Map<String, Value>,
+        }
+        let own = serde_json::to_value(self).map_err(|e| Error::Policy(e.to_string()))?;
+        let mut fields = Map::new();
+        for (name, value) in extra {
+            if own.get(*name).is_some() || fields.contains_key(*name) {
+                return Err(Error::Policy(format!(
+                    "the extra field {name} is already in the document; give it another name"
+                )));
+            }
+            fields.insert((*name).to_string(), value.clone());
+        }
+        let mut out = Vec::new();
+        let mut ser = serde_json::Serializer::with_formatter(&mut out, Shallow::default());
+        WithExtra { policy: self, extra: fields }
+            .serialize(&mut ser)
+            .map_err(|e| Error::Policy(e.to_string()))?;
+        String::from_utf8(out).map_err(|e| Error::Policy(e.to_string()))
+    }
+
     /// Reads a document; the error says what is wrong and where.
     pub fn from_json(text: &str) -> Result<Policy, Error> {
         serde_json::from_str(text).map_err(|e| Error::Policy(e.to_string()))

@@ -451,6 +451,17 @@ fn memory_policy_json_round_trips_bit_for_bit() {
     assert!(doc["flat_policies"]["A"][0].get("memory").is_none());
     // Each entry on one line.
     assert!(text.contains(r#"{"state": {"x": 0, "y": 0}, "memory": [8, 8, 8], "choice": "#));
+    // Extra fields go after the document's own, and read back as the same document.
+    let with = policy.to_json_with(&[("seed", 5.into()), ("spec_source", "spec S {}".into())]);
+    let with = with.unwrap();
+    assert!(
+        with.ends_with("\"seed\": 5,\n  \"spec_source\": \"spec S {}\"\n}"),
+        "{}",
+        &with[with.len() - 80..]
+    );
+    assert_eq!(Policy::from_json(&with).unwrap(), policy);
+    let clash = policy.to_json_with(&[("memory", 1.into())]).unwrap_err().to_string();
+    assert!(clash.contains("the extra field memory is already in the document"), "{clash}");
     // Training continues from the reloaded tables.
     let resumed = Learner::new(&spec, &env).unwrap().with_tables(back.q_tables().unwrap()).unwrap();
     assert_eq!(bits(resumed.q()), bits(learner.q()));
