@@ -769,11 +769,7 @@ impl<'g, 'a> Body<'g, 'a> {
             ([], None) => quote!(f64::NAN),
             (_, Some(and)) => {
                 let ps: Vec<TokenStream> = fs.iter().map(|g| self.point(g)).collect();
-                if and {
-                    quote!(f64::INFINITY #(.min(#ps))*)
-                } else {
-                    quote!(f64::NEG_INFINITY #(.max(#ps))*)
-                }
+                fold_parts(&ps, and)
             }
         };
         let arg = if self.uses_state { quote!(s) } else { quote!(_) };
@@ -896,13 +892,9 @@ impl<'g, 'a> Body<'g, 'a> {
                 let a = self.point(a);
                 quote!(-(#a))
             }
-            CFormulaKind::And(v) => {
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
                 let parts: Vec<TokenStream> = v.iter().map(|g| self.point(g)).collect();
-                quote!(f64::INFINITY #(.min(#parts))*)
-            }
-            CFormulaKind::Or(v) => {
-                let parts: Vec<TokenStream> = v.iter().map(|g| self.point(g)).collect();
-                quote!(f64::NEG_INFINITY #(.max(#parts))*)
+                fold_parts(&parts, matches!(f.kind, CFormulaKind::And(_)))
             }
             CFormulaKind::Implies(a, b) => {
                 let (a, b) = (self.point(a), self.point(b));
@@ -962,6 +954,16 @@ impl<'g, 'a> Body<'g, 'a> {
                 quote!(f64::sqrt(#a))
             }
         }
+    }
+}
+
+/// `rho` of `&&` (`and`) or `||` over operand expressions: `min` or `max` folded from
+/// the identity, which drops a NaN operand as the evaluators do.
+fn fold_parts(parts: &[TokenStream], and: bool) -> TokenStream {
+    if and {
+        quote!(f64::INFINITY #(.min(#parts))*)
+    } else {
+        quote!(f64::NEG_INFINITY #(.max(#parts))*)
     }
 }
 
