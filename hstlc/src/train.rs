@@ -151,17 +151,8 @@ pub fn train(
 /// `policy.json`: the runtime's document, plus the spec's source and the seed, so that
 /// `eval` needs nothing else.
 pub fn policy_json(policy: &Policy, source: &str, seed: u64) -> Result<String, CliError> {
-    let text = policy.to_json().map_err(|e| CliError::new(e.to_string(), None))?;
-    let mut value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| CliError::new(e.to_string(), None))?;
-    if let Some(map) = value.as_object_mut() {
-        map.insert("spec_source".into(), source.into());
-        map.insert("seed".into(), seed.into());
-    }
-    let mut out =
-        serde_json::to_string_pretty(&value).map_err(|e| CliError::new(e.to_string(), None))?;
-    out.push('\n');
-    Ok(out)
+    let extra = [("spec_source", source.into()), ("seed", seed.into())];
+    policy.to_json_with(&extra).map_err(|e| CliError::new(e.to_string(), None))
 }
 
 /// The window rate and mean task robustness of the greedy agent, for persistent tasks.
