@@ -17,17 +17,23 @@
 //!   indented like what follows it; trailing white space is dropped from line comments
 //!   (not from doc comments, whose text is part of the checked spec).
 //!
-//! Long formulas are not wrapped. A file with syntax errors is not formatted: [`format()`]
-//! returns the parser's diagnostics instead.
+//! A `let`, `task` or option field longer than [`MAX_WIDTH`] characters (and without
+//! comments) is broken before each operator of its formula's outermost `&&`, `||` or `->`
+//! chain, one level deeper; that is the only wrapping. A file with syntax errors is not
+//! formatted: [`format()`] returns the parser's diagnostics instead.
 
 use std::collections::{HashMap, HashSet};
 
 use crate::diagnostic::Diagnostic;
 use crate::parser::parse;
-use crate::syntax::{File, Item, OptionsKind, Param, ParamValue};
+use crate::syntax::{FieldValue, File, Formula, FormulaKind, Item, OptionsKind, Param, ParamValue};
 
 /// One level of indentation.
 pub const INDENT: &str = "    ";
+
+/// Lines longer than this (in characters) are broken at the outermost `&&`, `||` or `->`
+/// of their formula.
+pub const MAX_WIDTH: usize = 100;
 
 /// Formats a source text in the canonical layout.
 ///
@@ -188,6 +194,18 @@ impl Plan {
             plan.node(toks, first_at(spec.range.start), 0, n > 0);
             for item in &spec.items {
                 plan.node(toks, first_at(item.range().start), 1, false);
+                match item {
+                    Item::Let(l) => plan.wrap(src, toks, &l.range, &l.formula, 1, 0),
+                    Item::Task(t) => plan.wrap(src, toks, &t.range, &t.formula, 1, 0),
+                    Item::Option(o) => {
+                        for f in o.fields.iter().flatten() {
+                            if let FieldValue::Formula(g) = &f.value {
+                                plan.wrap(src, toks, &f.range, g, 2, 1);
+                            }
+                        }
+                    }
+                    _ => {}
+                }
                 let (entries, close): (Vec<usize>, usize) = match item {
                     Item::State(b) => (b.vars.iter().map(|v| v.range.start).collect(), b.range.end),
                     Item::Option(o) => match &o.fields {
@@ -254,6 +272,67 @@ impl Plan {
                 break;
             }
             k += 1;
+        }
+    }
+
+    /// Breaks a line longer than [`MAX_WIDTH`] before each operator of the outermost
+    /// `&&`, `||` or `->` chain of its formula (looking through parentheses and prefix
+    /// operators), one level deeper than the line. `span` is the item or field; `extra`
+    /// counts what follows it on its line (a field's comma). Lines with comments are
+    /// left as they are.
+    fn wrap(
+        &mut self,
+        src: &str,
+        toks: &[Tok],
+        span: &std::ops::Range<usize>,
+        f: &Formula,
+        indent: usize,
+        extra: usize,
+    ) {
+        let a = toks.partition_point(|t| t.start < span.start);
+        let b = toks.partition_point(|t| t.start < span.end);
+        let mut width = indent * INDENT.len() + extra;
+        let mut prev: Option<Tok> = None;
+        let mut prev_minus = false;
+        for &t in &toks[a..b] {
+            if t.kind == Kind::Doc {
+                continue;
+            }
+            if t.is_comment() {
+                return;
+            }
+            let text = &src[t.start..t.end];
+            if let Some(p) = prev {
+                width += spacing(&src[p.start..p.end], prev_minus, text).len();
+            }
+            width += text.chars().count();
+            prev_minus = text == "-" && minus_is_prefix(src, prev);
+            prev = Some(t);
+        }
+        if width <= MAX_WIDTH {
+            return;
+        }
+        let mut g = f;
+        while let FormulaKind::Paren(x)
+        | FormulaKind::Not(x)
+        | FormulaKind::Always(_, x)
+        | FormulaKind::Eventually(_, x) = &g.kind
+        {
+            g = x;
+        }
+        let operands: Vec<&Formula> = match &g.kind {
+            FormulaKind::And(v) | FormulaKind::Or(v) => v.iter().collect(),
+            FormulaKind::Implies(l, r) => vec![l, r],
+            _ => return,
+        };
+        for w in operands.windows(2) {
+            let k = toks.partition_point(|t| t.start < w[0].range.end);
+            if let Some(op) = (k..b).find(|&j| !toks[j].is_comment()) {
+                let level = indent + 1;
+                let brk =
+                    Break { indent: level, comment_indent: level, blank_ok: false, blank: false };
+                self.breaks.insert(op, brk);
+            }
         }
     }
 
@@ -421,6 +500,24 @@ mod tests {
              task always[0..] eventually[0..=4] A;\n}\n"
         );
         assert_eq!(format(&out).unwrap(), out);
+    }
+
+    #[test]
+    fn long_lines_break_at_the_outermost_chain() {
+        let long =
+            "eventually[0..40] Alpha && eventually[0..40] Bravo && eventually[0..40] Charlie";
+        let src = format!("spec S {{ task always[0..] ({long});\n let A = x > 1 && y < 2; }}");
+        let out = format(&src).unwrap();
+        assert_eq!(
+            out,
+            "spec S {\n    task always[0..] (eventually[0..40] Alpha\n        \
+             && eventually[0..40] Bravo\n        && eventually[0..40] Charlie);\n    \
+             let A = x > 1 && y < 2;\n}\n"
+        );
+        assert_eq!(format(&out).unwrap(), out);
+        // With a comment inside, the author's line breaks are kept instead.
+        let commented = src.replace("Bravo", "Bravo /* b */");
+        assert!(format(&commented).unwrap().contains("Alpha && eventually"));
     }
 
     #[test]

@@ -168,7 +168,16 @@ fn comments_stay_in_place() {
     assert_eq!(comments(&out), comments(src));
 }
 
-const FIXTURES: [&str; 7] = [
+/// Lines longer than the formatter's width, so that the properties cover wrapping.
+const LONG: &str = "spec Long {\n    state { x: int in 0..=14, y: int in 0..=14 }\n    \
+    let Alpha = x > 3 && x < 9 && y > 10 && y < 14 && abs(x - y) < 20 && sqrt(x * x + y * y) > 0.5 && x + y > 1;\n    \
+    let Bravo = (x > 1 || y > 1 || x + y > 3 || x - y < 7 || y - x < 7 || x * 2 > y || y * 2 > x || x + y > 20);\n    \
+    task always[0..] (eventually[0..40] Alpha && eventually[0..40] Bravo && !(x > 13 && y > 13 && x + y > 26));\n    \
+    option Alpha { reach: Alpha, init: x < 14 && y < 14 && x + y < 27 && x - y < 14 && y - x < 14 && x * y < 200 && x + 1 > 0 }\n    \
+    option Bravo;\n}\n";
+
+const FIXTURES: [&str; 8] = [
+    LONG,
     include_str!("fixtures/valid/case_study_ot1.hstl"),
     include_str!("fixtures/valid/case_study_ot2.hstl"),
     include_str!("fixtures/valid/assembly.hstl"),
