@@ -292,6 +292,9 @@ impl Server {
                 let edits = features::format(doc).map_err(|e| (ErrorCode::RequestFailed, e))?;
                 to_json(edits)
             }
+            // Lets the tests reach the internal-error path.
+            #[cfg(test)]
+            "hstlc/testPanic" => panic!("a deliberate panic"),
             _ => Err((ErrorCode::MethodNotFound, format!("unsupported request `{method}`"))),
         }
     }

@@ -280,6 +280,9 @@ fn a_session_from_initialize_to_shutdown() {
     // A malformed request: an error response, and the server goes on.
     let r = c.request("textDocument/hover", json!({ "textDocument": 42 }));
     assert_eq!(r.error.as_ref().map(|e| e.code), Some(lsp_server::ErrorCode::InvalidParams as i32));
+    // An internal error: an error response, and the server goes on.
+    let r = c.request("hstlc/testPanic", json!({}));
+    assert_eq!(r.error.map(|e| e.code), Some(lsp_server::ErrorCode::InternalError as i32));
     let r = c.request("textDocument/frobnicate", json!({}));
     assert_eq!(r.error.map(|e| e.code), Some(lsp_server::ErrorCode::MethodNotFound as i32));
     let r = c.at("textDocument/hover", 99, 0);
