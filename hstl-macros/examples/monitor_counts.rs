@@ -5,6 +5,8 @@
 //! cargo build --release -p hstl-macros --example monitor_counts
 //! valgrind --tool=callgrind target/release/examples/monitor_counts F2/generated
 //! ```
+//!
+//! A second argument sets the number of runs (3 by default).
 
 use hstl::robustness::{Evaluator, Trace};
 use hstl_macros::hstl;
@@ -27,7 +29,6 @@ hstl! {
 }
 
 const STEPS: usize = 1_000_000;
-const RUNS: usize = 3;
 
 /// The bench's walk: from (7, 7) on the 15 x 15 grid, moves drawn by splitmix64.
 fn walk() -> Vec<(i64, i64)> {
@@ -56,6 +57,7 @@ fn walk() -> Vec<(i64, i64)> {
 
 fn main() {
     let which = std::env::args().nth(1).unwrap_or_default();
+    let runs: usize = std::env::args().nth(2).and_then(|r| r.parse().ok()).unwrap_or(3);
     let cells = walk();
     let trace = Trace::from_columns(vec![
         cells.iter().map(|c| c.0 as f64).collect(),
@@ -67,7 +69,7 @@ fn main() {
     let (g1, g2) = (f1::task::formula(), f2::task::formula());
     let mut ev = Evaluator::new();
     let mut sum = 0.0;
-    for _ in 0..RUNS {
+    for _ in 0..runs {
         sum += match which.as_str() {
             "F1/generated" => f1::task::signal(black_box(&s1))[0],
             "F1/interpreter" => ev.signal(&g1, black_box(&trace))[0],
