@@ -16,9 +16,15 @@
 //! - `State`: one field per state variable (`int` is `i64`, `float` is `f64`);
 //! - `Primitive` and `Options`: the primitive options and the options set, with `ALL`,
 //!   `name()`, `index()` and (for `Options`) `sequence()`;
-//! - `task` and `lets::<name>`: monitors with `formula()`, `signal(&[State])`,
-//!   `robustness(&[State])`, an `Online` monitor, and `at(&State)` for state formulas;
+//! - `task` and `lets::<name>`: monitors with `formula()`, `signal(&[State])` (and
+//!   `signal_with`, which reuses the caller's kernel buffers), `robustness(&[State])`, an
+//!   `Online` monitor, and `at(&State)` for state formulas;
 //! - a unit struct named after the spec implementing `hstl::runtime::Spec`.
+//!
+//! The offline monitors compute each state subformula as one expression per step over
+//! `&[State]`, and hand the temporal operators to the kernels the runtime's offline
+//! evaluator runs (`hstl::robustness::kernels`: van Herk windows, block until, cache-sized
+//! pieces), so they give its values bit for bit and are at least as fast.
 //!
 //! Errors are reported at the offending tokens (for an included file, at the `include`
 //! with `path:line:col` in the message). Warnings become uses of a deprecated item, so
