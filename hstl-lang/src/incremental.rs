@@ -93,7 +93,13 @@ fn pieces(spec: &Spec) -> Vec<(Range<usize>, Piece)> {
 
 /// The end of the `{` that opens the body of `spec` (its header parsed).
 fn body_start(src: &str, spec: &Spec) -> Option<usize> {
-    let toks = lex(src.get(spec.name.range.end..spec.range.end)?);
+    // Only comments can stand between the name and `{`: a short window suffices (a
+    // longer comment there makes the caller parse everything again).
+    let mut end = spec.range.end.min(spec.name.range.end + 4096);
+    while !src.is_char_boundary(end) {
+        end -= 1;
+    }
+    let toks = lex(src.get(spec.name.range.end..end)?);
     let open = toks.iter().find(|t| !t.is_comment())?;
     let at = spec.name.range.end + open.start;
     (src.get(at..at + 1) == Some("{")).then_some(at + 1)

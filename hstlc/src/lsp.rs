@@ -191,6 +191,8 @@ pub fn serve(connection: &Connection) -> Result<bool, String> {
                 for out in server.notify(n) {
                     send(connection, Message::Notification(out));
                 }
+                // Free the previous versions once the diagnostics are on their way.
+                server.trash.clear();
             }
             Message::Response(_) => {}
         }
@@ -202,6 +204,8 @@ pub fn serve(connection: &Connection) -> Result<bool, String> {
 pub struct Server {
     encoding: Encoding,
     documents: HashMap<Uri, Analysis>,
+    /// What is left of replaced versions, freed after answering.
+    trash: Vec<features::Leftovers>,
 }
 
 type Answer = Result<Value, (ErrorCode, String)>;
@@ -209,7 +213,7 @@ type Answer = Result<Value, (ErrorCode, String)>;
 impl Server {
     /// A server with no open document.
     pub fn new(encoding: Encoding) -> Self {
-        Server { encoding, documents: HashMap::new() }
+        Server { encoding, documents: HashMap::new(), trash: Vec::new() }
     }
 
     /// Answers a request; never panics (an internal error becomes an error response).
@@ -336,7 +340,11 @@ impl Server {
                 }
                 let uri = p.text_document.uri;
                 let next = match self.documents.remove(&uri) {
-                    Some(prev) => Analysis::update(prev, change.text, self.encoding),
+                    Some(prev) => {
+                        let (next, leftovers) = Analysis::update(prev, change.text, self.encoding);
+                        self.trash.push(leftovers);
+                        next
+                    }
                     None => Analysis::new(change.text, self.encoding),
                 };
                 self.documents.insert(uri.clone(), next);

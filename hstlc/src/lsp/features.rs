@@ -52,6 +52,11 @@ pub struct Occurrence {
     pub decl: bool,
 }
 
+/// Parts of a previous analysis, to be dropped when the server is idle.
+pub struct Leftovers {
+    _parts: (String, Vec<CheckedSpec>, Vec<hstl::lang::Diagnostic>, OnceCell<Vec<Occurrence>>),
+}
+
 /// Everything the server knows about one version of a document.
 pub struct Analysis {
     /// The text.
@@ -77,11 +82,16 @@ impl Analysis {
 
     /// The analysis of a new version of the text of `prev`: only the items around the
     /// change are parsed again (see `hstl_lang::incremental`), then the whole is checked.
-    pub fn update(prev: Analysis, text: String, enc: Encoding) -> Self {
-        let Analysis { text: old, checked, parse_diagnostics, .. } = prev;
-        let prev = hstl::lang::Parsed { file: checked.file, diagnostics: parse_diagnostics };
+    ///
+    /// Also returns what is left of `prev` (the old text and checked specs), so that the
+    /// caller can free it after answering rather than before.
+    pub fn update(prev: Analysis, text: String, enc: Encoding) -> (Self, Leftovers) {
+        let Analysis { text: old, checked, parse_diagnostics, occurrences, .. } = prev;
+        let hstl::lang::Checked { file, specs, diagnostics } = checked;
+        let prev = hstl::lang::Parsed { file, diagnostics: parse_diagnostics };
         let (parsed, _) = hstl::lang::incremental::reparse(prev, &old, &text);
-        Self::from_parsed(text, parsed, enc)
+        let next = Self::from_parsed(text, parsed, enc);
+        (next, Leftovers { _parts: (old, specs, diagnostics, occurrences) })
     }
 
     fn from_parsed(text: String, parsed: hstl::lang::Parsed, enc: Encoding) -> Self {
