@@ -762,6 +762,14 @@ impl<'g, 'a> Body<'g, 'a> {
     /// alone when `fold` is `None`, else all of `fs` folded from the identity with `min`
     /// (`Some(true)`) or `max`, which drops NaN.
     fn map(&mut self, fs: &[&CFormula], fold: Option<bool>) -> TokenStream {
+        // A state `let` alone: its `at` function.
+        if let ([f], None) = (fs, fold)
+            && let CFormulaKind::Let(i) = f.kind
+        {
+            let lets = self.lets;
+            let name = &self.g.let_names[i];
+            return quote!(trace.iter().map(#lets::#name::at).collect::<::std::vec::Vec<f64>>());
+        }
         let before = self.uses_state;
         self.uses_state = false;
         let p = match (fs, fold) {
