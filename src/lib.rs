@@ -19,13 +19,43 @@
 //! assert_eq!(spec.primitives[0].name, "Goal");
 //! ```
 
-// The macro's generated code names `::hstl`, which must also resolve inside this package's
-// own tests and examples.
-extern crate self as hstl;
-
 pub mod lower;
 
 pub use hstl_lang as lang;
-pub use hstl_macros::hstl;
 pub use hstl_robustness as robustness;
 pub use hstl_runtime as runtime;
+
+/// Compiles hstl specs, written inline or included from a file, into Rust: a module per
+/// spec with its `State` type, option enums, monitors for the task and every `let`, and an
+/// implementation of [`runtime::Spec`].
+///
+/// ```
+/// hstl::hstl! {
+///     /// Reach the goal within 20 steps.
+///     spec Reach {
+///         state { x: int in 0..=9 }
+///         let Goal = x > 7;
+///         task eventually[0..20] Goal;
+///         option Goal;
+///     }
+/// }
+/// let rho = reach::task::robustness(&[reach::State { x: 3 }, reach::State { x: 9 }]);
+/// assert_eq!(rho, 2.0);
+/// ```
+///
+/// `hstl! { include "specs/task.hstl" }` reads the file relative to the crate's
+/// `CARGO_MANIFEST_DIR` at compile time and rebuilds when it changes. A spec with errors is
+/// a compile error at the offending tokens; warnings show as deprecation warnings there.
+/// The generated code names this crate through `$crate`, so it works under any name the
+/// dependency is given. See `hstl_macros` for the generated items in detail.
+#[macro_export]
+macro_rules! hstl {
+    ($($body:tt)*) => {
+        $crate::__private::hstl! { $crate; $($body)* }
+    };
+}
+
+#[doc(hidden)]
+pub mod __private {
+    pub use hstl_macros::hstl;
+}

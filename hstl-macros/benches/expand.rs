@@ -11,9 +11,7 @@ fn expand_case_study(c: &mut Criterion) {
     let text = include_str!("../specs/case_study.hstl");
     let tokens: proc_macro2::TokenStream =
         text.parse().expect("the case study lexes as Rust tokens");
-    c.bench_function("expand/case_study", |b| {
-        b.iter(|| expand::expand_tokens(black_box(tokens.clone())))
-    });
+    c.bench_function("expand/case_study", |b| b.iter(|| expand::expand(black_box(tokens.clone()))));
 }
 
 criterion_group!(benches, expand_case_study);

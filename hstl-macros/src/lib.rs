@@ -29,8 +29,9 @@
 //! Errors are reported at the offending tokens (for an included file, at the `include`
 //! with `path:line:col` in the message). Warnings become uses of a deprecated item, so
 //! rustc prints them as `use of deprecated constant` warnings at the offending tokens
-//! (`#![deny(warnings)]` turns them into errors). Generated code refers to the runtime
-//! as `::hstl::...`, so the crate using the macro depends on `hstl`.
+//! (`#![deny(warnings)]` turns them into errors). Users call it as `hstl::hstl!`, which
+//! passes `$crate` in: generated code then reaches the runtime through the facade under
+//! whatever name the dependency has. Called directly, it names `::hstl`.
 
 mod expand;
 

@@ -13,8 +13,13 @@ use quote::{format_ident, quote};
 /// The generated module of one spec. `complete` says whether the spec checked without
 /// errors; otherwise only the parts that checked are generated (no `Spec` implementation),
 /// so an editor keeps completing inside a half-typed spec.
-pub fn spec_module(spec: &CheckedSpec, src: &str, complete: bool) -> TokenStream {
-    let g = Gen::new(spec);
+pub fn spec_module(
+    spec: &CheckedSpec,
+    src: &str,
+    complete: bool,
+    root: &TokenStream,
+) -> TokenStream {
+    let g = Gen::new(spec, root.clone());
     let module = ident(&snake_case(&spec.name));
     let doc = doc_attrs(spec.doc.as_deref());
     let state = g.state();
@@ -61,10 +66,13 @@ struct Gen<'a> {
     // Variant names of the primitive and combined options.
     prim_variants: Vec<Ident>,
     option_variants: Vec<Ident>,
+    // The path generated code names the facade by: `$crate` through `hstl::hstl!`, or
+    // `::hstl` when the proc macro is called directly.
+    root: TokenStream,
 }
 
 impl<'a> Gen<'a> {
-    fn new(spec: &'a CheckedSpec) -> Gen<'a> {
+    fn new(spec: &'a CheckedSpec, root: TokenStream) -> Gen<'a> {
         let mut taken = HashSet::new();
         let let_names =
             spec.lets.iter().map(|l| unique(&mut taken, snake_case(&l.name), "let")).collect();
@@ -80,7 +88,7 @@ impl<'a> Gen<'a> {
             .iter()
             .map(|o| unique(&mut taken, camel_case(&o.name), "Option"))
             .collect();
-        Gen { spec, let_names, prim_variants, option_variants }
+        Gen { spec, let_names, prim_variants, option_variants, root }
     }
 
     /// Whether a formula (and every let it uses) checked.
@@ -312,9 +320,10 @@ impl<'a> Gen<'a> {
         doc: &TokenStream,
         name: &TokenStream,
     ) -> TokenStream {
+        let hstl = &self.root;
         let data = self.formula_data(f, lets);
         let empty = lit_f64(self.empty_value(f, &mut Vec::new()));
-        let kernels = quote!(::hstl::robustness::kernels::Kernels);
+        let kernels = quote!(#hstl::robustness::kernels::Kernels);
         let (at, signal_with, robustness) = if self.spec.is_state_formula(f) {
             let mut b = Body::new(self, lets);
             let p = b.point(f);
@@ -361,7 +370,7 @@ impl<'a> Gen<'a> {
                 #at
 
                 /// The formula as the runtime's data.
-                pub fn formula() -> ::hstl::robustness::Formula {
+                pub fn formula() -> #hstl::robustness::Formula {
                     #data
                 }
 
@@ -382,17 +391,17 @@ impl<'a> Gen<'a> {
                 /// streaming monitor over [`formula`]).
                 #[derive(Clone, Debug)]
                 pub struct Online {
-                    monitor: ::hstl::robustness::OnlineMonitor,
+                    monitor: #hstl::robustness::OnlineMonitor,
                 }
 
                 impl Online {
                     /// A monitor at step 0.
                     pub fn new() -> Online {
-                        Online { monitor: ::hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
+                        Online { monitor: #hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
                     }
 
                     /// Appends one state; returns the verdict it completes, if any.
-                    pub fn push(&mut self, state: &#state) -> ::core::option::Option<::hstl::robustness::Verdict> {
+                    pub fn push(&mut self, state: &#state) -> ::core::option::Option<#hstl::robustness::Verdict> {
                         // The row always has VARS values, so the monitor cannot refuse it.
                         self.monitor.push(&state.values()).ok().flatten()
                     }
@@ -404,7 +413,7 @@ impl<'a> Gen<'a> {
 
                     /// Ends the trace: the verdicts of every open step; the monitor then
                     /// starts a new trace.
-                    pub fn finish(&mut self) -> ::std::vec::Vec<::hstl::robustness::Verdict> {
+                    pub fn finish(&mut self) -> ::std::vec::Vec<#hstl::robustness::Verdict> {
                         self.monitor.finish()
                     }
 
@@ -489,14 +498,15 @@ impl<'a> Gen<'a> {
 
     /// Code building the runtime's `Formula`; lets are calls to their `formula()`.
     fn formula_data(&self, f: &CFormula, lets: &TokenStream) -> TokenStream {
+        let hstl = &self.root;
         let boxed = |g: &CFormula| {
             let d = self.formula_data(g, lets);
             quote!(::std::boxed::Box::new(#d))
         };
         match &f.kind {
-            CFormulaKind::True => quote!(::hstl::robustness::Formula::True),
+            CFormulaKind::True => quote!(#hstl::robustness::Formula::True),
             CFormulaKind::False | CFormulaKind::Invalid => {
-                quote!(::hstl::robustness::Formula::False)
+                quote!(#hstl::robustness::Formula::False)
             }
             CFormulaKind::Let(i) => {
                 let name = &self.let_names[*i];
@@ -509,22 +519,22 @@ impl<'a> Gen<'a> {
                     CmpOp::Gt => quote!(Gt),
                     CmpOp::Ge => quote!(Ge),
                 };
-                let (a, b) = (expr_data(a), expr_data(b));
-                quote!(::hstl::robustness::Formula::Cmp { lhs: #a, op: ::hstl::robustness::CmpOp::#op, rhs: #b })
+                let (a, b) = (expr_data(a, hstl), expr_data(b, hstl));
+                quote!(#hstl::robustness::Formula::Cmp { lhs: #a, op: #hstl::robustness::CmpOp::#op, rhs: #b })
             }
             CFormulaKind::Not(a) => {
                 let a = boxed(a);
-                quote!(::hstl::robustness::Formula::Not(#a))
+                quote!(#hstl::robustness::Formula::Not(#a))
             }
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
                 let parts = v.iter().map(|g| self.formula_data(g, lets));
                 let kind =
                     if matches!(f.kind, CFormulaKind::And(_)) { quote!(And) } else { quote!(Or) };
-                quote!(::hstl::robustness::Formula::#kind(::std::vec![#(#parts),*]))
+                quote!(#hstl::robustness::Formula::#kind(::std::vec![#(#parts),*]))
             }
             CFormulaKind::Implies(a, b) => {
                 let (a, b) = (boxed(a), boxed(b));
-                quote!(::hstl::robustness::Formula::Implies(#a, #b))
+                quote!(#hstl::robustness::Formula::Implies(#a, #b))
             }
             CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
                 let kind = if matches!(f.kind, CFormulaKind::Always(..)) {
@@ -532,17 +542,18 @@ impl<'a> Gen<'a> {
                 } else {
                     quote!(Eventually)
                 };
-                let (iv, a) = (interval_data(iv), boxed(a));
-                quote!(::hstl::robustness::Formula::#kind(#iv, #a))
+                let (iv, a) = (interval_data(iv, hstl), boxed(a));
+                quote!(#hstl::robustness::Formula::#kind(#iv, #a))
             }
             CFormulaKind::Until(iv, a, b) => {
-                let (iv, a, b) = (interval_data(iv), boxed(a), boxed(b));
-                quote!(::hstl::robustness::Formula::Until(#iv, #a, #b))
+                let (iv, a, b) = (interval_data(iv, hstl), boxed(a), boxed(b));
+                quote!(#hstl::robustness::Formula::Until(#iv, #a, #b))
             }
         }
     }
 
     fn spec_impl(&self, src: &str) -> TokenStream {
+        let hstl = &self.root;
         let Some(task) = &self.spec.task else { return TokenStream::new() };
         if !self.valid(&task.formula) {
             return TokenStream::new();
@@ -561,21 +572,21 @@ impl<'a> Gen<'a> {
                 Domain::Int { lo, hi } => quote!(::core::option::Option::Some(#lo..=#hi)),
                 _ => quote!(::core::option::Option::None),
             };
-            quote!(::hstl::runtime::StateVar { name: ::std::string::String::from(#name), domain: #domain })
+            quote!(#hstl::runtime::StateVar { name: ::std::string::String::from(#name), domain: #domain })
         });
         let prims = self.spec.primitives.iter().map(|p| {
             let name = &p.name;
             let reach = self.formula_data(&p.reach, &lets);
             let init = self.formula_data(&p.init, &lets);
             let terminate = match &p.terminate {
-                Terminate::Argmax => quote!(::hstl::runtime::Terminate::Argmax),
+                Terminate::Argmax => quote!(#hstl::runtime::Terminate::Argmax),
                 Terminate::Formula(f) => {
                     let f = self.formula_data(f, &lets);
-                    quote!(::hstl::runtime::Terminate::Formula(#f))
+                    quote!(#hstl::runtime::Terminate::Formula(#f))
                 }
             };
             quote! {
-                ::hstl::runtime::PrimitiveOption {
+                #hstl::runtime::PrimitiveOption {
                     name: ::std::string::String::from(#name),
                     reach: #reach,
                     init: #init,
@@ -587,7 +598,7 @@ impl<'a> Gen<'a> {
             let name = &o.name;
             let seq = &o.sequence;
             quote! {
-                ::hstl::runtime::CombinedOption {
+                #hstl::runtime::CombinedOption {
                     name: ::std::string::String::from(#name),
                     sequence: ::std::vec![#(#seq),*],
                 }
@@ -599,7 +610,7 @@ impl<'a> Gen<'a> {
                 let formula = self.formula_data(&c.region, &lets);
                 let steps = Literal::u64_unsuffixed(c.steps);
                 quote! {
-                    ::hstl::runtime::Region {
+                    #hstl::runtime::Region {
                         name: ::std::string::String::from(#name),
                         formula: #formula,
                         horizon: #steps,
@@ -616,7 +627,7 @@ impl<'a> Gen<'a> {
                 lit_f64(q.decay),
             );
             quote! {
-                ::hstl::runtime::LevelParams { gamma: #g, alpha: #a, epsilon: #e, min_epsilon: #m, decay: #d }
+                #hstl::runtime::LevelParams { gamma: #g, alpha: #a, epsilon: #e, min_epsilon: #m, decay: #d }
             }
         };
         let (flat, opts) = (level(&l.flat), level(&l.options));
@@ -643,20 +654,20 @@ impl<'a> Gen<'a> {
 
             impl #ty {
                 /// The spec as the runtime's plain data.
-                pub fn task_spec() -> ::hstl::runtime::TaskSpec {
-                    ::hstl::runtime::TaskSpec {
+                pub fn task_spec() -> #hstl::runtime::TaskSpec {
+                    #hstl::runtime::TaskSpec {
                         name: ::std::string::String::from(#name),
                         state_vars: ::std::vec![#(#vars),*],
                         task: task::formula(),
                         primitives: ::std::vec![#(#prims),*],
                         options: ::std::vec![#(#options),*],
-                        learn: ::hstl::runtime::LearnParams {
+                        learn: #hstl::runtime::LearnParams {
                             episodes: #episodes,
                             choices: #choices,
                             max_steps: #max_steps,
                             memory: #memory,
-                            intra: ::hstl::runtime::Intra::#intra,
-                            reward: ::hstl::runtime::RewardKind::#reward,
+                            intra: #hstl::runtime::Intra::#intra,
+                            reward: #hstl::runtime::RewardKind::#reward,
                             flat: #flat,
                             options: #opts,
                         },
@@ -665,8 +676,8 @@ impl<'a> Gen<'a> {
                 }
             }
 
-            impl ::hstl::runtime::Spec for #ty {
-                fn task_spec(&self) -> ::hstl::runtime::TaskSpec {
+            impl #hstl::runtime::Spec for #ty {
+                fn task_spec(&self) -> #hstl::runtime::TaskSpec {
                     #ty::task_spec()
                 }
             }
@@ -743,12 +754,13 @@ impl<'g, 'a> Body<'g, 'a> {
                 self.operator(f, in_piece)
             }
             (_, false, Some(h)) => {
+                let hstl = &self.g.root;
                 let outer = std::mem::take(&mut self.stmts);
                 let sig = self.operator(f, true).tokens();
                 let stmts = std::mem::replace(&mut self.stmts, outer);
                 let h = Literal::usize_unsuffixed(h);
                 Sig::Expr(quote! {
-                    ::hstl::robustness::kernels::pieces(trace.len(), #h, |steps| {
+                    #hstl::robustness::kernels::pieces(trace.len(), #h, |steps| {
                         let trace = &trace[steps];
                         #(#stmts)*
                         #sig
@@ -787,7 +799,8 @@ impl<'g, 'a> Body<'g, 'a> {
 
     /// [`Body::signal`] of a formula that is not a state formula, without pieces.
     fn operator(&mut self, f: &CFormula, in_piece: bool) -> Sig {
-        let kernels = quote!(::hstl::robustness::kernels);
+        let hstl = &self.g.root;
+        let kernels = quote!(#hstl::robustness::kernels);
         match &f.kind {
             CFormulaKind::Let(i) => {
                 let lets = self.lets;
@@ -797,7 +810,7 @@ impl<'g, 'a> Body<'g, 'a> {
             CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
                 let a = self.signal(a, in_piece);
                 let v = self.var(a);
-                let iv = interval_data(iv);
+                let iv = interval_data(iv, hstl);
                 let op = if matches!(f.kind, CFormulaKind::Always(..)) {
                     quote!(always)
                 } else {
@@ -811,7 +824,7 @@ impl<'g, 'a> Body<'g, 'a> {
                 let a = self.var(a);
                 let b = self.signal(b, in_piece);
                 let b = self.var(b);
-                let iv = interval_data(iv);
+                let iv = interval_data(iv, hstl);
                 self.stmts.push(quote!(k.until(&#iv, &mut #a, &mut #b);));
                 Sig::Var(b)
             }
@@ -975,34 +988,34 @@ fn fold_parts(parts: &[TokenStream], and: bool) -> TokenStream {
     }
 }
 
-fn interval_data(iv: &Interval) -> TokenStream {
+fn interval_data(iv: &Interval, hstl: &TokenStream) -> TokenStream {
     let start = Literal::u64_unsuffixed(iv.start);
     let end = match iv.end {
-        Bound::Unbounded => quote!(::hstl::robustness::Bound::Unbounded),
+        Bound::Unbounded => quote!(#hstl::robustness::Bound::Unbounded),
         Bound::Exclusive(b) => {
             let b = Literal::u64_unsuffixed(b);
-            quote!(::hstl::robustness::Bound::Exclusive(#b))
+            quote!(#hstl::robustness::Bound::Exclusive(#b))
         }
         Bound::Inclusive(b) => {
             let b = Literal::u64_unsuffixed(b);
-            quote!(::hstl::robustness::Bound::Inclusive(#b))
+            quote!(#hstl::robustness::Bound::Inclusive(#b))
         }
     };
-    quote!(::hstl::robustness::Interval { start: #start, end: #end })
+    quote!(#hstl::robustness::Interval { start: #start, end: #end })
 }
 
-fn expr_data(e: &CExpr) -> TokenStream {
+fn expr_data(e: &CExpr, hstl: &TokenStream) -> TokenStream {
     let boxed = |a: &CExpr| {
-        let d = expr_data(a);
+        let d = expr_data(a, hstl);
         quote!(::std::boxed::Box::new(#d))
     };
     match &e.kind {
         CExprKind::Const(c) => {
             let c = lit_f64(*c);
-            quote!(::hstl::robustness::Expr::Const(#c))
+            quote!(#hstl::robustness::Expr::Const(#c))
         }
-        CExprKind::Invalid => quote!(::hstl::robustness::Expr::Const(f64::NAN)),
-        CExprKind::Var(i) => quote!(::hstl::robustness::Expr::Var(#i)),
+        CExprKind::Invalid => quote!(#hstl::robustness::Expr::Const(f64::NAN)),
+        CExprKind::Var(i) => quote!(#hstl::robustness::Expr::Var(#i)),
         CExprKind::Neg(a) | CExprKind::Abs(a) | CExprKind::Sqrt(a) => {
             let kind = match e.kind {
                 CExprKind::Neg(_) => quote!(Neg),
@@ -1010,7 +1023,7 @@ fn expr_data(e: &CExpr) -> TokenStream {
                 _ => quote!(Sqrt),
             };
             let a = boxed(a);
-            quote!(::hstl::robustness::Expr::#kind(#a))
+            quote!(#hstl::robustness::Expr::#kind(#a))
         }
         CExprKind::Add(a, b)
         | CExprKind::Sub(a, b)
@@ -1023,7 +1036,7 @@ fn expr_data(e: &CExpr) -> TokenStream {
                 _ => quote!(Div),
             };
             let (a, b) = (boxed(a), boxed(b));
-            quote!(::hstl::robustness::Expr::#kind(#a, #b))
+            quote!(#hstl::robustness::Expr::#kind(#a, #b))
         }
     }
 }

@@ -16,25 +16,41 @@ use report::Target;
 use source::Source;
 
 /// Expands the body of `hstl! { ... }`: either hstl items, or `include "path"` naming a
-/// file relative to `CARGO_MANIFEST_DIR`.
+/// file relative to `CARGO_MANIFEST_DIR`. The facade's `hstl::hstl!` prefixes the body
+/// with `$crate ;`, and generated code then names the facade by `$crate`, which works
+/// under any name the user gave the dependency; without the prefix it names `::hstl`.
 pub fn expand(input: TokenStream) -> TokenStream {
+    let (root, input) = split_root(input);
     match include_path(&input) {
-        Some(Ok((path, spans))) => expand_file(&path, spans),
+        Some(Ok((path, spans))) => expand_file_with(&path, spans, &root),
         Some(Err(e)) => e.to_compile_error(),
-        None => expand_tokens(input),
+        None => expand_tokens_with(input, &root),
     }
 }
 
-/// Expands hstl items given as tokens.
-pub fn expand_tokens(input: TokenStream) -> TokenStream {
+/// The facade's path, when the input starts with `$crate ;`, and the rest of the input.
+fn split_root(input: TokenStream) -> (TokenStream, TokenStream) {
+    let mut tokens = input.clone().into_iter();
+    if let (Some(TokenTree::Ident(root)), Some(TokenTree::Punct(semi))) =
+        (tokens.next(), tokens.next())
+        && root == "$crate"
+        && semi.as_char() == ';'
+    {
+        return (TokenTree::Ident(root).into(), tokens.collect());
+    }
+    (quote!(::hstl), input)
+}
+
+/// Expands hstl items given as tokens; generated code names the facade by `root`.
+fn expand_tokens_with(input: TokenStream, root: &TokenStream) -> TokenStream {
     let source = Source::from_tokens(input);
     let checked = hstl_lang::check(&source.text);
-    emit(&Target::Tokens(&source), &source.text, &checked, TokenStream::new())
+    emit(&Target::Tokens(&source), &source.text, &checked, TokenStream::new(), root)
 }
 
 /// Expands the hstl file at `path` (relative to `CARGO_MANIFEST_DIR`), reporting at
 /// `spans` (the `include "..."` tokens).
-pub fn expand_file(path: &str, spans: (Span, Span)) -> TokenStream {
+fn expand_file_with(path: &str, spans: (Span, Span), root: &TokenStream) -> TokenStream {
     let full = resolve(path);
     let text = match std::fs::read_to_string(&full) {
         Ok(t) => t,
@@ -49,10 +65,16 @@ pub fn expand_file(path: &str, spans: (Span, Span)) -> TokenStream {
     let track = quote!(
         const _: &str = ::core::include_str!(#abs);
     );
-    emit(&Target::File { path, text: &text, spans }, &text, &checked, track)
+    emit(&Target::File { path, text: &text, spans }, &text, &checked, track, root)
 }
 
-fn emit(target: &Target, text: &str, checked: &Checked, mut out: TokenStream) -> TokenStream {
+fn emit(
+    target: &Target,
+    text: &str,
+    checked: &Checked,
+    mut out: TokenStream,
+    root: &TokenStream,
+) -> TokenStream {
     let mut seen = HashSet::new();
     for spec in &checked.specs {
         if !seen.insert(codegen::module_name(spec)) {
@@ -62,7 +84,7 @@ fn emit(target: &Target, text: &str, checked: &Checked, mut out: TokenStream) ->
             .diagnostics
             .iter()
             .any(|d| d.severity == Severity::Error && overlaps(d, &spec.range));
-        out.extend(codegen::spec_module(spec, text, complete));
+        out.extend(codegen::spec_module(spec, text, complete, root));
     }
     out.extend(report::warnings(target, &checked.diagnostics));
     if let Some(e) = report::errors(target, &checked.diagnostics) {
@@ -180,7 +202,7 @@ mod tests {
     fn case_study_expansion() {
         let text = include_str!("../../specs/case_study.hstl");
         let tokens: TokenStream = text.parse().expect("the case study lexes as Rust tokens");
-        insta::assert_snapshot!(pretty(expand_tokens(tokens)));
+        insta::assert_snapshot!(pretty(expand(tokens)));
     }
 
     #[test]
@@ -189,13 +211,30 @@ mod tests {
             "spec S { state { x: float } let A = x > 1; let B = x < ; task A; }"
                 .parse()
                 .expect("lexes");
-        let out = expand_tokens(tokens).to_string();
+        let out = expand(tokens).to_string();
         // One error, and the parts that checked are still generated.
         assert_eq!(out.matches("compile_error").count(), 1, "{out}");
         assert!(out.contains("pub mod s"), "{out}");
         assert!(out.contains("pub struct State"), "{out}");
         assert!(out.contains("pub mod a"), "{out}");
         assert!(!out.contains("impl :: hstl :: runtime :: Spec"), "{out}");
+    }
+
+    #[test]
+    fn every_runtime_path_goes_through_the_root() {
+        // `hstl::hstl!` passes `$crate` as the root (which proc_macro2 cannot build outside
+        // the compiler); any other path shows the same substitution.
+        let input: TokenStream = "spec S { state { x: int in 0..=3 } let A = x > 1; \
+             task always[0..] eventually[0..4] A; option A; }"
+            .parse()
+            .expect("lexes");
+        let out = expand_tokens_with(input.clone(), &quote!(::renamed)).to_string();
+        assert!(!out.contains(":: hstl ::"), "{out}");
+        assert!(out.contains(":: renamed :: runtime :: Spec"), "{out}");
+        assert!(out.contains(":: renamed :: robustness :: Formula"), "{out}");
+        assert!(out.contains(":: renamed :: robustness :: kernels"), "{out}");
+        // Called directly, without the facade's prefix, it names `::hstl`.
+        assert!(expand(input).to_string().contains(":: hstl :: runtime :: Spec"));
     }
 
     #[test]
@@ -208,7 +247,11 @@ mod tests {
         }
         let items: TokenStream = "spec include {}".parse().expect("lexes");
         assert!(include_path(&items).is_none());
-        let missing = expand_file("no/such/file.hstl", (Span::call_site(), Span::call_site()));
+        let missing = expand_file_with(
+            "no/such/file.hstl",
+            (Span::call_site(), Span::call_site()),
+            &quote!(::hstl),
+        );
         assert!(missing.to_string().contains("cannot read"), "{missing}");
     }
 
@@ -218,7 +261,8 @@ mod tests {
         std::fs::write(&path, "spec S {\n    state { x: float }\n    task always Goal;\n}\n")
             .expect("temp file");
         let shown = path.display().to_string();
-        let out = expand_file(&shown, (Span::call_site(), Span::call_site())).to_string();
+        let out = expand_file_with(&shown, (Span::call_site(), Span::call_site()), &quote!(::hstl))
+            .to_string();
         std::fs::remove_file(&path).ok();
         assert!(out.contains(&format!("{shown}:3:17: unknown name `Goal` [HSTL002]")), "{out}");
         assert!(out.contains("include_str"), "{out}");
@@ -230,7 +274,7 @@ mod tests {
             "spec S { state { x: float } let A = x > 1; let Spare = x < 0; task A; }"
                 .parse()
                 .expect("lexes");
-        let out = expand_tokens(tokens).to_string();
+        let out = expand(tokens).to_string();
         assert!(!out.contains("compile_error"), "{out}");
         assert_eq!(out.matches("deprecated").count(), 1, "{out}");
         assert!(out.contains("unused `let` `Spare`"), "{out}");
