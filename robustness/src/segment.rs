@@ -125,6 +125,9 @@ enum Op {
 struct Work {
     pool: Vec<Vec<f64>>,
     kernels: Kernels,
+    /// Prefix and suffix folds of [`van_herk`].
+    pre: Vec<f64>,
+    suf: Vec<f64>,
 }
 
 impl TabularScorer {
@@ -309,12 +312,12 @@ impl Work {
             }
             Op::Always(i, g) => {
                 let mut out = self.eval(g, tables, seg);
-                self.kernels.always(i, &mut out);
+                self.window::<Min>(i, &mut out, Kernels::always);
                 out
             }
             Op::Eventually(i, g) => {
                 let mut out = self.eval(g, tables, seg);
-                self.kernels.eventually(i, &mut out);
+                self.window::<Max>(i, &mut out, Kernels::eventually);
                 out
             }
             Op::Until(i, g, h) => {
@@ -325,6 +328,27 @@ impl Work {
                 out
             }
         }
+    }
+
+    /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, as `kernel`
+    /// (the kernels' `L`-window) computes it; the common case (a bounded window of two
+    /// steps or more that starts inside `buf`) runs [`van_herk`] below.
+    fn window<L: Lattice>(
+        &mut self,
+        i: &Interval,
+        buf: &mut [f64],
+        kernel: fn(&mut Kernels, &Interval, &mut [f64]),
+    ) {
+        let n = buf.len();
+        let len = match i.last_offset() {
+            Some(last) if !i.is_empty() && i.start < n => (last - i.start).saturating_add(1),
+            _ => 1,
+        };
+        if len == 1 {
+            kernel(&mut self.kernels, i, buf);
+            return;
+        }
+        van_herk::<L>(buf, i.start, len.min(n), &mut self.pre, &mut self.suf);
     }
 
     fn fold<L: Lattice>(&mut self, gs: &[Node], tables: &[Vec<f64>], seg: &[usize]) -> Vec<f64> {
@@ -348,6 +372,53 @@ impl Work {
         }
         out
     }
+}
+
+/// `buf[t]` becomes the `L`-fold of `buf[t + a ..= t + a + len - 1]` (clipped at the end),
+/// with `2 <= len <= n` and `a < n`: the blocks, folds and combinations of the evaluator's
+/// van Herk/Gil-Werman kernel, in the same order and so with the same bits (signed zeros
+/// included), in straight loops for the short segments of option executions.
+fn van_herk<L: Lattice>(
+    buf: &mut [f64],
+    a: usize,
+    len: usize,
+    pre: &mut Vec<f64>,
+    suf: &mut Vec<f64>,
+) {
+    let n = buf.len();
+    // Both are overwritten in full below: only their lengths matter.
+    pre.resize(n, 0.0);
+    pre.truncate(n);
+    suf.resize(n, 0.0);
+    suf.truncate(n);
+    for ((x, p), s) in buf.chunks(len).zip(pre.chunks_mut(len)).zip(suf.chunks_mut(len)) {
+        let mut acc = L::ID;
+        for (p, &x) in p.iter_mut().zip(x) {
+            acc = L::acc(acc, x);
+            *p = acc;
+        }
+        let mut acc = L::ID;
+        for (s, &x) in s.iter_mut().zip(x).rev() {
+            acc = L::acc(acc, x);
+            *s = acc;
+        }
+    }
+    // Window `s ..= s + len - 1`, `s = t + a`: the suffix of `s`'s block and the prefix of
+    // the next block; clipped windows reach at most into the last block.
+    let span = len - 1;
+    let full = n.saturating_sub(span + a);
+    let (pre, suf) = (&pre[..], &suf[..]);
+    for ((o, &s), &p) in buf[..full].iter_mut().zip(&suf[a..]).zip(&pre[(a + span).min(n)..]) {
+        *o = L::acc(s, p);
+    }
+    let last_block = (n - 1) / len * len;
+    let mid = last_block.clamp(full + a, n);
+    let p_last = pre[n - 1];
+    for (o, &s) in buf[full..mid - a].iter_mut().zip(&suf[full + a..mid]) {
+        *o = L::acc(s, p_last);
+    }
+    buf[mid - a..n - a].copy_from_slice(&suf[mid..]);
+    buf[n - a..].fill(L::ID);
 }
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {
@@ -442,6 +513,8 @@ mod tests {
             not(ev(window(2, Unbounded), not(x(Gt, 5.0)))),
             Formula::Until(window(0, Unbounded), Box::new(x(Lt, 8.0)), Box::new(x(Gt, 8.0))),
             not(band),
+            alw(window(6, Inclusive(9)), x(Gt, 5.0)),
+            alw(Interval::ALL, ev(window(30, Exclusive(70)), x(Lt, 1.0))),
             Formula::And(vec![]),
             alw(window(0, Inclusive(3)), Formula::True),
         ]
