@@ -36,7 +36,7 @@ use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
 use crate::memory::Memory;
-use crate::spec::{Intra, LearnParams, RewardKind};
+use crate::spec::{Intra, LearnParams, LevelParams, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
 
@@ -308,56 +308,45 @@ impl<'e, E: Env> Learner<'e, E> {
 
     fn run_option(&mut self, o: usize, mut s: usize, rng: &mut Rng, run: &mut Run) {
         let LearnParams { max_steps, flat, .. } = self.spec.learn;
-        let actions = self.tables.actions;
+        let Learner { env, tables, memory, q, counters, tau, code, values, states, .. } = self;
+        let (actions, values) = (tables.actions, *values);
         run.states.clear();
         run.leg_starts.clear();
         run.obs.clear();
         run.psi.clear();
         run.states.push(s);
-        run.obs.push(self.observe(s));
-        if let Some(m) = &self.memory {
-            run.psi.push(m.kept(&self.tau));
+        run.obs.push(s * values + *code);
+        if let Some(m) = memory {
+            run.psi.push(m.kept(tau));
         }
-        let counters = self.counters.take();
-        for l in 0..self.tables.legs[o].len() {
-            let p = self.tables.legs[o][l];
+        for &p in &tables.legs[o] {
             run.leg_starts.push(run.states.len() - 1);
+            let term = &tables.term[p];
             for _ in 0..max_steps {
-                let eps = flat.epsilon_at(self.q.steps);
-                self.q.steps += 1;
+                let eps = flat.epsilon_at(q.steps);
+                q.steps += 1;
                 let a = if rng.random::<f64>() < eps {
                     rng.random_range(0..actions)
                 } else {
-                    argmax(&self.q.flat[p][s * actions..][..actions])
+                    argmax(&q.flat[p][s * actions..][..actions])
                 };
-                let next = match self.states.get(s) {
-                    Some(state) => self.env.index(&self.env.step(state, a, rng)),
+                let next = match states.get(s) {
+                    Some(state) => env.index(&env.step(state, a, rng)),
                     None => s,
                 };
-                self.update_flat(s, a, next);
+                update_flat(&mut q.flat, &tables.reach, flat, actions, s * actions + a, next);
                 run.states.push(next);
-                if let Some(c) = &counters {
-                    let (kept, code) = c.step(next, &mut self.tau);
-                    self.code = code;
+                if let Some(c) = counters {
+                    let (kept, new_code) = c.step(next, tau);
+                    *code = new_code;
                     run.psi.push(kept);
                 }
-                run.obs.push(self.observe(next));
+                run.obs.push(next * values + *code);
                 s = next;
-                if self.tables.term[p][next] {
+                if term[next] {
                     break;
                 }
             }
-        }
-        self.counters = counters;
-    }
-
-    fn update_flat(&mut self, s: usize, a: usize, next: usize) {
-        let actions = self.tables.actions;
-        let flat = self.spec.learn.flat;
-        for (q, reach) in self.q.flat.iter_mut().zip(&self.tables.reach) {
-            let best = max_of(&q[next * actions..][..actions]);
-            let cell = &mut q[s * actions + a];
-            *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
         }
     }
 
@@ -377,16 +366,16 @@ impl<'e, E: Env> Learner<'e, E> {
             let last = self.gamma_powers.len();
             self.gamma_powers.extend((last..=k).map(|i| params.gamma.powi(i as i32)));
         }
+        let remaining = self.spec.learn.intra == Intra::Remaining;
         let mut leg = 0;
         for (j, (&s, &reward)) in run.states[..k].iter().zip(rewards).enumerate() {
-            while leg + 1 < run.leg_starts.len() && run.leg_starts[leg + 1] <= j {
-                leg += 1;
-            }
-            let credited = match (j, self.spec.learn.intra) {
-                (0, _) | (_, Intra::Paper) => Some(o),
-                (_, Intra::Remaining) => {
-                    self.tables.remaining[o][leg].filter(|r| self.tables.available[s].contains(r))
+            let credited = if j == 0 || !remaining {
+                Some(o)
+            } else {
+                while leg + 1 < run.leg_starts.len() && run.leg_starts[leg + 1] <= j {
+                    leg += 1;
                 }
+                self.tables.remaining[o][leg].filter(|r| self.tables.available[s].contains(r))
             };
             let Some(c) = credited else { continue };
             let target = reward + self.gamma_powers[k - j] * best;
@@ -424,6 +413,16 @@ pub(crate) fn argmax(row: &[f64]) -> usize {
     // Unless `row[0]` is NaN the running best is never NaN, and NaN values lose every
     // comparison: plain `>` gives the same index. A NaN `row[0]` stays the running best
     // here, which the slow rule below then handles.
+    if let [a, b, c, d] = *row {
+        // The grid's four actions, unrolled.
+        let (mut best, mut top) = (0, a);
+        for (i, v) in [(1, b), (2, c), (3, d)] {
+            if v > top {
+                (best, top) = (i, v);
+            }
+        }
+        return if top.is_nan() { argmax_nan(row) } else { best };
+    }
     let (mut best, mut top) = (0, row[0]);
     for (i, &v) in row.iter().enumerate().skip(1) {
         if v > top {
@@ -456,14 +455,40 @@ pub(crate) fn best_of(candidates: &[usize], row: &[f64]) -> usize {
     best
 }
 
+/// The flat update of every primitive after the step from cell `cell` (state times
+/// actions plus action) into state `next`: each table bootstraps from its own best value at
+/// `next`, with reward `rho(reach_p, next)`.
+#[inline]
+fn update_flat(
+    tables: &mut [Vec<f64>],
+    reach: &[Vec<f64>],
+    flat: LevelParams,
+    actions: usize,
+    cell: usize,
+    next: usize,
+) {
+    for (q, reach) in tables.iter_mut().zip(reach) {
+        let best = max_of(&q[next * actions..][..actions]);
+        let cell = &mut q[cell];
+        *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
+    }
+}
+
 /// The largest value of a non-empty row; comparisons skip NaN unless all are NaN.
 #[inline]
 fn max_of(row: &[f64]) -> f64 {
     // As in `argmax`: unless `row[0]` is NaN, plain maxima give the same value (the first
     // of equal values, so the sign of a zero too), one instruction each.
     let mut m = row[0];
-    for &v in &row[1..] {
-        m = if v > m { v } else { m };
+    if let [_, b, c, d] = *row {
+        // The grid's four actions, unrolled.
+        m = if b > m { b } else { m };
+        m = if c > m { c } else { m };
+        m = if d > m { d } else { m };
+    } else {
+        for &v in &row[1..] {
+            m = if v > m { v } else { m };
+        }
     }
     if m.is_nan() { max_of_nan(row) } else { m }
 }
@@ -485,7 +510,7 @@ mod tests {
     use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval};
 
     use super::*;
-    use crate::spec::{CombinedOption, LevelParams, PrimitiveOption, StateVar, Terminate};
+    use crate::spec::{CombinedOption, PrimitiveOption, StateVar, Terminate};
     use crate::{GridWorld, seeded_rng};
 
     /// `x op c` on the one-row grids below.
