@@ -292,7 +292,10 @@ pub fn diagnostics(a: &Analysis, uri: &Uri) -> Vec<lsp_types::Diagnostic> {
 /// interval in words.
 pub fn hover(a: &Analysis, pos: Position) -> Option<Hover> {
     let offset = a.conv.offset(&a.text, pos);
-    let (range, text) = match a.symbol_at(offset) {
+    // On `option A;` the name is both the option and the let it reaches: the option's
+    // hover, which names the let, is what the line is about.
+    let option = a.occurrences_at(offset).find(|o| o.symbol.kind == SymKind::Option);
+    let (range, text) = match option.or_else(|| a.symbol_at(offset)) {
         Some(o) => (o.range.clone(), symbol_hover(a, &o.symbol)?),
         None => operator_hover(a, offset)?,
     };
@@ -375,6 +378,18 @@ fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
                 })
             };
             let reach = field("reach").unwrap_or_else(|| o.name.name.clone());
+            if o.fields.is_none()
+                && let Some(l) = spec.items.iter().find_map(|i| match i {
+                    Item::Let(l) if l.name.name == o.name.name => Some(l),
+                    _ => None,
+                })
+            {
+                out.push_str(&format!(
+                    "```hstl\nlet {} = {};\n```\n",
+                    l.name.name,
+                    snippet(&a.text, &l.formula.range)
+                ));
+            }
             out.push_str(&format!(
                 "- reach: `{reach}` (flat reward: its robustness after each step)\n"
             ));

@@ -208,6 +208,12 @@ fn a_session_from_initialize_to_shutdown() {
     assert!(text.contains("let A = x > 1 && y < 2;"), "{text}");
     assert!(text.contains("in 6 of the 15 states"), "{text}");
     assert!(text.contains("Where x is large and y small."), "{text}");
+    // On `option A;`: the option, and the let it reaches.
+    let (line, col) = pos_of(FIXED, "option A", 0, 7);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("option A") && text.contains("let A = x > 1 && y < 2;"), "{text}");
+    assert!(text.contains("init: `true` (default"), "{text}");
     // On option B: sequence, init, terminate.
     let (line, col) = pos_of(FIXED, "option B", 0, 7);
     let text =
