@@ -45,6 +45,9 @@ pub struct GridWorld {
     width: usize,
     height: usize,
     p: f64,
+    /// `slip[i]`: the least draw `u >= p` that slips to the `i + 2`-th other action or
+    /// later (see [`GridWorld::step`]); infinite when there is none below 1.
+    slip: [f64; 2],
 }
 
 /// A cell of the [`GridWorld`].
@@ -71,7 +74,7 @@ impl GridWorld {
         if !(0.0..=1.0).contains(&p) {
             return Err(Error::Env(format!("p = {p} is not a probability in [0, 1]")));
         }
-        Ok(GridWorld { width, height, p })
+        Ok(GridWorld { width, height, p, slip: slip_thresholds(p) })
     }
 
     /// The grid from the `params` object that [`Env::params`] writes.
@@ -106,22 +109,47 @@ impl GridWorld {
     }
 
     /// Where `action` leads from `cell` without slipping; off the grid stays in place.
+    #[inline]
     pub fn intended(&self, cell: Cell, action: usize) -> Cell {
         // Only one coordinate changes, so clamping it to the grid is staying in place;
         // written without branches because slips make the action unpredictable.
-        const DX: [isize; 4] = [0, 0, -1, 1];
-        const DY: [isize; 4] = [1, -1, 0, 0];
+        // Coordinates fit in `i64`: the grid has at most `u32::MAX` cells.
+        const DX: [i64; 4] = [0, 0, -1, 1];
+        const DY: [i64; 4] = [1, -1, 0, 0];
         let Some((&dx, &dy)) = DX.get(action).zip(DY.get(action)) else { return cell };
-        let x = cell.x.saturating_add_signed(dx).min(self.width - 1);
-        let y = cell.y.saturating_add_signed(dy).min(self.height - 1);
-        Cell { x, y }
+        let x = (cell.x as i64 + dx).clamp(0, self.width as i64 - 1);
+        let y = (cell.y as i64 + dy).clamp(0, self.height as i64 - 1);
+        Cell { x: x as usize, y: y as usize }
     }
+}
+
+/// Which of the three other actions a draw `u >= p` slips to, as the contract computes it.
+fn slip_index(p: f64, u: f64) -> usize {
+    (((u - p) / (1.0 - p) * 3.0) as usize).min(2)
+}
+
+/// `[t1, t2]`: the least draws in `[p, 1)` with `slip_index` at least 1 and 2, or infinity.
+/// `slip_index` does not decrease in `u` (each rounded operation is monotone), so for every
+/// `u` in `[p, 1)` it equals the number of thresholds at or below `u`.
+fn slip_thresholds(p: f64) -> [f64; 2] {
+    // Non-negative doubles are ordered as their bits.
+    let lo = if p > 0.0 { p.to_bits() } else { 0 };
+    let hi = 1.0f64.to_bits();
+    [1, 2].map(|k| {
+        // The least bits in `lo..hi` whose value reaches `k`, or `hi` when none does.
+        let (mut a, mut b) = (lo, hi);
+        while a < b {
+            let mid = a + (b - a) / 2;
+            if slip_index(p, f64::from_bits(mid)) >= k { b = mid } else { a = mid + 1 }
+        }
+        if a < hi { f64::from_bits(a) } else { f64::INFINITY }
+    })
 }
 
 impl Default for GridWorld {
     /// The paper's 15 x 15 grid with p = 0.7.
     fn default() -> GridWorld {
-        GridWorld { width: 15, height: 15, p: 0.7 }
+        GridWorld { width: 15, height: 15, p: 0.7, slip: slip_thresholds(0.7) }
     }
 }
 
@@ -148,6 +176,7 @@ impl Env for GridWorld {
         self.width * self.height
     }
 
+    #[inline]
     fn index(&self, state: &Cell) -> usize {
         state.y * self.width + state.x
     }
@@ -165,17 +194,49 @@ impl Env for GridWorld {
         Cell { x: rng.random_range(0..self.width), y: rng.random_range(0..self.height) }
     }
 
+    #[inline]
     fn step(&self, state: &Cell, action: usize, rng: &mut Rng) -> Cell {
         if action >= GRID_ACTIONS.len() {
             return *state;
         }
         // One uniform draw decides both whether the robot slips and where: below `p` it
-        // takes the chosen action, the rest of [0, 1) splits evenly over the other three.
-        // Computed without branches: the slip is a coin flip the CPU cannot predict.
+        // takes the chosen action, the rest of [0, 1) splits evenly over the other three:
+        // the `k`-th other action with `k = min(2, floor((u - p) / (1 - p) * 3))`, which
+        // the two thresholds give without the division (see `slip_index`). Computed
+        // without branches: the slip is a coin flip the CPU cannot predict.
         let u = rng.random::<f64>();
-        let k = (((u - self.p) / (1.0 - self.p) * 3.0) as usize).min(2);
+        let k = usize::from(u >= self.slip[0]) + usize::from(u >= self.slip[1]);
         let other = k + usize::from(k >= action);
         let taken = if u < self.p { action } else { other };
         self.intended(*state, taken)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::seeded_rng;
+
+    /// The thresholds give the contract's slip index for every draw at or above `p`: at
+    /// each threshold, one ulp either side, and on many random draws.
+    #[test]
+    fn slip_thresholds_give_the_contracts_slip_index() {
+        let mut rng = seeded_rng(7);
+        for p in [0.0, 1e-9, 0.3, 1.0 / 3.0, 0.5, 0.7, 0.9, 0.999_999, 1.0] {
+            let grid = GridWorld::new(3, 3, p).unwrap();
+            let by_thresholds =
+                |u: f64| usize::from(u >= grid.slip[0]) + usize::from(u >= grid.slip[1]);
+            let mut draws: Vec<f64> = (0..100_000).map(|_| rng.random::<f64>()).collect();
+            for t in grid.slip.into_iter().filter(|t| t.is_finite()) {
+                draws.extend([t, f64::from_bits(t.to_bits() - 1), f64::from_bits(t.to_bits() + 1)]);
+            }
+            draws.extend([p, 1.0 - f64::EPSILON / 2.0]);
+            for u in draws.into_iter().filter(|&u| u >= p && u < 1.0) {
+                assert_eq!(by_thresholds(u), slip_index(p, u), "p = {p}, u = {u:e}");
+            }
+        }
+        // At p = 0.7 each other action takes a tenth of [0, 1).
+        let [t1, t2] = GridWorld::default().slip;
+        assert!((t1 - 0.8).abs() < 1e-12 && (t2 - 0.9).abs() < 1e-12, "{t1} {t2}");
     }
 }
