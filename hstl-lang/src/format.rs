@@ -22,8 +22,6 @@
 //! chain, one level deeper; that is the only wrapping. A file with syntax errors is not
 //! formatted: [`format()`] returns the parser's diagnostics instead.
 
-use std::collections::{HashMap, HashSet};
-
 use crate::diagnostic::Diagnostic;
 use crate::parser::parse;
 use crate::syntax::{FieldValue, File, Formula, FormulaKind, Item, OptionsKind, Param, ParamValue};
@@ -171,18 +169,19 @@ struct Break {
 }
 
 /// Where the layout differs from "one space between tokens".
-#[derive(Default)]
 struct Plan {
-    breaks: HashMap<usize, Break>,
+    breaks: Vec<Option<Break>>,
     /// Trailing commas to drop (token indices).
-    skip: HashSet<usize>,
+    skip: Vec<bool>,
     /// Tokens after which a trailing comma is added.
-    comma_after: HashSet<usize>,
+    comma_after: Vec<bool>,
 }
 
 impl Plan {
     fn new(file: &File, toks: &[Tok], src: &str) -> Plan {
-        let mut plan = Plan::default();
+        let n = toks.len();
+        let mut plan =
+            Plan { breaks: vec![None; n], skip: vec![false; n], comma_after: vec![false; n] };
         let text = |k: usize| &src[toks[k].start..toks[k].end];
         // First token starting at or after `offset`, and the token ending at `offset`.
         let first_at = |offset: usize| toks.partition_point(|t| t.start < offset);
@@ -232,24 +231,20 @@ impl Plan {
                     plan.node(toks, first_at(start), 2, false);
                 }
                 if let Some(close) = ending_at(close) {
-                    plan.breaks.insert(
-                        close,
-                        Break { indent: 1, comment_indent: 2, blank_ok: false, blank: false },
-                    );
+                    plan.breaks[close] =
+                        Some(Break { indent: 1, comment_indent: 2, blank_ok: false, blank: false });
                     // The last code token before the brace: a comma, or the last entry's end.
                     if let Some(last) = (0..close).rev().find(|&j| !toks[j].is_comment())
                         && text(last) != ","
                         && text(last) != "{"
                     {
-                        plan.comma_after.insert(last);
+                        plan.comma_after[last] = true;
                     }
                 }
             }
             if let Some(close) = ending_at(spec.range.end).filter(|&k| text(k) == "}") {
-                plan.breaks.insert(
-                    close,
-                    Break { indent: 0, comment_indent: 1, blank_ok: false, blank: false },
-                );
+                plan.breaks[close] =
+                    Some(Break { indent: 0, comment_indent: 1, blank_ok: false, blank: false });
             }
         }
         plan
@@ -266,7 +261,7 @@ impl Plan {
                 continue;
             }
             let b = Break { indent, comment_indent: indent, blank_ok: true, blank: blank && first };
-            self.breaks.insert(k, b);
+            self.breaks[k] = Some(b);
             first = false;
             if t.kind != Kind::Doc {
                 break;
@@ -331,7 +326,7 @@ impl Plan {
                 let level = indent + 1;
                 let brk =
                     Break { indent: level, comment_indent: level, blank_ok: false, blank: false };
-                self.breaks.insert(op, brk);
+                self.breaks[op] = Some(brk);
             }
         }
     }
@@ -364,7 +359,7 @@ impl Plan {
             && let Some(last) = (0..close).rev().find(|&j| !toks[j].is_comment())
             && text(last) == ","
         {
-            self.skip.insert(last);
+            self.skip[last] = true;
         }
     }
 }
@@ -407,7 +402,7 @@ fn emit(src: &str, toks: &[Tok], plan: &Plan) -> String {
     let mut indent = 0usize;
     let mut pending_newline = false;
     for (k, &t) in toks.iter().enumerate() {
-        if plan.skip.contains(&k) {
+        if plan.skip[k] {
             last_end = t.end;
             continue;
         }
@@ -420,7 +415,7 @@ fn emit(src: &str, toks: &[Tok], plan: &Plan) -> String {
                 let next = (k + 1..toks.len()).find(|&j| !toks[j].is_comment());
                 let level = match next {
                     None => 0,
-                    Some(j) => plan.breaks.get(&j).map_or(indent + 1, |b| b.comment_indent),
+                    Some(j) => plan.breaks[j].map_or(indent + 1, |b| b.comment_indent),
                 };
                 let blank = own_line && gap >= 2 && !out.ends_with('{');
                 newline(&mut out, blank, level);
@@ -438,7 +433,7 @@ fn emit(src: &str, toks: &[Tok], plan: &Plan) -> String {
             last_end = t.end;
             continue;
         }
-        if let Some(b) = plan.breaks.get(&k) {
+        if let Some(b) = plan.breaks[k] {
             if !out.is_empty() {
                 let blank = b.blank || (b.blank_ok && gap >= 2 && !out.ends_with('{'));
                 newline(&mut out, blank, b.indent);
@@ -459,7 +454,7 @@ fn emit(src: &str, toks: &[Tok], plan: &Plan) -> String {
         }
         prev_prefix_minus = text == "-" && minus_is_prefix(src, prev);
         prev = Some(t);
-        if plan.comma_after.contains(&k) {
+        if plan.comma_after[k] {
             out.push(',');
             prev = Some(Tok { kind: Kind::Punct, start: 0, end: 0 });
         }
