@@ -392,15 +392,16 @@ fn van_herk<L: Lattice>(
     suf.resize(n, 0.0);
     suf.truncate(n);
     for ((x, p), s) in buf.chunks(len).zip(pre.chunks_mut(len)).zip(suf.chunks_mut(len)) {
+        let (p, s) = (&mut p[..x.len()], &mut s[..x.len()]);
         let mut acc = L::ID;
-        for (p, &x) in p.iter_mut().zip(x) {
-            acc = L::acc(acc, x);
-            *p = acc;
+        for j in 0..x.len() {
+            acc = L::acc(acc, x[j]);
+            p[j] = acc;
         }
         let mut acc = L::ID;
-        for (s, &x) in s.iter_mut().zip(x).rev() {
-            acc = L::acc(acc, x);
-            *s = acc;
+        for j in (0..x.len()).rev() {
+            acc = L::acc(acc, x[j]);
+            s[j] = acc;
         }
     }
     // Window `s ..= s + len - 1`, `s = t + a`: the suffix of `s`'s block and the prefix of
