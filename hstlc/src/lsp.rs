@@ -11,6 +11,9 @@ use std::collections::HashMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use std::io::{BufRead, Write as _};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 use lsp_server::{Connection, ErrorCode, Message, Notification, Request, RequestId, Response};
 use lsp_types::notification::{
@@ -45,13 +48,23 @@ pub fn run() -> CmdResult {
     let (server, client) = Connection::memory();
     let Connection { sender: to_server, receiver: from_server } = client;
     let inject = server.sender.clone();
+    // The reader may keep a sender alive (blocked on standard input), so the writer stops
+    // on this flag once everything sent before it is written.
+    let done = Arc::new(AtomicBool::new(false));
+    let writer_done = Arc::clone(&done);
     let writer = std::thread::spawn(move || {
         let stdout = std::io::stdout();
-        for message in from_server {
-            let mut out = stdout.lock();
-            if message.write(&mut out).and_then(|()| out.flush()).is_err() {
-                eprintln!("hstlc lsp: cannot write to standard output; stopping");
-                break;
+        loop {
+            match from_server.recv_timeout(Duration::from_millis(20)) {
+                Ok(message) => {
+                    let mut out = stdout.lock();
+                    if message.write(&mut out).and_then(|()| out.flush()).is_err() {
+                        eprintln!("hstlc lsp: cannot write to standard output; stopping");
+                        return;
+                    }
+                }
+                Err(e) if e.is_timeout() && !writer_done.load(Ordering::SeqCst) => {}
+                Err(_) => return,
             }
         }
     });
@@ -66,6 +79,7 @@ pub fn run() -> CmdResult {
     });
     let clean = serve(&server).map_err(|e| CliError::new(format!("language server: {e}"), None));
     drop(server);
+    done.store(true, Ordering::SeqCst);
     let _ = writer.join();
     Ok(if clean? { Status::Clean } else { Status::Errors })
 }

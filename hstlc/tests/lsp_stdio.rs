@@ -132,3 +132,15 @@ fn exit_without_shutdown_is_status_1() {
     let (code, _) = s.finish();
     assert_eq!(code, Some(1));
 }
+
+#[test]
+fn requests_before_initialize_are_refused_and_end_of_input_ends_the_server() {
+    let mut s = Server::start();
+    s.send(json!({ "jsonrpc": "2.0", "id": 1, "method": "textDocument/hover", "params": {} }));
+    let r = s.response();
+    assert_eq!(r["id"], 1);
+    assert_eq!(r["error"]["code"], -32002, "{r}");
+    // The client goes away without a word: the server ends (it could not finish).
+    let (code, stderr) = s.finish();
+    assert_eq!(code, Some(2), "{stderr}");
+}
