@@ -386,6 +386,18 @@ fn van_herk<L: Lattice>(
     suf: &mut Vec<f64>,
 ) {
     let n = buf.len();
+    if a == 0 && len == n {
+        // One block (a segment no longer than the window): every window is a suffix of
+        // it, and the first also takes the block's prefix fold, as below.
+        let p_last = buf.iter().fold(L::ID, |acc, &x| L::acc(acc, x));
+        let mut acc = L::ID;
+        for x in buf.iter_mut().rev() {
+            acc = L::acc(acc, *x);
+            *x = acc;
+        }
+        buf[0] = L::acc(buf[0], p_last);
+        return;
+    }
     // Both are overwritten in full below: only their lengths matter.
     pre.resize(n, 0.0);
     pre.truncate(n);
@@ -503,7 +515,12 @@ mod tests {
             Box::new(not(ev(window(1, Inclusive(3)), band.clone()))),
             Box::new(alw(window(0, Inclusive(2)), x(Lt, 9.0))),
         );
+        // `-0` at x = 5 and `+0` at x = 8 in one state formula's values.
+        let zeros = Formula::Or(vec![not(x(Ge, 5.0)), x(Ge, 8.0)]);
         vec![
+            ev(window(0, Exclusive(5)), zeros.clone()),
+            alw(window(0, Exclusive(5)), zeros.clone()),
+            alw(Interval::ALL, ev(window(0, Inclusive(3)), zeros)),
             alw(Interval::ALL, body.clone()),
             alw(Interval::ALL, until.clone()),
             alw(Interval::ALL, implies.clone()),
@@ -536,17 +553,28 @@ mod tests {
         for task in tasks() {
             let mut tab = TabularScorer::new(&task, &states);
             let mut seg_scorer = SegmentScorer::new(&task);
-            for len in [0, 1, 2, 3, 6, 11, 40, 97, 2 * 8192 + 300] {
-                // A walk over the table with a few indices outside it.
-                let mut seg = vec![next(11)];
-                while seg.len() < len {
-                    let last = seg[seg.len() - 1].min(10);
-                    seg.push(match next(40) {
-                        0 => 11 + next(3),
-                        k => (last + (k % 3)).saturating_sub(1).min(10),
-                    });
-                }
-                seg.truncate(len);
+            // Walks over the table with a few indices outside it: many short ones (one van
+            // Herk block), then longer ones; and walks where `-0` (x = 5) and `+0` (x = 8)
+            // meet in one window, both ways round.
+            let short = (0..400).map(|i| i % 13);
+            let mut segments: Vec<Vec<usize>> = short
+                .chain([40, 97, 2 * 8192 + 300])
+                .map(|len| {
+                    let mut seg = vec![next(11)];
+                    while seg.len() < len {
+                        let last = seg[seg.len() - 1].min(10);
+                        seg.push(match next(40) {
+                            0 => 11 + next(3),
+                            k => (last + (k % 3)).saturating_sub(1).min(10),
+                        });
+                    }
+                    seg.truncate(len);
+                    seg
+                })
+                .collect();
+            segments.extend([vec![5, 6, 7, 8], vec![8, 7, 6, 5], vec![5, 8, 5, 8, 8, 5, 5, 8, 8]]);
+            for seg in segments {
+                let len = seg.len();
                 let rows: Vec<f64> =
                     seg.iter().map(|&s| if s < 11 { s as f64 } else { f64::NAN }).collect();
                 let trace = Trace::from_columns(vec![rows]).unwrap();
