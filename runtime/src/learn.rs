@@ -65,6 +65,8 @@ pub struct Learner<'e, E: Env> {
     gamma_powers: Vec<f64>,
     /// Every state by index, so that a step does not rebuild its state from the index.
     states: Vec<E::State>,
+    /// The first primitive step from which the flat epsilon is at its floor, if any.
+    flat_floor: Option<u64>,
 }
 
 /// The learned values, enough to continue training.
@@ -203,6 +205,7 @@ impl<'e, E: Env> Learner<'e, E> {
             values,
             gamma_powers: vec![1.0],
             states,
+            flat_floor: floor_from(&spec.learn.flat),
         })
     }
 
@@ -308,7 +311,9 @@ impl<'e, E: Env> Learner<'e, E> {
 
     fn run_option(&mut self, o: usize, mut s: usize, rng: &mut Rng, run: &mut Run) {
         let LearnParams { max_steps, flat, .. } = self.spec.learn;
-        let Learner { env, tables, memory, q, counters, tau, code, values, states, .. } = self;
+        let Learner {
+            env, tables, memory, q, counters, tau, code, values, states, flat_floor, ..
+        } = self;
         let (actions, values) = (tables.actions, *values);
         run.states.clear();
         run.leg_starts.clear();
@@ -323,7 +328,12 @@ impl<'e, E: Env> Learner<'e, E> {
             run.leg_starts.push(run.states.len() - 1);
             let term = &tables.term[p];
             for _ in 0..max_steps {
-                let eps = flat.epsilon_at(q.steps);
+                // At and past the floor `epsilon_at` is `min_epsilon` (or a value equal to
+                // it): the comparison below is the same.
+                let eps = match *flat_floor {
+                    Some(floor) if q.steps >= floor => flat.min_epsilon,
+                    _ => flat.epsilon_at(q.steps),
+                };
                 q.steps += 1;
                 let a = if rng.random::<f64>() < eps {
                     rng.random_range(0..actions)
@@ -455,6 +465,23 @@ pub(crate) fn best_of(candidates: &[usize], row: &[f64]) -> usize {
     best
 }
 
+/// The least `n` with `epsilon - decay * n <= min_epsilon`, from which
+/// [`LevelParams::epsilon_at`] is `min_epsilon`, or `None` when no `u64` reaches it. With
+/// `decay >= 0` (validated) the expression does not increase with `n`: every rounded
+/// operation is monotone.
+fn floor_from(level: &LevelParams) -> Option<u64> {
+    let at_floor = |n: u64| level.epsilon - level.decay * n as f64 <= level.min_epsilon;
+    if !at_floor(u64::MAX) {
+        return None;
+    }
+    let (mut lo, mut hi) = (0, u64::MAX);
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if at_floor(mid) { hi = mid } else { lo = mid + 1 }
+    }
+    Some(lo)
+}
+
 /// The flat update of every primitive after the step from cell `cell` (state times
 /// actions plus action) into state `next`: each table bootstraps from its own best value at
 /// `next`, with reward `rho(reach_p, next)`.
@@ -510,7 +537,7 @@ mod tests {
     use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval};
 
     use super::*;
-    use crate::spec::{CombinedOption, PrimitiveOption, StateVar, Terminate};
+    use crate::spec::{CombinedOption, LevelParams, PrimitiveOption, StateVar, Terminate};
     use crate::{GridWorld, seeded_rng};
 
     /// `x op c` on the one-row grids below.
@@ -754,6 +781,41 @@ mod tests {
         assert_eq!(argmax(rows[5]), 0);
         assert!(max_of(rows[5]).is_nan());
         assert_eq!((argmax(rows[6]), max_of(rows[6])), (2, 7.0));
+    }
+
+    /// From `floor_from` on, `epsilon_at` is `min_epsilon`; just before, it is above.
+    #[test]
+    fn the_epsilon_floor_starts_where_epsilon_at_reaches_it() {
+        let level = |epsilon, min_epsilon, decay| LevelParams {
+            epsilon,
+            min_epsilon,
+            decay,
+            ..LevelParams::FLAT
+        };
+        // (level, the floor when it is known exactly; `Some(None)`: there is none)
+        let cases = [
+            (LevelParams::FLAT, None),
+            (LevelParams::OPTIONS, None),
+            (level(0.9, 0.1, 1.0 / 3.0), None),
+            (level(0.3, 0.3, 1e-3), Some(Some(0))),
+            (level(0.5, 0.0, 0.0), Some(None)),
+            (level(1.0, 0.1, 1e300), Some(Some(1))),
+        ];
+        for (level, want) in cases {
+            let floor = floor_from(&level);
+            assert_eq!(floor.is_none(), want == Some(None), "{level:?}");
+            if let Some(want) = want {
+                assert_eq!(floor, want, "{level:?}");
+            }
+            if let Some(f) = floor {
+                for n in [f, f + 1, f + 1000, u64::MAX] {
+                    assert_eq!(level.epsilon_at(n), level.min_epsilon, "{level:?} at {n}");
+                }
+                if f > 0 {
+                    assert!(level.epsilon_at(f - 1) > level.min_epsilon, "{level:?}");
+                }
+            }
+        }
     }
 
     #[test]
