@@ -46,6 +46,12 @@ fn big_spec(lines: usize) -> String {
 
 fn bench(c: &mut Criterion) {
     let src = big_spec(10_000);
+    // `HSTL_BENCH_ONCE=parse|check`: one call and no timing, for callgrind.
+    match std::env::var("HSTL_BENCH_ONCE").as_deref() {
+        Ok("parse") => return drop(black_box(hstl_lang::parse(black_box(&src)))),
+        Ok("check") => return drop(black_box(hstl_lang::check(black_box(&src)))),
+        _ => {}
+    }
     assert!(src.lines().count() >= 10_000);
     let checked = hstl_lang::check(&src);
     assert!(

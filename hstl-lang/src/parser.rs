@@ -657,6 +657,43 @@ type Res<T> = Result<T, Fail>;
 /// height.
 type Factor = (Option<BinOp>, (Expr, usize));
 
+/// A formula operator: prefix (`!`, `always`, `eventually`) or infix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OpKind {
+    Not,
+    Always,
+    Eventually,
+    Implies,
+    Or,
+    And,
+    Until,
+}
+
+/// A formula operator with its byte range (keyword and interval) and interval.
+struct Op {
+    kind: OpKind,
+    range: Range<usize>,
+    interval: Option<Interval>,
+}
+
+/// One element of a formula's flat sequence.
+enum Piece {
+    Op(Op),
+    Operand(Formula, usize),
+}
+
+/// One element of an expression's flat sequence.
+enum EPiece {
+    /// A prefix `-` starting at this offset.
+    Neg(usize),
+    /// `+` or `-` between terms.
+    Add(BinOp),
+    /// `*` or `/` between factors.
+    Mul(BinOp),
+    /// An operand with its height.
+    Operand(Expr, usize),
+}
+
 impl Builder<'_> {
     fn range(&self, p: &Pair<'_, Rule>) -> Range<usize> {
         let s = p.as_span();
@@ -921,31 +958,64 @@ impl Builder<'_> {
             return self.primary(only);
         }
         let range = self.range(&p);
+        let mut kids = p.into_inner();
+        self.assemble(range, &mut |b: &mut Self| kids.next().map(|c| b.piece(c)))
+    }
+
+    /// One child of a `formula` pair as a piece: an operator or an operand.
+    fn piece(&mut self, c: Pair<'_, Rule>) -> Res<Piece> {
+        let kind = match c.as_rule() {
+            Rule::not_op => OpKind::Not,
+            Rule::always_op => OpKind::Always,
+            Rule::eventually_op => OpKind::Eventually,
+            Rule::implies_op => OpKind::Implies,
+            Rule::or_op => OpKind::Or,
+            Rule::and_op => OpKind::And,
+            Rule::until_op => OpKind::Until,
+            _ => {
+                let (f, h) = self.primary(c)?;
+                return Ok(Piece::Operand(f, h));
+            }
+        };
+        let range = self.range(&c);
+        let interval = if matches!(kind, OpKind::Always | OpKind::Eventually | OpKind::Until) {
+            c.into_inner().find(|c| c.as_rule() == Rule::interval).map(|i| self.interval(i))
+        } else {
+            None
+        };
+        Ok(Piece::Op(Op { kind, range, interval }))
+    }
+
+    /// Builds a formula from its pieces in source order (prefix operators, operands and
+    /// infix operators), applying precedence; `range` is the whole formula's, for errors.
+    fn assemble(
+        &mut self,
+        range: Range<usize>,
+        next: &mut dyn FnMut(&mut Self) -> Option<Res<Piece>>,
+    ) -> Res<(Formula, usize)> {
         // Operands (each with its prefix operators) and the infix operators between them.
         let mut operands: Vec<(Formula, usize)> = Vec::new();
-        let mut ops: Vec<Pair<'_, Rule>> = Vec::new();
-        let mut prefixes: Vec<Pair<'_, Rule>> = Vec::new();
-        for c in p.into_inner() {
-            match c.as_rule() {
-                Rule::not_op | Rule::always_op | Rule::eventually_op => {
+        let mut ops: Vec<Op> = Vec::new();
+        let mut prefixes: Vec<Op> = Vec::new();
+        while let Some(piece) = next(self) {
+            match piece? {
+                Piece::Op(op)
+                    if matches!(op.kind, OpKind::Not | OpKind::Always | OpKind::Eventually) =>
+                {
                     if prefixes.len() >= MAX_HEIGHT {
                         return Err(self.too_tall(range));
                     }
-                    prefixes.push(c);
+                    prefixes.push(op);
                 }
-                Rule::implies_op | Rule::or_op | Rule::and_op | Rule::until_op => ops.push(c),
-                _ => {
-                    let (mut f, mut h) = self.primary(c)?;
+                Piece::Op(op) => ops.push(op),
+                Piece::Operand(mut f, mut h) => {
                     for op in prefixes.drain(..).rev() {
-                        let r = self.range(&op).start..f.range.end;
-                        let interval =
-                            op.clone().into_inner().find(|c| c.as_rule() == Rule::interval);
-                        let interval = interval.map(|i| self.interval(i));
+                        let r = op.range.start..f.range.end;
                         let b = Box::new(f);
-                        let kind = match op.as_rule() {
-                            Rule::not_op => FormulaKind::Not(b),
-                            Rule::always_op => FormulaKind::Always(interval, b),
-                            _ => FormulaKind::Eventually(interval, b),
+                        let kind = match op.kind {
+                            OpKind::Not => FormulaKind::Not(b),
+                            OpKind::Always => FormulaKind::Always(op.interval, b),
+                            _ => FormulaKind::Eventually(op.interval, b),
                         };
                         f = Formula { kind, range: r };
                         h += 1;
@@ -964,9 +1034,9 @@ impl Builder<'_> {
         let mut segments: Vec<(Formula, usize)> = Vec::new();
         let mut operands = operands.into_iter();
         let mut group: Vec<(Formula, usize)> = operands.next().into_iter().collect();
-        let mut group_ops: Vec<Pair<'_, Rule>> = Vec::new();
+        let mut group_ops: Vec<Op> = Vec::new();
         for (op, rhs) in ops.into_iter().zip(operands) {
-            if op.as_rule() == Rule::implies_op {
+            if op.kind == OpKind::Implies {
                 segments.push(
                     self.disjunction(std::mem::take(&mut group), std::mem::take(&mut group_ops))?,
                 );
@@ -992,22 +1062,22 @@ impl Builder<'_> {
     fn disjunction(
         &mut self,
         operands: Vec<(Formula, usize)>,
-        ops: Vec<Pair<'_, Rule>>,
+        ops: Vec<Op>,
     ) -> Res<(Formula, usize)> {
         // Group by `||`, each group by `&&`, each of those by `until`.
         let mut ors: Vec<Vec<Vec<(Formula, usize)>>> = vec![vec![Vec::new()]];
-        let mut untils: Vec<Vec<Vec<Pair<'_, Rule>>>> = vec![vec![Vec::new()]];
+        let mut untils: Vec<Vec<Vec<Op>>> = vec![vec![Vec::new()]];
         let mut operands = operands.into_iter();
         if let Some(first) = operands.next() {
             ors[0][0].push(first);
         }
         for (op, rhs) in ops.into_iter().zip(operands) {
-            match op.as_rule() {
-                Rule::or_op => {
+            match op.kind {
+                OpKind::Or => {
                     ors.push(vec![Vec::new()]);
                     untils.push(vec![Vec::new()]);
                 }
-                Rule::and_op => {
+                OpKind::And => {
                     if let (Some(o), Some(u)) = (ors.last_mut(), untils.last_mut()) {
                         o.push(Vec::new());
                         u.push(Vec::new());
@@ -1035,11 +1105,7 @@ impl Builder<'_> {
     }
 
     /// `a until b` (a longer chain is reported as HSTL021 and built from the left).
-    fn until_chain(
-        &mut self,
-        chain: Vec<(Formula, usize)>,
-        ops: Vec<Pair<'_, Rule>>,
-    ) -> Res<(Formula, usize)> {
+    fn until_chain(&mut self, chain: Vec<(Formula, usize)>, ops: Vec<Op>) -> Res<(Formula, usize)> {
         let mut chain = chain.into_iter();
         let (mut acc, mut h) = chain.next().ok_or(Fail(Diagnostic::new(
             "HSTL001",
@@ -1047,7 +1113,7 @@ impl Builder<'_> {
             "could not read this formula",
         )))?;
         for (count, (op, (rhs, hr))) in ops.into_iter().zip(chain).enumerate() {
-            let op_range = self.range(&op);
+            let op_range = op.range;
             if count == 1 {
                 self.diagnostics.push(
                     Diagnostic::new("HSTL021", op_range, "`until` is not chainable")
@@ -1057,8 +1123,7 @@ impl Builder<'_> {
                         ),
                 );
             }
-            let interval = op.into_inner().find(|c| c.as_rule() == Rule::interval);
-            let interval = interval.map(|i| self.interval(i));
+            let interval = op.interval;
             h = h.max(hr) + 1;
             if h > MAX_HEIGHT {
                 return Err(self.too_tall(acc.range.start..rhs.range.end));
@@ -1134,27 +1199,45 @@ impl Builder<'_> {
             return self.operand(only);
         }
         let range = self.range(&p);
+        let mut kids = p.into_inner();
+        self.assemble_expr(range, &mut |b: &mut Self| {
+            kids.next().map(|c| match c.as_rule() {
+                Rule::neg_op => Ok(EPiece::Neg(b.range(&c).start)),
+                Rule::add_op => Ok(EPiece::Add(if c.as_str().starts_with('+') {
+                    BinOp::Add
+                } else {
+                    BinOp::Sub
+                })),
+                Rule::mul_op => {
+                    Ok(EPiece::Mul(if c.as_str() == "*" { BinOp::Mul } else { BinOp::Div }))
+                }
+                _ => b.operand(c).map(|(e, h)| EPiece::Operand(e, h)),
+            })
+        })
+    }
+
+    /// Builds an expression from its pieces in source order, applying precedence;
+    /// `range` is the whole expression's, for errors.
+    fn assemble_expr(
+        &mut self,
+        range: Range<usize>,
+        next: &mut dyn FnMut(&mut Self) -> Option<Res<EPiece>>,
+    ) -> Res<(Expr, usize)> {
         // Terms joined by `+`/`-`; each term is operands joined by `*`/`/`.
         let mut sums: Vec<(Option<BinOp>, Vec<Factor>)> = vec![(None, Vec::new())];
         let mut negs: Vec<usize> = Vec::new();
         let mut pending: Option<BinOp> = None;
-        for c in p.into_inner() {
-            match c.as_rule() {
-                Rule::neg_op => {
+        while let Some(piece) = next(self) {
+            match piece? {
+                EPiece::Neg(start) => {
                     if negs.len() >= MAX_HEIGHT {
                         return Err(self.too_tall(range));
                     }
-                    negs.push(self.range(&c).start);
+                    negs.push(start);
                 }
-                Rule::add_op => {
-                    let op = if c.as_str().starts_with('+') { BinOp::Add } else { BinOp::Sub };
-                    sums.push((Some(op), Vec::new()));
-                }
-                Rule::mul_op => {
-                    pending = Some(if c.as_str() == "*" { BinOp::Mul } else { BinOp::Div });
-                }
-                _ => {
-                    let (mut e, mut h) = self.operand(c)?;
+                EPiece::Add(op) => sums.push((Some(op), Vec::new())),
+                EPiece::Mul(op) => pending = Some(op),
+                EPiece::Operand(mut e, mut h) => {
                     for start in negs.drain(..).rev() {
                         let r = start..e.range.end;
                         e = Expr { kind: ExprKind::Neg(Box::new(e)), range: r };
