@@ -196,16 +196,18 @@ impl TabularScorer {
         match self.persistent {
             Some(h) => {
                 out.resize(m, 0.0);
-                let cut = m.saturating_sub(1).saturating_sub(h);
-                let mut acc = f64::INFINITY;
-                for i in (0..m).rev() {
-                    out[i] = if i <= cut {
-                        acc = acc.min(sig[i]);
-                        acc
-                    } else {
-                        // A suffix shorter than the horizon keeps only its step 0.
-                        f64::INFINITY.min(sig[i])
-                    };
+                if m > 0 {
+                    let cut = (m - 1).saturating_sub(h);
+                    // A suffix shorter than the horizon keeps only its step 0.
+                    for (o, &v) in out[cut + 1..].iter_mut().zip(&sig[cut + 1..]) {
+                        *o = f64::INFINITY.min(v);
+                    }
+                    // The others take the running minimum of `sig[i..=cut]`.
+                    let mut acc = f64::INFINITY;
+                    for (o, &v) in out[..=cut].iter_mut().zip(&sig[..=cut]).rev() {
+                        acc = acc.min(v);
+                        *o = acc;
+                    }
                 }
             }
             None => out.extend_from_slice(&sig),
