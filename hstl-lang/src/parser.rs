@@ -1038,6 +1038,9 @@ impl Builder<'_> {
         if operands.len() != ops.len() + 1 {
             return Err(self.internal(range));
         }
+        if !ops.iter().any(|op| op.kind == OpKind::Implies) {
+            return self.disjunction(operands, ops);
+        }
         // Split at `->` (loosest, right-associative), then `||`, then `&&`, then `until`.
         let mut segments: Vec<(Formula, usize)> = Vec::new();
         let mut operands = operands.into_iter();
@@ -1066,83 +1069,71 @@ impl Builder<'_> {
         Ok((acc, h))
     }
 
-    /// Operands joined by `||`, `&&` and `until` (no `->`).
+    /// Operands joined by `||`, `&&` and `until` (no `->`): `until` chains are folded
+    /// as they come, grouped by `&&`, and those by `||`.
     fn disjunction(
         &mut self,
         operands: Vec<(Formula, usize)>,
         ops: Vec<Op>,
     ) -> Res<(Formula, usize)> {
-        // Group by `||`, each group by `&&`, each of those by `until`.
-        let mut ors: Vec<Vec<Vec<(Formula, usize)>>> = vec![vec![Vec::new()]];
-        let mut untils: Vec<Vec<Vec<Op>>> = vec![vec![Vec::new()]];
         let mut operands = operands.into_iter();
-        if let Some(first) = operands.next() {
-            ors[0][0].push(first);
-        }
+        let Some(mut chain) = operands.next() else {
+            return Err(Fail(Diagnostic::new("HSTL001", 0..0, "could not read this formula")));
+        };
+        // `until` operators folded into `chain` so far.
+        let mut untils = 0;
+        let mut and_parts: Vec<(Formula, usize)> = Vec::new();
+        let mut or_parts: Vec<(Formula, usize)> = Vec::new();
         for (op, rhs) in ops.into_iter().zip(operands) {
             match op.kind {
                 OpKind::Or => {
-                    ors.push(vec![Vec::new()]);
-                    untils.push(vec![Vec::new()]);
+                    and_parts.push(std::mem::replace(&mut chain, rhs));
+                    or_parts.push(self.nary(std::mem::take(&mut and_parts), false)?);
+                    untils = 0;
                 }
                 OpKind::And => {
-                    if let (Some(o), Some(u)) = (ors.last_mut(), untils.last_mut()) {
-                        o.push(Vec::new());
-                        u.push(Vec::new());
-                    }
+                    and_parts.push(std::mem::replace(&mut chain, rhs));
+                    untils = 0;
                 }
                 _ => {
-                    if let Some(u) = untils.last_mut().and_then(|u| u.last_mut()) {
-                        u.push(op);
-                    }
+                    chain = self.until(chain, op, rhs, untils)?;
+                    untils += 1;
                 }
             }
-            if let Some(chain) = ors.last_mut().and_then(|o| o.last_mut()) {
-                chain.push(rhs);
-            }
         }
-        let mut or_parts = Vec::new();
-        for (ands, and_ops) in ors.into_iter().zip(untils) {
-            let mut and_parts = Vec::new();
-            for (chain, until_ops) in ands.into_iter().zip(and_ops) {
-                and_parts.push(self.until_chain(chain, until_ops)?);
-            }
-            or_parts.push(self.nary(and_parts, false)?);
-        }
+        and_parts.push(chain);
+        or_parts.push(self.nary(and_parts, false)?);
         self.nary(or_parts, true)
     }
 
-    /// `a until b` (a longer chain is reported as HSTL021 and built from the left).
-    fn until_chain(&mut self, chain: Vec<(Formula, usize)>, ops: Vec<Op>) -> Res<(Formula, usize)> {
-        let mut chain = chain.into_iter();
-        let (mut acc, mut h) = chain.next().ok_or(Fail(Diagnostic::new(
-            "HSTL001",
-            0..0,
-            "could not read this formula",
-        )))?;
-        for (count, (op, (rhs, hr))) in ops.into_iter().zip(chain).enumerate() {
-            let op_range = op.range;
-            if count == 1 {
-                self.diagnostics.push(
-                    Diagnostic::new("HSTL021", op_range, "`until` is not chainable")
-                        .with_label(acc.range.clone(), "this is already an `until` formula")
-                        .with_help(
-                            "add parentheses: `(a until b) until c` or `a until (b until c)`",
-                        ),
-                );
-            }
-            let interval = op.interval;
-            h = h.max(hr) + 1;
-            if h > MAX_HEIGHT {
-                return Err(self.too_tall(acc.range.start..rhs.range.end));
-            }
-            let r = acc.range.start..rhs.range.end;
-            acc = Formula {
-                kind: FormulaKind::Until(Box::new(acc), interval, Box::new(rhs)),
-                range: r,
-            };
+    /// `acc until rhs`, where `acc` already folds `count` `until`s (a chain is reported
+    /// as HSTL021 at its second `until` and built from the left).
+    fn until(
+        &mut self,
+        (acc, h): (Formula, usize),
+        op: Op,
+        (rhs, hr): (Formula, usize),
+        count: usize,
+    ) -> Res<(Formula, usize)> {
+        if count == 1 {
+            self.diagnostics.push(
+                Diagnostic::new("HSTL021", op.range, "`until` is not chainable")
+                    .with_label(acc.range.clone(), "this is already an `until` formula")
+                    .with_help("add parentheses: `(a until b) until c` or `a until (b until c)`"),
+            );
         }
-        Ok((acc, h))
+        let h = h.max(hr) + 1;
+        if h > MAX_HEIGHT {
+            return Err(self.too_tall(acc.range.start..rhs.range.end));
+        }
+        let r = acc.range.start..rhs.range.end;
+        Ok((
+            Formula {
+                kind: FormulaKind::Until(Box::new(acc), op.interval, Box::new(rhs)),
+                range: r,
+            },
+            h,
+        ))
     }
 
     /// One operand, or an `Or`/`And` node over two or more.
