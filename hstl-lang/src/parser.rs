@@ -53,11 +53,25 @@ struct Tok {
     end: usize,
 }
 
+/// Items in a spec from which they are parsed on several threads.
+const PARALLEL_ITEMS: usize = 512;
+
+/// Most threads the parser uses.
+const MAX_THREADS: usize = 4;
+
+/// A parsed item (`None` if broken) and its diagnostics.
+type ItemResult = (Option<Item>, Vec<Diagnostic>);
+
 /// Why building a node failed: the item is reported and skipped.
 struct Fail(Diagnostic);
 
 /// Parses a source text. Never fails: what cannot be parsed is reported and skipped.
 pub fn parse(src: &str) -> Parsed {
+    parse_with(src, true)
+}
+
+/// [`parse`], with the items of a large spec parsed on several threads if `parallel`.
+fn parse_with(src: &str, parallel: bool) -> Parsed {
     let mut diagnostics = Vec::new();
     let mut comments = Vec::new();
     let toks = lex(src, &mut comments, &mut diagnostics);
@@ -75,6 +89,7 @@ pub fn parse(src: &str) -> Parsed {
         toks: &toks,
         ends: &ends,
         i: 0,
+        parallel,
         diagnostics: &mut diagnostics,
     };
     while p.i < toks.len() {
@@ -190,6 +205,8 @@ struct Splitter<'a, 'd> {
     toks: &'a [Tok],
     ends: &'a [usize],
     i: usize,
+    /// Whether large specs are parsed on several threads.
+    parallel: bool,
     diagnostics: &'d mut Vec<Diagnostic>,
 }
 
@@ -285,10 +302,12 @@ impl Splitter<'_, '_> {
                 range: head_range.start..end,
             });
         }
+        let mut bounds = Vec::new();
+        let mut unclosed = None;
         loop {
             if self.i >= self.toks.len() {
                 let at = self.src.len();
-                self.diagnostics.push(
+                unclosed = Some(
                     Diagnostic::new("HSTL001", at..at, "expected `}`, found end of file")
                         .with_label(self.toks[h].start..self.toks[h].end, "this `{` is not closed")
                         .with_help("close the spec with `}`"),
@@ -303,7 +322,7 @@ impl Splitter<'_, '_> {
             }
             if self.is(self.i, "spec") {
                 let t = self.toks[self.i];
-                self.diagnostics.push(
+                unclosed = Some(
                     Diagnostic::new("HSTL001", t.start..t.end, "expected `}`, found `spec`")
                         .with_label(self.toks[h].start..self.toks[h].end, "this `{` is not closed")
                         .with_help("close the previous spec with `}` before starting another"),
@@ -313,11 +332,17 @@ impl Splitter<'_, '_> {
             }
             let (a, b) = self.item_bounds();
             self.i = b;
-            match self.item(a, b) {
+            bounds.push((a, b));
+        }
+        // Items are independent once split: parse them, then report in source order.
+        for ((a, b), (item, mut diags)) in bounds.iter().zip(self.items(&bounds)) {
+            self.diagnostics.append(&mut diags);
+            match item {
                 Some(item) => items.push(item),
-                None => broken.push(self.broken(a, b)),
+                None => broken.push(self.broken(*a, *b)),
             }
         }
+        self.diagnostics.extend(unclosed);
         Some(Spec { doc, name, items, broken, range: head_range.start..end })
     }
 
@@ -398,7 +423,48 @@ impl Splitter<'_, '_> {
         self.deep_comments.iter().any(|c| c.start < range.end && range.start < c.end)
     }
 
-    fn item(&mut self, a: usize, b: usize) -> Option<Item> {
+    /// Parses the items of `bounds` (token ranges), on several threads when there are
+    /// many; each result comes with the item's diagnostics, in the order of `bounds`.
+    fn items(&self, bounds: &[(usize, usize)]) -> Vec<ItemResult> {
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(MAX_THREADS);
+        if !self.parallel || bounds.len() < PARALLEL_ITEMS || threads < 2 {
+            return bounds.iter().map(|&(a, b)| self.item(a, b)).collect();
+        }
+        let chunk = bounds.len().div_ceil(threads);
+        let run = |part: &[(usize, usize)]| -> Vec<ItemResult> {
+            part.iter().map(|&(a, b)| self.item(a, b)).collect()
+        };
+        std::thread::scope(|scope| {
+            let mut parts = bounds.chunks(chunk);
+            let first = parts.next().unwrap_or(&[]);
+            let handles: Vec<_> = parts
+                .map(|part| {
+                    let spawned =
+                        std::thread::Builder::new().spawn_scoped(scope, move || run(part));
+                    (part, spawned)
+                })
+                .collect();
+            let mut out = run(first);
+            for (part, spawned) in handles {
+                // A thread that could not start (or failed) leaves its part to this one.
+                match spawned.ok().and_then(|h| h.join().ok()) {
+                    Some(results) => out.extend(results),
+                    None => out.extend(run(part)),
+                }
+            }
+            out
+        })
+    }
+
+    /// Parses the item of tokens `[a, b)`: the item, or `None` if it is broken, and its
+    /// diagnostics.
+    fn item(&self, a: usize, b: usize) -> ItemResult {
+        let mut diagnostics = Vec::new();
+        let item = self.item_into(a, b, &mut diagnostics);
+        (item, diagnostics)
+    }
+
+    fn item_into(&self, a: usize, b: usize, diagnostics: &mut Vec<Diagnostic>) -> Option<Item> {
         let range = self.toks[a].start..self.toks[b - 1].end;
         if self.has_deep_comment(&range) {
             return None;
@@ -411,7 +477,7 @@ impl Splitter<'_, '_> {
                     depth += 1;
                     if depth > MAX_NESTING {
                         let t = self.toks[k];
-                        self.diagnostics.push(Diagnostic::new(
+                        diagnostics.push(Diagnostic::new(
                             "HSTL001",
                             t.start..t.end,
                             format!("brackets nested too deeply (more than {MAX_NESTING} levels)"),
@@ -443,18 +509,18 @@ impl Splitter<'_, '_> {
                 };
                 match b.item(inner) {
                     Ok(item) => {
-                        self.diagnostics.append(&mut b.diagnostics);
+                        diagnostics.append(&mut b.diagnostics);
                         Some(item)
                     }
                     Err(Fail(d)) => {
-                        self.diagnostics.push(d);
+                        diagnostics.push(d);
                         None
                     }
                 }
             }
             Err(e) => {
                 let e = reparse_with_detail(Rule::item_entry, text).unwrap_or(e);
-                self.diagnostics.push(self.syntax_error(&e, range));
+                diagnostics.push(self.syntax_error(&e, range));
                 None
             }
         }
@@ -1670,6 +1736,36 @@ impl Fast<'_, '_> {
         let name = self.ident(k)?;
         let range = name.range.clone();
         Some((Expr { kind: ExprKind::Name(name), range }, 1, k + 1))
+    }
+}
+
+#[cfg(test)]
+mod parallel_tests {
+    use super::*;
+
+    /// A large spec with broken items, unreadable ones and an unclosed brace parses on
+    /// several threads exactly as on one.
+    #[test]
+    fn parallel_parse_is_sequential_parse() {
+        let mut src = String::from("spec Big {\n    state { x: int in 0..=9 }\n");
+        for i in 0..3000 {
+            let item = match i % 10 {
+                0 => format!("    let L{i} = x < ;\n"),
+                1 => format!("    let L{i} = x > 1 until[0..2] x < 3 until x > 4;\n"),
+                2 => format!("    option O{i} {{ reach: L{}, init: true }}\n", i - 1),
+                3 => format!("    /// doc {i}\n    let L{i} = always[0..3] (x + 1 > 2) -> !L1;\n"),
+                4 => format!("    let L{i} = ((((x)))) < 3 // c\n    ;\n"),
+                _ => format!("    let L{i} = x * 2 - 1 >= {i} && x < 9;\n"),
+            };
+            src.push_str(&item);
+        }
+        for text in [src.clone(), format!("{src}}}\n"), src.replace("L15 ", "L15 $ ")] {
+            assert_eq!(
+                format!("{:?}", parse_with(&text, true)),
+                format!("{:?}", parse_with(&text, false))
+            );
+        }
+        assert!(parse_with(&src, true).diagnostics.len() > 300);
     }
 }
 
