@@ -1584,10 +1584,49 @@ impl Fast<'_, '_> {
             }
             return None;
         }
+        if let Some(built) = Self::uniform(&mut pieces) {
+            return Some((built?, k));
+        }
         let range = self.span(k0, k);
         let mut pieces = pieces.into_iter();
         let built = self.b.assemble(range, &mut |_| pieces.next().map(Ok)).ok()?;
         Some((built, k))
+    }
+
+    /// Operands joined by one of `&&` or `||` only, without prefix operators: the `And`
+    /// or `Or` node that [`Builder::assemble`] builds, built directly (`Some(None)` if an
+    /// operand is too tall, left to pest to report); `None` for other sequences.
+    fn uniform(pieces: &mut Vec<Piece>) -> Option<Option<(Formula, usize)>> {
+        let Some(Piece::Op(first)) = pieces.get(1) else { return None };
+        let kind = first.kind;
+        if !matches!(kind, OpKind::And | OpKind::Or) {
+            return None;
+        }
+        let alternating = pieces.iter().enumerate().all(|(i, p)| match p {
+            Piece::Operand(..) => i % 2 == 0,
+            Piece::Op(op) => i % 2 == 1 && op.kind == kind,
+        });
+        if !alternating {
+            return None;
+        }
+        let mut parts = Vec::with_capacity(pieces.len() / 2 + 1);
+        let mut h = 0;
+        for p in pieces.drain(..) {
+            if let Piece::Operand(f, hf) = p {
+                if hf > MAX_HEIGHT {
+                    return Some(None);
+                }
+                h = h.max(hf);
+                parts.push(f);
+            }
+        }
+        let range = match (parts.first(), parts.last()) {
+            (Some(a), Some(b)) => a.range.start..b.range.end,
+            _ => return Some(None),
+        };
+        let kind =
+            if kind == OpKind::And { FormulaKind::And(parts) } else { FormulaKind::Or(parts) };
+        Some(Some((Formula { kind, range }, h + 1)))
     }
 
     /// `f_primary`: `true | false | name_ref | comparison | paren_f`.
@@ -1701,6 +1740,20 @@ impl Fast<'_, '_> {
             return None;
         }
         let range = self.span(k0, k);
+        // Operands joined by `+`/`-` only, or by `*`/`/` only, without a prefix `-`: a
+        // fold from the left, as [`Builder::assemble_expr`] builds it.
+        let adds = pieces.iter().all(|p| matches!(p, EPiece::Operand(..) | EPiece::Add(_)));
+        let muls = pieces.iter().all(|p| matches!(p, EPiece::Operand(..) | EPiece::Mul(_)));
+        if adds || muls {
+            let mut pieces = pieces.into_iter();
+            let Some(EPiece::Operand(mut acc, mut h)) = pieces.next() else { return None };
+            while let (Some(EPiece::Add(op) | EPiece::Mul(op)), Some(EPiece::Operand(e, he))) =
+                (pieces.next(), pieces.next())
+            {
+                (acc, h) = self.b.binary(op, acc, h, e, he, &range).ok()?;
+            }
+            return Some(((acc, h), k));
+        }
         let mut pieces = pieces.into_iter();
         let built = self.b.assemble_expr(range, &mut |_| pieces.next().map(Ok)).ok()?;
         Some((built, k))
