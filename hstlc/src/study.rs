@@ -114,7 +114,11 @@ pub fn run(args: &StudyArgs) -> CmdResult {
                 )
             }
         }
-        if args.both_intra {
+        let one_leg = spec.options.iter().all(|o| o.sequence.len() == 1);
+        if args.both_intra && one_leg {
+            // The rules differ only on suffixes inside a later leg.
+            println!("  intra: paper and remaining agree here: every option has one leg");
+        } else if args.both_intra {
             let mut other = spec.clone();
             other.learn.intra = match spec.learn.intra {
                 Intra::Paper => Intra::Remaining,
