@@ -1,6 +1,44 @@
 //! Name resolution and every check of LANGUAGE.md, building [`CheckedSpec`]s.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A fast hasher for the names of a spec (FxHash's multiply-rotate, eight bytes at a
+/// time): names come from the checked file, and nothing depends on the table's order.
+#[derive(Clone, Copy, Default)]
+struct NameHasher(u64);
+
+impl Hasher for NameHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(c);
+            self.add(u64::from_le_bytes(w));
+        }
+        for &b in chunks.remainder() {
+            self.add(u64::from(b));
+        }
+    }
+
+    fn write_u8(&mut self, i: u8) {
+        self.add(u64::from(i));
+    }
+
+    fn write_usize(&mut self, i: usize) {
+        self.add(i as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+impl NameHasher {
+    fn add(&mut self, w: u64) {
+        self.0 = (self.0.rotate_left(5) ^ w).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
 use std::ops::Range;
 
 use crate::checked::*;
@@ -73,7 +111,7 @@ pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
         let mut cx = Cx {
             src,
             diags: Vec::new(),
-            names: HashMap::new(),
+            names: HashMap::default(),
             let_refs: Vec::new(),
             broken_names: spec.broken.iter().flat_map(|b| b.names.iter().cloned()).collect(),
         };
@@ -95,7 +133,7 @@ enum NameRef {
 struct Cx<'s> {
     src: &'s str,
     diags: Vec<Diagnostic>,
-    names: HashMap<String, (NameRef, Range<usize>)>,
+    names: HashMap<String, (NameRef, Range<usize>), BuildHasherDefault<NameHasher>>,
     /// Let references found while resolving the current formula: (let index, range).
     let_refs: Vec<(usize, Range<usize>)>,
     /// Names declared by items that did not parse: unknown-name errors about them would
@@ -574,7 +612,7 @@ impl Cx<'_> {
                 let mut parts = Vec::new();
                 let mut lhs = self.expr(first);
                 let mut ok = true;
-                for (op, op_range, e) in rest {
+                for (k, (op, op_range, e)) in rest.iter().enumerate() {
                     let rhs = self.expr(e);
                     let cop = match op {
                         syntax::CmpOp::Lt => Some(CmpOp::Lt),
@@ -594,13 +632,23 @@ impl Cx<'_> {
                         }
                     };
                     match cop {
-                        Some(c) => parts.push(CFormula {
-                            range: lhs.range.start..rhs.range.end,
-                            kind: CFormulaKind::Cmp(c, lhs, rhs.clone()),
-                        }),
-                        None => ok = false,
+                        // The last expression is moved, not copied: it ends the chain.
+                        Some(c) if k + 1 == rest.len() => {
+                            let range = lhs.range.start..rhs.range.end;
+                            parts.push(CFormula { range, kind: CFormulaKind::Cmp(c, lhs, rhs) });
+                            break;
+                        }
+                        Some(c) => {
+                            let next = rhs.clone();
+                            let range = lhs.range.start..rhs.range.end;
+                            parts.push(CFormula { range, kind: CFormulaKind::Cmp(c, lhs, rhs) });
+                            lhs = next;
+                        }
+                        None => {
+                            ok = false;
+                            lhs = rhs;
+                        }
                     }
-                    lhs = rhs;
                 }
                 if !ok {
                     return invalid;
