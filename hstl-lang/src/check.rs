@@ -278,16 +278,17 @@ impl Cx<'_> {
         self.mark_used(&mut out);
         // A broken item or an invalid part may have used any let: stay quiet then.
         if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {
+            // One warning per unused let, possibly thousands: the code's severity is
+            // looked up once.
+            let unused = Diagnostic::new("HSTL101", 0..0, String::new())
+                .with_help("use it in the task or an option, or remove it");
             for l in &out.lets {
                 if !l.used {
-                    self.push(
-                        Diagnostic::new(
-                            "HSTL101",
-                            l.name_range.clone(),
-                            format!("unused `let` `{}`", l.name),
-                        )
-                        .with_help("use it in the task or an option, or remove it"),
-                    );
+                    self.push(Diagnostic {
+                        range: l.name_range.clone(),
+                        message: format!("unused `let` `{}`", l.name),
+                        ..unused.clone()
+                    });
                 }
             }
         }
