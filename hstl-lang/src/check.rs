@@ -1408,7 +1408,7 @@ impl Cx<'_> {
                 roots.push(f);
             }
         }
-        let mut ev = StateEvaluator::new(out, &roots);
+        let ev = StateEvaluator::new(out, &roots);
         // Bound the time spent: each state evaluates the lets the regions need.
         let work = size.saturating_mul((ev.needed_lets() + roots.len()) as u64);
         if work > MAX_DOMAIN_WORK {
@@ -1443,24 +1443,46 @@ impl Cx<'_> {
             }
             s
         };
-        // Pass 1: region counts and the maximum robustness of each reach.
-        let mut region_sat = vec![0u64; regions.len()];
-        let mut reach_max = vec![f64::NEG_INFINITY; np];
-        let mut init_set = vec![vec![false; n]; np];
-        for k in 0..n {
-            let s = states(k);
-            ev.load(&s);
-            for (r, (f, _, _)) in regions.iter().enumerate() {
-                if ev.robustness(f, &s) > 0.0 {
-                    region_sat[r] += 1;
+        // Pass 1: region counts and the maximum robustness of each reach. States are
+        // independent: large domains are split into contiguous chunks run on several
+        // threads, merged in state order (the same counts, maxima and sets).
+        let chunks = over_states(out, &roots, n, work, |ev, ks| {
+            let mut region_sat = vec![0u64; regions.len()];
+            let mut reach_max = vec![f64::NEG_INFINITY; np];
+            let mut init_set = vec![Vec::with_capacity(ks.len()); np];
+            for k in ks {
+                let s = states(k);
+                ev.load(&s);
+                for (r, (f, _, _)) in regions.iter().enumerate() {
+                    if ev.robustness(f, &s) > 0.0 {
+                        region_sat[r] += 1;
+                    }
+                }
+                for (p, prim) in out.primitives.iter().enumerate() {
+                    let v = ev.robustness(&prim.reach, &s);
+                    if v > reach_max[p] {
+                        reach_max[p] = v;
+                    }
+                    init_set[p].push(ev.robustness(&prim.init, &s) > 0.0);
                 }
             }
-            for (p, prim) in out.primitives.iter().enumerate() {
-                let v = ev.robustness(&prim.reach, &s);
-                if v > reach_max[p] {
-                    reach_max[p] = v;
+            (region_sat, reach_max, init_set)
+        });
+        let mut region_sat = vec![0u64; regions.len()];
+        let mut reach_max = vec![f64::NEG_INFINITY; np];
+        let mut init_set: Vec<Vec<bool>> = vec![Vec::with_capacity(n); np];
+        for (sat, max, init) in chunks {
+            for (total, c) in region_sat.iter_mut().zip(sat) {
+                *total += c;
+            }
+            // Chunks in state order, and only a larger value replaces: the first maximum.
+            for (m, v) in reach_max.iter_mut().zip(max) {
+                if v > *m {
+                    *m = v;
                 }
-                init_set[p][k] = ev.robustness(&prim.init, &s) > 0.0;
+            }
+            for (set, part) in init_set.iter_mut().zip(init) {
+                set.extend(part);
             }
         }
         for (r, (_, range, name)) in regions.iter().enumerate() {
@@ -1488,15 +1510,24 @@ impl Cx<'_> {
             return;
         }
         // Pass 2: termination sets.
-        let mut term_set = vec![vec![false; n]; np];
-        for k in 0..n {
-            let s = states(k);
-            ev.load(&s);
-            for (p, prim) in out.primitives.iter().enumerate() {
-                term_set[p][k] = match &prim.terminate {
-                    Terminate::Argmax => ev.robustness(&prim.reach, &s) == reach_max[p],
-                    Terminate::Formula(f) => ev.robustness(f, &s) > 0.0,
-                };
+        let chunks = over_states(out, &roots, n, work, |ev, ks| {
+            let mut term_set = vec![Vec::with_capacity(ks.len()); np];
+            for k in ks {
+                let s = states(k);
+                ev.load(&s);
+                for (p, prim) in out.primitives.iter().enumerate() {
+                    term_set[p].push(match &prim.terminate {
+                        Terminate::Argmax => ev.robustness(&prim.reach, &s) == reach_max[p],
+                        Terminate::Formula(f) => ev.robustness(f, &s) > 0.0,
+                    });
+                }
+            }
+            term_set
+        });
+        let mut term_set: Vec<Vec<bool>> = vec![Vec::with_capacity(n); np];
+        for chunk in chunks {
+            for (set, part) in term_set.iter_mut().zip(chunk) {
+                set.extend(part);
             }
         }
         // HSTL018: states where no option of the set can start.
@@ -1577,6 +1608,62 @@ fn value_range(v: &ParamValue) -> Range<usize> {
         ParamValue::Word(w) => w.range.clone(),
         ParamValue::Group(_, r) => r.clone(),
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests set this to run the finite-domain passes on one thread, for comparison.
+    static ONE_THREAD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Whether a test asked for one thread.
+fn one_thread() -> bool {
+    #[cfg(test)]
+    let one = ONE_THREAD.with(std::cell::Cell::get);
+    #[cfg(not(test))]
+    let one = false;
+    one
+}
+
+/// Work (states times formulas) from which the finite-domain passes use several threads.
+const PARALLEL_DOMAIN_WORK: u64 = 100_000;
+
+/// Runs `pass` over the states `0..n` with an evaluator of `roots`: in one piece, or for
+/// `work` of at least [`PARALLEL_DOMAIN_WORK`] in contiguous chunks on up to four
+/// threads. The results come in state order.
+fn over_states<T: Send>(
+    out: &CheckedSpec,
+    roots: &[&CFormula],
+    n: usize,
+    work: u64,
+    pass: impl Fn(&mut StateEvaluator<'_>, Range<usize>) -> T + Sync,
+) -> Vec<T> {
+    let run = |ks: Range<usize>| pass(&mut StateEvaluator::new(out, roots), ks);
+    let threads = std::thread::available_parallelism().map_or(1, |t| t.get()).min(4);
+    if work < PARALLEL_DOMAIN_WORK || threads < 2 || n < threads || one_thread() {
+        return vec![run(0..n)];
+    }
+    let chunk = n.div_ceil(threads);
+    let parts: Vec<Range<usize>> = (0..n).step_by(chunk).map(|a| a..(a + chunk).min(n)).collect();
+    std::thread::scope(|scope| {
+        let run = &run;
+        let handles: Vec<_> = parts[1..]
+            .iter()
+            .map(|ks| {
+                let ks = ks.clone();
+                (ks.clone(), std::thread::Builder::new().spawn_scoped(scope, move || run(ks)))
+            })
+            .collect();
+        let mut results = vec![run(parts[0].clone())];
+        for (ks, spawned) in handles {
+            // A thread that could not start (or failed) leaves its chunk to this one.
+            match spawned.ok().and_then(|h| h.join().ok()) {
+                Some(r) => results.push(r),
+                None => results.push(run(ks)),
+            }
+        }
+        results
+    })
 }
 
 fn has_temporal_node(f: &CFormula) -> bool {
@@ -1668,5 +1755,42 @@ fn gen_positions(
         gen_positions(n, size, perm, cur, used, out);
         cur.pop();
         used[p] = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fixtures whose finite-domain checks report something, with their domains widened
+    /// so that the passes run on several threads: the same diagnostics as on one thread.
+    #[test]
+    fn domain_passes_on_threads_match_one_thread() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures");
+        for name in [
+            "invalid/HSTL020_sequence_gap.hstl",
+            "invalid/HSTL018_no_option_can_start.hstl",
+            "invalid/HSTL102_empty_region.hstl",
+            "invalid/HSTL103_full_region.hstl",
+            "valid/case_study_ot1.hstl",
+        ] {
+            let text = std::fs::read_to_string(format!("{dir}/{name}")).unwrap_or_default();
+            assert!(text.contains("0..=14") || text.contains("0..=9"), "{name}");
+            let wide = text.replace("0..=14", "0..=239").replace("0..=9", "0..=239");
+            let threads = check(&wide);
+            ONE_THREAD.with(|c| c.set(true));
+            let one = check(&wide);
+            ONE_THREAD.with(|c| c.set(false));
+            assert_eq!(format!("{:?}", threads.diagnostics), format!("{:?}", one.diagnostics));
+            assert_eq!(format!("{:?}", threads.specs), format!("{:?}", one.specs));
+            if name.starts_with("invalid") {
+                let code = &name[8..15];
+                assert!(
+                    threads.diagnostics.iter().any(|d| d.code == code),
+                    "{name}: {:?}",
+                    threads.diagnostics
+                );
+            }
+        }
     }
 }
