@@ -21,7 +21,12 @@ pub struct CodeInfo {
 
 /// Looks a code up (case-insensitive).
 pub fn lookup(code: &str) -> Option<&'static CodeInfo> {
-    CODES.iter().find(|c| c.code.eq_ignore_ascii_case(code))
+    // Every diagnostic looks its code up: the exact spelling by binary search (the table is
+    // sorted), any other case by a scan.
+    match CODES.binary_search_by(|c| c.code.cmp(code)) {
+        Ok(i) => Some(&CODES[i]),
+        Err(_) => CODES.iter().find(|c| c.code.eq_ignore_ascii_case(code)),
+    }
 }
 
 use Severity::{Error as E, Warning as W};

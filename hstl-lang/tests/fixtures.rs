@@ -60,7 +60,10 @@ fn every_code_has_an_entry_and_a_fixture() {
         assert!(!c.summary.ends_with('.'), "{} summary ends with a period", c.code);
         assert!(c.explanation.contains("Fix"), "{} explanation names no fix", c.code);
         assert_eq!(codes::lookup(&c.code.to_lowercase()), Some(c));
+        assert_eq!(codes::lookup(c.code), Some(c));
     }
+    // `lookup` binary-searches the exact spelling.
+    assert!(codes::CODES.windows(2).all(|w| w[0].code < w[1].code), "CODES is not sorted");
     for (name, src) in fixtures("invalid").into_iter().chain(fixtures("valid")) {
         for d in check(&src).diagnostics {
             let info = codes::lookup(d.code)
