@@ -1,4 +1,4 @@
-//! Every spec in docs/LANGUAGE.md and in examples/specs checks without errors, as
+//! Every spec in docs/LANGUAGE.md, README.md and examples/specs checks without errors, as
 //! `hstlc check` would report them (warnings allowed, exit status 0).
 
 use std::path::Path;
@@ -13,14 +13,13 @@ fn assert_checks(name: &str, src: &str) {
     assert!(!checked.specs.is_empty(), "{name} holds no spec");
 }
 
-#[test]
-fn every_spec_in_the_language_document_checks() {
-    let doc =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/LANGUAGE.md"))
-            .expect("docs/LANGUAGE.md");
+/// The ```` ```hstl ```` blocks of a Markdown file under the package root.
+fn hstl_blocks(doc: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(doc))
+        .unwrap_or_else(|e| panic!("{doc}: {e}"));
     let mut blocks = Vec::new();
     let mut current: Option<String> = None;
-    for line in doc.lines() {
+    for line in text.lines() {
         match (&mut current, line.trim_start()) {
             (None, l) if l.starts_with("```hstl") => current = Some(String::new()),
             (Some(_), l) if l.starts_with("```") => blocks.extend(current.take()),
@@ -31,12 +30,20 @@ fn every_spec_in_the_language_document_checks() {
             (None, _) => {}
         }
     }
-    // Blocks that are whole specs; the others are items shown on their own (the memory
-    // variant's items are examples/specs/surveillance_memory.hstl, checked below).
-    let specs: Vec<&String> = blocks.iter().filter(|b| b.contains("spec ")).collect();
-    assert!(specs.len() >= 2, "found {} spec blocks", specs.len());
-    for (i, block) in specs.iter().enumerate() {
-        assert_checks(&format!("LANGUAGE.md spec block {}", i + 1), block);
+    blocks
+}
+
+#[test]
+fn every_spec_in_the_language_document_and_the_readme_checks() {
+    for doc in ["docs/LANGUAGE.md", "README.md"] {
+        // Blocks that are whole specs; the others are items shown on their own (the memory
+        // variant's items are examples/specs/surveillance_memory.hstl, checked below).
+        let blocks = hstl_blocks(doc);
+        let specs: Vec<&String> = blocks.iter().filter(|b| b.contains("spec ")).collect();
+        assert!(!specs.is_empty(), "{doc}: no spec blocks");
+        for (i, block) in specs.iter().enumerate() {
+            assert_checks(&format!("{doc} spec block {}", i + 1), block);
+        }
     }
 }
 
