@@ -55,6 +55,21 @@ pub(crate) trait Lattice {
     fn acc(acc: f64, x: f64) -> f64;
 }
 
+/// One step of an n-ary `&&` (`L = Min`) or `||` (`Max`): `out` becomes the fold of `out`
+/// and `v`. `first` says `out` still holds the first operand's raw values, which are folded
+/// into `ID` here (dropping a NaN) rather than in a pass of their own; `v = None` does only
+/// that, for a lone operand.
+#[inline]
+pub(crate) fn fold_operand<L: Lattice>(out: &mut [f64], v: Option<&[f64]>, first: bool) {
+    match (v, first) {
+        (None, _) => out.iter_mut().for_each(|a| *a = L::acc(L::ID, *a)),
+        (Some(v), true) => {
+            out.iter_mut().zip(v).for_each(|(a, b)| *a = L::acc(L::acc(L::ID, *a), *b))
+        }
+        (Some(v), false) => out.iter_mut().zip(v).for_each(|(a, b)| *a = L::acc(*a, *b)),
+    }
+}
+
 pub(crate) struct Min;
 pub(crate) struct Max;
 
@@ -247,15 +262,11 @@ impl Evaluator {
         // drops a NaN) happens in the first combining pass rather than a pass of its own.
         let mut out = self.eval(first, cols, n);
         if rest.is_empty() {
-            out.iter_mut().for_each(|a| *a = L::acc(L::ID, *a));
+            fold_operand::<L>(&mut out, None, true);
         }
         for (k, g) in rest.iter().enumerate() {
             let v = self.eval(g, cols, n);
-            if k == 0 {
-                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(L::acc(L::ID, *a), *b));
-            } else {
-                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(*a, *b));
-            }
+            fold_operand::<L>(&mut out, Some(&v), k == 0);
             self.pool.push(v);
         }
         out

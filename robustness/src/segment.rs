@@ -10,7 +10,7 @@
 //! running minimum gives all of them.
 
 use crate::kernels::Kernels;
-use crate::offline::{Evaluator, Lattice, Max, Min, piece_len};
+use crate::offline::{Evaluator, Lattice, Max, Min, fold_operand, piece_len};
 use crate::{CmpOp, Expr, Formula, Interval, Trace, reference};
 
 /// Scores segments of a trace against one task, reusing its buffers between calls.
@@ -361,15 +361,11 @@ impl Work {
         };
         let mut out = self.eval(first, tables, seg);
         if rest.is_empty() {
-            out.iter_mut().for_each(|a| *a = L::acc(L::ID, *a));
+            fold_operand::<L>(&mut out, None, true);
         }
         for (k, g) in rest.iter().enumerate() {
             let v = self.eval(g, tables, seg);
-            if k == 0 {
-                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(L::acc(L::ID, *a), *b));
-            } else {
-                out.iter_mut().zip(&v).for_each(|(a, b)| *a = L::acc(*a, *b));
-            }
+            fold_operand::<L>(&mut out, Some(&v), k == 0);
             self.pool.push(v);
         }
         out
