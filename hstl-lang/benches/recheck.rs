@@ -3,47 +3,13 @@
 //! previous parse) and checks the whole spec (`check_parsed`); for comparison, the full
 //! `check` of the new text, and formatting it. The target for re-checking is 50 ms.
 
+#[path = "common/mod.rs"]
+mod common;
+
+use common::big_spec;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use hstl_lang::incremental::{Reuse, reparse};
-use std::fmt::Write as _;
 use std::hint::black_box;
-
-/// The spec of `benches/check.rs`: about `lines` lines of lets over four bounded
-/// variables, a persistent task over the last four lets and four options.
-fn big_spec(lines: usize) -> String {
-    let mut s = String::from("/// Generated.\nspec Big {\n    state {\n");
-    for v in 0..4 {
-        let _ = writeln!(s, "        /// Variable {v}.\n        v{v}: int in 0..=9,");
-    }
-    s.push_str("    }\n");
-    for i in 0..lines {
-        let (a, b) = (i % 4, (i + 1) % 4);
-        if i >= 3 && i % 3 == 0 {
-            let _ = writeln!(
-                s,
-                "    let L{i} = L{} || (v{a} + {} > v{b} && abs(v{a} - 3) < 2.5);",
-                (i / 3) % 97 * 3 + 1,
-                i % 7
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                "    let L{i} = {} < v{a} < {} && v{b} >= {}; // region {i}",
-                i % 5,
-                5 + i % 5,
-                i % 3
-            );
-        }
-    }
-    let task: Vec<String> =
-        (0..4).map(|k| format!("eventually[0..40] L{}", lines - 1 - k)).collect();
-    let _ = writeln!(s, "    task always[0..] ({});", task.join(" && "));
-    for k in 0..4 {
-        let _ = writeln!(s, "    option L{};", lines - 1 - k);
-    }
-    s.push_str("    learn { episodes: 100, flat: { gamma: 0.95 } }\n}\n");
-    s
-}
 
 fn bench(c: &mut Criterion) {
     let src = big_spec(10_000);
