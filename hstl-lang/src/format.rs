@@ -23,8 +23,10 @@
 //! formatted: [`format()`] returns the parser's diagnostics instead.
 
 use crate::diagnostic::Diagnostic;
-use crate::parser::parse;
-use crate::syntax::{FieldValue, File, Formula, FormulaKind, Item, OptionsKind, Param, ParamValue};
+use crate::parser::{self, TokKind, parse};
+use crate::syntax::{
+    CommentKind, FieldValue, File, Formula, FormulaKind, Item, OptionsKind, Param, ParamValue,
+};
 
 /// One level of indentation.
 pub const INDENT: &str = "    ";
@@ -73,85 +75,33 @@ impl Tok {
     }
 }
 
-/// The same tokens as the parser's lexer, with comments as tokens.
+/// The parser's tokens, with its comments as tokens too, in source order.
 pub(crate) fn lex(src: &str) -> Vec<Tok> {
-    let b = src.as_bytes();
-    let mut toks = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        let c = b[i];
-        let start = i;
-        let kind = if c.is_ascii_whitespace() {
-            i += 1;
-            continue;
-        } else if b[i..].starts_with(b"//") {
-            while i < b.len() && b[i] != b'\n' {
-                i += 1;
-            }
-            if b[start..].starts_with(b"///") && !b[start..].starts_with(b"////") {
-                Kind::Doc
-            } else {
-                Kind::LineComment
-            }
-        } else if b[i..].starts_with(b"/*") {
-            let mut depth = 0usize;
-            while i < b.len() {
-                if b[i..].starts_with(b"/*") {
-                    depth += 1;
-                    i += 2;
-                } else if b[i..].starts_with(b"*/") {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-            if depth > 0 {
-                i = b.len();
-            }
-            Kind::BlockComment
-        } else if c.is_ascii_alphabetic() || c == b'_' {
-            while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
-                i += 1;
-            }
-            Kind::Word
-        } else if c.is_ascii_digit() {
-            while i < b.len() && b[i].is_ascii_digit() {
-                i += 1;
-            }
-            if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
-                i += 1;
-                while i < b.len() && b[i].is_ascii_digit() {
-                    i += 1;
-                }
-            }
-            if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-                let mut j = i + 1;
-                if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
-                    j += 1;
-                }
-                if j < b.len() && b[j].is_ascii_digit() {
-                    i = j;
-                    while i < b.len() && b[i].is_ascii_digit() {
-                        i += 1;
-                    }
-                }
-            }
-            Kind::Number
-        } else if c.is_ascii() {
-            let ops: [&[u8]; 10] =
-                [b"..=", b"..", b"->", b"&&", b"||", b"<=", b">=", b"==", b"!=", b"::"];
-            i += ops.iter().find(|op| b[i..].starts_with(op)).map_or(1, |op| op.len());
-            Kind::Punct
-        } else {
-            i += src[i..].chars().next().map_or(1, char::len_utf8);
-            Kind::Other
+    let mut comments = Vec::new();
+    let tokens = parser::lex(src, &mut comments, &mut Vec::new());
+    let mut toks: Vec<Tok> = tokens
+        .iter()
+        .map(|t| {
+            let kind = match t.kind {
+                TokKind::Word => Kind::Word,
+                TokKind::Number => Kind::Number,
+                TokKind::Punct => Kind::Punct,
+                TokKind::Doc => Kind::Doc,
+                TokKind::Other => Kind::Other,
+            };
+            Tok { kind, start: t.start, end: t.end }
+        })
+        .collect();
+    // Doc comments are tokens already.
+    toks.extend(comments.iter().filter_map(|c| {
+        let kind = match c.kind {
+            CommentKind::Line => Kind::LineComment,
+            CommentKind::Block => Kind::BlockComment,
+            CommentKind::Doc => return None,
         };
-        toks.push(Tok { kind, start, end: i });
-    }
+        Some(Tok { kind, start: c.range.start, end: c.range.end })
+    }));
+    toks.sort_unstable_by_key(|t| t.start);
     toks
 }
 

@@ -38,7 +38,7 @@ mod grammar {
 use grammar::{HstlParser, Rule};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum TokKind {
+pub(crate) enum TokKind {
     Word,
     Number,
     Punct,
@@ -47,10 +47,10 @@ enum TokKind {
 }
 
 #[derive(Clone, Copy, Debug)]
-struct Tok {
-    kind: TokKind,
-    start: usize,
-    end: usize,
+pub(crate) struct Tok {
+    pub(crate) kind: TokKind,
+    pub(crate) start: usize,
+    pub(crate) end: usize,
 }
 
 /// Items in a spec from which they are parsed on several threads.
@@ -100,7 +100,7 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
     Parsed { file: File { specs, comments }, diagnostics }
 }
 
-fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> Vec<Tok> {
+pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> Vec<Tok> {
     let b = src.as_bytes();
     let mut toks = Vec::new();
     let mut i = 0;
