@@ -65,6 +65,6 @@ pub use check::{Checked, check, check_parsed};
 pub use checked::*;
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use format::format;
-pub use parser::{Parsed, parse};
+pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Position};
 pub use render::render_plain;

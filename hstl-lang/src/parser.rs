@@ -1375,7 +1375,7 @@ impl Builder<'_> {
 }
 
 /// Words that are keywords of the grammar (`keyword` in `grammar.pest`): never names.
-const KEYWORDS: [&str; 20] = [
+pub const KEYWORDS: [&str; 20] = [
     "spec",
     "state",
     "sequences",

@@ -770,39 +770,17 @@ pub fn symbols(a: &Analysis) -> Vec<DocumentSymbol> {
     out
 }
 
-/// Keywords of the language, offered by completion.
-pub const KEYWORDS: [&str; 22] = [
-    "spec",
-    "state",
-    "int",
-    "float",
-    "in",
-    "let",
-    "task",
-    "option",
-    "options",
-    "sequences",
-    "permutations",
-    "learn",
-    "always",
-    "eventually",
-    "until",
-    "true",
-    "false",
-    "abs",
-    "sqrt",
-    "argmax",
-    "reach",
-    "init",
-];
+/// Words completion offers beside the grammar's keywords ([`hstl::lang::KEYWORDS`]): the
+/// fields of a long-form option, which are not reserved.
+const FIELD_WORDS: [&str; 3] = ["reach", "init", "terminate"];
 
 /// Keywords, then the names of the spec the cursor is in (variables, lets, options;
 /// also those declared by items that do not parse yet).
 pub fn completion(a: &Analysis, pos: Position) -> Vec<CompletionItem> {
     let offset = a.conv.offset(&a.text, pos);
-    let mut items: Vec<CompletionItem> = KEYWORDS
+    let mut items: Vec<CompletionItem> = hstl::lang::KEYWORDS
         .iter()
-        .chain(["terminate"].iter())
+        .chain(FIELD_WORDS.iter())
         .map(|k| CompletionItem {
             label: (*k).to_string(),
             kind: Some(CompletionItemKind::KEYWORD),
