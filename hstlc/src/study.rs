@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use hstl::runtime::eval::RegionTable;
 use hstl::runtime::optimum::{SolveConfig, solve};
-use hstl::runtime::{GridWorld, Intra, Region, RewardKind, TaskSpec, seeded_rng};
+use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutFile};
 use crate::cli_error::CliError;
@@ -51,6 +51,8 @@ struct RunResult {
     tail_reward: f64,
     window: Option<f64>,
     curve: Vec<f64>,
+    /// Seed 0's greedy policy, kept for the pictures and `policy.json`.
+    first: Option<(Policy, Agent)>,
 }
 
 /// Runs `hstlc study`.
@@ -173,6 +175,7 @@ fn one_run(spec: &TaskSpec, env: &GridWorld, seed: u64, file: &str) -> Result<Ru
         tail_reward: tail_mean(&outcome.curve, 100),
         window,
         curve: outcome.curve,
+        first: (seed == 0).then_some((outcome.policy, outcome.agent)),
     })
 }
 
@@ -228,7 +231,7 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) {
     }
 }
 
-/// The first seed's policy, curve and pictures, the learning curves of all seeds, and
+/// Seed 0's policy, curve and pictures, the learning curves of all seeds, and
 /// `seeds.csv` with each seed's figures.
 fn write_outputs(
     dir: &Path,
@@ -237,15 +240,16 @@ fn write_outputs(
     loaded: &spec_file::LoadedSpec,
     results: &[RunResult],
 ) -> Result<(), CliError> {
-    // Train seed 0 again for its agent: training is deterministic, so this is the same
-    // policy the table measured.
-    let outcome = train::train(spec, env, 0, &loaded.file, |_, _| {})?;
+    // Seeds run from 0, so the first result is seed 0's.
+    let Some(RunResult { curve, first: Some((policy, agent)), .. }) = results.first() else {
+        return Err(CliError::new("seed 0 did not report its policy", None));
+    };
     let mut files = vec![
-        OutFile::text("policy.json", train::policy_json(&outcome.policy, &loaded.source, 0)?),
-        OutFile::text("curve.csv", artifacts::curve_csv(&outcome.curve)),
+        OutFile::text("policy.json", train::policy_json(policy, &loaded.source, 0)?),
+        OutFile::text("curve.csv", artifacts::curve_csv(curve)),
     ];
     let mut rng = seeded_rng(PICTURE_SEED);
-    files.extend(artifacts::agent_pictures(spec, env, &outcome.agent, &mut rng)?);
+    files.extend(artifacts::agent_pictures(spec, env, agent, &mut rng)?);
     let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
     for (seed, r) in results.iter().enumerate() {
         let window = r.window.map_or(String::new(), |w| w.to_string());

@@ -131,3 +131,25 @@ fn eval_scores_other_tasks_by_their_robustness() {
     assert!(report.contains("task robustness over each run"), "{report}");
     assert!(!report.contains("window rate"), "{report}");
 }
+
+#[test]
+fn study_writes_seed_zero_as_train_does() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (study, single) = (dir.path().join("study"), dir.path().join("single"));
+    let s = hstlc(&[
+        "study",
+        "small.hstl",
+        "--seeds",
+        "2",
+        "--no-optimum",
+        "--out",
+        study.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(s.status.code(), Some(0), "{}", String::from_utf8_lossy(&s.stderr));
+    assert_eq!(train(&single, "0").status.code(), Some(0));
+    for file in ["policy.json", "curve.csv", "options.svg", "run_1.svg"] {
+        assert_eq!(read(&study.join("small").join(file)), read(&single.join(file)), "{file}");
+    }
+    let seeds = read(&study.join("small/seeds.csv"));
+    assert_eq!(seeds.lines().count(), 3, "{seeds}");
+}
