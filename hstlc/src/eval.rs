@@ -12,6 +12,7 @@ use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 use crate::artifacts;
 use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::study::{mean, range};
 use crate::train::env_words;
 use crate::{CmdResult, Status};
 
@@ -157,15 +158,11 @@ fn robustness_of_run(spec: &TaskSpec, states: &Trace, run: &[usize]) -> Result<f
 }
 
 fn print_robustness(values: &[f64]) {
-    let mean = values.iter().sum::<f64>() / values.len().max(1) as f64;
+    let mean = mean(values);
     let (lo, hi) = range(values);
     let satisfied = values.iter().filter(|&&v| v > 0.0).count();
     println!(
         "  task robustness over each run: mean {mean:.3}, min {lo:.3}, max {hi:.3}; satisfied in {satisfied} of {} runs",
         values.len()
     );
-}
-
-fn range(values: &[f64]) -> (f64, f64) {
-    values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)))
 }

@@ -275,10 +275,12 @@ fn intra_word(i: Intra) -> &'static str {
     }
 }
 
-fn mean(v: &[f64]) -> f64 {
+/// The mean (0 for no values).
+pub fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
-fn range(v: &[f64]) -> (f64, f64) {
+/// The smallest and the largest value.
+pub fn range(v: &[f64]) -> (f64, f64) {
     v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)))
 }
