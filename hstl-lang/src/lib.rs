@@ -60,6 +60,7 @@ pub mod parser;
 pub mod position;
 pub mod render;
 pub mod syntax;
+pub mod world;
 
 pub use check::{Checked, check, check_parsed};
 pub use checked::*;
@@ -68,3 +69,4 @@ pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Position};
 pub use render::render_plain;
+pub use world::{WorldFacts, check_in_world};

@@ -7,13 +7,14 @@ use clap::Args;
 use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
 use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::policy::EnvInfo;
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts;
 use crate::check::read_input;
 use crate::cli_error::CliError;
 use crate::study::{mean, range};
-use crate::train::env_words;
+use crate::world_arg::world_words;
 use crate::{CmdResult, Status};
 
 /// Arguments of `hstlc eval`.
@@ -49,23 +50,25 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         .map_err(|e| bad(e.to_string(), "pass the policy.json that `hstlc train` wrote"))?;
     let spec = spec_of(&text, &policy.spec)
         .map_err(|m| bad(m, "train the policy again with `hstlc train`"))?;
-    if policy.env.name != "gridworld" {
-        return Err(bad(
-            format!("unknown environment `{}`", policy.env.name),
-            "this hstlc replays `gridworld` policies",
-        ));
+    let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
+        bad(
+            format!("its world: {e}"),
+            "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)",
+        )
+    })?;
+    let mut policy = policy;
+    if policy.env.params.get("map").is_none() {
+        // Written before world files: the open grid it was, in today's terms.
+        policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };
     }
-    let env = GridWorld::from_params(&policy.env.params)
-        .map_err(|e| bad(e.to_string(), "the `env` entry must hold the grid world's parameters"))?;
-    let agent = policy
-        .agent(&env)
-        .map_err(|e| bad(e.to_string(), "the policy does not fit its environment"))?;
+    let agent =
+        policy.agent(&env).map_err(|e| bad(e.to_string(), "the policy does not fit its world"))?;
     let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
     let mut rng = seeded_rng(args.seed);
     println!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
-        env_words(&env),
+        world_words(&env, None),
         spec.options.len(),
         args.starts,
         args.steps,

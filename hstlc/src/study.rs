@@ -12,7 +12,8 @@ use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpe
 
 use crate::artifacts::{self, OutFile};
 use crate::cli_error::CliError;
-use crate::train::{self, PICTURE_SEED, env_words, tail_mean};
+use crate::train::{self, PICTURE_SEED, tail_mean};
+use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
 /// Arguments of `hstlc study`.
@@ -34,6 +35,9 @@ pub struct StudyArgs {
     /// Skip the optimum W* (value iteration takes a few seconds per region set).
     #[arg(long)]
     pub no_optimum: bool,
+    /// The grid world to train in.
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
+    pub world: String,
     /// Worker threads (default: every core).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -60,17 +64,20 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     if args.seeds == 0 {
         return Err(CliError::new("`--seeds` must be at least 1", None));
     }
-    // Check every spec before the long part starts.
+    // Check every spec against the world before the long part starts.
+    let world = LoadedWorld::load(&args.world)?;
     let mut loaded = Vec::new();
     for path in &args.specs {
-        let Some(l) = spec_file::load(path, None)? else { return Ok(Status::Errors) };
+        let Some(l) = spec_file::load(path, None, Some(&world))? else {
+            return Ok(Status::Errors);
+        };
         let mut spec = l.trainable()?;
         if let Some(e) = args.episodes {
             spec.learn.episodes = e.max(1);
         }
         loaded.push((path.clone(), l, spec));
     }
-    let env = GridWorld::default();
+    let env = &world.world;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
@@ -79,16 +86,16 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         "study: {} specs x {} seeds on {}, {threads} threads",
         loaded.len(),
         args.seeds,
-        env_words(&env)
+        world.words()
     );
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, RewardKind)> = None;
     for (path, l, spec) in &loaded {
-        let results = run_seeds(spec, &env, args.seeds, threads, &l.file)?;
+        let results = run_seeds(spec, env, args.seeds, threads, &l.file)?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
             None
         } else {
-            Some(optimum(&mut optima, spec, &env)?)
+            Some(optimum(&mut optima, spec, env)?)
         };
         let label = path.file_name().map_or(l.file.clone(), |n| n.to_string_lossy().into_owned());
         println!();
@@ -126,12 +133,12 @@ pub fn run(args: &StudyArgs) -> CmdResult {
                 Intra::Paper => Intra::Remaining,
                 Intra::Remaining => Intra::Paper,
             };
-            let alt = run_seeds(&other, &env, args.seeds, threads, &l.file)?;
+            let alt = run_seeds(&other, env, args.seeds, threads, &l.file)?;
             println!("  with intra: {} instead:", intra_word(other.learn.intra));
             print_table(&alt, w_star);
         }
         let dir = args.out.join(stem(path));
-        write_outputs(&dir, spec, &env, l, &results)?;
+        write_outputs(&dir, spec, env, l, &results)?;
         println!("  wrote {}", dir.display());
     }
     Ok(Status::Clean)
@@ -249,7 +256,8 @@ fn write_outputs(
         OutFile::text("curve.csv", artifacts::curve_csv(curve)),
     ];
     let mut rng = seeded_rng(PICTURE_SEED);
-    files.extend(artifacts::agent_pictures(spec, env, agent, &mut rng)?);
+    let regions = artifacts::pictured_regions(loaded)?;
+    files.extend(artifacts::agent_pictures(spec, env, &regions, agent, &mut rng)?);
     let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
     for (seed, r) in results.iter().enumerate() {
         let window = r.window.map_or(String::new(), |w| w.to_string());

@@ -4,12 +4,13 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
 use hstl::runtime::{GridWorld, Learner, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutFile};
 use crate::cli_error::CliError;
+use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
 /// Arguments of `hstlc train`.
@@ -18,9 +19,9 @@ pub struct TrainArgs {
     /// The spec file (`-` reads standard input).
     #[arg(value_name = "SPEC")]
     pub spec: PathBuf,
-    /// The environment.
-    #[arg(long, value_enum, default_value_t = EnvName::Gridworld)]
-    pub env: EnvName,
+    /// The grid world to train in.
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
+    pub world: String,
     /// The seed of the one random generator every draw comes from.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -33,13 +34,6 @@ pub struct TrainArgs {
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
     pub spec_name: Option<String>,
-}
-
-/// The environments `train` knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EnvName {
-    /// The paper's grid world: 15 x 15, each action taken with probability 0.7.
-    Gridworld,
 }
 
 /// One trained policy and what was measured while training it.
@@ -58,7 +52,8 @@ pub struct Outcome {
 
 /// Runs `hstlc train`.
 pub fn run(args: &TrainArgs) -> CmdResult {
-    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
+    let world = LoadedWorld::load(&args.world)?;
+    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), Some(&world))? else {
         return Ok(Status::Errors);
     };
     let mut spec = loaded.trainable()?;
@@ -68,11 +63,9 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         }
         spec.learn.episodes = e;
     }
-    let env = match args.env {
-        EnvName::Gridworld => GridWorld::default(),
-    };
+    let env = &world.world;
     let bar = progress_bar(spec.learn.episodes as u64);
-    let outcome = train(&spec, &env, args.seed, &loaded.file, |episode, reward| {
+    let outcome = train(&spec, env, args.seed, &loaded.file, |episode, reward| {
         bar.set_position(episode as u64 + 1);
         bar.set_message(format!("reward {reward:.1}"));
     })?;
@@ -83,19 +76,20 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         OutFile::text("curve.csv", artifacts::curve_csv(&outcome.curve)),
     ];
     let mut rng = seeded_rng(args.seed ^ PICTURE_SEED);
-    files.extend(artifacts::agent_pictures(&spec, &env, &outcome.agent, &mut rng)?);
+    let regions = artifacts::pictured_regions(&loaded)?;
+    files.extend(artifacts::agent_pictures(&spec, env, &regions, &outcome.agent, &mut rng)?);
     files.push(artifacts::curve_picture(
         &format!("Learning curve of {} (seed {})", spec.name, args.seed),
         std::slice::from_ref(&outcome.curve),
     )?);
-    let window = window_report(&spec, &env, &outcome.agent, args.seed)?;
+    let window = window_report(&spec, env, &outcome.agent, args.seed)?;
     let written = artifacts::write_all(&args.out, &files)?;
 
     let tail = tail_mean(&outcome.curve, 100);
     println!(
         "trained `{}` on {} (seed {}): {} episodes, {} steps in {:.2} s ({:.1}M steps/s)",
         spec.name,
-        env_words(&env),
+        world.words(),
         args.seed,
         outcome.curve.len(),
         outcome.steps,
@@ -133,11 +127,7 @@ pub fn train(
     let mut learner = Learner::new(spec, env).map_err(|e| {
         CliError::new(
             format!("{file}: cannot train `{}`: {e}", spec.name),
-            Some(
-                "options need `int` state variables with ranges that fit the environment, and \
-                 at least one option"
-                    .to_string(),
-            ),
+            Some("run `hstlc check` with the same `--world` to see where the spec and the world differ".to_string()),
         )
     })?;
     let mut rng = seeded_rng(seed);
@@ -183,11 +173,6 @@ pub fn window_report(
 pub fn tail_mean(curve: &[f64], n: usize) -> f64 {
     let tail = &curve[curve.len().saturating_sub(n)..];
     tail.iter().sum::<f64>() / tail.len().max(1) as f64
-}
-
-/// `gridworld 15 x 15, p = 0.7`.
-pub fn env_words(env: &GridWorld) -> String {
-    format!("gridworld {} x {}, p = {}", env.width(), env.height(), env.p())
 }
 
 fn names(files: &[OutFile]) -> String {

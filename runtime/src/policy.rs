@@ -340,13 +340,17 @@ impl Policy {
     /// `env`: another environment, a state it does not cover, an unknown name.
     pub fn agent<E: Env>(&self, env: &E) -> Result<Agent, Error> {
         let err = |m: String| Err(Error::Policy(m));
-        if self.env.name != env.name() || self.env.params != env.params() {
+        if self.env.name != env.name() {
             return err(format!(
-                "the policy was trained on {} {}, not on {} {}",
+                "the policy was trained on `{}`, not on `{}`",
                 self.env.name,
-                self.env.params,
-                env.name(),
-                env.params()
+                env.name()
+            ));
+        }
+        if self.env.params != env.params() {
+            return err(format!(
+                "the policy was trained on another `{}` (its parameters differ)",
+                env.name()
             ));
         }
         if self.state_vars != env.state_vars() || self.actions != env.actions() {
