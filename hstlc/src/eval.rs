@@ -5,7 +5,9 @@ use std::time::Instant;
 
 use clap::Args;
 use hstl::robustness::{Trace, offline};
-use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
+use hstl::runtime::eval::{
+    AgentController, EntryCycle, RegionTable, WindowConfig, rollout, window_rate,
+};
 use hstl::runtime::optimum::{SolveConfig, solve};
 use hstl::runtime::policy::EnvInfo;
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
@@ -113,6 +115,16 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             .join(", ")
     );
     print_robustness(&report.robustness);
+    // A hand-written yardstick over the same starts and slips: a learned policy below it has
+    // not learned the legs.
+    if let Ok(mut cycle) = EntryCycle::new(&env, &regions) {
+        let base = window_rate(&env, &mut cycle, &regions, config, &mut seeded_rng(args.seed))
+            .map_err(|e| CliError::new(e.to_string(), None))?;
+        println!(
+            "  hand-written baseline (the regions in turn, each by a shortest path around the walls): window rate {:.4}",
+            base.rate
+        );
+    }
     if !args.no_optimum {
         let start = Instant::now();
         let optimum = solve(&env, &regions, SolveConfig::default())
