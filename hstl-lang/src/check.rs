@@ -288,6 +288,9 @@ impl Cx<'_> {
             self.learn(l, &mut out);
         }
         self.persistent_needs(learn, &out);
+        if let Some(l) = learn {
+            self.diags.extend(crate::budget::learning(self.src, l, &out));
+        }
         self.mark_used(&mut out);
         // A broken item or an invalid part may have used any let: stay quiet then.
         if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {
@@ -1685,7 +1688,7 @@ impl Cx<'_> {
 }
 
 /// `1234567` as `1,234,567`.
-fn thousands(n: u64) -> String {
+pub(crate) fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {

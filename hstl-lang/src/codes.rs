@@ -327,6 +327,18 @@ Example:\n    option A { terminate: x > 20 }   // x runs over 0..=14\n\n\
 Fix: widen `terminate`, or leave it out: the option then stops where its region is most robust.",
     },
     CodeInfo {
+        code: "HSTL033",
+        name: "memory-too-large",
+        severity: E,
+        summary: "memory or the window reward would need more than the stated limits",
+        explanation: "`memory: B` gives the options level one observation per state and memory \
+value, (B + 1)^k memory values for k regions; `policy.json` holds an entry for each. At most \
+2,097,152 observations (states times memory values) are allowed. Memory and `reward: window` \
+also keep a table entry per step of each window: windows of at most 1,000,000 steps.\n\n\
+Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 million\n\n\
+Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,

@@ -50,6 +50,7 @@
 // generated parser then names `crate::alloc`.
 extern crate alloc;
 
+pub mod budget;
 pub mod check;
 pub mod checked;
 pub mod codes;

@@ -25,11 +25,11 @@ pub struct EvalArgs {
     /// The `policy.json` that `hstlc train` wrote.
     #[arg(value_name = "POLICY.json")]
     pub policy: PathBuf,
-    /// Greedy runs, each from a random start.
-    #[arg(long, default_value_t = 100)]
+    /// Greedy runs, each from a random start (at most 100,000).
+    #[arg(long, default_value_t = 100, value_parser = count(100_000))]
     pub starts: usize,
-    /// Steps per run.
-    #[arg(long, default_value_t = 2000)]
+    /// Steps per run (at most 1,000,000; a run is kept whole for its robustness).
+    #[arg(long, default_value_t = 2000, value_parser = count(1_000_000))]
     pub steps: usize,
     /// Steps at the start of each run that the window rate does not count.
     #[arg(long, default_value_t = 100)]
@@ -42,8 +42,26 @@ pub struct EvalArgs {
     pub no_optimum: bool,
 }
 
+/// At most this many steps over all runs of one evaluation.
+const MAX_EVAL_STEPS: usize = 200_000_000;
+
+/// A count flag from 1 to `max`.
+fn count(max: u64) -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(1..=max)
+}
+
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
+    // The flags first: nothing is read or printed for a run that cannot happen.
+    if args.starts.saturating_mul(args.steps) > MAX_EVAL_STEPS {
+        return Err(CliError::new(
+            format!(
+                "{} runs of {} steps are more than the {MAX_EVAL_STEPS} steps an evaluation may take",
+                args.starts, args.steps
+            ),
+            Some("lower `--starts` or `--steps`".into()),
+        ));
+    }
     let (name, text) = read_input(&args.policy, "<stdin>")?;
     let bad = |message: String, help: &str| {
         CliError::new(format!("{name}: {message}"), Some(help.to_string()))
@@ -63,9 +81,24 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         // Written before world files: the open grid it was, in today's terms.
         policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };
     }
+    policy.check_against(&spec, &env).map_err(|e| {
+        bad(
+            e.to_string(),
+            "the file was edited or damaged: train the policy again with `hstlc train`",
+        )
+    })?;
     let agent =
         policy.agent(&env).map_err(|e| bad(e.to_string(), "the policy does not fit its world"))?;
     let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
+    if !spec.regions.is_empty() && args.burn_in >= args.steps {
+        return Err(CliError::new(
+            format!(
+                "a burn-in of {} steps leaves nothing of {}-step runs",
+                args.burn_in, args.steps
+            ),
+            Some("use `--burn-in` smaller than `--steps`".into()),
+        ));
+    }
     let mut rng = seeded_rng(args.seed);
     println!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
@@ -78,9 +111,6 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     );
     if spec.regions.is_empty() {
         // Not a persistent task: the task's robustness over each run is the measure.
-        if args.starts == 0 || args.steps == 0 {
-            return Err(CliError::new("`--starts` and `--steps` must be at least 1", None));
-        }
         let all_states = artifacts::state_trace(&spec, &env)?;
         let mut controller = AgentController::new(&agent);
         let mut values = Vec::with_capacity(args.starts);

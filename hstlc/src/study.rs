@@ -23,11 +23,11 @@ pub struct StudyArgs {
     /// comparison.
     #[arg(required = true, value_name = "SPEC")]
     pub specs: Vec<PathBuf>,
-    /// Seeds per spec: 0, 1, ... N-1.
-    #[arg(long, default_value_t = 20)]
+    /// Seeds per spec: 0, 1, ... N-1 (at most 100,000).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub seeds: u64,
-    /// Training episodes (overrides each spec's `learn { episodes }`).
-    #[arg(long, value_name = "N")]
+    /// Training episodes (overrides each spec's `learn { episodes }`; at most 10,000,000).
+    #[arg(long, value_name = "N", value_parser = train::episodes_flag())]
     pub episodes: Option<usize>,
     /// Also train each spec with the other `intra` crediting rule, and report both.
     #[arg(long)]
@@ -38,8 +38,8 @@ pub struct StudyArgs {
     /// The grid world to train in.
     #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
     pub world: String,
-    /// Worker threads (default: every core).
-    #[arg(long)]
+    /// Worker threads (default: every core; at most 256).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=256))]
     pub threads: Option<usize>,
     /// The folder for each spec's policy (first seed), curves, pictures and per-seed
     /// figures (`seeds.csv`).
@@ -61,9 +61,6 @@ struct RunResult {
 
 /// Runs `hstlc study`.
 pub fn run(args: &StudyArgs) -> CmdResult {
-    if args.seeds == 0 {
-        return Err(CliError::new("`--seeds` must be at least 1", None));
-    }
     // Check every spec against the world before the long part starts.
     let world = LoadedWorld::load(&args.world)?;
     let mut loaded = Vec::new();
@@ -73,7 +70,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         };
         let mut spec = l.trainable()?;
         if let Some(e) = args.episodes {
-            spec.learn.episodes = e.max(1);
+            spec.learn.episodes = e;
         }
         loaded.push((path.clone(), l, spec));
     }
@@ -153,18 +150,26 @@ fn run_seeds(
     file: &str,
 ) -> Result<Vec<RunResult>, CliError> {
     let threads = threads.min(seeds as usize).max(1) as u64;
+    let share = |w: u64| {
+        (0..seeds)
+            .filter(|s| s % threads == w)
+            .map(|seed| (seed, one_run(spec, env, seed, file)))
+            .collect::<Vec<_>>()
+    };
     let mut all: Vec<(u64, Result<RunResult, CliError>)> = std::thread::scope(|scope| {
+        let share = &share;
         let workers: Vec<_> = (0..threads)
-            .map(|w| {
-                scope.spawn(move || {
-                    (0..seeds)
-                        .filter(|s| s % threads == w)
-                        .map(|seed| (seed, one_run(spec, env, seed, file)))
-                        .collect::<Vec<_>>()
-                })
-            })
+            .map(|w| (w, std::thread::Builder::new().spawn_scoped(scope, move || share(w))))
             .collect();
-        workers.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+        let mut all = Vec::new();
+        for (w, worker) in workers {
+            match worker {
+                Ok(handle) => all.extend(handle.join().unwrap_or_default()),
+                // A thread the system would not start: its seeds run here.
+                Err(_) => all.extend(share(w)),
+            }
+        }
+        all
     });
     if all.len() as u64 != seeds {
         return Err(CliError::new("a training thread failed", None));

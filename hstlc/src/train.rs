@@ -25,8 +25,8 @@ pub struct TrainArgs {
     /// The seed of the one random generator every draw comes from.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Training episodes (overrides the spec's `learn { episodes }`).
-    #[arg(long, value_name = "N")]
+    /// Training episodes (overrides the spec's `learn { episodes }`; at most 10,000,000).
+    #[arg(long, value_name = "N", value_parser = episodes_flag())]
     pub episodes: Option<usize>,
     /// The folder to write `policy.json`, `curve.csv` and the pictures into.
     #[arg(long, value_name = "DIR", default_value = "out")]
@@ -58,9 +58,6 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     };
     let mut spec = loaded.trainable()?;
     if let Some(e) = args.episodes {
-        if e == 0 {
-            return Err(CliError::new("`--episodes` must be at least 1", None));
-        }
         spec.learn.episodes = e;
     }
     let env = &world.world;
@@ -109,6 +106,11 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     }
     println!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files));
     Ok(Status::Clean)
+}
+
+/// `--episodes`: 1 to the limit a spec's `learn { episodes }` has.
+pub fn episodes_flag() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(1..=hstl::lang::budget::MAX_EPISODES)
 }
 
 /// The seed offset of the generator that draws the sample runs of the pictures.

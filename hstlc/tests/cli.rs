@@ -89,6 +89,15 @@ const CASES: &[Case] = &[
     case("eval_not_a_policy", &["eval", "not_a_policy.json"]),
     case("eval_missing_file", &["eval", "nowhere.json"]),
     case("study_no_seeds", &["study", "small.hstl", "--seeds", "0"]),
+    // sizes a user controls are checked before anything is allocated (issue 11, class 5)
+    case("train_huge_episodes", &["train", "small.hstl", "--episodes", "4611686018427387904"]),
+    case("train_episodes_not_a_count", &["train", "small.hstl", "--episodes", "1e12"]),
+    case("eval_huge_steps", &["eval", "nowhere.json", "--steps", "18446744073709551615"]),
+    case(
+        "eval_too_many_steps_in_all",
+        &["eval", "nowhere.json", "--starts", "100000", "--steps", "1000000"],
+    ),
+    case("study_too_many_threads", &["study", "small.hstl", "--threads", "5000"]),
 ];
 
 #[test]

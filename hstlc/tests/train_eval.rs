@@ -233,3 +233,43 @@ fn a_policy_from_before_worlds_still_replays() {
     let tail = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
     assert_eq!(tail(&new), tail(&old));
 }
+
+/// `eval` validates a policy whole before using it: a document edited by hand, damaged or
+/// paired with another spec of the same name is an error (exit 2) that says what is wrong.
+#[test]
+fn eval_refuses_tampered_policies() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    let o = train(&out, "2");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let good: serde_json::Value =
+        serde_json::from_str(&read(&out.join("policy.json"))).expect("JSON");
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit); 5] = [
+        ("holds NaN", |d| d["q_tables"]["options"][3] = "7ff8000000000001".into()),
+        ("not 16 hex digits", |d| d["q_tables"]["flat"]["A"][5] = "garbage".into()),
+        ("shape", |d| {
+            d["q_tables"]["options"].as_array_mut().expect("a list").pop();
+        }),
+        ("`flat_policies` is not what its `q_tables` give", |d| {
+            let choice = &mut d["flat_policies"]["A"][40]["choice"];
+            *choice = if choice == "Up" { "Down".into() } else { "Up".into() };
+        }),
+        // Same name, other regions: the termination sets no longer match.
+        ("`primitives` is not what its `q_tables` give", |d| {
+            let src = d["spec_source"].as_str().expect("source").replace("x < 3", "x < 4");
+            d["spec_source"] = src.into();
+        }),
+    ];
+    for (want, edit) in cases {
+        let mut doc = good.clone();
+        edit(&mut doc);
+        let path = dir.path().join("edited.json");
+        std::fs::write(&path, doc.to_string()).expect("write");
+        let e = hstlc(&["eval", path.to_str().expect("utf-8"), "--no-optimum"]);
+        let stderr = String::from_utf8_lossy(&e.stderr);
+        assert_eq!(e.status.code(), Some(2), "{want}: {stderr}");
+        assert!(e.stdout.is_empty(), "{want}: printed before failing");
+        assert!(stderr.contains(want), "{want}: {stderr}");
+    }
+}
