@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
-use hstl::runtime::{GridWorld, Learner, Policy, TaskSpec, seeded_rng};
+use hstl::runtime::eval::WindowConfig;
+use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutFile};
 use crate::cli_error::CliError;
@@ -113,12 +113,9 @@ pub fn episodes_flag() -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(1..=hstl::lang::budget::MAX_EPISODES)
 }
 
-/// The seed offset of the generator that draws the sample runs of the pictures.
-pub const PICTURE_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
-/// The seed offset of the generator that draws the evaluation's starts.
-pub const EVAL_SEED: u64 = 0x5eed;
+pub use hstl::train::PICTURE_SEED;
 
-/// Trains `spec` on `env` from `seed`; `progress` sees each episode and its reward.
+/// Trains `spec` in `env` from `seed`, timed; `progress` sees each episode and its reward.
 pub fn train(
     spec: &TaskSpec,
     env: &GridWorld,
@@ -126,25 +123,21 @@ pub fn train(
     file: &str,
     progress: impl FnMut(usize, f64),
 ) -> Result<Outcome, CliError> {
-    let mut learner = Learner::new(spec, env).map_err(|e| {
+    let start = Instant::now();
+    let trained = hstl::train::train(spec, env, seed, progress).map_err(|e| {
         CliError::new(
             format!("{file}: cannot train `{}`: {e}", spec.name),
             Some("run `hstlc check` with the same `--world` to see where the spec and the world differ".to_string()),
         )
     })?;
-    let mut rng = seeded_rng(seed);
-    let start = Instant::now();
-    let trained = learner.train(&mut rng, progress);
     let secs = start.elapsed().as_secs_f64();
-    let policy = Policy::new(&learner);
-    Ok(Outcome { policy, curve: trained.curve, steps: trained.steps, secs, agent: learner.agent() })
+    let hstl::train::Trained { policy, curve, steps, agent } = trained;
+    Ok(Outcome { policy, curve, steps, secs, agent })
 }
 
-/// `policy.json`: the runtime's document, plus the spec's source and the seed, so that
-/// `eval` needs nothing else.
+/// `policy.json`, as every front end writes it.
 pub fn policy_json(policy: &Policy, source: &str, seed: u64) -> Result<String, CliError> {
-    let extra = [("spec_source", source.into()), ("seed", seed.into())];
-    policy.to_json_with(&extra).map_err(|e| CliError::new(e.to_string(), None))
+    hstl::train::policy_json(policy, source, seed).map_err(|e| CliError::new(e.to_string(), None))
 }
 
 /// The window rate and mean task robustness of the greedy agent, for persistent tasks.
@@ -154,21 +147,9 @@ pub fn window_report(
     agent: &hstl::runtime::Agent,
     seed: u64,
 ) -> Result<Option<(f64, f64)>, CliError> {
-    if spec.regions.is_empty() {
-        return Ok(None);
-    }
-    let regions = RegionTable::new(spec, env).map_err(|e| CliError::new(e.to_string(), None))?;
-    let mut rng = seeded_rng(seed ^ EVAL_SEED);
-    let report = window_rate(
-        env,
-        &mut AgentController::new(agent),
-        &regions,
-        WindowConfig::default(),
-        &mut rng,
-    )
-    .map_err(|e| CliError::new(e.to_string(), None))?;
-    let robustness = report.robustness.iter().sum::<f64>() / report.robustness.len() as f64;
-    Ok(Some((report.rate, robustness)))
+    let summary = hstl::train::window_summary(spec, env, agent, seed)
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    Ok(summary.map(|s| (s.rate, s.robustness)))
 }
 
 /// The mean of the last `n` values.
