@@ -19,7 +19,9 @@
 //! assert_eq!(spec.primitives[0].name, "Goal");
 //! ```
 
+pub mod load;
 pub mod lower;
+pub mod monitor;
 
 pub use hstl_lang as lang;
 pub use hstl_robustness as robustness;
