@@ -9,11 +9,15 @@
 //! [`Online`] takes one state at a time.
 
 use std::fmt;
+use std::sync::{Mutex, PoisonError};
 
 use hstl_lang::CheckedSpec;
 use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
 
 use crate::lower::{self, LowerError};
+
+/// The most threads [`Monitor::signal_batch`] starts, whatever it is asked for.
+pub const MAX_BATCH_THREADS: usize = 64;
 
 /// The task of a spec, or one of its `let`s, ready to score traces.
 #[derive(Clone, Debug)]
@@ -204,7 +208,7 @@ impl Monitor {
     }
 
     /// The signals of many traces of one length (see [`Monitor::batch_steps`]) on up to
-    /// `threads` threads, row-major: trace `i`'s signal is `[i * steps .. (i + 1) * steps]`
+    /// `threads` threads (at most [`MAX_BATCH_THREADS`]), row-major: trace `i`'s signal is `[i * steps .. (i + 1) * steps]`
     /// of the result, and equals what [`Monitor::signal`] gives for that trace alone. Of
     /// several bad traces, the one of the lowest index is reported.
     pub fn signal_batch(
@@ -217,7 +221,10 @@ impl Monitor {
         if traces.is_empty() {
             return Ok((out, steps));
         }
-        let per = traces.len().div_ceil(threads.clamp(1, traces.len()));
+        let workers = threads.clamp(1, traces.len().min(MAX_BATCH_THREADS));
+        // A few pieces per worker, taken from a queue: a worker the OS delays takes fewer.
+        let pieces = if workers == 1 { 1 } else { 4 * workers };
+        let per = traces.len().div_ceil(pieces);
         let work = |first: usize, traces: &[Samples<'_>], out: &mut [f64]| {
             let mut eval = Evaluator::new();
             let mut scratch = Vec::new();
@@ -232,25 +239,41 @@ impl Monitor {
             }
             Ok(())
         };
-        if per == traces.len() {
-            work(0, traces, &mut out)?;
-            return Ok((out, steps));
-        }
-        let work = &work;
-        let results: Vec<Result<(), BatchError>> = std::thread::scope(|scope| {
-            let handles: Vec<_> = traces
-                .chunks(per)
-                .zip(out.chunks_mut(per * steps))
-                .enumerate()
-                .map(|(c, (traces, out))| scope.spawn(move || work(c * per, traces, out)))
+        let jobs: Vec<_> = traces
+            .chunks(per)
+            .zip(out.chunks_mut(per * steps))
+            .enumerate()
+            .map(|(i, (traces, out))| (i * per, traces, out))
+            .collect();
+        let queue = Mutex::new(jobs);
+        let run = || {
+            let mut failed = Vec::new();
+            loop {
+                let job = queue.lock().unwrap_or_else(PoisonError::into_inner).pop();
+                let Some((first, traces, out)) = job else { return failed };
+                if let Err(e) = work(first, traces, out) {
+                    failed.push((first, e));
+                }
+            }
+        };
+        let run = &run;
+        let mut failed = std::thread::scope(|scope| {
+            // A thread the OS refuses is no error: the others, and this one, take its share.
+            let helpers: Vec<_> = (1..workers)
+                .filter_map(|_| std::thread::Builder::new().spawn_scoped(scope, run).ok())
                 .collect();
-            handles
-                .into_iter()
-                .map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
-                .collect()
+            let mut failed = run();
+            for h in helpers {
+                failed.extend(h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
+            }
+            failed
         });
-        results.into_iter().collect::<Result<(), _>>()?;
-        Ok((out, steps))
+        // Each piece reports its first bad trace; the first piece's is the first of all.
+        failed.sort_by_key(|(first, _)| *first);
+        match failed.into_iter().next() {
+            Some((_, e)) => Err(e),
+            None => Ok((out, steps)),
+        }
     }
 
     /// An online monitor of this formula.
@@ -473,7 +496,7 @@ fn columns<'s>(
             scratch.resize_with(picks.len(), Vec::new);
             for (col, &p) in scratch.iter_mut().zip(picks) {
                 col.clear();
-                col.extend(data.chunks_exact(*width).take(len).filter_map(|row| row.get(p)));
+                col.extend(data.get(p..).unwrap_or(&[]).iter().step_by(*width).take(len));
             }
             scratch.iter().map(Vec::as_slice).collect()
         }
