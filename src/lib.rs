@@ -20,7 +20,9 @@
 //! assert_eq!(spec.primitives[0].name, "Goal");
 //! ```
 
+pub mod load;
 pub mod lower;
+pub mod monitor;
 pub mod train;
 pub mod world;
 

@@ -11,6 +11,16 @@ pub enum Severity {
     Error,
 }
 
+impl Severity {
+    /// `"error"` or `"warning"`, as every text and machine format spells it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        }
+    }
+}
+
 /// A secondary source location that matters to a diagnostic, such as a first definition.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Label {

@@ -68,6 +68,6 @@ pub use checked::*;
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
-pub use position::{LineIndex, Position};
-pub use render::render_plain;
+pub use position::{LineIndex, Location, Position};
+pub use render::{FileDiagnostics, render_concise, render_plain};
 pub use world::{WorldFacts, check_in_world};

@@ -11,6 +11,21 @@ pub struct Position {
     pub utf16_column: usize,
 }
 
+/// Where a byte range lies, as the machine formats report it (`hstlc check --format json`,
+/// the Python package's diagnostics): 1-based lines, columns counted in characters, the
+/// end exclusive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Location {
+    /// 1-based line of the start.
+    pub line: usize,
+    /// 1-based column of the start, in characters.
+    pub column: usize,
+    /// 1-based line of the end.
+    pub end_line: usize,
+    /// 1-based column just past the end, in characters.
+    pub end_column: usize,
+}
+
 /// Maps byte offsets of one source text to [`Position`]s. Lines end at `\n`; a `\r`
 /// before it counts as a character of the line.
 #[derive(Clone, Debug)]
@@ -42,6 +57,17 @@ impl LineIndex {
             line: line + 1,
             column: text.chars().count() + 1,
             utf16_column: text.chars().map(char::len_utf16).sum(),
+        }
+    }
+
+    /// The [`Location`] of the byte range `range` of `src`.
+    pub fn location(&self, src: &str, range: &std::ops::Range<usize>) -> Location {
+        let (start, end) = (self.position(src, range.start), self.position(src, range.end));
+        Location {
+            line: start.line,
+            column: start.column,
+            end_line: end.line,
+            end_column: end.column,
         }
     }
 

@@ -1,10 +1,66 @@
-//! A plain rustc-style renderer, for tests and for the macro's file errors.
+//! Plain-text renderers: rustc-style (for tests and the macro's file errors), and the
+//! one-line-per-diagnostic `concise` format that `hstlc check` prints and the Python
+//! package's `SpecError` shows.
 
 use std::fmt::Write as _;
 use std::ops::Range;
 
 use crate::diagnostic::{Diagnostic, Severity};
 use crate::position::LineIndex;
+
+/// One input's diagnostics with the text they point into.
+#[derive(Clone, Copy, Debug)]
+pub struct FileDiagnostics<'a> {
+    /// The name to report: a path, or a name such as `<stdin>`.
+    pub name: &'a str,
+    /// The source text the diagnostics' ranges index.
+    pub source: &'a str,
+    /// The diagnostics, in the order to report them.
+    pub diagnostics: &'a [Diagnostic],
+}
+
+/// The `concise` format: one line per diagnostic, `path:line:col: CODE severity: message`
+/// (1-based, columns in characters), then the [`summary`] line; every line ends with `\n`.
+pub fn render_concise(files: &[FileDiagnostics<'_>]) -> String {
+    let mut out = String::new();
+    for file in files {
+        let index = LineIndex::new(file.source);
+        for d in file.diagnostics {
+            let start = index.position(file.source, d.range.start);
+            let _ = writeln!(
+                out,
+                "{}:{}:{}: {} {}: {}",
+                file.name,
+                start.line,
+                start.column,
+                d.code,
+                d.severity.as_str(),
+                d.message
+            );
+        }
+    }
+    out.push_str(&summary(files));
+    out.push('\n');
+    out
+}
+
+/// The line that ends the human formats: `checked 2 files: 1 error, 3 warnings`, or
+/// `checked 1 file: no problems`.
+pub fn summary(files: &[FileDiagnostics<'_>]) -> String {
+    let all = || files.iter().flat_map(|f| f.diagnostics);
+    let errors = all().filter(|d| d.severity == Severity::Error).count();
+    let warnings = all().filter(|d| d.severity == Severity::Warning).count();
+    let checked = plural(files.len(), "file");
+    if errors + warnings == 0 {
+        format!("checked {checked}: no problems")
+    } else {
+        format!("checked {checked}: {}, {}", plural(errors, "error"), plural(warnings, "warning"))
+    }
+}
+
+fn plural(n: usize, word: &str) -> String {
+    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
+}
 
 /// Renders diagnostics in the style of rustc, without colour:
 ///
@@ -25,10 +81,7 @@ pub fn render_plain(path: &str, src: &str, diagnostics: &[Diagnostic]) -> String
     let index = LineIndex::new(src);
     let mut out = String::new();
     for d in diagnostics {
-        let sev = match d.severity {
-            Severity::Error => "error",
-            Severity::Warning => "warning",
-        };
+        let sev = d.severity.as_str();
         let mut lines: Vec<usize> = vec![index.position(src, d.range.start).line];
         lines.extend(d.labels.iter().map(|l| index.position(src, l.range.start).line));
         let width = lines.iter().max().copied().unwrap_or(1).to_string().len();

@@ -174,3 +174,22 @@ fn line_index_counts_characters_and_utf16_units() {
     let e = src.find('é').expect("é");
     assert_eq!(idx.position(src, e + 1), idx.position(src, e));
 }
+
+#[test]
+fn locations_and_the_concise_format_count_characters() {
+    // `é😀` takes 6 bytes but 2 columns.
+    let src = "\n/* é😀 */ spec S { state { x: int in 0..=9 } let A = x > 3; }\n";
+    let checked = check(src);
+    let d = &checked.diagnostics[0];
+    let at = LineIndex::new(src).location(src, &d.range);
+    assert_eq!((at.line, at.column, at.end_line, at.end_column), (2, 15, 2, 16));
+    let files = [hstl_lang::FileDiagnostics {
+        name: "s.hstl",
+        source: src,
+        diagnostics: &checked.diagnostics,
+    }];
+    assert_eq!(
+        hstl_lang::render_concise(&files),
+        "s.hstl:2:15: HSTL015 error: spec `S` has no `task`\nchecked 1 file: 1 error, 0 warnings\n"
+    );
+}

@@ -50,11 +50,9 @@ impl CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Read { path, source } => {
-                write!(f, "cannot read `{}`: {}", path.display(), io_reason(source))
-            }
+            CliError::Read { path, source } => f.write_str(&hstl::load::read_error(path, source)),
             CliError::Write { path, source } => {
-                write!(f, "cannot write `{}`: {}", path.display(), io_reason(source))
+                write!(f, "cannot write `{}`: {}", path.display(), hstl::load::io_reason(source))
             }
             CliError::Other { message, .. } => f.write_str(message),
         }
@@ -62,14 +60,3 @@ impl fmt::Display for CliError {
 }
 
 impl std::error::Error for CliError {}
-
-/// The OS reason in lower case, without the "(os error N)" tail.
-fn io_reason(e: &std::io::Error) -> String {
-    let text = e.to_string();
-    let text = text.split(" (os error").next().unwrap_or(&text).to_string();
-    let mut chars = text.chars();
-    match chars.next() {
-        Some(c) => c.to_lowercase().chain(chars).collect(),
-        None => text,
-    }
-}

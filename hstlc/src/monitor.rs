@@ -9,7 +9,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use clap::Args;
-use hstl::robustness::offline;
+use hstl::monitor::Monitor;
 
 use crate::check::read_input;
 use crate::cli_error::CliError;
@@ -49,11 +49,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     };
     let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
     let (spec, name) = (&loaded.spec, &loaded.file);
-    let formula = match &args.formula {
-        None => hstl::lower::task(spec),
-        Some(let_name) => hstl::lower::let_formula(spec, let_name),
-    }
-    .map_err(|e| {
+    let monitor = Monitor::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {
             hstl::lower::LowerError::UnknownLet { .. } => {
                 Some("leave out `--formula` to score the task".to_string())
@@ -62,19 +58,19 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
-    let vars: Vec<&str> = spec.state_vars.iter().map(|v| v.name.as_str()).collect();
+    let vars: Vec<&str> = monitor.state_vars().iter().map(String::as_str).collect();
     let trace = trace_csv::read_trace(&trace_text, &vars).map_err(|e| {
         CliError::new(format!("{trace_name}:{}:{}: {}", e.line, e.column, e.message), e.help)
     })?;
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
-        let signal = offline::signal(&formula, &trace);
+        let signal = monitor.signal_of_trace(&trace);
         writeln!(out, "t,robustness").and_then(|()| {
             signal.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))
         })
     } else {
-        writeln!(out, "{}", offline::robustness(&formula, &trace))
+        writeln!(out, "{}", monitor.robustness_of_trace(&trace))
     }
     .and_then(|()| out.flush());
     match written {

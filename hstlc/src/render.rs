@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use hstl::lang::{Diagnostic, LineIndex, Severity};
+use hstl::lang::{Diagnostic, FileDiagnostics, LineIndex, Severity};
 use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceSpan};
 use serde_json::{Value, json};
 
@@ -30,21 +30,7 @@ pub fn full(files: &[Checked], colour: bool) -> String {
 
 /// The `concise` format: `path:line:col: CODE message`, then a summary line.
 pub fn concise(files: &[Checked]) -> String {
-    let mut out = String::new();
-    for file in files {
-        let index = LineIndex::new(&file.source);
-        for d in &file.diagnostics {
-            let start = index.position(&file.source, d.range.start);
-            let kind = severity_word(d.severity);
-            out.push_str(&format!(
-                "{}:{}:{}: {} {kind}: {}\n",
-                file.name, start.line, start.column, d.code, d.message
-            ));
-        }
-    }
-    out.push_str(&summary(files));
-    out.push('\n');
-    out
+    hstl::lang::render_concise(&file_diagnostics(files))
 }
 
 /// The `json` format: one array of flat objects, positions 1-based, end exclusive.
@@ -53,17 +39,16 @@ pub fn json(files: &[Checked]) -> String {
     for file in files {
         let index = LineIndex::new(&file.source);
         for d in &file.diagnostics {
-            let start = index.position(&file.source, d.range.start);
-            let end = index.position(&file.source, d.range.end);
+            let at = index.location(&file.source, &d.range);
             items.push(json!({
                 "file": file.name,
-                "severity": severity_word(d.severity),
+                "severity": d.severity.as_str(),
                 "code": d.code,
                 "message": d.message,
-                "line": start.line,
-                "column": start.column,
-                "end_line": end.line,
-                "end_column": end.column,
+                "line": at.line,
+                "column": at.column,
+                "end_line": at.end_line,
+                "end_column": at.end_column,
                 "help": d.help,
             }));
         }
@@ -92,13 +77,10 @@ pub fn sarif(files: &[Checked]) -> String {
     for file in files {
         let index = LineIndex::new(&file.source);
         let region = |range: &std::ops::Range<usize>| {
-            let (s, e) = (
-                index.position(&file.source, range.start),
-                index.position(&file.source, range.end),
-            );
+            let at = index.location(&file.source, range);
             json!({
-                "startLine": s.line, "startColumn": s.column,
-                "endLine": e.line, "endColumn": e.column,
+                "startLine": at.line, "startColumn": at.column,
+                "endLine": at.end_line, "endColumn": at.end_column,
             })
         };
         let location = |range: &std::ops::Range<usize>, message: Option<&str>| {
@@ -120,7 +102,7 @@ pub fn sarif(files: &[Checked]) -> String {
             }
             results.push(json!({
                 "ruleId": d.code,
-                "level": match d.severity { Severity::Error => "error", Severity::Warning => "warning" },
+                "level": d.severity.as_str(),
                 "message": { "text": text },
                 "locations": [location(&d.range, None)],
                 "relatedLocations": d.labels.iter().enumerate().map(|(i, l)| {
@@ -164,27 +146,14 @@ pub fn cli_error(e: &CliError) -> String {
 
 /// `checked 2 files: 1 error, 3 warnings`.
 fn summary(files: &[Checked]) -> String {
-    let all = || files.iter().flat_map(|f| &f.diagnostics);
-    let errors = all().filter(|d| d.severity == Severity::Error).count();
-    let warnings = all().filter(|d| d.severity == Severity::Warning).count();
-    let n = files.len();
-    let files = plural(n, "file");
-    if errors + warnings == 0 {
-        format!("checked {files}: no problems")
-    } else {
-        format!("checked {files}: {}, {}", plural(errors, "error"), plural(warnings, "warning"))
-    }
+    hstl::lang::render::summary(&file_diagnostics(files))
 }
 
-fn plural(n: usize, word: &str) -> String {
-    if n == 1 { format!("1 {word}") } else { format!("{n} {word}s") }
-}
-
-fn severity_word(s: Severity) -> &'static str {
-    match s {
-        Severity::Error => "error",
-        Severity::Warning => "warning",
-    }
+fn file_diagnostics(files: &[Checked]) -> Vec<FileDiagnostics<'_>> {
+    files
+        .iter()
+        .map(|f| FileDiagnostics { name: &f.name, source: &f.source, diagnostics: &f.diagnostics })
+        .collect()
 }
 
 fn pretty(v: &Value) -> String {

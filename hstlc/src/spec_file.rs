@@ -4,6 +4,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 
 use hstl::lang::{CheckedSpec, Domain, LineIndex};
+use hstl::load::LoadError;
 use hstl::runtime::TaskSpec;
 
 use crate::check::{Checked, read_input};
@@ -80,38 +81,18 @@ pub fn load(
     world: Option<&LoadedWorld>,
 ) -> Result<Option<LoadedSpec>, CliError> {
     let (file, source) = read_input(path, "<stdin>")?;
-    let mut checked = match world {
-        Some(w) => hstl::world::check(&source, &w.world, &w.label),
-        None => hstl::lang::check(&source),
+    let loaded = match world {
+        Some(w) => hstl::load::load_in_world(&source, wanted, &w.world, &w.label),
+        None => hstl::load::load(&source, wanted),
     };
-    if checked.has_errors() {
-        let report = Checked { name: file, source, diagnostics: checked.diagnostics };
-        eprint!("{}", render::full(std::slice::from_ref(&report), std::io::stderr().is_terminal()));
-        return Ok(None);
-    }
-    let index = pick(&checked.specs, wanted, &file)?;
-    let spec = checked.specs.swap_remove(index);
-    Ok(Some(LoadedSpec { file, source, spec }))
-}
-
-/// The index of the spec named `wanted`, or of the only one in the file.
-fn pick(specs: &[CheckedSpec], wanted: Option<&str>, file: &str) -> Result<usize, CliError> {
-    let names = || specs.iter().map(|s| format!("`{}`", s.name)).collect::<Vec<_>>().join(", ");
-    match (wanted, specs.len()) {
-        (None, 1) => Ok(0),
-        (None, 0) => Err(CliError::new(
-            format!("{file}: the file holds no spec"),
-            Some("write `spec Name { ... }` in it".to_string()),
-        )),
-        (None, n) => Err(CliError::new(
-            format!("{file}: the file holds {n} specs"),
-            Some(format!("pick one with `--spec NAME`: {}", names())),
-        )),
-        (Some(w), _) => specs.iter().position(|s| s.name == w).ok_or_else(|| {
-            CliError::new(
-                format!("{file}: no spec named `{w}`"),
-                Some(format!("the file holds {}", names())),
-            )
-        }),
+    match loaded {
+        Ok(loaded) => Ok(Some(LoadedSpec { file, source, spec: loaded.spec })),
+        Err(LoadError::Invalid(diagnostics)) => {
+            let report = Checked { name: file, source, diagnostics };
+            let colour = std::io::stderr().is_terminal();
+            eprint!("{}", render::full(std::slice::from_ref(&report), colour));
+            Ok(None)
+        }
+        Err(e) => Err(CliError::new(format!("{file}: {e}"), e.help("`--spec NAME`"))),
     }
 }

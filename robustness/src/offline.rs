@@ -27,7 +27,7 @@
 //! (`min(0, -0)`): the tests compare with `==`, under which `0 == -0`.
 
 use crate::kernels::Kernels;
-use crate::{CmpOp, Expr, Formula, Interval, Trace};
+use crate::{CmpOp, Expr, Formula, Interval, Trace, TraceError};
 
 const INF: f64 = f64::INFINITY;
 const NEG_INF: f64 = f64::NEG_INFINITY;
@@ -101,6 +101,14 @@ pub fn robustness(f: &Formula, trace: &Trace) -> f64 {
     Evaluator::new().robustness(f, trace)
 }
 
+/// [`signal`] over borrowed columns, read in place: `columns[i]` holds variable `i`, and all
+/// columns have the same length (that of `columns[0]`).
+pub fn signal_of_slices(f: &Formula, columns: &[&[f64]]) -> Result<Vec<f64>, TraceError> {
+    let mut e = Evaluator::new();
+    e.signal_of_slices(f, columns)?;
+    Ok(std::mem::take(&mut e.result))
+}
+
 impl Evaluator {
     /// An evaluator with no buffers yet.
     pub fn new() -> Evaluator {
@@ -122,6 +130,28 @@ impl Evaluator {
     pub fn robustness(&mut self, f: &Formula, trace: &Trace) -> f64 {
         let cols = columns(trace);
         self.robustness_of_columns(f, &cols, trace.len())
+    }
+
+    /// [`Evaluator::signal`] over borrowed columns, read in place: `columns[i]` holds
+    /// variable `i`, and all columns have the same length (that of `columns[0]`).
+    pub fn signal_of_slices(
+        &mut self,
+        f: &Formula,
+        columns: &[&[f64]],
+    ) -> Result<&[f64], TraceError> {
+        let n = same_length(columns)?;
+        Ok(self.signal_of_columns(f, columns, n))
+    }
+
+    /// [`Evaluator::robustness`] over borrowed columns, as [`Evaluator::signal_of_slices`]
+    /// takes them. A formula with a finite horizon `H` reads only the first `H + 1` samples.
+    pub fn robustness_of_slices(
+        &mut self,
+        f: &Formula,
+        columns: &[&[f64]],
+    ) -> Result<f64, TraceError> {
+        let n = same_length(columns)?;
+        Ok(self.robustness_of_columns(f, columns, n))
     }
 
     /// [`Evaluator::signal`] over columns given as slices, each at least `n` long.
@@ -431,6 +461,17 @@ fn simple_atom<'a>(f: &Formula, cols: &[&'a [f64]]) -> Option<(&'a [f64], f64, b
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {
     (0..trace.vars()).map(|i| trace.column(i)).collect()
+}
+
+/// The length of `columns[0]` (0 with no column), if every column has it.
+fn same_length(columns: &[&[f64]]) -> Result<usize, TraceError> {
+    let len = columns.first().map_or(0, |c| c.len());
+    match columns.iter().position(|c| c.len() != len) {
+        None => Ok(len),
+        Some(column) => {
+            Err(TraceError::Ragged { column, expected: len, found: columns[column].len() })
+        }
+    }
 }
 
 /// `buf[t] = buf[t + a]`, and the identity where `t + a` is past the end.

@@ -109,3 +109,17 @@ fn huge_bounds() {
         check_all(&f, &t, &reference::signal(&f, &t));
     }
 }
+
+#[test]
+fn borrowed_slices_give_the_trace_values_or_a_length_error() {
+    let f = parse("always[0..=1] (x > 1) || y > 3");
+    let (x, y) = ([1.0, 2.0, 3.0, 0.5], [4.0, 0.0, 0.0, 9.0]);
+    let trace = trace_xy(&x, &y);
+    let mut ev = hstl_robustness::Evaluator::new();
+    assert_eq!(offline::signal_of_slices(&f, &[&x, &y]).unwrap(), offline::signal(&f, &trace));
+    assert_eq!(ev.signal_of_slices(&f, &[&x, &y]).unwrap(), &offline::signal(&f, &trace)[..]);
+    assert_eq!(ev.robustness_of_slices(&f, &[&x, &y]).unwrap(), offline::robustness(&f, &trace));
+    let ragged = hstl_robustness::TraceError::Ragged { column: 1, expected: 4, found: 2 };
+    assert_eq!(offline::signal_of_slices(&f, &[&x, &y[..2]]).unwrap_err(), ragged);
+    assert_eq!(ev.robustness_of_slices(&f, &[&x, &y[..2]]).unwrap_err(), ragged);
+}

@@ -1,0 +1,81 @@
+//! The facade's monitors on the benchmark walk: the calls the Python package makes
+//! (`Monitor::signal` on borrowed columns, allocating its result; row-major samples; a
+//! batch of 1,000 traces x 1,000 steps on 1 and 2 threads), the native side of
+//! `bench/python/bench.py`.
+//!
+//! `cargo bench -p hstl --bench monitor -- --warm-up-time 1 --measurement-time 3`
+
+#[path = "../robustness/benches/walk.rs"]
+#[allow(dead_code)]
+mod walk;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use hstl::monitor::{Monitor, Samples};
+use std::hint::black_box;
+
+const SPEC: &str = include_str!("../bench/python/bench.hstl");
+/// The batch: the walk cut into this many traces of this many steps.
+const TRACES: usize = 1000;
+const STEPS: usize = 1000;
+
+fn benches(c: &mut Criterion) {
+    let trace = walk::walk(walk::STEPS, &mut walk::SplitMix64(walk::SEED));
+    let (x, y) = (trace.column(0), trace.column(1));
+    let rows: Vec<f64> = x.iter().zip(y).flat_map(|(x, y)| [*x, *y]).collect();
+    let spec = hstl::load::load(SPEC, None).expect("the bench spec checks").spec;
+    let cases = [
+        ("F1_w40", Some("F1_w40")),
+        ("F1_w4000", Some("F1_w4000")),
+        ("F2", None),
+        ("F3", Some("F3")),
+    ];
+    let monitor = |formula| Monitor::new(&spec, formula).expect("the bench formulas lower");
+    // The same formulas as hstl-robustness's bench, so the figures compare.
+    let lowered = |name| hstl::lower::let_formula(&spec, name).expect("a bench let");
+    assert_eq!(lowered("F1_w40"), walk::f1(40));
+    assert_eq!(lowered("F1_w4000"), walk::f1(4000));
+    assert_eq!(hstl::lower::task(&spec).expect("the task"), walk::f2());
+    assert_eq!(lowered("F3"), walk::f3());
+
+    let mut g = c.benchmark_group("monitor/signal");
+    g.throughput(Throughput::Elements(trace.len() as u64));
+    g.sample_size(20);
+    for (name, formula) in cases {
+        let m = monitor(formula);
+        g.bench_function(name, |b| {
+            b.iter(|| black_box(m.signal(&Samples::Columns(vec![x, y])).map(|s| s[0])))
+        });
+    }
+    g.finish();
+
+    let mut g = c.benchmark_group("monitor/signal_rows");
+    g.throughput(Throughput::Elements(trace.len() as u64));
+    g.sample_size(20);
+    let m = monitor(Some("F1_w40"));
+    g.bench_function("F1_w40", |b| {
+        let samples = Samples::Rows { data: &rows, width: 2, picks: vec![0, 1] };
+        b.iter(|| black_box(m.signal(&samples).map(|s| s[0])))
+    });
+    g.finish();
+
+    let batch: Vec<Samples<'_>> = (0..TRACES)
+        .map(|i| {
+            Samples::Columns(vec![&x[i * STEPS..(i + 1) * STEPS], &y[i * STEPS..(i + 1) * STEPS]])
+        })
+        .collect();
+    let mut g = c.benchmark_group("monitor/signal_batch");
+    g.throughput(Throughput::Elements((TRACES * STEPS) as u64));
+    g.sample_size(10);
+    for (name, formula) in [("F1_w40", Some("F1_w40")), ("F2", None)] {
+        let m = monitor(formula);
+        for threads in [1, 2] {
+            g.bench_function(format!("{name}/{threads}_threads"), |b| {
+                b.iter(|| black_box(m.signal_batch(&batch, threads).map(|(s, _)| s[0])))
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(monitor, benches);
+criterion_main!(monitor);

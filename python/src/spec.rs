@@ -1,0 +1,340 @@
+//! `hstl.Spec` and `hstl.Diagnostic`.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+use hstl::lang::{CheckedSpec, Location};
+use hstl::monitor::Monitor;
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::errors::{self, batch_error, diagnostics_of, lower_error, trace_error, value_error};
+use crate::online::OnlineMonitor;
+use crate::trace::{hold, hold_batch};
+
+/// A checked hstl spec: its state variables, its `let`s and its task, ready to monitor
+/// traces.
+///
+/// Make one with `Spec.load(path)` or `Spec.parse(text)`; both raise `hstl.SpecError` when
+/// the text does not check. A trace maps each state variable's name to one sample per
+/// step (a dict of arrays or sequences, a pandas DataFrame), or is a 2-D array of shape
+/// (steps, columns) whose columns `columns=` names (by default the state variables, in
+/// order). `formula` names a `let` to score instead of the task. Values are exactly those
+/// of `hstlc monitor`, bit for bit.
+///
+/// A spec pickles by its source text, file name and spec name.
+#[pyclass(module = "hstl", frozen)]
+pub struct Spec {
+    source: String,
+    filename: String,
+    requested: Option<String>,
+    spec: CheckedSpec,
+    warnings: Vec<hstl::lang::Diagnostic>,
+    /// Lowered monitors by formula name (`None`: the task), made on first use.
+    monitors: Mutex<HashMap<Option<String>, Arc<Monitor>>>,
+}
+
+/// One diagnostic of `hstlc check`, positioned as `hstlc check --format json` gives it:
+/// lines and columns 1-based, columns counted in characters, the end exclusive.
+#[pyclass(module = "hstl", frozen, eq, hash, get_all)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Diagnostic {
+    /// The file name, as given to `Spec.load` or `Spec.parse`.
+    file: String,
+    /// `"error"` or `"warning"`.
+    severity: String,
+    /// The stable code, such as `HSTL015`; `hstlc explain CODE` explains it.
+    code: String,
+    /// What is wrong.
+    message: String,
+    /// 1-based line of the start.
+    line: usize,
+    /// 1-based column of the start, in characters.
+    column: usize,
+    /// 1-based line of the end.
+    end_line: usize,
+    /// 1-based column just past the end, in characters.
+    end_column: usize,
+    /// How to fix it, or None.
+    help: Option<String>,
+}
+
+impl Diagnostic {
+    pub fn new(file: &str, d: &hstl::lang::Diagnostic, at: Location) -> Diagnostic {
+        Diagnostic {
+            file: file.to_string(),
+            severity: d.severity.as_str().to_string(),
+            code: d.code.to_string(),
+            message: d.message.clone(),
+            line: at.line,
+            column: at.column,
+            end_line: at.end_line,
+            end_column: at.end_column,
+            help: d.help.clone(),
+        }
+    }
+}
+
+#[pymethods]
+impl Diagnostic {
+    #[new]
+    #[pyo3(signature = (file, severity, code, message, line, column, end_line, end_column, help=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn py_new(
+        file: String,
+        severity: String,
+        code: String,
+        message: String,
+        line: usize,
+        column: usize,
+        end_line: usize,
+        end_column: usize,
+        help: Option<String>,
+    ) -> Diagnostic {
+        Diagnostic { file, severity, code, message, line, column, end_line, end_column, help }
+    }
+
+    fn __getnewargs__(
+        &self,
+    ) -> (String, String, String, String, usize, usize, usize, usize, Option<String>) {
+        let d = self.clone();
+        (d.file, d.severity, d.code, d.message, d.line, d.column, d.end_line, d.end_column, d.help)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Diagnostic({}:{}:{}: {} {}: {})",
+            self.file, self.line, self.column, self.code, self.severity, self.message
+        )
+    }
+
+    /// The line `hstlc check --format concise` prints for it.
+    fn __str__(&self) -> String {
+        format!(
+            "{}:{}:{}: {} {}: {}",
+            self.file, self.line, self.column, self.code, self.severity, self.message
+        )
+    }
+}
+
+impl Spec {
+    fn from_source(
+        py: Python<'_>,
+        source: String,
+        filename: String,
+        name: Option<String>,
+    ) -> PyResult<Spec> {
+        let loaded = py
+            .detach(|| hstl::load::load(&source, name.as_deref()))
+            .map_err(|e| errors::load_error(py, &filename, &source, e))?;
+        Ok(Spec {
+            source,
+            filename,
+            requested: name,
+            spec: loaded.spec,
+            warnings: loaded.diagnostics,
+            monitors: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The monitor of the task or of the `let` called `formula`, lowered once.
+    fn monitor(&self, formula: Option<&str>) -> PyResult<Arc<Monitor>> {
+        let key = formula.map(str::to_string);
+        let mut monitors = self.monitors.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(m) = monitors.get(&key) {
+            return Ok(Arc::clone(m));
+        }
+        let m = Arc::new(
+            Monitor::new(&self.spec, formula).map_err(|e| lower_error(&self.filename, &e))?,
+        );
+        monitors.insert(key, Arc::clone(&m));
+        Ok(m)
+    }
+}
+
+#[pymethods]
+impl Spec {
+    /// Reads and checks the spec file at `path`, and picks the spec called `name` (needed
+    /// when the file holds several).
+    ///
+    /// Raises `FileNotFoundError` (or another `OSError`) when the file cannot be read, and
+    /// `hstl.SpecError` when it does not check or holds no such spec.
+    #[staticmethod]
+    #[pyo3(signature = (path, name=None))]
+    fn load(py: Python<'_>, path: PathBuf, name: Option<String>) -> PyResult<Spec> {
+        let source = std::fs::read_to_string(&path).map_err(|e| errors::read_error(&path, &e))?;
+        Spec::from_source(py, source, path.display().to_string(), name)
+    }
+
+    /// Checks the spec text `text` (reported as `filename`), and picks the spec called
+    /// `name` (needed when the text holds several).
+    ///
+    /// Raises `hstl.SpecError` when it does not check or holds no such spec.
+    #[staticmethod]
+    #[pyo3(signature = (text, filename="<string>".to_string(), name=None))]
+    fn parse(
+        py: Python<'_>,
+        text: String,
+        filename: String,
+        name: Option<String>,
+    ) -> PyResult<Spec> {
+        Spec::from_source(py, text, filename, name)
+    }
+
+    /// The spec's name.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.spec.name
+    }
+
+    /// The file name it was loaded from, or the `filename` given to `parse`.
+    #[getter]
+    fn filename(&self) -> &str {
+        &self.filename
+    }
+
+    /// The source text it was checked from.
+    #[getter]
+    fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// The state variables, in declaration order: the columns a trace needs.
+    #[getter]
+    fn state_vars(&self) -> Vec<String> {
+        self.spec.state_vars.iter().map(|v| v.name.clone()).collect()
+    }
+
+    /// The names of the `let`s, in declaration order: what `formula=` can name.
+    #[getter]
+    fn lets(&self) -> Vec<String> {
+        self.spec.lets.iter().map(|l| l.name.clone()).collect()
+    }
+
+    /// The file's warnings (a spec with errors does not load), as `hstl.Diagnostic`s.
+    #[getter]
+    fn diagnostics(&self) -> Vec<Diagnostic> {
+        diagnostics_of(&self.filename, &self.source, &self.warnings)
+    }
+
+    /// The horizon `H` of the task (or of the `let` called `formula`): its value at step
+    /// `t` depends on steps `t` to `t + H` only. None when unbounded.
+    #[pyo3(signature = (formula=None))]
+    fn horizon(&self, formula: Option<&str>) -> PyResult<Option<usize>> {
+        Ok(self.monitor(formula)?.horizon())
+    }
+
+    /// The robustness of the trace at step 0, as `hstlc monitor` prints it (`inf` and
+    /// `-inf` when infinite).
+    ///
+    /// For a formula with horizon `H` only the first `H + 1` steps are read (and checked
+    /// for NaN), so a long float64 trace costs no more than a short one.
+    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    fn robustness(
+        &self,
+        py: Python<'_>,
+        trace: &Bound<'_, PyAny>,
+        formula: Option<&str>,
+        columns: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<f64> {
+        let monitor = self.monitor(formula)?;
+        let held = hold(trace, columns, &monitor)?;
+        let samples = held.samples()?;
+        py.detach(|| monitor.robustness(&samples)).map_err(|e| trace_error(py, &e))
+    }
+
+    /// The robustness signal of the trace: a float64 array with one value per step, the
+    /// rows `hstlc monitor --signal` prints.
+    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    fn signal<'py>(
+        &self,
+        py: Python<'py>,
+        trace: &Bound<'py, PyAny>,
+        formula: Option<&str>,
+        columns: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let monitor = self.monitor(formula)?;
+        let held = hold(trace, columns, &monitor)?;
+        let samples = held.samples()?;
+        let signal = py.detach(|| monitor.signal(&samples)).map_err(|e| trace_error(py, &e))?;
+        Ok(PyArray1::from_vec(py, signal))
+    }
+
+    /// The robustness signals of many traces of one length, on `threads` threads (default:
+    /// every core): a float64 array of shape (traces, steps) whose row `i` equals
+    /// `signal(traces[i])`.
+    ///
+    /// `traces` is a list of traces (as `signal` takes them), a 3-D array of shape
+    /// (traces, steps, columns) whose columns `columns=` names, or a mapping from each
+    /// state variable to a 2-D array of shape (traces, steps).
+    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None))]
+    fn signal_batch<'py>(
+        &self,
+        py: Python<'py>,
+        traces: &Bound<'py, PyAny>,
+        formula: Option<&str>,
+        columns: Option<&Bound<'py, PyAny>>,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let threads = match threads {
+            Some(0) => return Err(value_error("`threads` must be at least 1", None)),
+            Some(n) => n,
+            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        };
+        let monitor = self.monitor(formula)?;
+        let held = hold_batch(traces, columns, &monitor)?;
+        let samples = held.samples()?;
+        let n = samples.len();
+        let (out, steps) = py
+            .detach(|| monitor.signal_batch(&samples, threads))
+            .map_err(|e| batch_error(py, &e))?;
+        // An array of no traces still has steps.
+        let steps = if n == 0 { held.shape_steps().unwrap_or(0) } else { steps };
+        Ok(PyArray1::from_vec(py, out).reshape([n, steps])?.into_any())
+    }
+
+    /// An online monitor of the task (or of the `let` called `formula`), fed one state at
+    /// a time; see `hstl.OnlineMonitor`.
+    #[pyo3(signature = (formula=None))]
+    fn online(&self, formula: Option<&str>) -> PyResult<OnlineMonitor> {
+        Ok(OnlineMonitor::new(self.monitor(formula)?.online()))
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let py = slf.py();
+        let this = slf.get();
+        let parse = slf.get_type().getattr("parse")?;
+        let args = PyTuple::new(
+            py,
+            [
+                this.source.clone().into_pyobject(py)?.into_any(),
+                this.filename.clone().into_pyobject(py)?.into_any(),
+                this.requested.clone().into_pyobject(py)?.into_any(),
+            ],
+        )?;
+        Ok((parse, args))
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<Spec>().is_ok_and(|o| {
+            let o = o.get();
+            (&o.source, &o.filename, &o.spec.name)
+                == (&self.source, &self.filename, &self.spec.name)
+        })
+    }
+
+    fn __hash__(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        (&self.source, &self.filename, &self.spec.name).hash(&mut h);
+        h.finish()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<hstl.Spec {} from {}>", self.spec.name, self.filename)
+    }
+}

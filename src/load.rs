@@ -1,0 +1,131 @@
+//! One spec from source text: checked, and picked by name from the specs of its file.
+//!
+//! This is what the command line (`hstlc monitor`, `train`, `study`) and the Python package
+//! (`hstl.Spec.load`, `hstl.Spec.parse`) share, so both refuse the same files with the same
+//! words. Reading the file is the caller's part (nothing here touches the file system);
+//! [`read_error`] words a failed read the same way for both.
+
+use std::fmt;
+use std::path::Path;
+
+use hstl_lang::{CheckedSpec, Diagnostic};
+
+/// A spec that checked without errors.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The checked spec.
+    pub spec: CheckedSpec,
+    /// The file's diagnostics: warnings only, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Why no spec came out of a source text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LoadError {
+    /// The text has errors: all its diagnostics (warnings too), in source order.
+    Invalid(Vec<Diagnostic>),
+    /// The text holds no spec.
+    NoSpec,
+    /// The text holds several specs and none was asked for.
+    Several {
+        /// The specs' names, in source order.
+        names: Vec<String>,
+    },
+    /// No spec has the name asked for.
+    Unknown {
+        /// The name asked for.
+        wanted: String,
+        /// The specs' names, in source order.
+        names: Vec<String>,
+    },
+}
+
+impl LoadError {
+    /// How to fix it; `pick` is how the caller's users name a spec, such as `--spec NAME`.
+    pub fn help(&self, pick: &str) -> Option<String> {
+        match self {
+            LoadError::Invalid(_) => None,
+            LoadError::NoSpec => Some("write `spec Name { ... }` in it".to_string()),
+            LoadError::Several { names } => {
+                Some(format!("pick one with {pick}: {}", quote_list(names)))
+            }
+            LoadError::Unknown { names, .. } => {
+                Some(format!("the file holds {}", quote_list(names)))
+            }
+        }
+    }
+}
+
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::Invalid(diagnostics) => {
+                let errors = diagnostics.iter().filter(|d| d.is_error()).count();
+                let s = if errors == 1 { "" } else { "s" };
+                write!(f, "the file has {errors} error{s}")
+            }
+            LoadError::NoSpec => f.write_str("the file holds no spec"),
+            LoadError::Several { names } => write!(f, "the file holds {} specs", names.len()),
+            LoadError::Unknown { wanted, .. } => write!(f, "no spec named `{wanted}`"),
+        }
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+/// Checks `source` and picks the spec named `wanted`, or the only one.
+pub fn load(source: &str, wanted: Option<&str>) -> Result<Loaded, LoadError> {
+    pick(hstl_lang::check(source), wanted)
+}
+
+/// [`load`], with the specs that have options also checked against `world` (`label`
+/// names it in messages, see [`crate::world::check`]): what the commands that train use.
+pub fn load_in_world(
+    source: &str,
+    wanted: Option<&str>,
+    world: &crate::world::GridWorld,
+    label: &str,
+) -> Result<Loaded, LoadError> {
+    pick(crate::world::check(source, world, label), wanted)
+}
+
+/// The spec named `wanted` (or the only one) of a checked text without errors.
+fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loaded, LoadError> {
+    if checked.has_errors() {
+        return Err(LoadError::Invalid(checked.diagnostics));
+    }
+    let names = || checked.specs.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+    let index = match (wanted, checked.specs.len()) {
+        (None, 1) => 0,
+        (None, 0) => return Err(LoadError::NoSpec),
+        (None, _) => return Err(LoadError::Several { names: names() }),
+        (Some(w), _) => checked
+            .specs
+            .iter()
+            .position(|s| s.name == w)
+            .ok_or_else(|| LoadError::Unknown { wanted: w.to_string(), names: names() })?,
+    };
+    let spec = checked.specs.swap_remove(index);
+    Ok(Loaded { spec, diagnostics: checked.diagnostics })
+}
+
+/// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
+/// "(os error N)" tail.
+pub fn read_error(path: &Path, error: &std::io::Error) -> String {
+    format!("cannot read `{}`: {}", path.display(), io_reason(error))
+}
+
+/// The OS reason of an I/O error in lower case, without the "(os error N)" tail.
+pub fn io_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    let text = text.split(" (os error").next().unwrap_or(&text).to_string();
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(c) => c.to_lowercase().chain(chars).collect(),
+        None => text,
+    }
+}
+
+fn quote_list(names: &[String]) -> String {
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+}

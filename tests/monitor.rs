@@ -1,0 +1,312 @@
+//! The facade's monitors (`hstl::monitor`) and spec loading (`hstl::load`): what `hstlc
+//! monitor` and the Python package share. Values are held against the rtamt cases (the
+//! oracle file of hstl-robustness) and against the evaluators they wrap; every refused
+//! input against its message.
+
+use hstl::load::{LoadError, load};
+use hstl::monitor::{BatchError, Monitor, Samples, TraceError};
+use hstl::robustness::{Trace, offline};
+use serde_json::Value;
+
+const ORACLE: &str = include_str!("../robustness/tests/data/rtamt-cases.jsonl");
+
+struct Case {
+    id: u64,
+    task: String,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    signal: Vec<f64>,
+    robustness: f64,
+}
+
+fn number(v: &Value) -> f64 {
+    match v.as_str() {
+        Some("inf") => f64::INFINITY,
+        Some("-inf") => f64::NEG_INFINITY,
+        _ => v.as_f64().unwrap_or_else(|| panic!("not a number: {v}")),
+    }
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array().expect("an array").iter().map(number).collect()
+}
+
+fn cases() -> Vec<Case> {
+    ORACLE
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|line| {
+            let c: Value = serde_json::from_str(line).expect("one JSON object a line");
+            Case {
+                id: c["id"].as_u64().expect("an id"),
+                task: c["task"].as_str().expect("a task").to_string(),
+                x: numbers(&c["trace"]["x"]),
+                y: numbers(&c["trace"]["y"]),
+                signal: numbers(&c["signal"]),
+                robustness: number(&c["robustness"]),
+            }
+        })
+        .collect()
+}
+
+fn monitor(src: &str, formula: Option<&str>) -> Monitor {
+    let loaded = load(src, None).unwrap_or_else(|e| panic!("{src}: {e}"));
+    Monitor::new(&loaded.spec, formula).unwrap_or_else(|e| panic!("{src}: {e}"))
+}
+
+fn case_monitor(task: &str) -> Monitor {
+    monitor(&format!("spec T {{ state {{ x: float, y: float }} task {task}; }}"), None)
+}
+
+/// `x`, `y` as row-major data with a column the spec does not name in between.
+fn rows(x: &[f64], y: &[f64]) -> Vec<f64> {
+    x.iter().zip(y).flat_map(|(&x, &y)| [y, -7.0, x]).collect()
+}
+
+fn rows_of(data: &[f64]) -> Samples<'_> {
+    Samples::Rows { data, width: 3, picks: vec![2, 0] }
+}
+
+/// Equal, so `0 == -0`; the oracle has no NaN.
+fn assert_signal(what: &str, got: &[f64], want: &[f64]) {
+    assert_eq!(got, want, "{what}");
+}
+
+#[test]
+fn oracle_cases_through_columns_rows_batches_and_online() {
+    let cases = cases();
+    assert_eq!(cases.len(), 100, "the oracle file holds 100 cases");
+    for c in &cases {
+        let m = case_monitor(&c.task);
+        let label = format!("case {}: {}", c.id, c.task);
+        let columns = Samples::Columns(vec![&c.x, &c.y]);
+        let data = rows(&c.x, &c.y);
+        assert_signal(&label, &m.signal(&columns).unwrap(), &c.signal);
+        assert_signal(&format!("{label} (rows)"), &m.signal(&rows_of(&data)).unwrap(), &c.signal);
+        assert_eq!(m.robustness(&columns).unwrap(), c.robustness, "{label}");
+        assert_eq!(m.robustness(&rows_of(&data)).unwrap(), c.robustness, "{label} (rows)");
+
+        // What the CLI computes from its CSV reader's trace, bit for bit.
+        let trace = Trace::from_columns(vec![c.x.clone(), c.y.clone()]).unwrap();
+        let cli = m.signal_of_trace(&trace);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&m.signal(&columns).unwrap()), bits(&cli), "{label}");
+        assert_eq!(m.robustness_of_trace(&trace).to_bits(), c.robustness.to_bits(), "{label}");
+
+        for threads in [1, 2, 3] {
+            let batch = [columns.clone(), rows_of(&data), columns.clone()];
+            let (out, steps) = m.signal_batch(&batch, threads).unwrap();
+            assert_eq!(steps, c.x.len());
+            for row in out.chunks(steps) {
+                assert_signal(&format!("{label} (batch, {threads} threads)"), row, &c.signal);
+            }
+        }
+
+        let mut online = m.online();
+        let mut verdicts = Vec::new();
+        for (x, y) in c.x.iter().zip(&c.y) {
+            verdicts.extend(online.push(&[*x, *y]).unwrap());
+        }
+        verdicts.extend(online.finish());
+        let steps: Vec<usize> = verdicts.iter().map(|v| v.step).collect();
+        assert_eq!(steps, (0..c.x.len()).collect::<Vec<_>>(), "{label} (online)");
+        let values: Vec<f64> = verdicts.iter().map(|v| v.value).collect();
+        assert_signal(&format!("{label} (online)"), &values, &c.signal);
+    }
+}
+
+#[test]
+fn a_batch_of_many_traces_on_several_threads_equals_each_signal() {
+    let cases = cases();
+    let m =
+        case_monitor("always[0..=3] eventually[1..=2] (x >= 4) || (x > 0) until[0..=2] (y > 4)");
+    // Every case's trace cut to the shortest length, so they make one batch.
+    let steps = cases.iter().map(|c| c.x.len()).min().unwrap();
+    let batch: Vec<Samples<'_>> =
+        cases.iter().map(|c| Samples::Columns(vec![&c.x[..steps], &c.y[..steps]])).collect();
+    for threads in [1, 2, 7, 100, 1000] {
+        let (out, got_steps) = m.signal_batch(&batch, threads).unwrap();
+        assert_eq!((out.len(), got_steps), (cases.len() * steps, steps));
+        for (samples, row) in batch.iter().zip(out.chunks(steps)) {
+            assert_signal(&format!("{threads} threads"), row, &m.signal(samples).unwrap());
+        }
+    }
+    assert_eq!(m.signal_batch(&[], 2).unwrap(), (Vec::new(), 0));
+}
+
+#[test]
+fn robustness_reads_only_the_horizon() {
+    let m = case_monitor("always[0..=2] (x > 1)");
+    assert_eq!(m.horizon(), Some(2));
+    assert_eq!((m.samples_read(10), m.samples_read(2)), (3, 2));
+    let x = [5.0, 4.0, 3.0, f64::NAN, 9.0];
+    let y = [0.0; 5];
+    let columns = Samples::Columns(vec![&x, &y]);
+    // The NaN at step 3 is past what step 0 reads: the value is the whole trace's.
+    assert_eq!(m.robustness(&columns).unwrap(), 2.0);
+    assert_eq!(m.robustness(&rows_of(&rows(&x, &y))).unwrap(), 2.0);
+    let nan = TraceError::NotANumber { var: "x".into(), step: 3 };
+    assert_eq!(m.signal(&columns).unwrap_err(), nan);
+    assert_eq!(m.signal(&rows_of(&rows(&x, &y))).unwrap_err(), nan);
+    // An unbounded formula reads the whole trace.
+    let unbounded = case_monitor("always[0..] (x > 1)");
+    assert_eq!(unbounded.robustness(&columns).unwrap_err(), nan);
+}
+
+/// One refused trace: the error's message and help.
+fn check(got: Result<impl std::fmt::Debug, TraceError>, message: &str, help: Option<&str>) {
+    let e = got.expect_err(message);
+    assert_eq!((e.to_string().as_str(), e.help().as_deref()), (message, help));
+}
+
+#[test]
+fn bad_traces_are_refused_with_their_message() {
+    let m = monitor(
+        "spec S { state { x: int in 0..=9, y: float } let A = x > 3; task eventually[0..5] A; }",
+        None,
+    );
+    let (x, short) = ([1.0, 2.0, 3.0], [0.0, 0.0]);
+    let nan_help = "robustness has no meaning for NaN: drop the step or give it a number \
+                    (`inf` and `-inf` are allowed)";
+    check(
+        m.signal(&Samples::Columns(vec![&x, &short])),
+        "state variable `y` has 2 samples, but `x` has 3 samples",
+        Some("give every state variable one sample per step"),
+    );
+    check(
+        m.signal(&Samples::Columns(vec![&[], &[]])),
+        "the trace has no samples",
+        Some("give every state variable at least one sample"),
+    );
+    check(
+        m.robustness(&Samples::Columns(vec![&x, &[0.0, f64::NAN, 1.0]])),
+        "`y` is NaN at step 1",
+        Some(nan_help),
+    );
+    check(
+        m.signal(&Samples::Columns(vec![&x])),
+        "the state has 1 value, the spec has 2 state variables",
+        Some("give one value per state variable, in the order `x`, `y`"),
+    );
+    check(
+        m.picks(&["t", "x"]),
+        "missing state variable `y`",
+        Some("the trace has `t`, `x`; the spec's state variables are `x`, `y`"),
+    );
+    assert_eq!(m.picks(&["y", "t", "x"]).unwrap(), vec![2, 0]);
+    let data = [1.0, 2.0, 3.0, 4.0, 5.0];
+    check(
+        m.signal(&Samples::Rows { data: &data, width: 2, picks: vec![0, 1] }),
+        "5 samples do not make whole rows of 2",
+        None,
+    );
+    check(
+        m.signal(&Samples::Rows { data: &data[..4], width: 2, picks: vec![0, 2] }),
+        "4 samples do not make whole rows of 2",
+        None,
+    );
+    let nan_rows = [1.0, 0.0, 2.0, f64::NAN];
+    check(
+        m.signal(&Samples::Rows { data: &nan_rows, width: 2, picks: vec![0, 1] }),
+        "`y` is NaN at step 1",
+        Some(nan_help),
+    );
+    // A NaN in a column no state variable reads is not the trace's.
+    let ignored = [1.0, 0.0, f64::NAN, 2.0, 0.0, f64::NAN];
+    assert!(m.signal(&Samples::Rows { data: &ignored, width: 3, picks: vec![0, 1] }).is_ok());
+
+    let mut online = m.online();
+    assert_eq!(online.push(&[1.0, 2.0]).unwrap(), None);
+    check(online.push(&[f64::NAN, 2.0]), "`x` is NaN at step 1", Some(nan_help));
+    check(
+        online.push(&[1.0]),
+        "the state has 1 value, the spec has 2 state variables",
+        Some("give one value per state variable, in the order `x`, `y`"),
+    );
+    assert_eq!(online.steps(), 1, "a refused state changes nothing");
+}
+
+#[test]
+fn bad_batches_name_the_first_bad_trace() {
+    let m = case_monitor("eventually[0..=1] (x > 1)");
+    let (a, b, nan) = ([1.0, 2.0, 3.0], [1.0, 2.0], [1.0, f64::NAN, 3.0]);
+    let good = Samples::Columns(vec![&a, &a]);
+    let e = m.signal_batch(&[good.clone(), Samples::Columns(vec![&b, &b])], 2).unwrap_err();
+    assert_eq!(e, BatchError::Steps { trace: 1, steps: 2, first_steps: 3 });
+    assert_eq!(e.to_string(), "trace 1 has 2 steps, but trace 0 has 3");
+    let mut batch = vec![good.clone(); 9];
+    batch[7] = Samples::Columns(vec![&a, &nan]);
+    batch[4] = Samples::Columns(vec![&nan, &a]);
+    for threads in [1, 2, 3, 9] {
+        let e = m.signal_batch(&batch, threads).unwrap_err();
+        assert_eq!(e.to_string(), "trace 4: `x` is NaN at step 1", "{threads} threads");
+    }
+}
+
+#[test]
+fn a_let_is_scored_alone_and_unknown_names_are_refused() {
+    let src = "spec S { state { x: int in 0..=9 } let A = x > 3; let B = x < 2; \
+               task eventually[0..5] A; }";
+    let x = [1.0, 5.0];
+    let a = monitor(src, Some("A"));
+    assert_eq!(a.signal(&Samples::Columns(vec![&x])).unwrap(), vec![-2.0, 2.0]);
+    assert_eq!(a.horizon(), Some(0));
+    let spec = load(src, None).unwrap().spec;
+    let e = Monitor::new(&spec, Some("Z")).unwrap_err();
+    assert_eq!(e.to_string(), "spec `S` has no `let` named `Z`; its lets are `A`, `B`");
+}
+
+#[test]
+fn loading_picks_one_spec_or_says_why_not() {
+    let two = "spec First { state { x: int in 0..=9 } let Hi = x > 5; task eventually[0..3] Hi; }\n\
+               spec Second { state { x: int in 0..=9 } let Lo = x < 2; task always[0..3] Lo; }";
+    assert_eq!(load(two, Some("Second")).unwrap().spec.name, "Second");
+    let cases: [(&str, Option<&str>, &str, Option<&str>); 4] = [
+        (
+            two,
+            None,
+            "the file holds 2 specs",
+            Some("pick one with `--spec NAME`: `First`, `Second`"),
+        ),
+        (two, Some("Third"), "no spec named `Third`", Some("the file holds `First`, `Second`")),
+        ("// nothing\n", None, "the file holds no spec", Some("write `spec Name { ... }` in it")),
+        ("spec S { state { x: int in 0..=9 } }", None, "the file has 1 error", None),
+    ];
+    for (src, wanted, message, help) in cases {
+        let e = load(src, wanted).unwrap_err();
+        assert_eq!((e.to_string().as_str(), e.help("`--spec NAME`").as_deref()), (message, help));
+    }
+    let LoadError::Invalid(diagnostics) =
+        load("spec S { state { x: int in 0..=9 } }", None).unwrap_err()
+    else {
+        panic!("a spec without a task does not load")
+    };
+    assert_eq!(diagnostics[0].code, "HSTL015");
+    // Warnings do not stop a spec; they come with it.
+    let warned = load(
+        "spec S { state { x: int in 0..=9 } let U = x > 1; let A = x > 3; \
+                       task eventually[0..5] A; }",
+        None,
+    )
+    .unwrap();
+    assert!(!warned.diagnostics.is_empty() && warned.diagnostics.iter().all(|d| !d.is_error()));
+}
+
+#[test]
+fn io_errors_read_as_the_cli_prints_them() {
+    let e = std::io::Error::from(std::io::ErrorKind::NotFound);
+    let os = std::fs::read_to_string("/nonexistent/spec.hstl").unwrap_err();
+    assert_eq!(
+        hstl::load::read_error(std::path::Path::new("/nonexistent/spec.hstl"), &os),
+        "cannot read `/nonexistent/spec.hstl`: no such file or directory"
+    );
+    assert_eq!(hstl::load::io_reason(&e), "entity not found");
+    // The offline evaluator on a Trace and on borrowed slices agree bit for bit.
+    let x = [1.0, 2.0, 3.0];
+    let f = hstl::lower::task(
+        &load("spec S { state { x: float } task eventually[0..=1] (x > 2); }", None).unwrap().spec,
+    )
+    .unwrap();
+    let trace = Trace::from_columns(vec![x.to_vec()]).unwrap();
+    assert_eq!(offline::signal_of_slices(&f, &[&x]).unwrap(), offline::signal(&f, &trace));
+}
