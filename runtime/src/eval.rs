@@ -186,10 +186,38 @@ impl RegionTable {
     }
 }
 
+/// Where an [`AgentController`] is in its execution (the running option, its leg, the
+/// memory counters), apart from the agent: the owner of an agent pauses a controller into
+/// this and resumes it later, step by step (the Python package's `Policy.act`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AgentProgress {
+    running: Option<(usize, usize, usize)>,
+    tau: Vec<usize>,
+    fresh: bool,
+}
+
+impl Default for AgentProgress {
+    /// Nothing running: the next step starts afresh, as after [`Controller::reset`].
+    fn default() -> AgentProgress {
+        AgentProgress { running: None, tau: Vec::new(), fresh: true }
+    }
+}
+
 impl<'a> AgentController<'a> {
     /// A controller following `agent`.
     pub fn new(agent: &'a Agent) -> AgentController<'a> {
-        AgentController { agent, running: None, tau: Vec::new(), fresh: true }
+        AgentController::resume(agent, AgentProgress::default())
+    }
+
+    /// A controller following `agent` from where `progress` left off.
+    pub fn resume(agent: &'a Agent, progress: AgentProgress) -> AgentController<'a> {
+        let AgentProgress { running, tau, fresh } = progress;
+        AgentController { agent, running, tau, fresh }
+    }
+
+    /// Where the controller is, to [`AgentController::resume`] it later with the same agent.
+    pub fn pause(self) -> AgentProgress {
+        AgentProgress { running: self.running, tau: self.tau, fresh: self.fresh }
     }
 
     /// The counters `tau_j` of an agent with memory, as of the last state seen (empty

@@ -32,6 +32,8 @@
 //! at both levels with linear decay and a floor: the flat epsilon decays per primitive
 //! step, the options epsilon per option choice. Greedy ties go to the lowest index.
 
+use std::ops::ControlFlow;
+
 use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
@@ -254,6 +256,20 @@ impl<'e, E: Env> Learner<'e, E> {
 
     /// Runs `learn.episodes` episodes, calling `progress(episode, reward)` after each.
     pub fn train(&mut self, rng: &mut Rng, mut progress: impl FnMut(usize, f64)) -> Trained {
+        self.train_until(rng, |episode, reward| {
+            progress(episode, reward);
+            ControlFlow::Continue(())
+        })
+    }
+
+    /// [`Learner::train`], stopped after the episode for which `progress` breaks (a caller
+    /// that was interrupted, or whose environment failed). The episodes run are those
+    /// [`Learner::train`] runs, draw for draw; the curve holds the episodes done.
+    pub fn train_until(
+        &mut self,
+        rng: &mut Rng,
+        mut progress: impl FnMut(usize, f64) -> ControlFlow<()>,
+    ) -> Trained {
         let episodes = self.spec.learn.episodes;
         let mut curve = Vec::with_capacity(episodes);
         let steps_before = self.q.steps;
@@ -262,7 +278,9 @@ impl<'e, E: Env> Learner<'e, E> {
         for episode in 0..episodes {
             let reward = self.episode(rng, &mut run, &mut rewards);
             curve.push(reward);
-            progress(episode, reward);
+            if progress(episode, reward).is_break() {
+                break;
+            }
         }
         Trained { curve, steps: self.q.steps - steps_before }
     }

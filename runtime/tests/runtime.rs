@@ -6,7 +6,9 @@ mod common;
 use std::collections::HashMap;
 
 use hstl_runtime::env::{Cell, Env};
-use hstl_runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
+use hstl_runtime::eval::{
+    AgentController, AgentProgress, Controller, RegionTable, WindowConfig, rollout, window_rate,
+};
 use hstl_runtime::optimum::{SolveConfig, solve};
 use hstl_runtime::robustness::Formula;
 use hstl_runtime::{Error, GridWorld, Learner, Policy, QTables, TaskSpec, seeded_rng};
@@ -51,6 +53,25 @@ fn progress_reports_every_episode_and_the_curve() {
     let want: Vec<(usize, f64)> = trained.curve.iter().copied().enumerate().collect();
     assert_eq!(seen, want);
     assert_eq!(trained.steps, learner.q().steps);
+}
+
+#[test]
+fn training_stopped_after_k_episodes_is_training_k_episodes() {
+    let env = GridWorld::default();
+    let spec = small(false, true);
+    let mut stopped = Learner::new(&spec, &env).unwrap();
+    let trained = stopped.train_until(&mut seeded_rng(5), |episode, _| {
+        if episode == 3 {
+            std::ops::ControlFlow::Break(())
+        } else {
+            std::ops::ControlFlow::Continue(())
+        }
+    });
+    assert_eq!(trained.curve.len(), 4);
+    let mut four = spec.clone();
+    four.learn.episodes = 4;
+    assert_eq!(bits(stopped.q()), bits(&train(&four, &env, 5)));
+    assert_eq!(trained.steps, stopped.q().steps);
 }
 
 #[test]
@@ -312,6 +333,29 @@ fn greedy_rollouts_follow_option_legs() {
             assert!(b.option != a.option || b.leg == a.leg + 1 || b.leg == 0);
         } else {
             assert_eq!((b.option, b.leg), (a.option, a.leg));
+        }
+    }
+}
+
+#[test]
+fn a_paused_controller_resumes_where_it_was() {
+    let env = GridWorld::default();
+    for spec in [small(false, false), small_memory()] {
+        let mut learner = Learner::new(&spec, &env).unwrap();
+        learner.train(&mut seeded_rng(2), |_, _| {});
+        let agent = learner.agent();
+        let whole = rollout(&env, &mut AgentController::new(&agent), 17, 300, &mut seeded_rng(3));
+        // The same run, with the controller paused and resumed around every call.
+        let (mut rng, mut progress) = (seeded_rng(3), AgentProgress::default());
+        let mut s = 17;
+        for step in &whole {
+            let mut c = AgentController::resume(&agent, progress);
+            let decision = c.act(s);
+            assert_eq!((s, decision), (step.state, step.decision));
+            let next = env.index(&env.step(&env.state(s).unwrap(), decision.action, &mut rng));
+            c.observe(next);
+            progress = c.pause();
+            s = next;
         }
     }
 }
