@@ -8,8 +8,10 @@
 //!   into typed Rust;
 //!
 //! and [`lower`] turns a checked spec into the runtime's data at run time (the path the
-//! command line takes); [`world`] reads grid worlds and checks specs against them, and
-//! [`train`] trains a spec as `hstlc train` does.
+//! command line takes); [`world`] reads grid worlds and checks specs against them,
+//! [`train`] trains a spec as `hstlc train` does, [`evaluate`] replays a `policy.json`
+//! as `hstlc eval` does, and [`reward`] scores an episode state by state (the Python
+//! package's `STLReward`). Every front end words what it refuses with a [`Problem`].
 //!
 //! ```
 //! let src = "spec S { state { x: int in 0..=9 } let Goal = x > 6; task eventually[0..5] Goal;
@@ -20,11 +22,16 @@
 //! assert_eq!(spec.primitives[0].name, "Goal");
 //! ```
 
+pub mod evaluate;
 pub mod load;
 pub mod lower;
 pub mod monitor;
+mod problem;
+pub mod reward;
 pub mod train;
 pub mod world;
+
+pub use problem::Problem;
 
 pub use hstl_lang as lang;
 pub use hstl_robustness as robustness;

@@ -1,8 +1,13 @@
 //! Training a spec in an environment, as `hstlc train` does, so that every front end (the
 //! CLI, the Python package) writes the same `policy.json`, bit for bit, for the same seed.
 
+use std::ops::ControlFlow;
+
+use hstl_lang::{CheckedSpec, Domain, LineIndex};
 use hstl_runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
 use hstl_runtime::{Agent, Env, Error, Learner, Policy, TaskSpec, seeded_rng};
+
+use crate::Problem;
 
 /// The seed offset of the generator that draws the sample runs of the pictures.
 pub const PICTURE_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -32,18 +37,71 @@ pub struct WindowSummary {
     pub robustness: f64,
 }
 
+/// The spec as the runtime's data, when it can be trained: it has options, and every
+/// state variable is an `int` with a range (the learner's tables enumerate them). `source`
+/// is the text it was checked from and `file` names it in messages, which point at
+/// `FILE:LINE:COL`.
+pub fn trainable(spec: &CheckedSpec, source: &str, file: &str) -> Result<TaskSpec, Problem> {
+    let at = |offset: usize| {
+        let p = LineIndex::new(source).position(source, offset);
+        format!("{file}:{}:{}", p.line, p.column)
+    };
+    if spec.primitives.is_empty() {
+        return Err(Problem::new(
+            format!("{}: spec `{}` has no options to train", at(spec.name_range.start), spec.name),
+            "add an option per region, such as `option A;` for `let A = ...;`".to_string(),
+        ));
+    }
+    if let Some(v) = spec.state_vars.iter().find(|v| !matches!(v.domain, Domain::Int { .. })) {
+        return Err(Problem::new(
+            format!(
+                "{}: state variable `{}` needs an `int` range for training",
+                at(v.name_range.start),
+                v.name
+            ),
+            format!("declare it like `{}: int in 0..=14`, matching the world's size", v.name),
+        ));
+    }
+    crate::lower::task_spec(spec, source).map_err(|e| Problem::new(format!("{file}: {e}"), None))
+}
+
 /// Trains `spec` in `env` from `seed` (the one generator every draw comes from);
 /// `progress` sees each episode and its reward.
 pub fn train<E: Env>(
     spec: &TaskSpec,
     env: &E,
     seed: u64,
-    progress: impl FnMut(usize, f64),
+    mut progress: impl FnMut(usize, f64),
+) -> Result<Trained, Error> {
+    train_until(spec, env, seed, |episode, reward| {
+        progress(episode, reward);
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`train`], stopped after the episode for which `progress` breaks (see
+/// [`Learner::train_until`]): the curve then holds the episodes done, and the policy is
+/// the one those episodes learned.
+pub fn train_until<E: Env>(
+    spec: &TaskSpec,
+    env: &E,
+    seed: u64,
+    progress: impl FnMut(usize, f64) -> ControlFlow<()>,
 ) -> Result<Trained, Error> {
     let mut learner = Learner::new(spec, env)?;
-    let trained = learner.train(&mut seeded_rng(seed), progress);
+    let trained = learner.train_until(&mut seeded_rng(seed), progress);
     let policy = Policy::new(&learner);
     Ok(Trained { policy, curve: trained.curve, steps: trained.steps, agent: learner.agent() })
+}
+
+/// Training `spec_name` (from `file`) failed with `error`: the spec does not fit the
+/// environment in a way its check cannot see.
+pub fn cannot_train(file: &str, spec_name: &str, error: &Error) -> Problem {
+    Problem::new(
+        format!("{file}: cannot train `{spec_name}`: {error}"),
+        "run `hstlc check` with the same `--world` to see where the spec and the world differ"
+            .to_string(),
+    )
 }
 
 /// `policy.json`: the runtime's document, plus the spec's source and the seed, so that a

@@ -3,7 +3,9 @@
 //! A world is data: the CLI and the Python package read a world file's text (or take a
 //! built-in name), build a [`GridWorld`] with [`GridWorld::from_toml`] or
 //! [`GridWorld::builtin`], and check a spec against it with [`check`] before training, so
-//! that what `hstlc check --world` accepts is what `hstlc train --world` trains.
+//! that what `hstlc check --world` accepts is what `hstlc train --world` trains. Both
+//! front ends name worlds ([`label`]) and word a bad world file ([`from_file`]) or name
+//! ([`unknown`]) with the functions here.
 //!
 //! ```
 //! let world = hstl::world::GridWorld::builtin("four-rooms").unwrap();
@@ -13,8 +15,10 @@
 //! assert_eq!(checked.diagnostics[0].code, "HSTL030"); // four-rooms is 13 x 13
 //! ```
 
-use hstl_lang::{Checked, WorldFacts};
+use hstl_lang::{Checked, LineIndex, WorldFacts};
 use hstl_runtime::Env;
+
+use crate::Problem;
 
 pub use hstl_runtime::GridWorld;
 pub use hstl_runtime::world::{BUILTIN, DEFAULT_SLIP, WorldError};
@@ -38,4 +42,53 @@ pub fn facts(world: &GridWorld, label: &str) -> WorldFacts {
 /// [`hstl_lang::world`]). Never fails and never panics.
 pub fn check(src: &str, world: &GridWorld, label: &str) -> Checked {
     hstl_lang::check_in_world(src, &facts(world, label))
+}
+
+/// How messages name a world: ``world `paper` `` for a built-in one, ``world `office`
+/// (maps/office.toml)`` for one read from a file.
+pub fn label(world: &GridWorld, file: Option<&str>) -> String {
+    match file {
+        Some(file) => format!("world `{}` ({file})", world.world_name()),
+        None => format!("world `{}`", world.world_name()),
+    }
+}
+
+/// Whether a world argument that is no built-in name reads as a world file by its form
+/// (it ends in `.toml` or holds a path separator); a caller also takes a path that exists.
+pub fn looks_like_file(arg: &str) -> bool {
+    arg.ends_with(".toml") || arg.contains(['/', '\\'])
+}
+
+/// A name that is neither a built-in world nor a world file.
+pub fn unknown(name: &str) -> Problem {
+    Problem::new(
+        format!("unknown world `{name}`"),
+        format!(
+            "use a built-in world ({}) or the path of a world file such as `office.toml`",
+            builtin_names()
+        ),
+    )
+}
+
+/// How to fix a world file that cannot be read.
+pub fn read_help() -> String {
+    format!("check the path of the world file, or use a built-in world ({})", builtin_names())
+}
+
+/// The world in `text`, the world file `file` (named `stem` when the file gives no
+/// `name`); an error names the file, line and column: ``office.toml:5:4: unknown
+/// character `o` in the map``.
+pub fn from_file(text: &str, file: &str, stem: &str) -> Result<GridWorld, Problem> {
+    GridWorld::from_toml(text, stem).map_err(|e| {
+        let at = e.span.as_ref().map_or(String::new(), |span| {
+            let p = LineIndex::new(text).position(text, span.start);
+            format!("{}:{}: ", p.line, p.column)
+        });
+        Problem::new(format!("{file}:{at}{}", e.message), e.help.clone())
+    })
+}
+
+/// The built-in worlds' names, quoted and listed.
+fn builtin_names() -> String {
+    BUILTIN.map(|b| format!("`{b}`")).join(", ")
 }

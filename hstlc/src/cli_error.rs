@@ -60,3 +60,9 @@ impl fmt::Display for CliError {
 }
 
 impl std::error::Error for CliError {}
+
+impl From<hstl::Problem> for CliError {
+    fn from(p: hstl::Problem) -> CliError {
+        CliError::new(p.message, p.help)
+    }
+}

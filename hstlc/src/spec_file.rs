@@ -3,7 +3,7 @@
 use std::io::IsTerminal;
 use std::path::Path;
 
-use hstl::lang::{CheckedSpec, Domain, LineIndex};
+use hstl::lang::CheckedSpec;
 use hstl::load::LoadError;
 use hstl::runtime::TaskSpec;
 
@@ -23,51 +23,11 @@ pub struct LoadedSpec {
 }
 
 impl LoadedSpec {
-    /// The spec as the runtime's data.
-    pub fn task_spec(&self) -> Result<TaskSpec, CliError> {
-        hstl::lower::task_spec(&self.spec, &self.source)
-            .map_err(|e| CliError::new(format!("{}: {e}", self.file), None))
-    }
-
     /// The spec as the runtime's data, when it can be trained: it has options, and every
     /// state variable is an `int` with a range (the learner's tables enumerate them).
     pub fn trainable(&self) -> Result<TaskSpec, CliError> {
-        if self.spec.primitives.is_empty() {
-            return Err(CliError::new(
-                format!(
-                    "{}:{}: spec `{}` has no options to train",
-                    self.file,
-                    self.at(self.spec.name_range.start),
-                    self.spec.name
-                ),
-                Some(
-                    "add an option per region, such as `option A;` for `let A = ...;`".to_string(),
-                ),
-            ));
-        }
-        if let Some(v) =
-            self.spec.state_vars.iter().find(|v| !matches!(v.domain, Domain::Int { .. }))
-        {
-            return Err(CliError::new(
-                format!(
-                    "{}:{}: state variable `{}` needs an `int` range for training",
-                    self.file,
-                    self.at(v.name_range.start),
-                    v.name
-                ),
-                Some(format!(
-                    "declare it like `{}: int in 0..=14`, matching the world's size",
-                    v.name
-                )),
-            ));
-        }
-        self.task_spec()
-    }
-
-    /// `line:col` of a byte offset.
-    fn at(&self, offset: usize) -> String {
-        let p = LineIndex::new(&self.source).position(&self.source, offset);
-        format!("{}:{}", p.line, p.column)
+        hstl::train::trainable(&self.spec, &self.source, &self.file)
+            .map_err(|p| CliError::new(p.message, p.help))
     }
 }
 

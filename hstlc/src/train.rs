@@ -125,10 +125,8 @@ pub fn train(
 ) -> Result<Outcome, CliError> {
     let start = Instant::now();
     let trained = hstl::train::train(spec, env, seed, progress).map_err(|e| {
-        CliError::new(
-            format!("{file}: cannot train `{}`: {e}", spec.name),
-            Some("run `hstlc check` with the same `--world` to see where the spec and the world differ".to_string()),
-        )
+        let p = hstl::train::cannot_train(file, &spec.name, &e);
+        CliError::new(p.message, p.help)
     })?;
     let secs = start.elapsed().as_secs_f64();
     let hstl::train::Trained { policy, curve, steps, agent } = trained;

@@ -2,8 +2,7 @@
 
 use std::path::Path;
 
-use hstl::lang::LineIndex;
-use hstl::world::{BUILTIN, GridWorld};
+use hstl::world::GridWorld;
 
 use crate::check::read_input;
 use crate::cli_error::CliError;
@@ -28,37 +27,20 @@ impl LoadedWorld {
     /// file, line and column.
     pub fn load(arg: &str) -> Result<LoadedWorld, CliError> {
         if let Some(world) = GridWorld::builtin(arg) {
-            return Ok(LoadedWorld { world, label: format!("world `{arg}`"), file: None });
+            let label = hstl::world::label(&world, None);
+            return Ok(LoadedWorld { world, label, file: None });
         }
         let path = Path::new(arg);
-        let looks_like_file = arg.ends_with(".toml") || arg.contains(['/', '\\']) || path.exists();
-        if !looks_like_file {
-            return Err(CliError::new(
-                format!("unknown world `{arg}`"),
-                Some(format!(
-                    "use a built-in world ({}) or the path of a world file such as `office.toml`",
-                    BUILTIN.map(|b| format!("`{b}`")).join(", ")
-                )),
-            ));
+        if !hstl::world::looks_like_file(arg) && !path.exists() {
+            let unknown = hstl::world::unknown(arg);
+            return Err(CliError::new(unknown.message, unknown.help));
         }
-        let (file, text) = read_input(path, "<stdin>").map_err(|e| {
-            CliError::new(
-                e.to_string(),
-                Some(format!(
-                    "check the path of the world file, or use a built-in world ({})",
-                    BUILTIN.map(|b| format!("`{b}`")).join(", ")
-                )),
-            )
-        })?;
+        let (file, text) = read_input(path, "<stdin>")
+            .map_err(|e| CliError::new(e.to_string(), Some(hstl::world::read_help())))?;
         let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
-        let world = GridWorld::from_toml(&text, &stem).map_err(|e| {
-            let at = e.span.as_ref().map_or(String::new(), |span| {
-                let p = LineIndex::new(&text).position(&text, span.start);
-                format!("{}:{}: ", p.line, p.column)
-            });
-            CliError::new(format!("{file}:{at}{}", e.message), Some(e.help.clone()))
-        })?;
-        let label = format!("world `{}` ({file})", world.world_name());
+        let world = hstl::world::from_file(&text, &file, &stem)
+            .map_err(|p| CliError::new(p.message, p.help))?;
+        let label = hstl::world::label(&world, Some(&file));
         Ok(LoadedWorld { world, label, file: Some(file) })
     }
 

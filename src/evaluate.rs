@@ -1,0 +1,327 @@
+//! Replaying a trained policy: what `hstlc eval` computes, shared with the Python package
+//! (`hstl.Policy.load`, `policy.evaluate`) so that both check a `policy.json` the same way,
+//! refuse the same documents in the same words and report the same figures.
+//!
+//! [`replay`] reads a `policy.json` and checks it whole against the spec in its
+//! `spec_source` and the world in its `env`; [`evaluate`] runs the greedy agent from
+//! random starts and measures the window rate of a persistent task (or the task's
+//! robustness over each run of another task); [`baseline`] runs the hand-written
+//! nearest-cell cycle over the same starts and slips; [`optimum`] is `W*`.
+//!
+//! ```
+//! let src = "spec S { state { x: int in 0..=14, y: int in 0..=14 } let A = x < 3;
+//!            let B = x > 11; task always[0..] (eventually[0..30] A && eventually[0..30] B);
+//!            option A; option B; learn { episodes: 2, choices: 5 } }";
+//! let loaded = hstl::load::load(src, None).unwrap();
+//! let spec = hstl::train::trainable(&loaded.spec, src, "s.hstl").unwrap();
+//! let world = hstl::world::GridWorld::builtin("paper").unwrap();
+//! let trained = hstl::train::train(&spec, &world, 0, |_, _| {}).unwrap();
+//! let text = hstl::train::policy_json(&trained.policy, src, 0).unwrap();
+//! let replay = hstl::evaluate::replay(&text).unwrap();
+//! let runs = hstl::evaluate::Runs { starts: 2, steps: 200, ..Default::default() };
+//! match hstl::evaluate::evaluate(&replay, runs).unwrap() {
+//!     hstl::evaluate::Evaluation::Window { report } => assert!((0.0..=1.0).contains(&report.rate)),
+//!     hstl::evaluate::Evaluation::Robustness { .. } => unreachable!("a persistent task"),
+//! }
+//! ```
+
+use hstl_robustness::{Trace, offline};
+use hstl_runtime::eval::{
+    AgentController, EntryCycle, RegionTable, WindowConfig, WindowReport, rollout, window_rate,
+};
+use hstl_runtime::optimum::{Optimum, SolveConfig, solve};
+use hstl_runtime::policy::EnvInfo;
+use hstl_runtime::{Agent, Env, GridWorld, Policy, TaskSpec, seeded_rng};
+
+use crate::Problem;
+
+/// At most this many runs in one evaluation.
+pub const MAX_STARTS: usize = 100_000;
+/// At most this many steps in one run (a run is kept whole for its robustness).
+pub const MAX_STEPS: usize = 1_000_000;
+/// At most this many steps over all runs of one evaluation.
+pub const MAX_EVAL_STEPS: usize = 200_000_000;
+
+/// A `policy.json` checked against its spec and environment, ready to replay.
+#[derive(Clone, Debug)]
+pub struct Replay<E> {
+    /// The document.
+    pub policy: Policy,
+    /// The spec it was trained on, from its `spec_source`.
+    pub spec: TaskSpec,
+    /// The environment it was trained in.
+    pub env: E,
+    /// The greedy agent the document describes.
+    pub agent: Agent,
+    /// The text of the spec file it was trained on (its `spec_source`).
+    pub source: String,
+    /// The seed it was trained from (its `seed`), when the document records one.
+    pub seed: Option<u64>,
+}
+
+/// How the greedy runs of an evaluation go: `hstlc eval`'s `--starts`, `--steps`,
+/// `--burn-in` and `--seed`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Runs {
+    /// Greedy runs, each from a random start.
+    pub starts: usize,
+    /// Steps per run.
+    pub steps: usize,
+    /// Steps at the start of each run that the window rate does not count.
+    pub burn_in: usize,
+    /// The seed of the random starts and slips.
+    pub seed: u64,
+}
+
+/// What an evaluation measured.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Evaluation {
+    /// A persistent task: the window rate, per run and pooled, and the task's robustness
+    /// over each run.
+    Window {
+        /// The measurement.
+        report: WindowReport,
+    },
+    /// Another task: its robustness over each run.
+    Robustness {
+        /// `rho(task, 0)` over each run, in order.
+        values: Vec<f64>,
+    },
+}
+
+impl Default for Runs {
+    /// `hstlc eval`'s defaults: 100 runs of 2000 steps, the first 100 not counted, seed 0.
+    fn default() -> Runs {
+        let w = WindowConfig::default();
+        Runs { starts: w.starts, steps: w.steps, burn_in: w.burn_in, seed: 0 }
+    }
+}
+
+impl Runs {
+    /// Checks the counts against the budgets before anything runs. `flag` names a setting
+    /// (`starts`, `steps`) as the caller's users write it, quoted (`` `--starts` ``).
+    pub fn check_budget(&self, flag: impl Fn(&str) -> String) -> Result<(), Problem> {
+        for (name, value, max) in
+            [("starts", self.starts, MAX_STARTS), ("steps", self.steps, MAX_STEPS)]
+        {
+            if value == 0 || value > max {
+                return Err(Problem::new(
+                    format!("{} must be in 1..={max}; got {value}", flag(name)),
+                    None,
+                ));
+            }
+        }
+        if self.starts.saturating_mul(self.steps) > MAX_EVAL_STEPS {
+            return Err(Problem::new(
+                format!(
+                    "{} runs of {} steps are more than the {MAX_EVAL_STEPS} steps an evaluation may take",
+                    self.starts, self.steps
+                ),
+                format!("lower {} or {}", flag("starts"), flag("steps")),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks that the burn-in leaves steps to count, for a persistent task (the window
+    /// rate counts the steps after it). `flag` names a setting as in [`Runs::check_budget`].
+    pub fn check_burn_in(
+        &self,
+        spec: &TaskSpec,
+        flag: impl Fn(&str) -> String,
+    ) -> Result<(), Problem> {
+        if spec.regions.is_empty() || self.burn_in < self.steps {
+            return Ok(());
+        }
+        Err(Problem::new(
+            format!(
+                "a burn-in of {} steps leaves nothing of {}-step runs",
+                self.burn_in, self.steps
+            ),
+            format!("use {} smaller than {}", flag("burn_in"), flag("steps")),
+        ))
+    }
+
+    fn window(&self) -> WindowConfig {
+        WindowConfig { starts: self.starts, steps: self.steps, burn_in: self.burn_in }
+    }
+}
+
+/// The `policy.json` in `text`, checked whole against the spec in its `spec_source` and
+/// the grid world in its `env` (a document written before world files loads as the open
+/// grid it was). Messages are worded as `hstlc eval` prints them, after `FILE: `.
+pub fn replay(text: &str) -> Result<Replay<GridWorld>, Problem> {
+    replay_in(text, |policy| {
+        let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
+            Problem::new(
+                format!("its world: {e}"),
+                "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)"
+                    .to_string(),
+            )
+        })?;
+        if policy.env.params.get("map").is_none() {
+            // Written before world files: the open grid it was, in today's terms.
+            policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };
+        }
+        Ok(env)
+    })
+}
+
+/// [`replay`] in the environment `make_env` builds from the document (it may bring the
+/// document's `env` entry up to date).
+pub fn replay_in<E: Env>(
+    text: &str,
+    make_env: impl FnOnce(&mut Policy) -> Result<E, Problem>,
+) -> Result<Replay<E>, Problem> {
+    let mut policy = Policy::from_json(text).map_err(|e| {
+        Problem::new(e.to_string(), "pass the policy.json that `hstlc train` wrote".to_string())
+    })?;
+    let (source, seed) = trained_from(text)
+        .map_err(|m| Problem::new(m, "train the policy again with `hstlc train`".to_string()))?;
+    let spec = lowered(&source, &policy.spec)
+        .map_err(|m| Problem::new(m, "train the policy again with `hstlc train`".to_string()))?;
+    let env = make_env(&mut policy)?;
+    policy.check_against(&spec, &env).map_err(|e| {
+        Problem::new(
+            e.to_string(),
+            "the file was edited or damaged: train the policy again with `hstlc train`".to_string(),
+        )
+    })?;
+    let agent = policy.agent(&env).map_err(|e| {
+        Problem::new(e.to_string(), "the policy does not fit its world".to_string())
+    })?;
+    Ok(Replay { policy, spec, env, agent, source, seed })
+}
+
+/// The spec that `policy.json` was trained from, checked and lowered again.
+pub fn spec_of(policy_text: &str, expected: &str) -> Result<TaskSpec, String> {
+    lowered(&trained_from(policy_text)?.0, expected)
+}
+
+/// The document's `spec_source` and `seed`.
+fn trained_from(policy_text: &str) -> Result<(String, Option<u64>), String> {
+    let value: serde_json::Value = serde_json::from_str(policy_text).map_err(|e| e.to_string())?;
+    let Some(source) = value.get("spec_source").and_then(|s| s.as_str()) else {
+        return Err("it has no `spec_source` entry with the spec it was trained on".into());
+    };
+    Ok((source.to_string(), value.get("seed").and_then(serde_json::Value::as_u64)))
+}
+
+/// The spec called `expected` in `source`, checked and lowered.
+fn lowered(source: &str, expected: &str) -> Result<TaskSpec, String> {
+    let checked = hstl_lang::check(source);
+    if checked.has_errors() {
+        return Err("its `spec_source` does not check; run `hstlc check` on the spec".into());
+    }
+    let spec = checked
+        .specs
+        .iter()
+        .find(|s| s.name == expected)
+        .ok_or_else(|| format!("its `spec_source` has no spec named `{expected}`"))?;
+    crate::lower::task_spec(spec, source).map_err(|e| e.to_string())
+}
+
+/// Runs the greedy agent `runs.starts` times from random starts (drawn, with the slips,
+/// from one generator seeded with `runs.seed`) and measures the window rate of a
+/// persistent task, or the task's robustness over each run of another task.
+pub fn evaluate<E: Env>(replay: &Replay<E>, runs: Runs) -> Result<Evaluation, Problem> {
+    let Replay { spec, env, agent, .. } = replay;
+    let mut rng = seeded_rng(runs.seed);
+    let mut controller = AgentController::new(agent);
+    if spec.regions.is_empty() {
+        // Not a persistent task: the task's robustness over each run is the measure.
+        let all_states = state_trace(spec, env)?;
+        let mut values = Vec::with_capacity(runs.starts);
+        for _ in 0..runs.starts {
+            let start = env.index(&env.reset(&mut rng));
+            let states: Vec<usize> = rollout(env, &mut controller, start, runs.steps, &mut rng)
+                .iter()
+                .map(|s| s.state)
+                .collect();
+            values.push(robustness_of_run(spec, &all_states, &states)?);
+        }
+        return Ok(Evaluation::Robustness { values });
+    }
+    let regions = RegionTable::new(spec, env).map_err(|e| Problem::new(e.to_string(), None))?;
+    let report =
+        window_rate(env, &mut controller, &regions, runs.window(), &mut rng).map_err(|e| {
+            Problem::new(
+                e.to_string(),
+                "use a burn-in smaller than the steps, and at least one start".to_string(),
+            )
+        })?;
+    Ok(Evaluation::Window { report })
+}
+
+/// The window rate of the hand-written yardstick (the regions in turn, each by a shortest
+/// path around the walls) over the same starts and slips as [`evaluate`]: a learned policy
+/// below it has not learned the legs. `None` for a task that is not persistent, or whose
+/// regions the cycle cannot visit.
+pub fn baseline(replay: &Replay<GridWorld>, runs: Runs) -> Result<Option<f64>, Problem> {
+    let Replay { spec, env, .. } = replay;
+    if spec.regions.is_empty() {
+        return Ok(None);
+    }
+    let regions = RegionTable::new(spec, env).map_err(|e| Problem::new(e.to_string(), None))?;
+    let Ok(mut cycle) = EntryCycle::new(env, &regions) else { return Ok(None) };
+    let report = window_rate(env, &mut cycle, &regions, runs.window(), &mut seeded_rng(runs.seed))
+        .map_err(|e| Problem::new(e.to_string(), None))?;
+    Ok(Some(report.rate))
+}
+
+/// The optimal window rate `W*` of the policy's persistent task on its world (value
+/// iteration; a few seconds for the case study), or `None` for another task.
+pub fn optimum(
+    replay: &Replay<GridWorld>,
+    config: SolveConfig,
+) -> Result<Option<Optimum>, Problem> {
+    let Replay { spec, env, .. } = replay;
+    if spec.regions.is_empty() {
+        return Ok(None);
+    }
+    let regions = RegionTable::new(spec, env).map_err(|e| Problem::new(e.to_string(), None))?;
+    solve(env, &regions, config).map(Some).map_err(|e| Problem::new(e.to_string(), None))
+}
+
+/// Row `s`: the values of the spec's state variables in state `s` of `env`.
+pub fn state_trace<E: Env>(spec: &TaskSpec, env: &E) -> Result<Trace, Problem> {
+    let env_vars = env.state_vars();
+    let picks = spec
+        .state_vars
+        .iter()
+        .map(|v| {
+            env_vars.iter().position(|e| *e == v.name).ok_or_else(|| {
+                Problem::new(
+                    format!(
+                        "state variable `{}` is not one of the {} environment's",
+                        v.name,
+                        env.name()
+                    ),
+                    format!("the environment has {}", env_vars.join(", ")),
+                )
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut columns = vec![Vec::with_capacity(env.num_states()); picks.len()];
+    let mut row = Vec::new();
+    for s in 0..env.num_states() {
+        let Some(state) = env.state(s) else { continue };
+        env.valuation(&state, &mut row);
+        for (col, &i) in columns.iter_mut().zip(&picks) {
+            col.push(row.get(i).copied().unwrap_or(f64::NAN));
+        }
+    }
+    Trace::from_columns(columns).map_err(|e| Problem::new(e.to_string(), None))
+}
+
+/// The task's robustness over the states of one run (indices into `states`, the trace of
+/// every state of the environment).
+fn robustness_of_run(spec: &TaskSpec, states: &Trace, run: &[usize]) -> Result<f64, Problem> {
+    let mut trace = Trace::new(states.vars());
+    let mut row = Vec::with_capacity(states.vars());
+    for &s in run {
+        states.row_into(s, &mut row);
+        trace.push(&row).map_err(|e| Problem::new(e.to_string(), None))?;
+    }
+    Ok(offline::robustness(&spec.task, &trace))
+}

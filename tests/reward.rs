@@ -1,0 +1,187 @@
+//! The episode monitor (`hstl::reward`) against the offline evaluator on every prefix of
+//! a trace: the reward at step `t` is the last value of the signal over `s_0 ..= s_t`, the
+//! task's robustness is `rho(task, 0)` over it, and the window kept is the window rate's
+//! `psi(t)`. Tasks: every task of the rtamt oracle file and random formulas of every shape
+//! (unbounded, nested, until).
+
+use hstl::load::load;
+use hstl::reward::EpisodeMonitor;
+use hstl::robustness::{Trace, offline};
+use hstl::runtime::eval::RegionTable;
+use hstl::runtime::{Env, GridWorld};
+use serde_json::Value;
+
+const ORACLE: &str = include_str!("../robustness/tests/data/rtamt-cases.jsonl");
+
+/// Equal, with `0 == -0` and NaN equal to NaN.
+fn same(a: f64, b: f64) -> bool {
+    a == b || (a.is_nan() && b.is_nan())
+}
+
+/// A small reproducible generator (splitmix64).
+struct Draws(u64);
+
+impl Draws {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+
+    fn interval(&mut self) -> String {
+        let a = self.below(4);
+        match self.below(3) {
+            0 => format!("[{a}..]"),
+            1 => format!("[{a}..={}]", a + self.below(5)),
+            _ => format!("[{a}..{}]", a + 1 + self.below(5)),
+        }
+    }
+
+    fn formula(&mut self, depth: u32) -> String {
+        let atom = |d: &mut Draws| {
+            let var = if d.below(2) == 0 { "x" } else { "y" };
+            let op = ["<", "<=", ">", ">="][d.below(4) as usize];
+            format!("({var} {op} {})", d.below(10) as i64 - 3)
+        };
+        if depth == 0 {
+            return atom(self);
+        }
+        match self.below(9) {
+            0 => atom(self),
+            1 => format!("!{}", self.formula(depth - 1)),
+            2 => format!("({} && {})", self.formula(depth - 1), self.formula(depth - 1)),
+            3 => format!("({} || {})", self.formula(depth - 1), self.formula(depth - 1)),
+            4 => format!("({} -> {})", self.formula(depth - 1), self.formula(depth - 1)),
+            5 => format!("always{} {}", self.interval(), self.formula(depth - 1)),
+            6 => format!("eventually{} {}", self.interval(), self.formula(depth - 1)),
+            _ => format!(
+                "({} until{} {})",
+                self.formula(depth - 1),
+                self.interval(),
+                self.formula(depth - 1)
+            ),
+        }
+    }
+}
+
+fn spec_text(task: &str) -> String {
+    format!("spec T {{ state {{ x: float, y: float }} task {task}; }}")
+}
+
+/// Pushes the trace state by state and holds every step against the offline evaluator
+/// on the prefix so far.
+fn check_prefixes(task: &str, x: &[f64], y: &[f64]) {
+    let src = spec_text(task);
+    let loaded = load(&src, None).unwrap_or_else(|e| panic!("{task}: {e}"));
+    let formula = hstl::lower::task(&loaded.spec).unwrap();
+    let mut episode = EpisodeMonitor::new(&loaded.spec, &src, None).unwrap();
+    for round in 0..2 {
+        // The second round after a reset: nothing of the first may remain.
+        episode.reset();
+        let mut prefix = Trace::new(2);
+        for t in 0..x.len() {
+            prefix.push(&[x[t], y[t]]).unwrap();
+            let score = episode.push(&[x[t], y[t]]).unwrap();
+            let signal = offline::signal(&formula, &prefix);
+            let want = offline::robustness(&formula, &prefix);
+            assert!(
+                same(score.task_robustness, want),
+                "{task}, round {round}, step {t}: task robustness {} but offline {want}",
+                score.task_robustness
+            );
+            assert!(same(score.reward, signal[t]), "{task}, step {t}: reward {}", score.reward);
+            assert_eq!(score.window_kept, None, "{task} is not persistent");
+        }
+    }
+}
+
+#[test]
+fn the_oracle_tasks_agree_with_the_offline_evaluator_on_every_prefix() {
+    let mut cases = 0;
+    for line in ORACLE.lines().filter(|l| !l.trim().is_empty()) {
+        let c: Value = serde_json::from_str(line).unwrap();
+        let column = |v: &Value| -> Vec<f64> {
+            v.as_array().unwrap().iter().map(|n| n.as_f64().unwrap()).collect()
+        };
+        let task = c["task"].as_str().unwrap();
+        check_prefixes(task, &column(&c["trace"]["x"]), &column(&c["trace"]["y"]));
+        cases += 1;
+    }
+    assert!(cases >= 100);
+}
+
+#[test]
+fn random_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
+    let mut draws = Draws(2016);
+    for _ in 0..400 {
+        let task = draws.formula(3);
+        let len = 1 + draws.below(25) as usize;
+        let mut values = || (0..len).map(|_| draws.below(9) as f64 - 3.0).collect::<Vec<_>>();
+        let (x, y) = (values(), values());
+        check_prefixes(&task, &x, &y);
+    }
+}
+
+#[test]
+fn the_window_kept_is_the_window_rates_psi() {
+    let src = "spec P { state { x: int in 0..=14, y: int in 0..=14 }
+        let A = x < 4 && y < 4;
+        let B = x > 10;
+        task always[0..] (eventually[0..12] A && eventually[0..=5] B); }";
+    let loaded = load(src, None).unwrap();
+    let spec = hstl::lower::task_spec(&loaded.spec, src).unwrap();
+    let world = GridWorld::builtin("paper").unwrap();
+    let regions = RegionTable::new(&spec, &world).unwrap();
+    let mut draws = Draws(7);
+    // A walk that crosses the grid often, so that both regions come and go.
+    let (mut x, mut y) = (7i64, 7i64);
+    let mut states = Vec::new();
+    for _ in 0..3000 {
+        let step =
+            |v: i64, d: &mut Draws| (v + [-2, -1, 0, 1, 2][d.below(5) as usize]).clamp(0, 14);
+        (x, y) = (step(x, &mut draws), step(y, &mut draws));
+        states.push(world.index(&hstl::runtime::Cell { x: x as usize, y: y as usize }));
+    }
+    let psi = regions.psi(&states);
+    assert!(psi.iter().any(|&k| k) && psi.iter().any(|&k| !k), "the walk keeps some windows");
+    let mut episode = EpisodeMonitor::new(&loaded.spec, src, Some("A")).unwrap();
+    assert!(episode.is_persistent());
+    let task = hstl::lower::task(&loaded.spec).unwrap();
+    let a = hstl::lower::let_formula(&loaded.spec, "A").unwrap();
+    let mut prefix = Trace::new(2);
+    for (t, &s) in states.iter().enumerate() {
+        let cell = world.state(s).unwrap();
+        let state = [cell.x as f64, cell.y as f64];
+        prefix.push(&state).unwrap();
+        let score = episode.push(&state).unwrap();
+        assert_eq!(score.window_kept, Some(psi[t]), "step {t}");
+        // A region's reward is its full signal, step for step.
+        let one = Trace::from_columns(vec![vec![state[0]], vec![state[1]]]).unwrap();
+        assert_eq!(score.reward.to_bits(), offline::robustness(&a, &one).to_bits());
+        if t % 250 == 0 {
+            assert!(same(score.task_robustness, offline::robustness(&task, &prefix)), "step {t}");
+        }
+    }
+}
+
+#[test]
+fn bad_states_are_refused_and_change_nothing() {
+    let src = spec_text("eventually[0..] (x > 2)");
+    let loaded = load(&src, None).unwrap();
+    let mut episode = EpisodeMonitor::new(&loaded.spec, &src, None).unwrap();
+    episode.push(&[1.0, 0.0]).unwrap();
+    let e = episode.push(&[f64::NAN, 0.0]).unwrap_err();
+    assert_eq!(e.to_string(), "`x` is NaN at step 1");
+    let e = episode.push(&[1.0]).unwrap_err();
+    assert!(e.to_string().contains("1 value"), "{e}");
+    assert_eq!(episode.steps(), 1);
+    assert_eq!(episode.push(&[5.0, 0.0]).unwrap().task_robustness, 3.0);
+    let e = EpisodeMonitor::new(&loaded.spec, &src, Some("Nope")).unwrap_err();
+    assert_eq!(e.to_string(), "spec `T` has no `let` named `Nope` (it has no lets)");
+}
