@@ -1,4 +1,5 @@
-"""hstl: exact Signal Temporal Logic monitors for hstl task specs, on numpy arrays.
+"""hstl: exact Signal Temporal Logic monitors for hstl task specs on numpy arrays, grid
+worlds for gymnasium, and the hierarchical learner.
 
 >>> import hstl
 >>> spec = hstl.Spec.parse('''
@@ -14,16 +15,39 @@
 step as a numpy array, ``spec.signal_batch(traces)`` many traces' on every core, and
 ``spec.online()`` a monitor fed one state at a time. The values are those of
 ``hstlc monitor``, bit for bit. See ``help(hstl.Spec)``.
+
+``hstl.train(spec, world="paper", seed=0)`` learns a ``hstl.Policy`` as ``hstlc train``
+does (the same ``policy.json``, byte for byte); ``policy.evaluate()`` measures it as
+``hstlc eval`` does. With gymnasium installed, ``hstl.GridWorldEnv`` is a grid world as a
+``gymnasium.Env`` (``gymnasium.make("hstl/GridWorld-v0")``, ``"hstl/FourRooms-v0"``) and
+``hstl.STLReward`` rewards any environment by robustness.
 """
 
-from ._errors import MissingVariableError, SpecError
-from ._hstl import Diagnostic, OnlineMonitor, Spec, __version__
+from ._errors import MissingVariableError, PolicyError, SpecError, WorldError
+from ._hstl import MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__
+from ._train import train
 
 __all__ = [
+    "MAX_EPISODES",
     "Diagnostic",
     "MissingVariableError",
     "OnlineMonitor",
+    "Policy",
+    "PolicyError",
     "Spec",
     "SpecError",
+    "World",
+    "WorldError",
     "__version__",
+    "train",
 ]
+
+try:
+    import gymnasium as _gymnasium  # noqa: F401
+except ImportError:  # gymnasium is optional: the monitors and training do not need it
+    pass
+else:
+    from ._gym import MAX_EPISODE_STEPS, GridWorldEnv, STLReward, register as _register
+
+    _register()
+    __all__ += ["GridWorldEnv", "MAX_EPISODE_STEPS", "STLReward"]

@@ -29,3 +29,13 @@ class MissingVariableError(KeyError):
     def __str__(self) -> str:
         # KeyError shows the repr of its argument; the message reads better as it is.
         return str(self.args[0]) if self.args else ""
+
+
+class WorldError(ValueError):
+    """A world file or name that gives no world (a ``ValueError``): the message names the
+    file, line and column, as ``hstlc --world`` prints it."""
+
+
+class PolicyError(ValueError):
+    """A ``policy.json`` that cannot be replayed (a ``ValueError``): unreadable, edited,
+    damaged, or not what its own spec and world give, as ``hstlc eval`` reports it."""

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use hstl::Problem;
 use hstl::lang::{Diagnostic as LangDiagnostic, LineIndex};
 use hstl::load::LoadError;
 use hstl::lower::LowerError;
@@ -49,12 +50,7 @@ pub fn spec_error(py: Python<'_>, message: String, diagnostics: Vec<Diagnostic>)
 
 /// A missing state variable: `hstl.MissingVariableError`, a `KeyError`.
 pub fn missing_variable(py: Python<'_>, message: String) -> PyErr {
-    match python_class(py, &MISSING_VARIABLE, "MissingVariableError")
-        .and_then(|cls| cls.call1((message,)))
-    {
-        Ok(e) => PyErr::from_value(e),
-        Err(e) => e,
-    }
+    package_error(py, &MISSING_VARIABLE, "MissingVariableError", message)
 }
 
 /// A trace that cannot be scored.
@@ -104,15 +100,72 @@ pub fn load_error(py: Python<'_>, file: &str, source: &str, e: LoadError) -> PyE
 /// A file that could not be read, as the matching `OSError`, with the CLI's words.
 pub fn read_error(path: &Path, e: &std::io::Error) -> PyErr {
     let message = hstl::load::read_error(path, e);
+    let help = match e.kind() {
+        std::io::ErrorKind::NotFound => {
+            Some("check the path; it is read relative to the working directory".to_string())
+        }
+        std::io::ErrorKind::InvalidData => Some("save it as UTF-8".to_string()),
+        _ => None,
+    };
+    os_error(with_help(message, help), e)
+}
+
+/// [`read_error`] with `help` whatever the reason, as `hstlc` words a world file it
+/// cannot read.
+pub fn read_error_with(path: &Path, e: &std::io::Error, help: String) -> PyErr {
+    os_error(with_help(hstl::load::read_error(path, e), Some(help)), e)
+}
+
+/// A file that could not be written, as the matching `OSError`, with the CLI's words.
+pub fn write_error(path: &Path, e: &std::io::Error) -> PyErr {
+    os_error(format!("cannot write `{}`: {}", path.display(), hstl::load::io_reason(e)), e)
+}
+
+/// The `OSError` subclass of `e`'s kind (a `ValueError` for text that is not UTF-8).
+fn os_error(text: String, e: &std::io::Error) -> PyErr {
     match e.kind() {
-        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(with_help(
-            message,
-            Some("check the path; it is read relative to the working directory".into()),
-        )),
-        std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
-        std::io::ErrorKind::IsADirectory => PyIsADirectoryError::new_err(message),
-        std::io::ErrorKind::InvalidData => value_error(message, Some("save it as UTF-8".into())),
-        _ => PyOSError::new_err(message),
+        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(text),
+        std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(text),
+        std::io::ErrorKind::IsADirectory => PyIsADirectoryError::new_err(text),
+        std::io::ErrorKind::InvalidData => PyValueError::new_err(text),
+        _ => PyOSError::new_err(text),
+    }
+}
+
+/// A `ValueError` with the problem's words.
+pub fn problem_error(p: &Problem) -> PyErr {
+    value_error(p.message.clone(), p.help.clone())
+}
+
+/// A world file or name that gives no world: `hstl.WorldError`, a `ValueError`.
+pub fn world_error(p: &Problem) -> PyErr {
+    Python::attach(|py| {
+        package_error(py, &WORLD_ERROR, "WorldError", with_help(p.message.clone(), p.help.clone()))
+    })
+}
+
+/// A `policy.json` that cannot be replayed: `hstl.PolicyError`, a `ValueError`.
+pub fn policy_error(p: &Problem) -> PyErr {
+    Python::attach(|py| {
+        package_error(
+            py,
+            &POLICY_ERROR,
+            "PolicyError",
+            with_help(p.message.clone(), p.help.clone()),
+        )
+    })
+}
+
+/// An instance of the package's exception class `name`, made with `message`.
+fn package_error(
+    py: Python<'_>,
+    cell: &'static PyOnceLock<Py<PyType>>,
+    name: &str,
+    message: String,
+) -> PyErr {
+    match python_class(py, cell, name).and_then(|cls| cls.call1((message,))) {
+        Ok(e) => PyErr::from_value(e),
+        Err(e) => e,
     }
 }
 
@@ -124,6 +177,8 @@ pub fn diagnostics_of(file: &str, source: &str, diagnostics: &[LangDiagnostic]) 
 
 static SPEC_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static MISSING_VARIABLE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static WORLD_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static POLICY_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// A class of the package's pure-Python part (`hstl._errors`).
 fn python_class<'py>(

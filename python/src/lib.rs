@@ -1,5 +1,6 @@
 //! `hstl._hstl`: the Python package's native module, a thin PyO3 shell over the `hstl`
-//! facade (`hstl::load`, `hstl::monitor`), as the `hstl!` macro is over hstl-lang.
+//! facade (`hstl::load`, `hstl::monitor`, `hstl::world`, `hstl::train`,
+//! `hstl::evaluate`, `hstl::reward`), as the `hstl!` macro is over hstl-lang.
 //!
 //! Everything that computes lives in the facade and is tested there. This crate converts
 //! Python values into borrowed samples (contiguous float64 arrays are read in place; other
@@ -7,9 +8,14 @@
 //! the facade's errors into Python exceptions with the command line's words.
 
 mod errors;
+mod gym;
 mod online;
+mod policy;
+mod reward;
 mod spec;
 mod trace;
+mod train;
+mod world;
 
 use pyo3::prelude::*;
 
@@ -19,6 +25,13 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<spec::Spec>()?;
     m.add_class::<spec::Diagnostic>()?;
     m.add_class::<online::OnlineMonitor>()?;
+    m.add_class::<world::World>()?;
+    m.add_class::<world::Generator>()?;
+    m.add_class::<policy::Policy>()?;
+    m.add_class::<reward::EpisodeMonitor>()?;
+    m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
+    m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
+    m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -27,10 +27,10 @@ use crate::trace::{hold, hold_batch};
 /// A spec pickles by its source text, file name and spec name.
 #[pyclass(module = "hstl", frozen)]
 pub struct Spec {
-    source: String,
-    filename: String,
+    pub(crate) source: String,
+    pub(crate) filename: String,
     requested: Option<String>,
-    spec: CheckedSpec,
+    pub(crate) spec: CheckedSpec,
     warnings: Vec<hstl::lang::Diagnostic>,
     /// Lowered monitors by formula name (`None`: the task), made on first use.
     monitors: Mutex<HashMap<Option<String>, Arc<Monitor>>>,
@@ -120,7 +120,8 @@ impl Diagnostic {
 }
 
 impl Spec {
-    fn from_source(
+    /// Checks `source` (reported as `filename`) and picks the spec called `name`.
+    pub(crate) fn from_source(
         py: Python<'_>,
         source: String,
         filename: String,

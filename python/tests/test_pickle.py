@@ -51,3 +51,26 @@ def test_a_spec_crosses_to_a_spawned_process():
     spec = hstl.Spec.load(CLI_FIXTURES / "surveillance.hstl")
     with multiprocessing.get_context("spawn").Pool(1) as pool:
         assert pool.map(score, [spec]) == [score(spec)]
+
+
+def test_worlds_and_policies_round_trip_by_their_contents():
+    from conftest import REPO
+
+    world = hstl.World.load(REPO / "examples" / "worlds" / "warehouse.toml")
+    policy = hstl.train(CLI_FIXTURES / "small.hstl", seed=4, episodes=2)
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        assert pickle.loads(pickle.dumps(world, protocol)) == world
+        back = pickle.loads(pickle.dumps(policy, protocol))
+        assert back == policy and back.json == policy.json
+        assert back.curve.tolist() == policy.curve.tolist() and back.steps == policy.steps
+        assert back.q_tables["options"].tobytes() == policy.q_tables["options"].tobytes()
+
+
+def window_rate(policy):
+    return policy.evaluate(starts=2, steps=300, optimum=False)["window_rate"]
+
+
+def test_a_policy_crosses_to_a_spawned_process():
+    policy = hstl.train(CLI_FIXTURES / "small.hstl", seed=4, episodes=2)
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        assert pool.map(window_rate, [policy]) == [window_rate(policy)]

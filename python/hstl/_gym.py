@@ -1,0 +1,242 @@
+"""Gymnasium environments and wrappers: ``GridWorldEnv`` and ``STLReward``.
+
+Importing ``hstl`` registers the built-in worlds with gymnasium (when it is installed):
+``gymnasium.make("hstl/GridWorld-v0")`` is the paper's world and
+``gymnasium.make("hstl/FourRooms-v0")`` the four rooms, each with
+``max_episode_steps=MAX_EPISODE_STEPS``.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from ._hstl import EpisodeMonitor, Generator, Spec, World
+
+#: The episode length of the registered environments: the length of the greedy runs that
+#: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
+MAX_EPISODE_STEPS = 2000
+
+#: The ids registered for the built-in worlds, and the world each makes.
+REGISTERED = {"hstl/GridWorld-v0": "paper", "hstl/FourRooms-v0": "four-rooms"}
+
+_MAX_SEED = 2**64 - 1
+
+
+def _world(world: Union[World, str, "os.PathLike[str]"]) -> World:
+    if isinstance(world, World):
+        return world
+    return World._resolve(os.fspath(world))
+
+
+def _seed_of(seed: Any) -> int:
+    if isinstance(seed, (bool, float)) or not isinstance(seed, (int, np.integer)):
+        raise TypeError(f"`seed` must be an integer; got {type(seed).__name__}")
+    if not 0 <= int(seed) <= _MAX_SEED:
+        raise ValueError(f"`seed` must be in 0..={_MAX_SEED}; got {seed}")
+    return int(seed)
+
+
+class GridWorldEnv(gymnasium.Env):
+    """A grid world as a gymnasium environment, stepped in Rust.
+
+    ``world`` is a ``hstl.World``, a built-in world's name (``"paper"``, the paper's 15 x 15
+    open grid with slip 0.3, or ``"four-rooms"``) or a world file's path. The observation
+    is the robot's cell ``(x, y)``: ``MultiDiscrete([width, height])`` (int64), ``x``
+    counting columns from 0 at the left and ``y`` rows from 0 at the bottom, as a spec's
+    ``state { x: int in 0..=W-1, y: int in 0..=H-1 }`` names them; only free cells occur.
+    The actions are ``Discrete(4)``: 0 ``Up`` (y + 1), 1 ``Down``, 2 ``Left`` (x - 1),
+    3 ``Right``. With probability ``world.slip`` one of the other three is taken instead,
+    each equally likely; a move into a wall or off the map stays in place.
+
+    Every random draw (starts and slips) comes from one Rust generator (ChaCha8, the
+    learner's), seeded by ``reset(seed=...)`` and continued by ``reset()``, as gymnasium's
+    conventions ask; the same seed and actions give the same cells as ``hstlc train``'s
+    draws. The reward is always 0: the world has no task (wrap it in ``hstl.STLReward``).
+    Episodes never terminate; the registered ids truncate them after
+    ``MAX_EPISODE_STEPS``. ``info["state"]`` is the cell's state index
+    (``world.free_cells[index]``). ``reset(options={"start": (x, y)})`` starts on a given
+    free cell. ``render_mode="ansi"`` renders the map as text (``R`` the robot).
+    """
+
+    metadata = {"render_modes": ["ansi"], "render_fps": 4}
+
+    def __init__(
+        self, world: Union[World, str, "os.PathLike[str]"] = "paper", render_mode: Optional[str] = None
+    ) -> None:
+        self.world = _world(world)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be None or 'ansi'; got {render_mode!r}")
+        self.render_mode = render_mode
+        self.observation_space = spaces.MultiDiscrete([self.world.width, self.world.height], dtype=np.int64)
+        self.action_space = spaces.Discrete(4)
+        self._generator: Optional[Generator] = None
+        self._state: Optional[int] = None
+        self._cell = (0, 0)
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        super().reset(seed=seed)
+        if seed is not None:
+            self._generator = Generator(_seed_of(seed))
+        elif self._generator is None:
+            # No seed ever given: one from the entropy gymnasium seeded np_random with.
+            self._generator = Generator(int(self.np_random.integers(0, 2**63)))
+        start = (options or {}).get("start")
+        if start is None:
+            state, x, y = self.world._reset(self._generator)
+        else:
+            x, y = (int(v) for v in start)
+            index = self.world._index(x, y)
+            if index is None:
+                raise ValueError(f"options['start'] = ({x}, {y}) is not a free cell of world `{self.world.name}`")
+            state = index
+        self._state, self._cell = state, (x, y)
+        return np.array(self._cell, dtype=np.int64), {"state": state}
+
+    def step(self, action: Any):
+        if self._state is None:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        a = int(action)
+        if not 0 <= a < 4:
+            raise ValueError(f"action {action!r} is not in Discrete(4) (0 Up, 1 Down, 2 Left, 3 Right)")
+        state, x, y = self.world._step(self._state, a, self._generator)
+        self._state, self._cell = state, (x, y)
+        return np.array(self._cell, dtype=np.int64), 0.0, False, False, {"state": state}
+
+    def render(self) -> Optional[str]:
+        if self.render_mode != "ansi":
+            return None
+        rows = [list(line) for line in self.world.map]
+        if self._state is not None:
+            x, y = self._cell
+            rows[self.world.height - 1 - y][x] = "R"
+        return "\n".join("".join(r) for r in rows) + "\n"
+
+
+Valuation = Union[Callable[[Any], Any], Mapping[str, Any], None]
+
+
+class STLReward(gymnasium.Wrapper):
+    """Rewards any environment with STL robustness computed in Rust, and reports the task's
+    own success apart from the reward.
+
+    ``valuation`` maps an observation to the spec's state variables: a callable
+    (observation -> a dict of state variable values, or a sequence of them in
+    ``spec.state_vars`` order), or a dict from each state variable to its index (or key)
+    in the observation, such as ``{"x": 0, "y": 1}``. The spec is ``stl_spec`` (``spec`` is
+    gymnasium's registration of the environment). Leave it out for a
+    ``GridWorldEnv`` (its observation is ``(x, y)``) or an observation that is itself a
+    dict of the state variables.
+
+    The reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
+    ``s_0 ..= s_t`` (``s_0`` is the state ``reset`` returns), for the task or the ``let``
+    called ``formula``. hstl's operators look only forward and windows are clipped at the
+    end of the trace, so this is the formula on ``s_t`` alone: for a state formula, such
+    as a region ``let A = ...``, it is the full trace's signal (``hstlc monitor --signal``)
+    at ``t``; a temporal operator sees only the present (``eventually[0..40] A`` gives
+    ``A`` at ``t``). Pick a region as ``formula`` for a dense reward.
+
+    ``info`` (of ``reset`` and ``step``) holds the task's own measure, apart from the
+    reward: ``task_robustness``, ``rho(task, 0)`` over the trace so far (what
+    ``hstlc monitor`` prints for it), and for a persistent task
+    (``always[0..] (eventually[0..N1] R1 && ...)``) ``window_kept``: whether every region
+    held within its window ending at ``t``, the steps the window rate counts. ``step``'s
+    ``info["env_reward"]`` is the wrapped environment's reward.
+
+    Cost per step: the reward is one evaluation of the formula on one state; the task's
+    robustness is kept up to date incrementally (O(1) amortised for a bounded task once
+    its horizon has passed, O(h) for ``always``/``eventually`` over a body of horizon
+    ``h``; see ``hstl::reward``), not by scoring the whole trace again.
+    """
+
+    def __init__(
+        self,
+        env: gymnasium.Env,
+        spec: Union[Spec, str, "os.PathLike[str]"],
+        valuation: Valuation = None,
+        formula: Optional[str] = None,
+    ) -> None:
+        super().__init__(env)
+        # `spec` is gymnasium's (the environment's registration) on a wrapper.
+        self.stl_spec = spec if isinstance(spec, Spec) else Spec.load(spec)
+        self.formula = formula
+        self._monitor = EpisodeMonitor(self.stl_spec, formula)
+        self._valuation = _valuation_of(env, self.stl_spec, valuation)
+
+    def _score(self, obs: Any, info: Mapping[str, Any]) -> tuple[float, dict]:
+        reward, robustness, kept = self._monitor.push(self._valuation(obs))
+        info = dict(info)
+        info["task_robustness"] = robustness
+        if kept is not None:
+            info["window_kept"] = kept
+        return reward, info
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        obs, info = self.env.reset(seed=seed, options=options)
+        self._monitor.reset()
+        _, info = self._score(obs, info)
+        return obs, info
+
+    def step(self, action: Any):
+        obs, env_reward, terminated, truncated, info = self.env.step(action)
+        reward, info = self._score(obs, info)
+        info["env_reward"] = env_reward
+        return obs, reward, terminated, truncated, info
+
+
+def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Callable[[Any], Any]:
+    """The function from an observation to what ``EpisodeMonitor.push`` takes."""
+    if callable(valuation):
+        return valuation
+    vars = spec.state_vars
+    if isinstance(valuation, Mapping):
+        missing = [v for v in vars if v not in valuation]
+        if missing:
+            raise _missing(f"valuation has no entry for state variable `{missing[0]}`", vars)
+        picks = [(v, valuation[v]) for v in vars]
+        return lambda obs: {v: obs[k] for v, k in picks}
+    if valuation is not None:
+        raise TypeError(
+            f"valuation must be a callable or a dict from state variables to observation indices; got {type(valuation).__name__}"
+        )
+    if isinstance(env.unwrapped, GridWorldEnv):
+        extra = [v for v in vars if v not in ("x", "y")]
+        if extra:
+            raise TypeError(
+                f"spec `{spec.name}` has state variable `{extra[0]}`, which a GridWorldEnv observation (x, y) does not give\n"
+                "  help: pass valuation=, a function from the observation to the state variables"
+            )
+        if vars == ["x", "y"]:
+            return lambda obs: obs
+        picks = [(v, 0 if v == "x" else 1) for v in vars]
+        return lambda obs: {v: obs[k] for v, k in picks}
+    if isinstance(env.observation_space, spaces.Dict):
+        return lambda obs: obs
+    raise TypeError(
+        f"STLReward cannot read state variables from a {type(env.observation_space).__name__} observation\n"
+        '  help: pass valuation=, a function from the observation to the state variables (or a dict such as {"x": 0, "y": 1})'
+    )
+
+
+def _missing(message: str, vars: Sequence[str]) -> Exception:
+    from ._errors import MissingVariableError
+
+    return MissingVariableError(f"{message}\n  help: the spec's state variables are {', '.join(f'`{v}`' for v in vars)}")
+
+
+def register() -> None:
+    """Registers the built-in worlds' ids with gymnasium (done by ``import hstl``)."""
+    from gymnasium.envs.registration import registry
+
+    for env_id, world in REGISTERED.items():
+        if env_id not in registry:
+            gymnasium.register(
+                id=env_id,
+                entry_point="hstl._gym:GridWorldEnv",
+                kwargs={"world": world},
+                max_episode_steps=MAX_EPISODE_STEPS,
+            )

@@ -1,0 +1,64 @@
+//! `hstl._hstl.EpisodeMonitor`: what `hstl.STLReward` scores each step with.
+
+use hstl::reward::EpisodeMonitor as Inner;
+use pyo3::prelude::*;
+
+use crate::errors::{lower_error, trace_error};
+use crate::spec::Spec;
+use crate::trace::state_values;
+
+/// Scores the states of one episode as they arrive: the reward `rho(formula, t)` over the
+/// states so far, the task's robustness `rho(task, 0)` over them and, for a persistent
+/// task, whether the window ending at `t` is kept. See `hstl.STLReward`.
+#[pyclass(module = "hstl._hstl")]
+pub struct EpisodeMonitor {
+    inner: Inner,
+}
+
+#[pymethods]
+impl EpisodeMonitor {
+    #[new]
+    #[pyo3(signature = (spec, formula=None))]
+    fn new(spec: &Bound<'_, Spec>, formula: Option<&str>) -> PyResult<EpisodeMonitor> {
+        let spec = spec.get();
+        let inner = Inner::new(&spec.spec, &spec.source, formula)
+            .map_err(|e| lower_error(&spec.filename, &e))?;
+        Ok(EpisodeMonitor { inner })
+    }
+
+    /// Starts a new episode.
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+
+    /// Appends one state (a mapping from state variable names to numbers, or numbers in
+    /// the order of `state_vars`) and returns `(reward, task_robustness, window_kept)`;
+    /// `window_kept` is None for a task that is not persistent.
+    fn push(
+        &mut self,
+        py: Python<'_>,
+        state: &Bound<'_, PyAny>,
+    ) -> PyResult<(f64, f64, Option<bool>)> {
+        let values = state_values(state, self.inner.state_vars())?;
+        let score = self.inner.push(&values).map_err(|e| trace_error(py, &e))?;
+        Ok((score.reward, score.task_robustness, score.window_kept))
+    }
+
+    /// The state variables, in the order a sequence state lists them.
+    #[getter]
+    fn state_vars(&self) -> Vec<String> {
+        self.inner.state_vars().to_vec()
+    }
+
+    /// Whether the task is persistent (`always[0..] (eventually[0..N1] R1 && ...)`).
+    #[getter]
+    fn persistent(&self) -> bool {
+        self.inner.is_persistent()
+    }
+
+    /// The states given since creation or the last `reset()`.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.inner.steps()
+    }
+}

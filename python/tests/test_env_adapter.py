@@ -1,0 +1,159 @@
+"""`hstl.train(spec, env=..., valuation=...)`: the learner over a gymnasium environment with
+`Discrete` spaces, deterministic for a seed, with what `terminated` does, what bad
+environments and valuations raise, and the policy's round trip."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium import spaces
+
+import hstl
+
+LAKE = hstl.Spec.parse(
+    """spec Lake {
+        state { row: int in 0..=3, col: int in 0..=3 }
+        let Goal = row > 2 && col > 2;
+        task eventually[0..40] Goal;
+        option Goal;
+        learn { episodes: 25, choices: 3, max_steps: 40 }
+    }""",
+    filename="lake.hstl",
+)
+
+
+def lake_state(obs):
+    return {"row": obs // 4, "col": obs % 4}
+
+
+def tables(policy):
+    q = policy.q_tables
+    return [t.tobytes() for t in q["flat"].values()] + [q["options"].tobytes()]
+
+
+class Line(gymnasium.Env):
+    """Cells 0..n-1 on a line; action 1 moves right, 0 left; cell n-1 terminates. Counts
+    its calls, and slips (from its own np_random) with probability `slip`."""
+
+    def __init__(self, n=6, slip=0.2, fail_at=None):
+        self.n, self.slip, self.fail_at = n, slip, fail_at
+        self.observation_space = spaces.Discrete(n)
+        self.action_space = spaces.Discrete(2, start=10)
+        self.steps_after_end = 0
+        self.calls = 0
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.cell, self.ended = 0, False
+        return 0, {}
+
+    def step(self, action):
+        self.calls += 1
+        if self.fail_at is not None and self.calls == self.fail_at:
+            raise RuntimeError("the robot fell over")
+        if self.ended:
+            self.steps_after_end += 1
+        move = 1 if action == 11 else -1
+        if self.np_random.random() < self.slip:
+            move = -move
+        self.cell = min(self.n - 1, max(0, self.cell + move))
+        self.ended = self.cell == self.n - 1
+        return self.cell, 0.0, self.ended, False, {}
+
+
+LINE = hstl.Spec.parse(
+    """spec Reach {
+        state { s: int in 0..=5 }
+        let End = s > 4;
+        task eventually[0..30] End;
+        option End;
+        learn { episodes: 15, choices: 2, max_steps: 30 }
+    }"""
+)
+
+
+def test_frozen_lake_trains_deterministically():
+    a = hstl.train(LAKE, env=gymnasium.make("FrozenLake-v1"), valuation=lake_state, seed=3)
+    b = hstl.train(LAKE, env=gymnasium.make("FrozenLake-v1"), valuation=lake_state, seed=3)
+    c = hstl.train(LAKE, env=gymnasium.make("FrozenLake-v1"), valuation=lake_state, seed=4)
+    assert tables(a) == tables(b) and a.json == b.json and a.curve.tolist() == b.curve.tolist()
+    assert tables(a) != tables(c)
+    assert a.env_name == "FrozenLake-v1" and a.actions == ["0", "1", "2", "3"] and a.world is None
+    assert a.q_tables["flat"]["Goal"].shape == (16, 4) and np.any(a.q_tables["flat"]["Goal"] != 0)
+
+
+def test_a_terminated_step_absorbs_until_the_learners_episode_ends():
+    env = Line()
+    policy = hstl.train(LINE, env=env, valuation=lambda o: {"s": o}, seed=1)
+    # The learner never stepped past the end: after `terminated` it stayed put.
+    assert env.steps_after_end == 0 and env.calls < policy.steps
+    assert hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o}, seed=1) == policy
+    # Actions are the environment's own (Discrete(2, start=10)).
+    assert policy.actions == ["10", "11"]
+    policy.reset()
+    assert policy.act(0) in (10, 11) and policy.act({"s": 3}) in (10, 11)
+    report = policy.evaluate(starts=4, steps=30, env=Line(), valuation=lambda o: {"s": o})
+    assert len(report["robustness"]) == 4 and report["window_rate"] is None
+
+
+def test_a_saved_policy_loads_and_needs_its_environment_to_evaluate(tmp_path):
+    policy = hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o}, seed=2)
+    policy.save(tmp_path / "policy.json")
+    loaded = hstl.Policy.load(tmp_path / "policy.json")
+    assert loaded == policy and tables(loaded) == tables(policy)
+    with pytest.raises(TypeError, match="pass `env=`"):
+        loaded.evaluate()
+    with pytest.raises(ValueError, match="outside Discrete"):
+        loaded.act(6)
+    same = loaded.evaluate(starts=3, steps=20, env=Line(), valuation=lambda o: {"s": o})
+    assert same == policy.evaluate(starts=3, steps=20, env=Line(), valuation=lambda o: {"s": o})
+    with pytest.raises(ValueError, match=r"trained on `Line` \(Discrete\(6\) observations, Discrete\(2, start=10\) actions\); `env` is `Line` \(Discrete\(5\)"):
+        loaded.evaluate(env=Line(n=5), valuation=lambda o: {"s": o})
+    # The states are named by their values: a relabelled environment replays the same policy.
+    relabelled = loaded.evaluate(starts=3, steps=20, env=Line(), valuation=lambda o: {"s": 5 - o})
+    assert len(relabelled["robustness"]) == 3
+
+
+def test_bad_environments_and_valuations_raise():
+    line = lambda o: {"s": o}  # noqa: E731
+    with pytest.raises(TypeError, match="needs a `Discrete` observation space; this environment's is Box"):
+        hstl.train(LINE, env=gymnasium.make("CartPole-v1"), valuation=line)
+    with pytest.raises(TypeError, match="needs valuation="):
+        hstl.train(LINE, env=Line())
+    with pytest.raises(TypeError, match="either world= or env="):
+        hstl.train(LINE, world="four-rooms", env=Line(), valuation=line)
+    with pytest.raises(ValueError, match=r"valuation\(5\) gives `s` = 7, outside its declared domain 0..=5"):
+        hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o + 2 if o == 5 else o})
+    with pytest.raises(ValueError, match="observations 0 and 1 have the same valuation"):
+        hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o // 2})
+    with pytest.raises(hstl.MissingVariableError, match=r"valuation\(0\): missing state variable `s`"):
+        hstl.train(LINE, env=Line(), valuation=lambda o: {"t": o})
+    with pytest.raises(ZeroDivisionError):
+        hstl.train(LINE, env=Line(), valuation=lambda o: 1 / 0)
+    with pytest.raises(ValueError, match="observations; the learner's tables take 1 to"):
+        big = Line()
+        big.observation_space = spaces.Discrete(2**40)
+        hstl.train(LINE, env=big, valuation=line)
+
+
+def test_an_exception_in_the_environment_stops_training_and_is_raised():
+    env = Line(fail_at=50)
+    with pytest.raises(RuntimeError, match="the robot fell over"):
+        hstl.train(LINE, env=env, valuation=lambda o: {"s": o}, episodes=1000)
+    # Training stopped at the end of that episode: far fewer calls than 1000 episodes make.
+    assert env.calls == 50
+
+    class BadObservation(Line):
+        def step(self, action):
+            return "left", 0.0, False, False, {}
+
+    with pytest.raises(ValueError, match="env.step gave the observation 'left', not an integer"):
+        hstl.train(LINE, env=BadObservation(), valuation=lambda o: {"s": o})
+
+    class OffTheLine(Line):
+        def step(self, action):
+            return 9, 0.0, False, False, {}
+
+    with pytest.raises(ValueError, match=r"env.step gave the observation 9, outside Discrete\(6, start=0\)"):
+        hstl.train(LINE, env=OffTheLine(), valuation=lambda o: {"s": o})

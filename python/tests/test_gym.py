@@ -1,0 +1,202 @@
+"""Gymnasium: `GridWorldEnv` passes gymnasium's checker and draws from its one seeded
+generator, the registered ids make the built-in worlds, and `STLReward`'s rewards and
+task robustness are those of `hstlc monitor` on the same trace."""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import hstl
+from conftest import CLI_FIXTURES, REPO, run_cli
+
+SURVEILLANCE = CLI_FIXTURES / "surveillance.hstl"
+REACH = CLI_FIXTURES / "reach.hstl"
+CORRIDORS = REPO / "examples" / "worlds" / "corridors.toml"
+
+
+@pytest.mark.parametrize("world", ["paper", "four-rooms", CORRIDORS], ids=["paper", "four-rooms", "corridors"])
+def test_grid_world_env_passes_the_env_checker(world):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(hstl.GridWorldEnv(world))
+    # Made directly it has no registration to make its render modes from; nothing else.
+    assert all("alternative render modes" in str(w.message) for w in caught), [str(w.message) for w in caught]
+
+
+@pytest.mark.parametrize("env_id, world", sorted(hstl._gym.REGISTERED.items()))
+def test_the_registered_ids_make_the_built_in_worlds(env_id, world):
+    env = gymnasium.make(env_id)
+    assert env.unwrapped.world == hstl.World.builtin(world)
+    assert env.spec.max_episode_steps == hstl.MAX_EPISODE_STEPS == 2000
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(env.unwrapped)
+    assert not caught, [str(w.message) for w in caught]
+    assert gymnasium.make("hstl/GridWorld-v0").unwrapped.world.name == "paper"
+    # The time limit truncates an episode after max_episode_steps.
+    env.reset(seed=0)
+    for t in range(1, 2001):
+        _, _, terminated, truncated, _ = env.step(t % 4)
+        assert not terminated and truncated == (t == 2000)
+
+
+def run(env, seed, actions):
+    obs, info = env.reset(seed=seed)
+    cells = [tuple(obs)]
+    for a in actions:
+        obs, reward, terminated, truncated, info = env.step(a)
+        assert (reward, terminated, truncated) == (0.0, False, False)
+        cells.append(tuple(obs))
+    return cells
+
+
+def test_the_same_seed_gives_the_same_cells_and_reset_continues_the_generator():
+    actions = np.random.default_rng(3).integers(0, 4, size=400)
+    env = hstl.GridWorldEnv("four-rooms")
+    a, b = run(env, 11, actions), run(hstl.GridWorldEnv("four-rooms"), 11, actions)
+    assert a == b and len(set(a)) > 20
+    assert run(env, 12, actions) != a
+    # reset() without a seed continues the generator: another start and other slips.
+    env.reset(seed=11)
+    for x in actions:
+        env.step(x)
+    second = [tuple(env.reset()[0])] + [tuple(env.step(x)[0]) for x in actions]
+    assert second != a
+    world = env.world
+    assert all(world.is_free(x, y) for x, y in a + second)
+    # Slips happen at the world's rate: the chosen action is taken with p = 1 - slip.
+    env.reset(seed=5)
+    moved_up = 0
+    for _ in range(4000):
+        env.reset(options={"start": (3, 3)})
+        moved_up += tuple(env.step(0)[0]) == (3, 4)
+    assert abs(moved_up / 4000 - (1 - world.slip)) < 0.03
+
+
+def test_bad_calls_raise():
+    env = hstl.GridWorldEnv()
+    with pytest.raises(gymnasium.error.ResetNeeded):
+        env.step(0)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="not in Discrete"):
+        env.step(4)
+    with pytest.raises(ValueError, match=r"`seed` must be in 0\.\.="):
+        env.reset(seed=2**64)
+    with pytest.raises(ValueError, match="not a free cell of world `four-rooms`"):
+        hstl.GridWorldEnv("four-rooms").reset(options={"start": (0, 0)})
+    with pytest.raises(ValueError, match="render_mode"):
+        hstl.GridWorldEnv(render_mode="human")
+    with pytest.raises(hstl.WorldError, match="unknown world `mars`"):
+        hstl.GridWorldEnv("mars")
+    env = hstl.GridWorldEnv("four-rooms", render_mode="ansi")
+    env.reset(options={"start": (1, 1)})
+    assert env.render().splitlines()[-2] == "#R....#.....#"
+
+
+def write_csv(path, cells):
+    path.write_text("x,y\n" + "".join(f"{x},{y}\n" for x, y in cells))
+    return path
+
+
+def cli_signal(hstlc, spec, trace, formula=None):
+    args = ["monitor", str(spec), "--trace", str(trace), "--signal"] + (["--formula", formula] if formula else [])
+    out = run_cli(hstlc, *args)
+    assert out.returncode == 0, out.stderr
+    return [float(line.split(",")[1]) for line in out.stdout.splitlines()[1:]]
+
+
+def cli_robustness(hstlc, spec, trace):
+    out = run_cli(hstlc, "monitor", str(spec), "--trace", str(trace))
+    assert out.returncode == 0, out.stderr
+    return float(out.stdout)
+
+
+def episode(env, seed, steps, start=None, up=0.25):
+    """A random episode through `env` (an `STLReward`), from `start`, moving up with
+    probability `up`: its cells, rewards and infos."""
+    rng = np.random.default_rng(seed)
+    obs, info = env.reset(seed=seed, options={"start": start} if start else None)
+    cells, rewards, infos = [tuple(int(v) for v in obs)], [], [info]
+    down = (1 - up) / 3
+    for _ in range(steps):
+        obs, reward, _, _, info = env.step(rng.choice(4, p=[up, down, down, down]))
+        cells.append(tuple(int(v) for v in obs))
+        rewards.append(reward)
+        infos.append(info)
+    return cells, rewards, infos
+
+
+def test_a_regions_rewards_are_hstlc_monitors_signal(hstlc, tmp_path):
+    env = hstl.STLReward(gymnasium.make("hstl/GridWorld-v0"), SURVEILLANCE, formula="A")
+    cells, rewards, infos = episode(env, 2016, 600, start=(6, 6), up=0.3)
+    trace = write_csv(tmp_path / "walk.csv", cells)
+    signal = cli_signal(hstlc, SURVEILLANCE, trace, "A")
+    # The reward of the step into s_t is the region's signal at t, bit for bit.
+    assert np.array_equal(np.array(rewards), np.array(signal[1:]))
+    assert any(r > 0 for r in rewards) and any(r < 0 for r in rewards)
+    assert all(i["env_reward"] == 0.0 for i in infos[1:])
+    # The task's robustness over the whole episode is what hstlc monitor prints for it.
+    assert infos[-1]["task_robustness"] == cli_robustness(hstlc, SURVEILLANCE, trace)
+    kept = [i["window_kept"] for i in infos]
+    assert kept[0] is False and kept.count(True) < len(kept)
+
+
+def test_rewards_and_task_robustness_are_hstlc_monitors_on_every_prefix(hstlc, tmp_path):
+    env = hstl.STLReward(hstl.GridWorldEnv(), REACH)
+    cells, rewards, infos = episode(env, 7, 40)
+    assert all("window_kept" not in i for i in infos), "not a persistent task"
+    for t in [0, 1, 5, 17, 31, 40]:
+        prefix = write_csv(tmp_path / f"prefix{t}.csv", cells[: t + 1])
+        assert infos[t]["task_robustness"] == cli_robustness(hstlc, REACH, prefix), t
+        if t > 0:
+            # rho(task, t) over the trace so far: the last row of --signal on the prefix.
+            assert rewards[t - 1] == cli_signal(hstlc, REACH, prefix)[-1], t
+
+
+def test_state_variables_come_from_the_observation_as_the_user_maps_them():
+    spec = hstl.Spec.parse("spec P { state { y: float, x: float } let Top = y > 12; task eventually[0..] Top; }")
+    env = hstl.STLReward(hstl.GridWorldEnv(), spec, formula="Top")
+    obs, _ = env.reset(options={"start": (2, 14)})
+    assert env.step(2)[1] in (1.0, 2.0)  # y 13 or 14, whatever the order of the spec's variables
+    # A dict of indices, a callable, or an observation that is a dict.
+    mapped = hstl.STLReward(hstl.GridWorldEnv(), spec, valuation={"x": 0, "y": 1}, formula="Top")
+    called = hstl.STLReward(hstl.GridWorldEnv(), spec, valuation=lambda o: {"x": o[0], "y": o[1]}, formula="Top")
+    for wrapped in (mapped, called):
+        wrapped.reset(options={"start": (2, 14)})
+        assert wrapped.step(2)[1] in (1.0, 2.0)
+    with pytest.raises(hstl.MissingVariableError, match="no entry for state variable `x`"):
+        hstl.STLReward(hstl.GridWorldEnv(), spec, valuation={"y": 1})
+    other = hstl.Spec.parse("spec Q { state { z: float } task always[0..] z > 0; }")
+    with pytest.raises(TypeError, match="state variable `z`"):
+        hstl.STLReward(hstl.GridWorldEnv(), other)
+    with pytest.raises(TypeError, match="pass valuation="):
+        hstl.STLReward(gymnasium.make("FrozenLake-v1"), other)
+    with pytest.raises(ValueError, match="no `let` named `Nope`"):
+        hstl.STLReward(hstl.GridWorldEnv(), spec, formula="Nope")
+    nan = hstl.STLReward(hstl.GridWorldEnv(), spec, valuation=lambda o: {"x": float("nan"), "y": 1.0})
+    with pytest.raises(ValueError, match="`x` is NaN at step 0"):
+        nan.reset(seed=0)
+
+
+def test_a_policy_replayed_in_gymnasium_is_hstlc_evals_run(tmp_path):
+    """The greedy policy acting in GridWorldEnv, seeded as `evaluate` seeds its runs,
+    visits the cells `evaluate` scores: STLReward's windows kept and task robustness give
+    its window rate and robustness exactly."""
+    policy = hstl.train(CLI_FIXTURES / "small.hstl", seed=3, episodes=10)
+    steps, burn_in = 400, 50
+    report = policy.evaluate(starts=1, steps=steps, burn_in=burn_in, seed=9, optimum=False)
+    env = hstl.STLReward(hstl.GridWorldEnv(policy.world), CLI_FIXTURES / "small.hstl")
+    obs, info = env.reset(seed=9)
+    policy.reset()
+    kept = [info["window_kept"]]
+    for _ in range(steps - 1):
+        obs, _, _, _, info = env.step(policy.act(obs))
+        kept.append(info["window_kept"])
+    assert sum(kept[burn_in:]) / (steps - burn_in) == report["window_rate"]
+    assert info["task_robustness"] == report["robustness"][0]
+    assert 0 < sum(kept) < steps
