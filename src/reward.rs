@@ -14,14 +14,18 @@
 //!   window ending at `t` is **kept** (`psi(t)` of LANGUAGE.md: every region held within
 //!   its last `N_j` steps), the measure the window rate counts.
 //!
-//! Cost per state: the reward is `O(|formula|)`. The task's robustness is kept up to date
-//! without evaluating the trace again where the formula allows: `!`, `&&`, `||` and `->`
-//! combine their parts' running values; `always[I] f` and `eventually[I] f` with `f` of
-//! finite horizon `h` fold the values of `f` that are final and evaluate only the last `h`
-//! states again, `O(h)` a step (`O(1)` for a region); any other part with a finite horizon
-//! `H` is evaluated over the states so far until `H + 1` have arrived and is fixed from
-//! then on. Only a part that is none of these (an unbounded `until`, or an unbounded
-//! operator over another one) is evaluated over the whole trace at every step.
+//! Cost per state: the reward is `O(|formula|)` (the formula on one state). The task's
+//! robustness is kept up to date without evaluating the trace again where the formula
+//! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
+//! distributes over `&&` (`eventually` over `||`); `always[c..] eventually[J] f` and
+//! `eventually[c..] always[J] f` with `f` a state formula (the persistent task's parts)
+//! take `O(1)` amortised through the online monitor of the inner operator;
+//! `always[I] f` and `eventually[I] f` with `f` of finite horizon `h` fold the values of
+//! `f` that are final and evaluate only the last `h` states again, `O(h)` a step; any
+//! other part with a finite horizon `H` is evaluated over the states so far until `H + 1`
+//! have arrived and is fixed from then on. Only a part that is none of these (an
+//! unbounded `until`, or an unbounded operator over another one) is evaluated over the
+//! whole trace at every step.
 //!
 //! ```
 //! let src = "spec S { state { x: float } let Hot = x > 2; task eventually[0..] Hot; }";
@@ -35,7 +39,7 @@
 //! ```
 
 use hstl_lang::CheckedSpec;
-use hstl_robustness::{Evaluator, Formula, Interval};
+use hstl_robustness::{Bound, Evaluator, Formula, Interval, OnlineMonitor};
 
 use crate::lower::{self, LowerError};
 use crate::monitor::TraceError;
@@ -87,6 +91,24 @@ enum Running {
         states: Columns,
         /// The position of the first state in `states`.
         first: usize,
+    },
+    /// `always[c..] g` (`min`) or `eventually[c..] g` (`max`), `g` being
+    /// `eventually[I] f` or `always[I] f` (the other operator) with `f` a state formula:
+    /// the persistent task's shape, `O(1)` amortised a step. The positions whose value of
+    /// `g` is final come from the online monitor of `g`; every other position's window is
+    /// clipped at the end of the trace to a suffix of it, and of those suffixes the
+    /// latest position's (`g` on the last state alone) is the least for `always` over
+    /// `eventually` (the greatest for the dual), so it alone stands for them.
+    Stream {
+        always: bool,
+        /// The outer operator's first offset `c`.
+        from: usize,
+        /// `g`, evaluated on the last state alone.
+        body: Formula,
+        /// The online monitor of `g`: its final values, in order.
+        online: Box<OnlineMonitor>,
+        /// The fold of the final values of `g` at positions from `c` on.
+        settled: f64,
     },
     Not(Box<Running>),
     And(Vec<Running>),
@@ -159,17 +181,13 @@ impl EpisodeMonitor {
             return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps });
         }
         self.steps += 1;
-        let sample: Vec<&[f64]> = state.iter().map(std::slice::from_ref).collect();
-        let at_state = |eval: &mut Evaluator, f: &Formula| {
-            eval.robustness_of_slices(f, &sample).unwrap_or(f64::NAN)
-        };
-        let reward = at_state(&mut self.eval, &self.reward);
+        let reward = at_state(&self.reward, state);
         let window_kept = if self.regions.is_empty() {
             None
         } else {
             let mut kept = true;
             for ((formula, n), tau) in self.regions.iter().zip(&mut self.tau) {
-                let inside = at_state(&mut self.eval, formula) > 0.0;
+                let inside = at_state(formula, state) > 0.0;
                 *tau = if inside { 0 } else { (*tau + 1).min(*n) };
                 kept &= *tau < *n;
             }
@@ -194,6 +212,31 @@ impl Running {
             Formula::Or(gs) => Running::Or(gs.iter().map(|g| Running::new(g, vars)).collect()),
             Formula::Implies(g, h) => {
                 Running::Implies(Box::new(Running::new(g, vars)), Box::new(Running::new(h, vars)))
+            }
+            // `always` distributes over `&&` and `eventually` over `||` (the same min or
+            // max, clipped windows and empty ones alike), so each part can take a
+            // cheaper shape below.
+            Formula::Always(interval, body) if matches!(**body, Formula::And(_)) => {
+                let Formula::And(gs) = &**body else { unreachable!("matched above") };
+                let part = |g: &Formula| Formula::Always(*interval, Box::new(g.clone()));
+                Running::And(gs.iter().map(|g| Running::new(&part(g), vars)).collect())
+            }
+            Formula::Eventually(interval, body) if matches!(**body, Formula::Or(_)) => {
+                let Formula::Or(gs) = &**body else { unreachable!("matched above") };
+                let part = |g: &Formula| Formula::Eventually(*interval, Box::new(g.clone()));
+                Running::Or(gs.iter().map(|g| Running::new(&part(g), vars)).collect())
+            }
+            Formula::Always(interval, body) | Formula::Eventually(interval, body)
+                if interval.end == Bound::Unbounded && is_dual_over_state(f) =>
+            {
+                let always = matches!(f, Formula::Always(..));
+                Running::Stream {
+                    always,
+                    from: interval.start,
+                    body: (**body).clone(),
+                    online: Box::new(OnlineMonitor::new(body, vars)),
+                    settled: identity(always),
+                }
             }
             Formula::Always(interval, body) | Formula::Eventually(interval, body) => {
                 match body.horizon() {
@@ -223,6 +266,11 @@ impl Running {
                 *settled = identity(*always);
                 states.clear();
                 *first = 0;
+            }
+            Running::Stream { always, online, settled, .. } => {
+                // Ending the trace readies the monitor for a new one.
+                online.finish();
+                *settled = identity(*always);
             }
             Running::Not(g) => g.reset(),
             Running::And(gs) | Running::Or(gs) => gs.iter_mut().for_each(Running::reset),
@@ -278,6 +326,20 @@ impl Running {
                 }
                 value
             }
+            Running::Stream { always, from, body, online, settled } => {
+                let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
+                // The state has the monitor's width and no NaN (checked by the caller).
+                if let Ok(Some(verdict)) = online.push(state)
+                    && verdict.step >= *from
+                {
+                    *settled = fold(*settled, verdict.value);
+                }
+                if n <= *from {
+                    // No position of the outer window has arrived.
+                    return *settled;
+                }
+                fold(*settled, at_state(body, state))
+            }
             Running::Not(g) => -g.push(state, n, eval),
             Running::And(gs) => {
                 gs.iter_mut().map(|g| g.push(state, n, eval)).fold(f64::INFINITY, f64::min)
@@ -291,6 +353,48 @@ impl Running {
             }
         }
     }
+}
+
+/// `rho(f, 0)` over the one-state trace `state`: the reference semantics with `n = 1`
+/// (a window holds step 0 or nothing), without building a trace. The parser bounds a
+/// formula's height, so the recursion is bounded too.
+fn at_state(f: &Formula, state: &[f64]) -> f64 {
+    let holds_now = |i: &Interval| !i.window(0, 1).is_empty();
+    match f {
+        Formula::True => f64::INFINITY,
+        Formula::False => f64::NEG_INFINITY,
+        Formula::Cmp { lhs, op, rhs } => op.robustness(lhs.eval(state), rhs.eval(state)),
+        Formula::Not(g) => -at_state(g, state),
+        Formula::And(gs) => gs.iter().map(|g| at_state(g, state)).fold(f64::INFINITY, f64::min),
+        Formula::Or(gs) => gs.iter().map(|g| at_state(g, state)).fold(f64::NEG_INFINITY, f64::max),
+        Formula::Implies(g, h) => (-at_state(g, state)).max(at_state(h, state)),
+        Formula::Always(i, g) if holds_now(i) => f64::INFINITY.min(at_state(g, state)),
+        Formula::Always(..) => f64::INFINITY,
+        Formula::Eventually(i, g) if holds_now(i) => f64::NEG_INFINITY.max(at_state(g, state)),
+        Formula::Eventually(..) => f64::NEG_INFINITY,
+        // Nothing comes before step 0, so the left side's minimum is over no step.
+        Formula::Until(i, _, h) if holds_now(i) => {
+            f64::NEG_INFINITY.max(at_state(h, state).min(f64::INFINITY))
+        }
+        Formula::Until(..) => f64::NEG_INFINITY,
+    }
+}
+
+/// Whether `f` is `always[I] eventually[J] g` or `eventually[I] always[J] g` with `g` a
+/// state formula (horizon 0) and `J` bounded: what [`Running::Stream`] takes.
+fn is_dual_over_state(f: &Formula) -> bool {
+    let inner = match f {
+        Formula::Always(_, body) => match &**body {
+            Formula::Eventually(j, g) => Some((j, g)),
+            _ => None,
+        },
+        Formula::Eventually(_, body) => match &**body {
+            Formula::Always(j, g) => Some((j, g)),
+            _ => None,
+        },
+        _ => None,
+    };
+    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && g.horizon() == Some(0))
 }
 
 /// The value of an empty window: `+inf` for `always`, `-inf` for `eventually`.

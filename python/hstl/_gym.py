@@ -55,8 +55,9 @@ class GridWorldEnv(gymnasium.Env):
 
     Every random draw (starts and slips) comes from one Rust generator (ChaCha8, the
     learner's), seeded by ``reset(seed=...)`` and continued by ``reset()``, as gymnasium's
-    conventions ask; the same seed and actions give the same cells as ``hstlc train``'s
-    draws. The reward is always 0: the world has no task (wrap it in ``hstl.STLReward``).
+    conventions ask; the same seed and actions give the same cells as the Rust world
+    drawing from that seed (``policy.evaluate(starts=1, seed=s)`` scores exactly the run
+    that ``reset(seed=s)`` and ``policy.act`` give). The reward is always 0: the world has no task (wrap it in ``hstl.STLReward``).
     Episodes never terminate; the registered ids truncate them after
     ``MAX_EPISODE_STEPS``. ``info["state"]`` is the cell's state index
     (``world.free_cells[index]``). ``reset(options={"start": (x, y)})`` starts on a given
@@ -148,9 +149,10 @@ class STLReward(gymnasium.Wrapper):
     ``info["env_reward"]`` is the wrapped environment's reward.
 
     Cost per step: the reward is one evaluation of the formula on one state; the task's
-    robustness is kept up to date incrementally (O(1) amortised for a bounded task once
-    its horizon has passed, O(h) for ``always``/``eventually`` over a body of horizon
-    ``h``; see ``hstl::reward``), not by scoring the whole trace again.
+    robustness is kept up to date incrementally, not by scoring the whole trace again:
+    O(1) amortised for a persistent task (``always[0..] (eventually[0..N1] R1 && ...)``)
+    and for a bounded task once its horizon has passed, O(h) for ``always``/``eventually``
+    over another body of horizon ``h`` (see the facade's ``hstl::reward``).
     """
 
     def __init__(

@@ -9,13 +9,13 @@
 
 use hstl::monitor::{Monitor, Samples, TraceError};
 use numpy::{
-    PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyBytes, PyDict, PyString};
+use pyo3::types::{PyBytes, PyDict, PyList, PyString, PyTuple};
 
 use crate::errors::{trace_error, type_error, value_error};
 
@@ -208,6 +208,40 @@ pub fn state_values(state: &Bound<'_, PyAny>, vars: &[String]) -> PyResult<Vec<f
             type_error(format!("`{var}` must be a number; got {}", type_name(&v)), None)
         })
     };
+    // The common kinds first, without the attribute lookups (and the exceptions they
+    // raise) that tell any mapping from any sequence: this runs at every step of an
+    // environment.
+    if let Ok(dict) = state.cast_exact::<PyDict>() {
+        return vars
+            .iter()
+            .map(|var| match dict.get_item(var)? {
+                Some(v) => number(v, var),
+                None => Err(missing(py, var, Some(keys(state)), vars)),
+            })
+            .collect();
+    }
+    let numbers = |items: &mut dyn Iterator<Item = Bound<'_, PyAny>>| {
+        items
+            .zip(vars.iter().chain(std::iter::repeat(&String::new())))
+            .map(|(v, var)| number(v, if var.is_empty() { "a value" } else { var }))
+            .collect::<PyResult<Vec<f64>>>()
+    };
+    if let Ok(tuple) = state.cast_exact::<PyTuple>() {
+        return numbers(&mut tuple.iter());
+    }
+    if let Ok(list) = state.cast_exact::<PyList>() {
+        return numbers(&mut list.iter());
+    }
+    if let Ok(array) = state.cast::<PyArray1<f64>>().map(|a| a.try_readonly())
+        && let Ok(array) = array
+    {
+        return Ok(array.as_array().to_vec());
+    }
+    if let Ok(array) = state.cast::<PyArray1<i64>>().map(|a| a.try_readonly())
+        && let Ok(array) = array
+    {
+        return Ok(array.as_array().iter().map(|&v| v as f64).collect());
+    }
     if is_mapping(state)? {
         return vars
             .iter()

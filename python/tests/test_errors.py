@@ -3,6 +3,8 @@ nothing crashes the interpreter or leaks a Rust panic."""
 
 from __future__ import annotations
 
+import collections
+
 import os
 import random
 
@@ -322,6 +324,10 @@ def test_bad_states_for_the_online_monitor():
         ({"x": "a", "y": 0}, TypeError, "`x` must be a number; got str"),
         ([1.0], ValueError, "the state has 1 value, the spec has 2 state variables" + ORDER_HELP),
         ([1.0, 2.0, 3.0], ValueError, "the state has 3 values, the spec has 2 state variables" + ORDER_HELP),
+        ((1.0,), ValueError, "the state has 1 value, the spec has 2 state variables" + ORDER_HELP),
+        (np.array([1, 2, 3]), ValueError, "the state has 3 values, the spec has 2 state variables" + ORDER_HELP),
+        (np.array([np.nan, 0.0]), ValueError, "`x` is NaN at step 1" + NAN_HELP),
+        (("a", 0), TypeError, "`x` must be a number; got str"),
         ("xy", TypeError, "a state is a mapping or a sequence of numbers; got str"),
         (3, TypeError, 'a state is a mapping or a sequence of numbers; got int\n  help: pass a dict such as `{"x": 1, "y": 2}`'),
     ]
@@ -331,6 +337,26 @@ def test_bad_states_for_the_online_monitor():
         assert str(e.value) == message, state
     assert online.steps == 1, "a refused state changes nothing"
     assert online.update(np.array([2.0, 0.0])) is None
+
+
+def test_every_kind_of_state_gives_the_same_values():
+    states = [(3, 0), (1, 2), (7, 1), (0, 5)]
+    kinds = [
+        lambda x, y: {"x": x, "y": y},
+        lambda x, y: (x, y),
+        lambda x, y: [float(x), y],
+        lambda x, y: np.array([x, y]),  # int64, read directly
+        lambda x, y: np.array([x, y], dtype=np.float64),
+        lambda x, y: np.array([x, y], dtype=np.float32),  # converted element by element
+        lambda x, y: np.array([[x, 9], [y, 9]])[:, 0],  # a strided view
+        lambda x, y: collections.OrderedDict(y=y, x=x),
+    ]
+    results = []
+    for kind in kinds:
+        online = SPEC.online()
+        verdicts = [online.update(kind(x, y)) for x, y in states]
+        results.append([v for v in verdicts if v] + online.finish())
+    assert all(r == results[0] for r in results) and len(results[0]) == len(states)
 
 
 SPEC_TEXTS = [
