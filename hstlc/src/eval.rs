@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::Args;
 use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
-use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::optimum::{Moves, SolveConfig, solve};
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts;
@@ -112,7 +112,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     print_robustness(&report.robustness);
     if !args.no_optimum {
         let start = Instant::now();
-        let optimum = solve(&env, &regions, SolveConfig::default())
+        let optimum = solve(&Moves::of(&env), &regions, SolveConfig::default())
             .map_err(|e| CliError::new(e.to_string(), None))?;
         println!(
             "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
