@@ -39,6 +39,9 @@ pub struct EvalArgs {
     pub no_optimum: bool,
 }
 
+/// The help of an optimum that cannot be computed.
+pub const SKIP_OPTIMUM: &str = "pass --no-optimum to skip the optimum W*";
+
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
     let (name, text) = read_input(&args.policy, "<stdin>")?;
@@ -113,7 +116,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     if !args.no_optimum {
         let start = Instant::now();
         let optimum = solve(&Moves::of(&env), &regions, SolveConfig::default())
-            .map_err(|e| CliError::new(e.to_string(), None))?;
+            .map_err(|e| CliError::new(e.to_string(), Some(SKIP_OPTIMUM.into())))?;
         println!(
             "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
             optimum.gain,

@@ -191,7 +191,7 @@ fn optimum(
     let regions = RegionTable::new(spec, env).map_err(|e| CliError::new(e.to_string(), None))?;
     let start = Instant::now();
     let o = solve(&Moves::of(env), &regions, SolveConfig::default())
-        .map_err(|e| CliError::new(e.to_string(), None))?;
+        .map_err(|e| CliError::new(e.to_string(), Some(crate::eval::SKIP_OPTIMUM.into())))?;
     println!(
         "optimum for regions {}: W* = {:.4} (value iteration, {} sweeps, {:.1} s{})",
         spec.regions.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),

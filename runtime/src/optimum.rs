@@ -50,9 +50,10 @@
 //! refused before its tables are allocated.
 
 use std::cell::Cell;
+use std::fmt;
 
 use crate::eval::{Controller, Decision, RegionTable};
-use crate::{Error, GridWorld};
+use crate::{Env, Error, GridWorld};
 
 /// A world's moves as plain data: the solver's view of a grid world.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,7 +84,7 @@ pub struct SolveConfig {
 }
 
 /// The optimal window rate and how it was found.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Optimum {
     /// `W*`, the midpoint of the bracket.
     pub gain: f64,
@@ -208,20 +209,16 @@ impl Default for SolveConfig {
 }
 
 impl Moves {
-    /// The moves of an open grid (no walls), every cell a start.
+    /// The moves of `grid`: from each state, where each action leads without slipping;
+    /// every state a start.
     pub fn of(grid: &GridWorld) -> Moves {
-        let width = grid.width();
-        let cells = width * grid.height();
-        let dest = (0..cells)
-            .map(|c| {
-                let cell = crate::env::Cell { x: c % width, y: c / width };
-                std::array::from_fn(|d| {
-                    let to = grid.intended(cell, d);
-                    (to.y * width + to.x) as u32
-                })
-            })
+        let cells: Vec<crate::env::Cell> =
+            (0..grid.num_states()).filter_map(|s| grid.state(s)).collect();
+        let dest = cells
+            .iter()
+            .map(|&c| std::array::from_fn(|a| grid.index(&grid.intended(c, a)) as u32))
             .collect();
-        Moves { dest, p: grid.p(), starts: (0..cells as u32).collect() }
+        Moves { dest, p: grid.p(), starts: (0..cells.len() as u32).collect() }
     }
 
     /// The number of states.
@@ -372,10 +369,11 @@ pub fn solve_windows(
     let limit = config.max_states.min(u32::MAX as usize / 2);
     let dense = horizons.iter().fold(cells as u128, |a, &h| a.saturating_mul(h as u128));
     let rows = (cells as u128).saturating_mul(clocks.prefixes as u128);
-    if dense > (limit as u128).saturating_mul(SEARCH_PER_STATE) || rows > limit as u128 {
+    let search = (limit as u128).saturating_mul(SEARCH_PER_STATE);
+    if dense > search || rows > limit as u128 {
         return Err(Error::Config(format!(
             "the exact optimum's state space has {dense} states ({what}), too many to search \
-             with max_states = {limit}; use fewer regions or shorter windows"
+             (the limit is {search}); use fewer regions or shorter windows"
         )));
     }
     let mut place: Vec<Option<(u32, u32)>> = vec![None; n];
@@ -391,17 +389,16 @@ pub fn solve_windows(
         };
         let Some((reach, count)) = clocks.reachable(&world, limit - states) else {
             return Err(Error::Config(format!(
-                "the exact optimum needs more than {limit} reachable states ({what}), the \
-                 limit (max_states); use fewer regions or shorter windows"
+                "the exact optimum needs more than {limit} reachable states, the limit \
+                 ({what}); use fewer regions or shorter windows"
             )));
         };
         states += count;
         bytes += clocks.table_bytes(&reach, count, world.dest.len());
         if bytes > limit.saturating_mul(BYTES_PER_STATE) {
             return Err(Error::Config(format!(
-                "the exact optimum needs {} MiB for its {states} reachable states ({what}), \
-                 more than the limit of {} MiB ({BYTES_PER_STATE} bytes per state of max_states \
-                 = {limit}); use fewer regions or shorter windows",
+                "the exact optimum needs {} MiB of tables for {states} reachable states \
+                 ({what}), more than the limit of {} MiB; use fewer regions or shorter windows",
                 bytes.div_ceil(1 << 20),
                 limit.saturating_mul(BYTES_PER_STATE) >> 20
             )));
@@ -934,6 +931,21 @@ impl Kernel {
             stats.horizon_change += sums.1;
         }
         stats
+    }
+}
+
+impl fmt::Debug for Optimum {
+    /// The figures, without the value tables.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Optimum")
+            .field("gain", &self.gain)
+            .field("lower", &self.lower)
+            .field("upper", &self.upper)
+            .field("iterations", &self.iterations)
+            .field("converged", &self.converged)
+            .field("states", &self.states)
+            .field("components", &self.tables.len())
+            .finish_non_exhaustive()
     }
 }
 

@@ -14,6 +14,8 @@
 //! Goal(s))`, 0 once the run fails and 1 once it cannot fail any more.
 
 use crate::Error;
+use std::fmt;
+
 use crate::eval::{Controller, Decision};
 use crate::optimum::Moves;
 
@@ -33,7 +35,7 @@ pub struct ReachAvoid {
 }
 
 /// The optimal probability of a [`ReachAvoid`] task, and the values behind it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct ReachAvoidOptimum {
     /// The most probability any policy gives the task, from a uniform start.
     pub probability: f64,
@@ -159,6 +161,17 @@ fn best_action(dest: &[u32; 4], next: &[f64], p: f64, q: f64) -> (usize, f64) {
     (0..4)
         .map(|a| (a, p * w[a] + q * (sum - w[a])))
         .fold((0, f64::NEG_INFINITY), |best, (a, v)| if v > best.1 { (a, v) } else { best })
+}
+
+impl fmt::Debug for ReachAvoidOptimum {
+    /// The figures, without the value table.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("ReachAvoidOptimum")
+            .field("probability", &self.probability)
+            .field("starts", &self.per_start.len())
+            .field("last_step", &self.last)
+            .finish_non_exhaustive()
+    }
 }
 
 impl ReachAvoidOptimum {

@@ -260,8 +260,16 @@ fn oversized_tasks_are_refused_before_they_are_allocated() {
     // A state space too large to search at all is refused before anything is allocated.
     let message = refused(&[20, 20], 1000);
     assert!(message.contains("has 90000 states (225 cells x windows 20 x 20)"), "{message}");
-    assert!(message.contains("max_states = 1000"), "{message}");
-    // Within both limits, the same task is solved.
+    assert!(message.contains("the limit is 32000"), "{message}");
+    // With windows of 1 and 2 steps every row holds one or two states, whose tables take
+    // more than 64 bytes each: a budget of exactly the states needed refuses them.
+    let holds3 = vec![holds[0].clone(), holds[1].clone(), world.region(|x, _| x == 7)];
+    let windows = [1, 1, 2];
+    let needed = solve_windows(&world.moves, &holds3, &windows, SolveConfig::default()).unwrap();
+    let config = SolveConfig { max_states: needed.states, ..SolveConfig::default() };
+    let e = solve_windows(&world.moves, &holds3, &windows, config);
+    let Err(Error::Config(message)) = e else { panic!("{} states: {e:?}", needed.states) };
+    assert!(message.contains("MiB of tables for"), "{message}");
     let config = SolveConfig { max_states: 90_000, ..SolveConfig::default() };
     assert!(solve_windows(&world.moves, &holds, &[20, 20], config).is_ok());
 }
