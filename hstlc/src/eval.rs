@@ -8,7 +8,7 @@ use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::{
     AgentController, EntryCycle, RegionTable, WindowConfig, rollout, window_rate,
 };
-use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::optimum::{Moves, SolveConfig, solve};
 use hstl::runtime::policy::EnvInfo;
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
@@ -49,6 +49,9 @@ const MAX_EVAL_STEPS: usize = 200_000_000;
 fn count(max: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(1..=max)
 }
+
+/// The help of an optimum that cannot be computed.
+pub const SKIP_OPTIMUM: &str = "pass --no-optimum to skip the optimum W*";
 
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
@@ -157,8 +160,8 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     }
     if !args.no_optimum {
         let start = Instant::now();
-        let optimum = solve(&env, &regions, SolveConfig::default())
-            .map_err(|e| CliError::new(e.to_string(), None))?;
+        let optimum = solve(&Moves::of(&env), &regions, SolveConfig::default())
+            .map_err(|e| CliError::new(e.to_string(), Some(SKIP_OPTIMUM.into())))?;
         println!(
             "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
             optimum.gain,

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::Args;
 use hstl::runtime::eval::RegionTable;
-use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::optimum::{Moves, SolveConfig, solve};
 use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutFile};
@@ -202,8 +202,8 @@ fn optimum(
     }
     let regions = RegionTable::new(spec, env).map_err(|e| CliError::new(e.to_string(), None))?;
     let start = Instant::now();
-    let o = solve(env, &regions, SolveConfig::default())
-        .map_err(|e| CliError::new(e.to_string(), None))?;
+    let o = solve(&Moves::of(env), &regions, SolveConfig::default())
+        .map_err(|e| CliError::new(e.to_string(), Some(crate::eval::SKIP_OPTIMUM.into())))?;
     println!(
         "optimum for regions {}: W* = {:.4} (value iteration, {} sweeps, {:.1} s{})",
         spec.regions.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
