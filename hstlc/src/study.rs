@@ -262,7 +262,9 @@ fn write_outputs(
     ];
     let mut rng = seeded_rng(PICTURE_SEED);
     let regions = artifacts::pictured_regions(loaded)?;
-    files.extend(artifacts::agent_pictures(spec, env, &regions, agent, &mut rng)?);
+    let subject = artifacts::subject(&loaded.file, None);
+    let captions = artifacts::Captions { subject, note: "seed 0".into() };
+    files.extend(artifacts::agent_pictures(spec, env, &regions, agent, &captions, &mut rng)?);
     let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
     for (seed, r) in results.iter().enumerate() {
         let window = r.window.map_or(String::new(), |w| w.to_string());
@@ -271,7 +273,7 @@ fn write_outputs(
     files.push(OutFile::text("seeds.csv", seeds));
     let curves: Vec<Vec<f64>> = results.iter().map(|r| r.curve.clone()).collect();
     files.push(artifacts::curve_picture(
-        &format!("Learning curve of {} over {} seeds", spec.name, curves.len()),
+        &format!("{}: learning curves\n{} seeds", captions.subject, curves.len()),
         &curves,
     )?);
     artifacts::write_all(dir, &files).map(|_| ())

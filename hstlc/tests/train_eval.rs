@@ -154,6 +154,32 @@ fn study_writes_seed_zero_as_train_does() {
     assert_eq!(seeds.lines().count(), 3, "{seeds}");
 }
 
+/// The sample runs mark every slip of the rollout they draw: replaying it from
+/// `policy.json` with the pictures' generator finds as many slips as the picture counts.
+#[test]
+fn sample_runs_count_the_slips_of_their_rollout() {
+    use hstl::runtime::eval::{AgentController, sample_runs};
+    use hstl::runtime::{GridWorld, Policy, seeded_rng};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    assert_eq!(train(&out, "5").status.code(), Some(0));
+    let policy = Policy::from_json(&read(&out.join("policy.json"))).expect("a policy");
+    let env = GridWorld::from_params(&policy.env.name, &policy.env.params).expect("its world");
+    let agent = policy.agent(&env).expect("its agent");
+    let mut rng = seeded_rng(5 ^ hstl::train::PICTURE_SEED);
+    let runs = sample_runs(&env, &mut AgentController::new(&agent), 2, 120, &mut rng);
+    for (i, run) in runs.iter().enumerate() {
+        let slips = run.iter().filter(|s| s.next != env.dest(s.state, s.decision.action)).count();
+        let svg = read(&out.join(format!("run_{}.svg", i + 1)));
+        assert!(
+            svg.contains(&format!("120 moves, {slips} slip")),
+            "run {}: {slips} slips, but the picture says otherwise",
+            i + 1
+        );
+        assert!(slips > 0, "slip 0.3 over 120 steps");
+    }
+}
+
 /// A world file with walls and start cells: `train --world` obeys it, `policy.json` holds
 /// it whole, `eval` replays it from `policy.json` alone, and the pictures draw the walls.
 #[test]
@@ -272,4 +298,39 @@ fn eval_refuses_tampered_policies() {
         assert!(e.stdout.is_empty(), "{want}: printed before failing");
         assert!(stderr.contains(want), "{want}: {stderr}");
     }
+}
+
+/// A world too large to draw still trains: the policy and curve are written, the grid
+/// pictures are left out, and the summary says why.
+#[test]
+fn a_world_too_large_to_draw_trains_without_grid_pictures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let row = ".".repeat(300);
+    let world = format!("name = \"strip\"\nslip = 0.1\nmap = \"\"\"\n{row}\n{row}\n\"\"\"\n");
+    std::fs::write(dir.path().join("strip.toml"), world).expect("write the world");
+    let spec = "spec Strip {\n    state { x: int in 0..=299, y: int in 0..=1 }\n    let A = x < 3;\n    \
+                let B = x > 296;\n    task always[0..] (eventually[0..400] A && eventually[0..400] B);\n    \
+                option A;\n    option B;\n    learn { episodes: 2, choices: 3 }\n}\n";
+    std::fs::write(dir.path().join("strip.hstl"), spec).expect("write the spec");
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["train", "strip.hstl", "--world", "strip.toml", "--out"])
+        .arg(&out)
+        .current_dir(dir.path())
+        .output()
+        .expect("hstlc runs");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains(
+            "no grid pictures: the world is 300 x 2 cells, and pictures are drawn up to 256 a side"
+        ),
+        "{stdout}"
+    );
+    let mut written: Vec<String> = std::fs::read_dir(&out)
+        .expect("out")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(written, ["curve.csv", "curve.svg", "policy.json"]);
 }
