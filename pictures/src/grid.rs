@@ -45,17 +45,20 @@ pub(crate) struct Layers<'f> {
     /// A strip under the grid's axes of this many pixels, and what is drawn there: its
     /// top edge is the third argument.
     pub(crate) footer: Option<(i32, Footer<'f>)>,
+    /// Region names as tabs on the regions' top edges (for pictures with a mark in every
+    /// cell) instead of inside them.
+    pub(crate) edge_labels: bool,
 }
 
 impl<'f> Layers<'f> {
     /// Only a layer under the boundaries.
     fn under(under: Layer<'f>) -> Layers<'f> {
-        Layers { under, over: &|_, _| Ok(()), footer: None }
+        Layers { under, over: &|_, _| Ok(()), footer: None, edge_labels: false }
     }
 
     /// Only a layer over everything.
     pub(crate) fn over(over: Layer<'f>) -> Layers<'f> {
-        Layers { under: &|_, _| Ok(()), over, footer: None }
+        Layers { under: &|_, _| Ok(()), over, footer: None, edge_labels: false }
     }
 }
 
@@ -113,7 +116,8 @@ impl Canvas {
 }
 
 /// Draws a flat policy: an arrow for the action in each given cell and a dot on each
-/// termination cell, over the shaded regions, with a legend.
+/// termination cell, over the shaded regions (named in tabs on their top edges), with a
+/// legend.
 ///
 /// Cells without an action are left empty. Errors for an empty or too large grid, a cell
 /// outside the grid, or two actions for one cell.
@@ -156,7 +160,8 @@ pub fn flat_policy(
         }
         Ok(())
     };
-    render(grid, title, "Legend", &legend, Layers::over(&over))
+    // Arrows fill every cell: names go on the regions' edges, where they hide the least.
+    render(grid, title, "Legend", &legend, Layers { edge_labels: true, ..Layers::over(&over) })
 }
 
 /// Draws the options policy: each cell filled with the colour of the option chosen there,
@@ -410,7 +415,11 @@ pub(crate) fn render(
         let mut tags = Vec::new();
         for region in &grid.regions {
             draw_outline(&area, &canvas, region.kind, &region.cells)?;
-            tags.extend(draw_label(&area, &canvas, region.kind, &region.name, &region.cells)?);
+            if layers.edge_labels {
+                tags.extend(edge_tag(&canvas, region.kind, &region.name, &region.cells));
+            } else {
+                tags.extend(draw_label(&area, &canvas, region.kind, &region.name, &region.cells)?);
+            }
         }
         (layers.over)(&area, &canvas)?;
         for tag in &tags {
@@ -539,7 +548,18 @@ struct Tag {
     bounds: [(i32, i32); 2],
     /// The pixel size of the text.
     pixels: f64,
-    inside: bool,
+    place: Place,
+}
+
+/// Where a boxed region name goes relative to its `bounds`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Place {
+    /// Centred in them.
+    Inside,
+    /// Just above them (below when there is no room), with a short leader.
+    Beside,
+    /// Across their top edge, like a tab: over arrows, it hides only the rims of the cells.
+    Edge,
 }
 
 /// Writes a region's name inside it, as large as fits its largest rectangle of cells.
@@ -562,13 +582,13 @@ fn draw_label(
     if pixels < MIN_INSIDE_LABEL_PX {
         let (min_x, max_x, min_y, max_y) = bounds(&set);
         let bounds = canvas.box_rect(CellBox { x0: min_x, x1: max_x, y0: min_y, y1: max_y });
-        return Ok(Some(Tag { name, kind, bounds, pixels: TAG_PX, inside: false }));
+        return Ok(Some(Tag { name, kind, bounds, pixels: TAG_PX, place: Place::Beside }));
     }
     let bounds = canvas.box_rect(b);
     if pixels < MIN_FAINT_LABEL_PX {
         // The box's margins must fit too.
         let pixels = pixels.min(TAG_PX);
-        return Ok(Some(Tag { name, kind, bounds, pixels, inside: true }));
+        return Ok(Some(Tag { name, kind, bounds, pixels, place: Place::Inside }));
     }
     let [(l, t), (r, bottom)] = bounds;
     let faint = match kind {
@@ -580,6 +600,17 @@ fn draw_label(
         .pos(Pos::new(HPos::Center, VPos::Center));
     area.draw(&Text::new(name, ((l + r) / 2, (t + bottom) / 2), style)).map_err(draw_err)?;
     Ok(None)
+}
+
+/// A region's name as a tab across the top edge of its topmost row of cells (the longest
+/// run there), for pictures whose every cell holds a mark.
+fn edge_tag(canvas: &Canvas, kind: RegionKind, name: &str, cells: &[(i64, i64)]) -> Option<Tag> {
+    let top = cells.iter().map(|&(_, y)| y).max()?;
+    let row: BTreeSet<i64> = cells.iter().filter(|&&(_, y)| y == top).map(|&(x, _)| x).collect();
+    let (x0, x1) = spans(&row).into_iter().max_by_key(|(a, b)| (b - a, -a))?;
+    let bounds = canvas.box_rect(CellBox { x0, x1, y0: top, y1: top });
+    let name = shorten(&clean_text(name));
+    Some(Tag { name, kind, bounds, pixels: TAG_PX, place: Place::Edge })
 }
 
 /// The bounding box of a non-empty set of cells, as `(min_x, max_x, min_y, max_y)`.
@@ -601,16 +632,19 @@ fn draw_tag(area: &Area<'_>, canvas: &Canvas, tag: &Tag) -> Result<()> {
         RegionKind::Avoid => AVOID,
         RegionKind::Reach | RegionKind::Other => INK,
     };
-    let (centre_x, box_top) = if tag.inside {
-        ((l + r) / 2, (t + b) / 2 - h / 2)
-    } else {
-        let x = (l + r) / 2;
-        let (box_top, from, to) =
-            if t - 4 - h >= canvas.top { (t - 4 - h, t - 4, t) } else { (b + 4, b + 4, b) };
-        area.draw(&PathElement::new(vec![(x, from), (x, to)], colour.stroke_width(1)))
-            .map_err(draw_err)?;
-        let x = x.clamp(canvas.left + w / 2, (canvas.right() - w / 2).max(canvas.left + w / 2));
-        (x, box_top)
+    let keep_inside =
+        |x: i32| x.clamp(canvas.left + w / 2, (canvas.right() - w / 2).max(canvas.left + w / 2));
+    let (centre_x, box_top) = match tag.place {
+        Place::Inside => ((l + r) / 2, (t + b) / 2 - h / 2),
+        Place::Edge => (keep_inside((l + r) / 2), t - h / 2),
+        Place::Beside => {
+            let x = (l + r) / 2;
+            let (box_top, from, to) =
+                if t - 4 - h >= canvas.top { (t - 4 - h, t - 4, t) } else { (b + 4, b + 4, b) };
+            area.draw(&PathElement::new(vec![(x, from), (x, to)], colour.stroke_width(1)))
+                .map_err(draw_err)?;
+            (keep_inside(x), box_top)
+        }
     };
     let rect = [(centre_x - w / 2, box_top), (centre_x + w / 2, box_top + h)];
     area.draw(&Rectangle::new(rect, WHITE.mix(0.85).filled())).map_err(draw_err)?;

@@ -847,7 +847,7 @@ fn region_names_stay_inside_small_regions_or_go_beside_them() {
         walls: vec![],
         starts: vec![],
     };
-    let svg = flat_policy(&grid, "Small regions", &[], &[]).expect("draws");
+    let svg = options_policy(&grid, "Small regions", &[], &[]).expect("draws");
     let doc = parse(&svg);
     let frame = frame(&doc, &grid);
     let placed = placed_texts(&doc);
@@ -870,6 +870,35 @@ fn region_names_stay_inside_small_regions_or_go_beside_them() {
     let (cx, cy) = frame.centre((15, 15));
     assert!((x - cx).abs() < frame.cell * 2.0 && (y - cy).abs() < frame.cell * 1.5, "{x}, {y}");
     assert!(size >= 12.0, "{size}");
+}
+
+#[test]
+fn flat_policies_name_regions_in_tabs_on_their_top_edges() {
+    // Arrows fill every cell, so a name inside a region would hide one.
+    let grid = Grid {
+        width: 10,
+        height: 10,
+        regions: vec![
+            region("Goal", &[(6, 7), (7, 7), (8, 7), (6, 6), (7, 6), (8, 6)]),
+            region("Pit", &[(2, 2)]).with_kind(RegionKind::Avoid),
+        ],
+        walls: vec![],
+        starts: vec![],
+    };
+    let arrows: Vec<Cell> =
+        (0..10).flat_map(|x| (0..10).map(move |y| Cell { x, y, action: Action::Up })).collect();
+    let svg = flat_policy(&grid, "Tabs", &arrows, &[]).expect("draws");
+    let doc = parse(&svg);
+    let frame = frame(&doc, &grid);
+    let placed = placed_texts(&doc);
+    for (name, (x0, x1, top)) in [("Goal", (6, 8, 7)), ("Pit", (2, 2, 2))] {
+        let (_, (x, y), size) = placed.iter().find(|(t, _, _)| t == name).cloned().expect(name);
+        let edge = frame.top + (grid.height as i64 - 1 - top) as f64 * frame.cell;
+        assert!((y - edge).abs() < 3.0, "{name} at {y}, its top edge at {edge}");
+        let (left, right) = (frame.centre((x0, top)).0, frame.centre((x1, top)).0);
+        assert!(x >= left - 1.0 && x <= right + 1.0, "{name} at {x}, not over {left}..{right}");
+        assert!(size >= 10.0, "{size}");
+    }
 }
 
 #[test]
