@@ -8,7 +8,7 @@ use hstl::runtime::eval::{AgentController, sample_runs};
 use hstl::runtime::{Agent, Env, GridWorld, Rng, TaskSpec};
 use hstl_pictures as pic;
 
-use hstl::lang::{LetKind, visit_lets};
+use hstl::lang::{CFormula, CFormulaKind, CheckedSpec, LetKind};
 
 use crate::cli_error::CliError;
 use crate::spec_file::LoadedSpec;
@@ -70,6 +70,49 @@ pub fn write_all(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError
     Ok(temps.into_iter().map(|(_, target)| target).collect())
 }
 
+/// What the pictures of a trained agent say about where they come from.
+#[derive(Clone, Debug)]
+pub struct Captions {
+    /// What was trained, leading every title: the spec's file name, or a variant of it.
+    pub subject: String,
+    /// The line under every title: which seed, and why that one.
+    pub note: String,
+}
+
+/// A region a picture draws: its name, where it holds, and what it is to the task.
+#[derive(Clone, Debug)]
+pub struct PicturedRegion {
+    /// The option's or the `let`'s name.
+    pub name: String,
+    /// The state formula that holds on the region's cells.
+    pub formula: Formula,
+    /// A region to reach (an option's), to avoid (negated in the task), or another.
+    pub kind: pic::RegionKind,
+}
+
+/// Why a world gets no grid pictures, if it is too large to draw.
+pub fn too_large_to_draw(env: &GridWorld) -> Option<String> {
+    let side = pic::MAX_GRID_SIDE;
+    (env.width() > side || env.height() > side).then(|| {
+        format!(
+            "no grid pictures: the world is {} x {} cells, and pictures are drawn up to {side} a side",
+            env.width(),
+            env.height()
+        )
+    })
+}
+
+/// What the pictures of a spec file name it by: the file's name without its folders, and
+/// the spec's name when one was picked from a file of several.
+pub fn subject(file: &str, spec: Option<&str>) -> String {
+    let name =
+        Path::new(file).file_name().map_or(file.to_owned(), |n| n.to_string_lossy().into_owned());
+    match spec {
+        Some(spec) => format!("{name}, spec {spec}"),
+        None => name,
+    }
+}
+
 /// `episode,reward` rows, episodes counted from 1.
 pub fn curve_csv(curve: &[f64]) -> String {
     let mut out = String::from("episode,reward\n");
@@ -81,15 +124,18 @@ pub fn curve_csv(curve: &[f64]) -> String {
 
 /// The paper's Figure 2 for a trained agent in a grid world: one arrow field per primitive
 /// option with its termination states, the options policy (one map per region visited last
-/// when the agent has memory), and two sample runs, over the world's walls, start cells and
-/// `regions` (see [`pictured_regions`]).
+/// when the agent has memory), and two sample runs with their slips, over the world's
+/// walls, start cells and `regions` (see [`pictured_regions`]); every title names
+/// `captions.subject`, with `captions.note` under it.
 pub fn agent_pictures(
     spec: &TaskSpec,
     env: &GridWorld,
-    regions: &[(String, Formula)],
+    regions: &[PicturedRegion],
     agent: &Agent,
+    captions: &Captions,
     rng: &mut Rng,
 ) -> Result<Vec<OutFile>, CliError> {
+    let title = |what: &str| format!("{}: {what}\n{}", captions.subject, captions.note);
     let cells = cells(env);
     let states = state_trace(spec, env)?;
     let grid = picture_grid(env, regions, &states, &cells);
@@ -116,12 +162,12 @@ pub fn agent_pictures(
             .filter(|&(s, _)| agent.terminate.get(p).and_then(|t| t.get(s)).copied() == Some(true))
             .map(|(_, &c)| c)
             .collect();
-        let title = format!("Flat policy of option {} (terminates on dots)", prim.name);
+        let title = title(&format!("flat policy of option {}", prim.name));
         let svg = pic::flat_policy(&grid, &title, &arrows, &terminate).map_err(picture_error)?;
         out.push(OutFile::text(format!("flat_{}.svg", file_safe(&prim.name)), svg));
     }
     let names: Vec<String> = spec.options.iter().map(|o| o.name.clone()).collect();
-    for (file, title, tau) in option_slices(spec, agent) {
+    for (file, what, tau) in option_slices(spec, agent) {
         let choices: Vec<((i64, i64), String)> = cells
             .iter()
             .enumerate()
@@ -130,23 +176,55 @@ pub fn agent_pictures(
                 Some((c, names.get(o)?.clone()))
             })
             .collect();
-        let svg = pic::options_policy(&grid, &title, &choices, &names).map_err(picture_error)?;
+        let svg =
+            pic::options_policy(&grid, &title(&what), &choices, &names).map_err(picture_error)?;
         out.push(OutFile::text(file, svg));
     }
-    let runs = sample_runs(env, &mut AgentController::new(agent), 2, 120, rng);
+    let runs = sample_runs(env, &mut AgentController::new(agent), 2, RUN_STEPS, rng);
     for (i, run) in runs.iter().enumerate() {
-        let steps: Vec<((i64, i64), String)> = run
-            .iter()
-            .filter_map(|step| {
-                let cell = *cells.get(step.state)?;
-                Some((cell, names.get(step.decision.option)?.clone()))
-            })
-            .collect();
-        let title = format!("Sample run {} ({} steps, greedy)", i + 1, run.len());
-        let svg = pic::sample_run_ordered(&grid, &title, &steps, &names).map_err(picture_error)?;
+        let steps = run_steps(env, &cells, &names, run);
+        let title = format!(
+            "{}: sample run {}\n{}; {} steps of the greedy policy",
+            captions.subject,
+            i + 1,
+            captions.note,
+            run.len()
+        );
+        let svg = pic::sample_run(&grid, &title, &steps, &names).map_err(picture_error)?;
         out.push(OutFile::text(format!("run_{}.svg", i + 1), svg));
     }
     Ok(out)
+}
+
+/// Steps of each sample run.
+const RUN_STEPS: usize = 120;
+
+/// A rollout as the picture's steps: each state's cell, its option, and the cell its action
+/// leads to without a slip; then the cell the last action led to.
+fn run_steps(
+    env: &GridWorld,
+    cells: &[(i64, i64)],
+    names: &[String],
+    run: &[hstl::runtime::eval::Step],
+) -> Vec<pic::RunStep> {
+    let cell = |s: usize| cells.get(s).copied().unwrap_or((-1, -1));
+    let name = |o: usize| names.get(o).cloned().unwrap_or_default();
+    let mut steps: Vec<pic::RunStep> = run
+        .iter()
+        .map(|step| pic::RunStep {
+            cell: cell(step.state),
+            option: name(step.decision.option),
+            intended: Some(cell(env.dest(step.state, step.decision.action))),
+        })
+        .collect();
+    if let Some(last) = run.last() {
+        steps.push(pic::RunStep {
+            cell: cell(last.next),
+            option: name(last.decision.option),
+            intended: None,
+        });
+    }
+    steps
 }
 
 /// The learning curve of one or more seeds (a band over seeds), as in the paper's Figure 3.
@@ -156,12 +234,13 @@ pub fn curve_picture(title: &str, curves: &[Vec<f64>]) -> Result<OutFile, CliErr
     Ok(OutFile::text("curve.svg", svg))
 }
 
-/// The options maps to draw: one without memory; with memory, one per region, as the agent
-/// sees the grid right after leaving that region with every other counter expired.
+/// The options maps to draw, as (file, what the map shows, memory): one without memory;
+/// with memory, one per region, as the agent sees the grid right after leaving that region
+/// with every other counter expired.
 fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usize>)> {
     let horizons: Vec<usize> = spec.regions.iter().map(|r| r.horizon).collect();
     if agent.memory.is_none() || horizons.is_empty() {
-        return vec![("options.svg".into(), "Options policy".into(), horizons)];
+        return vec![("options.svg".into(), "options policy".into(), horizons)];
     }
     spec.regions
         .iter()
@@ -171,7 +250,7 @@ fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usi
             tau[j] = 1;
             (
                 format!("options_after_{}.svg", file_safe(&r.name)),
-                format!("Options policy one step after {} (others overdue)", r.name),
+                format!("options policy one step after {} (others overdue)", r.name),
                 tau,
             )
         })
@@ -181,7 +260,7 @@ fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usi
 /// The grid under every picture: the world's walls and start cells, and the regions.
 fn picture_grid(
     env: &GridWorld,
-    regions: &[(String, Formula)],
+    regions: &[PicturedRegion],
     states: &Trace,
     cells: &[(i64, i64)],
 ) -> pic::Grid {
@@ -200,57 +279,93 @@ fn picture_grid(
         height: env.height(),
         regions: regions
             .iter()
-            .map(|(name, f)| pic::Region { name: name.clone(), cells: holding(f, states, cells) })
+            .map(|r| pic::Region {
+                name: r.name.clone(),
+                cells: holding(&r.formula, states, cells),
+                kind: r.kind,
+            })
             .collect(),
         walls,
         starts,
     }
 }
 
-/// The regions a picture shows: each option's region (named by the option), then every
-/// state `let` the task names, directly or through temporal lets (an obstacle in
-/// `always !Obstacle`, say). Lets used only inside other state lets are not drawn.
-pub fn pictured_regions(loaded: &LoadedSpec) -> Result<Vec<(String, Formula)>, CliError> {
+/// The regions a picture shows: each option's region (named by the option, to reach), then
+/// every state `let` the task names, directly or through temporal lets: to avoid when the
+/// task only negates it (an obstacle in `always !Obstacle`), another region otherwise.
+/// Lets used only inside other state lets are not drawn.
+pub fn pictured_regions(loaded: &LoadedSpec) -> Result<Vec<PicturedRegion>, CliError> {
     let spec = &loaded.spec;
     let lower_err =
         |e: hstl::lower::LowerError| CliError::new(format!("{}: {e}", loaded.file), None);
-    let mut out: Vec<(String, Formula)> = Vec::new();
+    let mut out: Vec<PicturedRegion> = Vec::new();
     for p in &spec.primitives {
-        let f = hstl::lower::formula(spec, &p.reach).ok_or_else(|| {
+        let formula = hstl::lower::formula(spec, &p.reach).ok_or_else(|| {
             lower_err(hstl::lower::LowerError::Invalid { spec: spec.name.clone() })
         })?;
-        out.push((p.name.clone(), f));
+        out.push(PicturedRegion { name: p.name.clone(), formula, kind: pic::RegionKind::Reach });
     }
-    let mut drawn: Vec<Formula> = out.iter().map(|(_, f)| f.clone()).collect();
-    let mut stack = Vec::new();
-    let mut seen = vec![false; spec.lets.len()];
-    if let Some(task) = &spec.task {
-        visit_lets(&task.formula, &mut |i| stack.push(i));
-    }
-    // Depth first, so that lets come out in the order the task names them.
-    stack.reverse();
-    while let Some(i) = stack.pop() {
+    for (i, negated_only) in task_lets(spec) {
         let Some(l) = spec.lets.get(i) else { continue };
-        if std::mem::replace(&mut seen[i], true) {
+        let formula = hstl::lower::let_formula(spec, &l.name).map_err(lower_err)?;
+        // An option's region drawn already under the option's name.
+        if out.iter().any(|r| r.formula == formula) {
             continue;
         }
-        match l.kind {
-            LetKind::Temporal => {
-                let mut inner = Vec::new();
-                visit_lets(&l.formula, &mut |j| inner.push(j));
-                stack.extend(inner.into_iter().rev());
-            }
-            LetKind::State => {
-                let f = hstl::lower::let_formula(spec, &l.name).map_err(lower_err)?;
-                // An option's region drawn already under the option's name.
-                if !drawn.contains(&f) {
-                    drawn.push(f.clone());
-                    out.push((l.name.clone(), f));
-                }
-            }
-        }
+        let kind = if negated_only { pic::RegionKind::Avoid } else { pic::RegionKind::Other };
+        out.push(PicturedRegion { name: l.name.clone(), formula, kind });
     }
     Ok(out)
+}
+
+/// The state lets the task names, directly or through temporal lets, in the order it names
+/// them, each with whether the task only ever negates it (under an odd number of `!`,
+/// outside the left side of any `->`, which neither requires nor forbids it).
+fn task_lets(spec: &CheckedSpec) -> Vec<(usize, bool)> {
+    // Per let: seen other than negated, seen negated.
+    let mut seen = vec![(false, false); spec.lets.len()];
+    let mut order = Vec::new();
+    let Some(task) = &spec.task else { return Vec::new() };
+    // `Some(negated)`, or `None` on the left of `->`. Depth first with an explicit stack (a
+    // deep formula must not overflow the call stack), children pushed in reverse so that
+    // lets come out in source order.
+    let mut stack: Vec<(&CFormula, Option<bool>)> = vec![(&task.formula, Some(false))];
+    while let Some((f, negated)) = stack.pop() {
+        match &f.kind {
+            CFormulaKind::Let(i) => {
+                let (Some(l), Some(flags)) = (spec.lets.get(*i), seen.get_mut(*i)) else {
+                    continue;
+                };
+                let first = *flags == (false, false);
+                let flag = if negated == Some(true) { &mut flags.1 } else { &mut flags.0 };
+                let again = std::mem::replace(flag, true);
+                match l.kind {
+                    LetKind::State if first => order.push(*i),
+                    LetKind::State => {}
+                    LetKind::Temporal if !again => stack.push((&l.formula, negated)),
+                    LetKind::Temporal => {}
+                }
+            }
+            CFormulaKind::Not(a) => stack.push((a, negated.map(|n| !n))),
+            CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => stack.push((a, negated)),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                stack.extend(v.iter().rev().map(|g| (g, negated)))
+            }
+            CFormulaKind::Implies(a, b) => {
+                stack.push((b, negated));
+                stack.push((a, None));
+            }
+            CFormulaKind::Until(_, a, b) => {
+                stack.push((b, negated));
+                stack.push((a, negated));
+            }
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Cmp(..)
+            | CFormulaKind::Invalid => {}
+        }
+    }
+    order.into_iter().map(|i| (i, seen[i] == (false, true))).collect()
 }
 
 /// `(x, y)` of every state index.
@@ -307,4 +422,56 @@ pub fn file_safe(name: &str) -> String {
 
 fn picture_error(e: pic::PictureError) -> CliError {
     CliError::new(format!("cannot draw a picture: {e}"), None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::world_arg::LoadedWorld;
+
+    fn kinds(task: &str) -> Vec<(String, pic::RegionKind)> {
+        let source = format!(
+            "spec Kinds {{\n    state {{ x: int in 0..=14, y: int in 0..=14 }}\n    \
+             let Goal = x > 11 && y > 11;\n    let Obstacle = x > 5 && x < 9 && y > 4 && y < 10;\n    \
+             let Pit = x < 2 && y < 2;\n    let Zone = x > 11 && y < 3;\n    \
+             let Near = x < 3 && y > 11;\n    let Both = x > 3 && x < 5 && y < 3;\n    \
+             let Safe = always[0..20] !Obstacle;\n    task {task};\n    \
+             option Goal;\n    options {{ Goal }}\n}}\n"
+        );
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("kinds.hstl");
+        std::fs::write(&path, source).expect("write the spec");
+        let world = LoadedWorld::load("paper").expect("paper");
+        let loaded =
+            crate::spec_file::load(&path, None, Some(&world)).expect("loads").expect("checks");
+        pictured_regions(&loaded).expect("regions").into_iter().map(|r| (r.name, r.kind)).collect()
+    }
+
+    #[test]
+    fn lets_the_task_only_negates_are_regions_to_avoid() {
+        use pic::RegionKind::{Avoid, Other, Reach};
+        let named = |list: &[(&str, pic::RegionKind)]| -> Vec<(String, pic::RegionKind)> {
+            list.iter().map(|(n, k)| ((*n).to_owned(), *k)).collect()
+        };
+        // Through a temporal let and under `until`, beside a let on the left of `->` (not
+        // forbidden), one named positively and one named both ways.
+        let task = "eventually[0..40] Goal && Safe && (!Pit until[0..40] Goal) \
+                    && (Near -> eventually[0..10] Zone) && eventually[0..5] Both && always[0..5] !Both";
+        assert_eq!(
+            kinds(task),
+            named(&[
+                ("Goal", Reach),
+                ("Obstacle", Avoid),
+                ("Pit", Avoid),
+                ("Near", Other),
+                ("Zone", Other),
+                ("Both", Other)
+            ])
+        );
+        // `!!Pit` is Pit itself.
+        assert_eq!(
+            kinds("eventually[0..40] Goal && always[0..5] !!Pit"),
+            named(&[("Goal", Reach), ("Pit", Other)])
+        );
+    }
 }

@@ -74,9 +74,23 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     ];
     let mut rng = seeded_rng(args.seed ^ PICTURE_SEED);
     let regions = artifacts::pictured_regions(&loaded)?;
-    files.extend(artifacts::agent_pictures(&spec, env, &regions, &outcome.agent, &mut rng)?);
+    let captions = artifacts::Captions {
+        subject: artifacts::subject(&loaded.file, args.spec_name.as_deref()),
+        note: format!("seed {}", args.seed),
+    };
+    let skipped = artifacts::too_large_to_draw(env);
+    if skipped.is_none() {
+        files.extend(artifacts::agent_pictures(
+            &spec,
+            env,
+            &regions,
+            &outcome.agent,
+            &captions,
+            &mut rng,
+        )?);
+    }
     files.push(artifacts::curve_picture(
-        &format!("Learning curve of {} (seed {})", spec.name, args.seed),
+        &format!("{}: learning curve\n{}", captions.subject, captions.note),
         std::slice::from_ref(&outcome.curve),
     )?);
     let window = window_report(&spec, env, &outcome.agent, args.seed)?;
@@ -105,6 +119,9 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         );
     }
     println!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files));
+    if let Some(why) = skipped {
+        println!("  {why}");
+    }
     Ok(Status::Clean)
 }
 

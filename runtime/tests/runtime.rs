@@ -309,6 +309,36 @@ fn greedy_rollouts_follow_option_legs() {
     }
 }
 
+/// Each step records where its action led: the next step's state, and for the last step
+/// the state after it. A step leaves the cell its action leads to without slipping only
+/// when the grid's one draw for it slipped (`u >= p`), which replaying the draws shows.
+#[test]
+fn rollout_steps_record_where_each_action_led() {
+    use hstl_runtime::RngExt;
+    let env = GridWorld::default();
+    let spec = small(false, false);
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(2), |_, _| {});
+    let agent = learner.agent();
+    let steps = rollout(&env, &mut AgentController::new(&agent), 0, 300, &mut seeded_rng(3));
+    for w in steps.windows(2) {
+        assert_eq!(w[0].next, w[1].state);
+    }
+    // The greedy agent draws nothing: the rollout's draws are the grid's, one per step.
+    let mut draws = seeded_rng(3);
+    let mut slips = 0;
+    for step in &steps {
+        let slipped = draws.random::<f64>() >= env.p();
+        let off_course = step.next != env.dest(step.state, step.decision.action);
+        assert!(!off_course || slipped, "{step:?} left its course without a slip");
+        slips += usize::from(off_course);
+    }
+    assert!(slips > 0, "300 steps with slip 0.3 slip somewhere");
+    let last = steps.last().unwrap();
+    let again = rollout(&env, &mut AgentController::new(&agent), 0, 301, &mut seeded_rng(3));
+    assert_eq!(again[300].state, last.next);
+}
+
 #[test]
 fn persistent_regions_are_read_off_the_task() {
     use hstl_runtime::robustness::{Bound, CmpOp, Interval};
