@@ -1,13 +1,14 @@
-//! In-process protocol tests: a client talks to [`super::serve`] over
-//! `Connection::memory()`.
+//! In-process protocol tests: a client talks to [`super::serve`] over pipes.
 
+use std::io::BufReader;
 use std::path::Path;
 use std::thread::JoinHandle;
-use std::time::Duration;
 
 use hstl::lang::LineIndex;
-use lsp_server::{Connection, Message, Notification, Request, RequestId, ResponseError};
+use lsp_server::{Message, Notification, Request, RequestId, ResponseError};
 use serde_json::{Value, json};
+
+use super::transport::{Frame, FrameReader, Incoming, Problem, decode};
 
 const URI: &str = "file:///tmp/spec.hstl";
 
@@ -43,9 +44,12 @@ struct Reply {
     error: Option<ResponseError>,
 }
 
+/// A client of [`super::serve`] over in-memory pipes, framing with `lsp-server`'s own
+/// reader and writer.
 struct Client {
-    conn: Connection,
-    server: Option<JoinHandle<Result<bool, String>>>,
+    to_server: Option<std::io::PipeWriter>,
+    from_server: BufReader<std::io::PipeReader>,
+    server: Option<JoinHandle<std::io::Result<super::Ending>>>,
     next_id: i32,
     notifications: Vec<Notification>,
 }
@@ -53,21 +57,32 @@ struct Client {
 impl Client {
     /// Starts a server and initialises it; returns the client and the `initialize` result.
     fn start(capabilities: Value) -> (Client, Value) {
-        let (client, server) = Connection::memory();
-        let handle = std::thread::spawn(move || super::serve(&server));
-        let mut c =
-            Client { conn: client, server: Some(handle), next_id: 0, notifications: vec![] };
+        let (server_in, to_server) = std::io::pipe().expect("pipe");
+        let (from_server, server_out) = std::io::pipe().expect("pipe");
+        let handle = std::thread::spawn(move || super::serve(server_in, server_out));
+        let mut c = Client {
+            to_server: Some(to_server),
+            from_server: BufReader::new(from_server),
+            server: Some(handle),
+            next_id: 0,
+            notifications: vec![],
+        };
         let init = c.request("initialize", json!({ "capabilities": capabilities }));
         let result = init.result.expect("initialize succeeds");
         c.notify("initialized", json!({}));
         (c, result)
     }
 
+    fn send(&mut self, message: Message) {
+        let out = self.to_server.as_mut().expect("the client is connected");
+        message.write(out).expect("server is up");
+    }
+
     fn request(&mut self, method: &str, params: Value) -> Reply {
         self.next_id += 1;
         let id = RequestId::from(self.next_id);
         let req = Request { id: id.clone(), method: method.into(), params };
-        self.conn.sender.send(Message::Request(req)).expect("server is up");
+        self.send(Message::Request(req));
         loop {
             match self.recv() {
                 Message::Response(r) if r.id == id => {
@@ -82,13 +97,13 @@ impl Client {
         }
     }
 
-    fn notify(&self, method: &str, params: Value) {
+    fn notify(&mut self, method: &str, params: Value) {
         let n = Notification { method: method.into(), params };
-        self.conn.sender.send(Message::Notification(n)).expect("server is up");
+        self.send(Message::Notification(n));
     }
 
-    fn recv(&self) -> Message {
-        self.conn.receiver.recv_timeout(Duration::from_secs(20)).expect("the server answers")
+    fn recv(&mut self) -> Message {
+        Message::read(&mut self.from_server).expect("a frame").expect("the server answers")
     }
 
     /// The next `publishDiagnostics` for the document.
@@ -134,7 +149,7 @@ impl Client {
         assert!(r.error.is_none(), "{r:?}");
         self.notify("exit", Value::Null);
         let result = self.server.take().map(|h| h.join().expect("server thread ends"));
-        assert_eq!(result, Some(Ok(true)));
+        assert_eq!(result.map(|r| r.expect("threads start")), Some(super::Ending::Exit));
     }
 }
 
@@ -386,4 +401,224 @@ fn keystrokes_publish_checks_diagnostics() {
     }
     assert!(text.contains("let D"));
     c.shutdown();
+}
+
+/// A tall formula (250 nested `!`, under the parser's height limit) and a long `&&`
+/// chain: hover, references and symbols answer from the innermost name outwards (the
+/// walks keep their own stacks).
+#[test]
+fn tall_formulas_are_walked_without_recursion() {
+    let nots = "!".repeat(250);
+    let chain = vec!["x > 1"; 2000].join(" && ");
+    let text = format!(
+        "spec S {{\n    state {{ x: int in 0..=3 }}\n    let A = {nots}(x > 2);\n    let B = {chain};\n    task always (A || B);\n}}\n"
+    );
+    assert!(hstl::lang::check(&text).diagnostics.iter().all(|d| !d.is_error()));
+    let (mut c, _) = Client::start(json!({}));
+    c.open(&text);
+    // On the `>` inside the 250 `!`.
+    let (line, col) = pos_of(&text, "> 2", 0, 0);
+    let r = c.at("textDocument/hover", line, col);
+    let hover = r.result.unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("how far `e1` is above `e2`"), "{hover}");
+    // On a `!` half way in.
+    let (line, col) = pos_of(&text, "!", 125, 0);
+    let hover =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("(not)"), "{hover}");
+    // `x`: declared once, used once in A and 2,000 times in B.
+    let (line, col) = pos_of(&text, "x > 2", 0, 0);
+    let refs = c.at("textDocument/references", line, col).result.unwrap();
+    assert_eq!(refs.as_array().map(Vec::len), Some(2002));
+    c.shutdown();
+}
+
+/// What [`super::transport::FrameReader`] reads from `input`, frame by frame, up to the
+/// end.
+fn check_frames(input: &[u8], expect: &[Frame]) {
+    let mut reader = FrameReader::new(input);
+    let mut got = Vec::new();
+    loop {
+        let frame = reader.next_frame();
+        let end = matches!(frame, Frame::End(_));
+        got.push(frame);
+        if end {
+            break;
+        }
+        assert!(got.len() <= input.len() + 1, "every frame consumes input");
+    }
+    assert_eq!(got, expect, "input {:?}", String::from_utf8_lossy(input));
+}
+
+#[test]
+fn the_frame_reader_skips_what_it_cannot_read_and_finds_the_next_frame() {
+    use Frame::*;
+    let msg = |s: &str| Message(s.as_bytes().to_vec());
+    check_frames(b"", &[End(None)]);
+    check_frames(b"Content-Length: 2\r\n\r\n{}", &[msg("{}"), End(None)]);
+    // Blank lines between frames, bare LF, any case, spaces, other headers.
+    check_frames(
+        b"\r\n\r\ncontent-length:2\n\n{}CONTENT-LENGTH :  3 \r\nContent-Type: x\r\n\r\n[1]",
+        &[msg("{}"), msg("[1]"), End(None)],
+    );
+    // The next frame after a bad length starts at the next `Content-Length:`, even one
+    // glued to the body before it.
+    check_frames(
+        b"Content-Length: 2x\r\n\r\n{ ... }Content-Length: 2\r\n\r\n{}",
+        &[Skipped(Problem::BadLength("2x".into())), msg("{}"), End(None)],
+    );
+    check_frames(
+        b"Content-Length: 99999999999999999999\r\n\r\n{}",
+        &[Skipped(Problem::LengthOverflow), End(None)],
+    );
+    check_frames(
+        b"Content-Type: a\r\n\r\n{}content-LENGTH: 1\r\n\r\n1",
+        &[Skipped(Problem::MissingLength), msg("1"), End(None)],
+    );
+    check_frames(
+        b"Content-Length: 2\r\nContent-Length: 3\r\n\r\n{}Content-Length: 1\r\n\r\n1",
+        &[Skipped(Problem::ConflictingLengths(2, 3)), msg("1"), End(None)],
+    );
+    // A wrong header with a usable length: the body is read, to find its id.
+    check_frames(
+        b"Content-Length: 2\r\nContent-Length: 2\r\n\r\n{}",
+        &[BadHeader { problem: Problem::DuplicateLength, body: b"{}".to_vec() }, End(None)],
+    );
+    check_frames(
+        b"Content-Length: 2\r\nno colon\r\n\r\n{}",
+        &[
+            BadHeader {
+                problem: Problem::MalformedHeader("no colon".into()),
+                body: b"{}".to_vec(),
+            },
+            End(None),
+        ],
+    );
+    // Too large: refused at once, the body skipped (up to the end of the input here).
+    check_frames(
+        b"Content-Length: 67108865\r\n\r\n{}",
+        &[
+            Skipped(Problem::TooLarge(67_108_865)),
+            End(Some(Problem::EndInBody { read: 2, expected: 67_108_865 })),
+        ],
+    );
+    let mut huge = b"Content-Length: 67108865\r\n\r\n".to_vec();
+    huge.resize(huge.len() + 67_108_865, b'x');
+    huge.extend_from_slice(b"Content-Length: 2\r\n\r\n{}");
+    check_frames(&huge, &[Skipped(Problem::TooLarge(67_108_865)), msg("{}"), End(None)]);
+    // Headers past 8 KiB.
+    let mut long = b"Content-Length: 2\r\nX: ".to_vec();
+    long.resize(9000, b'a');
+    long.extend_from_slice(b"\r\n\r\n{}Content-Length: 1\r\n\r\n1");
+    check_frames(&long, &[Skipped(Problem::HeadersTooLong), msg("1"), End(None)]);
+    // Ends inside a frame.
+    check_frames(b"Content-Length: 5\r\n", &[End(Some(Problem::EndInHeaders))]);
+    check_frames(
+        b"Content-Length: 5\r\n\r\n{}",
+        &[End(Some(Problem::EndInBody { read: 2, expected: 5 }))],
+    );
+}
+
+/// `decode(body)` in words.
+fn check_decode(body: &[u8], expect: &str) {
+    let got = match decode(body) {
+        Incoming::Request { id, method, .. } => format!("request {id} {method}"),
+        Incoming::Notification { method, .. } => format!("notification {method}"),
+        Incoming::Response => "response".to_string(),
+        Incoming::Invalid { id: Some(id), code, message } => {
+            format!("invalid {} to {id}: {message}", code as i32)
+        }
+        Incoming::Invalid { id: None, code, message } => {
+            format!("invalid {}: {message}", code as i32)
+        }
+    };
+    assert!(got.starts_with(expect), "{:?}: {got}", String::from_utf8_lossy(body));
+}
+
+#[test]
+fn bodies_decode_to_messages_or_to_errors_with_the_id_when_it_can_be_read() {
+    check_decode(br#"{"jsonrpc":"2.0","id":1,"method":"m"}"#, "request 1 m");
+    check_decode(br#"{"id":"a","method":"m","params":[]}"#, "request \"a\" m");
+    check_decode(
+        br#"{"jsonrpc":"2.0","id":18446744073709551615,"method":"m"}"#,
+        "request 18446744073709551615 m",
+    );
+    check_decode(br#"{"jsonrpc":"2.0","method":"exit"}"#, "notification exit");
+    check_decode(br#"{"jsonrpc":"2.0","id":1,"result":null}"#, "response");
+    check_decode(
+        br#"{"jsonrpc":"2.0","id":2,"method":"m"} {"#,
+        "invalid -32700 to 2: the message is not valid JSON: trailing characters",
+    );
+    check_decode(
+        b"{\"id\":3,\"method\":\"\xc0\"}",
+        "invalid -32700 to 3: the message is not valid UTF-8 (at byte 18)",
+    );
+    check_decode(b"{\"id\":3,", "invalid -32700: the message is not valid JSON: EOF");
+    check_decode(
+        br#"{"id":{"x":1},"method":"m"}"#,
+        "invalid -32600: the id must be an integer or a string",
+    );
+    check_decode(br#"{"id":1e3,"method":"m"}"#, "invalid -32600: the id must be");
+    check_decode(br#"{"id":-1.5,"method":"m"}"#, "invalid -32600: the id must be");
+    check_decode(br#"{"id":4,"method":null}"#, "invalid -32600 to 4: `method` must be a string");
+    check_decode(br#"{"id":5,"method":"m","params":1}"#, "invalid -32600 to 5: `params` must be");
+    check_decode(br#"{"jsonrpc":2,"id":6,"method":"m"}"#, "invalid -32600 to 6: `jsonrpc` must be");
+    check_decode(br#"{"jsonrpc":"2.0"}"#, "invalid -32600: a message needs a `method`");
+    check_decode(b"[]", "invalid -32600: a message must be a JSON object");
+    check_decode(
+        "[".repeat(10_000).as_bytes(),
+        "invalid -32700: the message is not valid JSON: recursion limit exceeded",
+    );
+}
+
+/// A session as one stream, on one thread: 200 changes queued behind each other cost
+/// one analysis, of the newest text, before the hover behind them is answered.
+#[test]
+fn queued_changes_are_coalesced_into_one_analysis() {
+    let frame = |v: Value| {
+        let body = v.to_string();
+        format!("Content-Length: {}\r\n\r\n{body}", body.len())
+    };
+    let text = |v: i32| {
+        format!(
+            "spec S {{\n    state {{ x: int in 0..=3 }}\n    let A = x > {v};\n    task always B{v};\n}}\n"
+        )
+    };
+    let mut input = String::new();
+    input += &frame(
+        json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } }),
+    );
+    input += &frame(json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
+    input += &frame(json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
+        "textDocument": { "uri": URI, "languageId": "hstl", "version": 1, "text": text(1) } } }));
+    for v in 2..=201 {
+        input += &frame(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+            "textDocument": { "uri": URI, "version": v }, "contentChanges": [{ "text": text(v) }] } }));
+    }
+    input += &frame(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params": {
+        "textDocument": { "uri": URI }, "position": { "line": 2, "character": 8 } } }));
+    input += &frame(json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown" }));
+    input += &frame(json!({ "jsonrpc": "2.0", "method": "exit" }));
+    let (output, ending) = super::serve_bytes(input.as_bytes());
+    assert_eq!(ending, super::Ending::Exit);
+    let mut out = BufReader::new(&output[..]);
+    let mut messages = Vec::new();
+    while let Some(m) = Message::read(&mut out).expect("the server writes frames") {
+        messages.push(m);
+    }
+    let kinds: Vec<String> = messages
+        .iter()
+        .map(|m| match m {
+            Message::Response(r) => format!("response {}", r.id),
+            Message::Notification(n) => format!("{} {}", n.method, n.params["version"]),
+            Message::Request(r) => format!("request {}", r.method),
+        })
+        .collect();
+    assert_eq!(
+        kinds,
+        ["response 1", "textDocument/publishDiagnostics 201", "response 2", "response 3"]
+    );
+    let Message::Response(hover) = &messages[2] else { unreachable!() };
+    let hover = hover.response_result.as_ref().unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("let A = x > 201;"), "{hover}");
 }
