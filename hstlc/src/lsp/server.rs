@@ -7,7 +7,7 @@
 //! unanalysed one), and the newest text is analysed when a request needs it or when the
 //! server is idle. So a burst of changes costs one analysis, not one per change.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fmt::Display;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -76,6 +76,8 @@ struct Document {
     version: i32,
     /// The newest text, when it is newer than `state`.
     pending: Option<String>,
+    /// Its key in `Server::stale` while `pending` is set.
+    queued: Option<u64>,
     state: State,
 }
 
@@ -117,6 +119,10 @@ pub struct Server {
     phase: Phase,
     encoding: Encoding,
     documents: HashMap<Uri, Document>,
+    /// The documents with a text not analysed yet, in the order they got it (keyed by
+    /// `Document::queued`): the idle work, found without a scan of every document.
+    stale: BTreeMap<u64, Uri>,
+    next_stale: u64,
     /// What is left of replaced analyses, dropped once the diagnostics are queued.
     trash: Vec<Leftovers>,
     log: Log,
@@ -131,6 +137,8 @@ impl Server {
             phase: Phase::Uninitialized,
             encoding: Encoding::Utf16,
             documents: HashMap::new(),
+            stale: BTreeMap::new(),
+            next_stale: 0,
             trash: Vec::new(),
             log,
         }
@@ -173,15 +181,15 @@ impl Server {
         Flow::Continue
     }
 
-    /// Whether a document has a text that is not analysed yet.
+    /// Whether a document may have a text that is not analysed yet.
     pub fn has_idle_work(&self) -> bool {
-        self.documents.values().any(|d| d.pending.is_some())
+        !self.stale.is_empty()
     }
 
-    /// Analyses one document with a newer text and publishes its diagnostics.
+    /// Analyses the next document with a newer text (if it still has one) and publishes
+    /// its diagnostics.
     pub fn idle_step(&mut self, out: &mut impl Sink) {
-        let next = self.documents.iter().find(|(_, d)| d.pending.is_some()).map(|(u, _)| u);
-        if let Some(uri) = next.cloned() {
+        if let Some((_, uri)) = self.stale.pop_first() {
             self.analyse(&uri, out);
         }
     }
@@ -384,6 +392,9 @@ impl Server {
                     serde_json::from_value(params).map_err(|e| e.to_string())?;
                 let uri = p.text_document.uri;
                 if let Some(doc) = self.documents.remove(&uri) {
+                    if let Some(key) = doc.queued {
+                        self.stale.remove(&key);
+                    }
                     self.discard(doc.state);
                 }
                 out.send(publish(&uri, None, Vec::new()));
@@ -396,13 +407,19 @@ impl Server {
 
     /// Stores a newer text, replacing one that was never analysed.
     fn store(&mut self, uri: Uri, version: i32, text: String) {
-        let doc = self.documents.entry(uri).or_insert(Document {
+        let doc = self.documents.entry(uri.clone()).or_insert(Document {
             version,
             pending: None,
+            queued: None,
             state: State::Unanalysed,
         });
         doc.version = version;
         doc.pending = Some(text);
+        if doc.queued.is_none() {
+            doc.queued = Some(self.next_stale);
+            self.stale.insert(self.next_stale, uri);
+            self.next_stale += 1;
+        }
     }
 
     fn discard(&mut self, state: State) {
@@ -414,6 +431,9 @@ impl Server {
     /// Analyses the newest text of `uri` and publishes its diagnostics.
     fn analyse(&mut self, uri: &Uri, out: &mut impl Sink) {
         let Some(doc) = self.documents.get_mut(uri) else { return };
+        if let Some(key) = doc.queued.take() {
+            self.stale.remove(&key);
+        }
         let Some(text) = doc.pending.take() else { return };
         let version = doc.version;
         let prev = std::mem::replace(&mut doc.state, State::Unanalysed);

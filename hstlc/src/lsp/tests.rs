@@ -2,7 +2,9 @@
 
 use std::io::BufReader;
 use std::path::Path;
+use std::sync::mpsc::{Receiver, channel};
 use std::thread::JoinHandle;
+use std::time::Duration;
 
 use hstl::lang::LineIndex;
 use lsp_server::{Message, Notification, Request, RequestId, ResponseError};
@@ -11,6 +13,9 @@ use serde_json::{Value, json};
 use super::transport::{Frame, FrameReader, Incoming, Problem, decode};
 
 const URI: &str = "file:///tmp/spec.hstl";
+
+/// Guards the tests against a server that never answers (a failure, not a measurement).
+const STUCK: Duration = Duration::from_secs(120);
 
 /// A spec with a missing `;` after `let B = ...` (HSTL001 after `x > 3`) and a
 /// duplicate `let` (HSTL003 with a related location).
@@ -48,7 +53,7 @@ struct Reply {
 /// reader and writer.
 struct Client {
     to_server: Option<std::io::PipeWriter>,
-    from_server: BufReader<std::io::PipeReader>,
+    from_server: Receiver<Message>,
     server: Option<JoinHandle<std::io::Result<super::Ending>>>,
     next_id: i32,
     notifications: Vec<Notification>,
@@ -60,9 +65,18 @@ impl Client {
         let (server_in, to_server) = std::io::pipe().expect("pipe");
         let (from_server, server_out) = std::io::pipe().expect("pipe");
         let handle = std::thread::spawn(move || super::serve(server_in, server_out));
+        let (tx, messages) = channel();
+        std::thread::spawn(move || {
+            let mut input = BufReader::new(from_server);
+            while let Ok(Some(m)) = Message::read(&mut input) {
+                if tx.send(m).is_err() {
+                    return;
+                }
+            }
+        });
         let mut c = Client {
             to_server: Some(to_server),
-            from_server: BufReader::new(from_server),
+            from_server: messages,
             server: Some(handle),
             next_id: 0,
             notifications: vec![],
@@ -103,7 +117,7 @@ impl Client {
     }
 
     fn recv(&mut self) -> Message {
-        Message::read(&mut self.from_server).expect("a frame").expect("the server answers")
+        self.from_server.recv_timeout(STUCK).expect("the server answers")
     }
 
     /// The next `publishDiagnostics` for the document.
@@ -571,54 +585,105 @@ fn bodies_decode_to_messages_or_to_errors_with_the_id_when_it_can_be_read() {
     );
 }
 
+/// Runs `messages` as one stream through [`super::serve_bytes`] (one thread, no timing):
+/// how it ended, and each message written, in words, with the messages.
+fn session(messages: &[Value]) -> (super::Ending, Vec<String>, Vec<Message>) {
+    let mut input = Vec::new();
+    for m in messages {
+        super::transport::write_frame(&mut input, m.to_string().as_bytes()).unwrap();
+    }
+    let (output, ending) = super::serve_bytes(&input);
+    let mut out = BufReader::new(&output[..]);
+    let mut written = Vec::new();
+    while let Some(m) = Message::read(&mut out).expect("the server writes frames") {
+        written.push(m);
+    }
+    let words = written
+        .iter()
+        .map(|m| match m {
+            Message::Response(r) => format!("response {}", r.id),
+            Message::Notification(n) => {
+                let uri =
+                    n.params["uri"].as_str().unwrap_or_default().trim_start_matches("file:///");
+                format!("{} {uri} {}", n.method, n.params["version"])
+            }
+            Message::Request(r) => format!("request {}", r.method),
+        })
+        .collect();
+    (ending, words, written)
+}
+
+fn open_doc(uri: &str, text: &str) -> Value {
+    json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
+        "textDocument": { "uri": uri, "languageId": "hstl", "version": 1, "text": text } } })
+}
+
+const INIT: [&str; 2] = [
+    r#"{"jsonrpc":"2.0","id":1,"method":"initialize","params":{"capabilities":{}}}"#,
+    r#"{"jsonrpc":"2.0","method":"initialized","params":{}}"#,
+];
+
 /// A session as one stream, on one thread: 200 changes queued behind each other cost
 /// one analysis, of the newest text, before the hover behind them is answered.
 #[test]
 fn queued_changes_are_coalesced_into_one_analysis() {
-    let frame = |v: Value| {
-        let body = v.to_string();
-        format!("Content-Length: {}\r\n\r\n{body}", body.len())
-    };
     let text = |v: i32| {
         format!(
             "spec S {{\n    state {{ x: int in 0..=3 }}\n    let A = x > {v};\n    task always B{v};\n}}\n"
         )
     };
-    let mut input = String::new();
-    input += &frame(
-        json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } }),
-    );
-    input += &frame(json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} }));
-    input += &frame(json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
-        "textDocument": { "uri": URI, "languageId": "hstl", "version": 1, "text": text(1) } } }));
+    let mut messages: Vec<Value> = INIT.iter().map(|m| serde_json::from_str(m).unwrap()).collect();
+    messages.push(open_doc(URI, &text(1)));
     for v in 2..=201 {
-        input += &frame(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+        messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
             "textDocument": { "uri": URI, "version": v }, "contentChanges": [{ "text": text(v) }] } }));
     }
-    input += &frame(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params": {
+    messages.push(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params": {
         "textDocument": { "uri": URI }, "position": { "line": 2, "character": 8 } } }));
-    input += &frame(json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown" }));
-    input += &frame(json!({ "jsonrpc": "2.0", "method": "exit" }));
-    let (output, ending) = super::serve_bytes(input.as_bytes());
+    messages.push(json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown" }));
+    messages.push(json!({ "jsonrpc": "2.0", "method": "exit" }));
+    let (ending, words, written) = session(&messages);
     assert_eq!(ending, super::Ending::Exit);
-    let mut out = BufReader::new(&output[..]);
-    let mut messages = Vec::new();
-    while let Some(m) = Message::read(&mut out).expect("the server writes frames") {
-        messages.push(m);
-    }
-    let kinds: Vec<String> = messages
-        .iter()
-        .map(|m| match m {
-            Message::Response(r) => format!("response {}", r.id),
-            Message::Notification(n) => format!("{} {}", n.method, n.params["version"]),
-            Message::Request(r) => format!("request {}", r.method),
-        })
-        .collect();
     assert_eq!(
-        kinds,
-        ["response 1", "textDocument/publishDiagnostics 201", "response 2", "response 3"]
+        words,
+        [
+            "response 1",
+            "textDocument/publishDiagnostics tmp/spec.hstl 201",
+            "response 2",
+            "response 3"
+        ]
     );
-    let Message::Response(hover) = &messages[2] else { unreachable!() };
+    let Message::Response(hover) = &written[2] else { unreachable!() };
     let hover = hover.response_result.as_ref().unwrap()["contents"]["value"].to_string();
     assert!(hover.contains("let A = x > 201;"), "{hover}");
+}
+
+/// Idle work follows the documents: a document closed before it was analysed is never
+/// analysed, the others are, in the order they changed, once the input is drained.
+#[test]
+fn idle_analysis_skips_closed_documents_and_keeps_the_order_of_changes() {
+    let spec =
+        "spec S {\n    state { x: int in 0..=3 }\n    let A = x > 1;\n    task always A;\n}\n";
+    let mut messages: Vec<Value> = INIT.iter().map(|m| serde_json::from_str(m).unwrap()).collect();
+    for name in ["a", "b", "c", "d"] {
+        messages.push(open_doc(&format!("file:///{name}"), spec));
+    }
+    messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didClose", "params": { "textDocument": { "uri": "file:///b" } } }));
+    // A request analyses its document now; the rest wait for the idle work.
+    messages.push(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/documentSymbol", "params": { "textDocument": { "uri": "file:///c" } } }));
+    messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+        "textDocument": { "uri": "file:///a", "version": 2 }, "contentChanges": [{ "text": spec }] } }));
+    let (ending, words, _) = session(&messages);
+    assert_eq!(ending, super::Ending::InputClosed);
+    assert_eq!(
+        words,
+        [
+            "response 1",
+            "textDocument/publishDiagnostics b null",
+            "textDocument/publishDiagnostics c 1",
+            "response 2",
+            "textDocument/publishDiagnostics a 2",
+            "textDocument/publishDiagnostics d 1",
+        ]
+    );
 }

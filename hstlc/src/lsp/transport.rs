@@ -24,6 +24,9 @@ pub const MAX_HEADER_BYTES: usize = 8 << 10;
 /// The header that starts every frame, which resynchronisation looks for.
 const LENGTH_HEADER: &[u8] = b"content-length:";
 
+/// The first allocation for a body; it doubles up to the announced length.
+const CHUNK: u64 = 64 << 10;
+
 /// One step of reading the input.
 #[derive(Debug, PartialEq, Eq)]
 pub enum Frame {
@@ -276,20 +279,22 @@ impl<R: BufRead> FrameReader<R> {
         }
     }
 
-    /// Reads a body of `n` bytes (at most [`MAX_MESSAGE_BYTES`]); memory grows only as
-    /// the bytes arrive.
+    /// Reads a body of `n` bytes (at most [`MAX_MESSAGE_BYTES`]). Memory grows with the
+    /// bytes that arrive, doubling from 64 KiB and never past `n`: an announced length
+    /// with nothing behind it costs nothing.
     fn body(&mut self, n: u64) -> Result<Vec<u8>, Problem> {
-        // `n` is at most 64 MiB, so it fits in `usize`; reserving does not touch memory.
-        let mut body = Vec::with_capacity(n as usize);
-        loop {
-            match (&mut self.input).take(n - body.len() as u64).read_to_end(&mut body) {
-                Ok(_) => break,
-                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+        let mut body = Vec::new();
+        while (body.len() as u64) < n {
+            let have = body.len() as u64;
+            let step = (n - have).min(have.max(CHUNK));
+            // `step` is at most 64 MiB, so it fits in `usize`.
+            body.reserve_exact(step as usize);
+            match (&mut self.input).take(step).read_to_end(&mut body) {
+                Ok(0) => return Err(Problem::EndInBody { read: have, expected: n }),
+                Ok(_) => {}
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                 Err(e) => return Err(Problem::Read(e.to_string())),
             }
-        }
-        if (body.len() as u64) < n {
-            return Err(Problem::EndInBody { read: body.len() as u64, expected: n });
         }
         Ok(body)
     }
