@@ -3,9 +3,9 @@
 //!
 //! Diagnostics are exactly those of `hstlc check`, published (with the document's
 //! version) after open and change and cleared on close. Documents are synchronised in
-//! full; each version is checked at most once, and the result (an analysis)
-//! answers hover, definition, references, document symbols, completion and formatting.
-//! Positions use UTF-8 when the client offers it, else UTF-16.
+//! full; each version is checked at most once, and that analysis answers hover,
+//! definition, references, document symbols, completion and formatting. Positions use
+//! UTF-8 when the client offers it, else UTF-16.
 //!
 //! Hostile or broken input is survived by design:
 //! - [`transport`] reads frames with every size checked before it is read: a body over
@@ -18,8 +18,8 @@
 //! - Lifecycle: before `initialize`, requests get `ServerNotInitialized` and
 //!   notifications other than `exit` are dropped; after `shutdown`, requests get
 //!   `InvalidRequest`. Only `exit` ends the server.
-//! - [`queue`]: the messages waiting for the server and for the client are bounded (64
-//!   and 16 MiB), and a document has at most one `publishDiagnostics` waiting: a newer
+//! - The messages waiting for the server and for the client are bounded (64 and 16
+//!   MiB), and a document has at most one `publishDiagnostics` waiting: a newer
 //!   one replaces it, so a client that reads slowly costs bounded memory.
 //! - A change only stores the text; the newest text is analysed when a request needs it
 //!   or the server is idle, so a burst of changes costs one analysis.
@@ -35,7 +35,7 @@ use std::time::Duration;
 
 mod convert;
 mod features;
-pub mod queue;
+mod queue;
 mod server;
 #[cfg(test)]
 mod tests;
@@ -81,9 +81,8 @@ pub fn run() -> std::io::Result<Ending> {
     serve(std::io::stdin(), std::io::stdout())
 }
 
-/// Serves one client: a reader thread decodes `input` into the bounded [`Inbox`], this
-/// thread runs the server, and a writer thread writes the bounded [`Outbox`] to
-/// `output`. Returns once the client exits or the input ends (the reader thread may be
+/// Serves one client: a reader thread decodes `input` into a bounded inbox, this thread
+/// runs the server, and a writer thread writes a bounded outbox to `output`. Returns once the client exits or the input ends (the reader thread may be
 /// left blocked on `input`). Errors only when a thread cannot start.
 pub fn serve<R, W>(input: R, output: W) -> std::io::Result<Ending>
 where
