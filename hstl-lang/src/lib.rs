@@ -70,4 +70,4 @@ pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Location, Position};
 pub use render::{FileDiagnostics, render_concise, render_plain};
-pub use world::{WorldFacts, check_in_world};
+pub use world::{WorldFacts, check_in_world, check_parsed_in_world};

@@ -9,7 +9,6 @@ mod cli_error;
 mod eval;
 mod explain;
 mod fmt;
-mod lsp;
 mod monitor;
 mod render;
 mod spec_file;
@@ -65,7 +64,7 @@ fn main() -> ExitCode {
         Command::Check(args) => check::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Fmt(args) => fmt::run(&args),
-        Command::Lsp => lsp::run(),
+        Command::Lsp => lsp(),
         Command::Monitor(args) => monitor::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Eval(args) => eval::run(&args),
@@ -77,6 +76,16 @@ fn main() -> ExitCode {
             eprintln!("{}", render::cli_error(&e));
             ExitCode::from(2)
         }
+    }
+}
+
+/// `hstlc lsp`: status 0 after `shutdown` then `exit`, 1 when the client exits without
+/// `shutdown` or goes away.
+fn lsp() -> CmdResult {
+    match hstlc::lsp::run() {
+        Ok(ending) if ending.is_clean() => Ok(Status::Clean),
+        Ok(_) => Ok(Status::Errors),
+        Err(e) => Err(CliError::new(format!("cannot start the language server: {e}"), None)),
     }
 }
 
