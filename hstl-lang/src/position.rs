@@ -74,7 +74,8 @@ impl LineIndex {
         let end = self.starts.get(l + 1).copied().unwrap_or(src.len()).min(src.len());
         let mut units = 0;
         for (i, c) in src[start..end].char_indices() {
-            if units >= utf16_column || c == '\n' || c == '\r' {
+            let lone_cr = c == '\r' && src.as_bytes().get(start + i + 1) != Some(&b'\n');
+            if units >= utf16_column || c == '\n' || lone_cr {
                 return start + i;
             }
             units += c.len_utf16();
@@ -117,6 +118,8 @@ mod tests {
         assert_eq!(index.line_count(), 4);
         assert_eq!(&src[index.line_range(src, 2)], "b");
         assert_eq!(index.offset_utf16(src, 0, 5), 1);
+        // Past the end of a `\r\n` line: its `\n`, as LSP clients count.
+        assert_eq!(index.offset_utf16(src, 1, 5), src.find('\n').unwrap());
         assert_eq!(index.offset(src, 3, 1), src.find('c').unwrap());
     }
 }

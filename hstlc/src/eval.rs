@@ -10,11 +10,10 @@ use hstl::runtime::optimum::{SolveConfig, solve};
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts;
-use crate::check::read_input;
 use crate::cli_error::CliError;
 use crate::study::{mean, range};
 use crate::train::env_words;
-use crate::{CmdResult, Status};
+use crate::{CmdResult, Status, input};
 
 /// Arguments of `hstlc eval`.
 #[derive(Args, Debug)]
@@ -41,7 +40,8 @@ pub struct EvalArgs {
 
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
-    let (name, text) = read_input(&args.policy, "<stdin>")?;
+    let input::Input { name, text, .. } =
+        input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
     let bad = |message: String, help: &str| {
         CliError::new(format!("{name}: {message}"), Some(help.to_string()))
     };
@@ -60,6 +60,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let agent = policy
         .agent(&env)
         .map_err(|e| bad(e.to_string(), "the policy does not fit its environment"))?;
+    check_flags(args, !spec.regions.is_empty())?;
     let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
     let mut rng = seeded_rng(args.seed);
     println!(
@@ -73,9 +74,6 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     );
     if spec.regions.is_empty() {
         // Not a persistent task: the task's robustness over each run is the measure.
-        if args.starts == 0 || args.steps == 0 {
-            return Err(CliError::new("`--starts` and `--steps` must be at least 1", None));
-        }
         let all_states = artifacts::state_trace(&spec, &env)?;
         let mut controller = AgentController::new(&agent);
         let mut values = Vec::with_capacity(args.starts);
@@ -92,12 +90,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     }
     let regions = RegionTable::new(&spec, &env).map_err(|e| CliError::new(e.to_string(), None))?;
     let report = window_rate(&env, &mut AgentController::new(&agent), &regions, config, &mut rng)
-        .map_err(|e| {
-        CliError::new(
-            e.to_string(),
-            Some("use --burn-in smaller than --steps, and --starts > 0".into()),
-        )
-    })?;
+        .map_err(|e| CliError::new(e.to_string(), None))?;
     let (lo, hi) = range(&report.per_rollout);
     println!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
@@ -125,6 +118,30 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         );
     }
     Ok(Status::Clean)
+}
+
+/// Refuses flags that cannot make a report, before anything is printed: every run needs a
+/// step, and the window rate (of a persistent task) needs steps after the burn-in.
+fn check_flags(args: &EvalArgs, persistent: bool) -> Result<(), CliError> {
+    if args.starts == 0 || args.steps == 0 {
+        return Err(CliError::new(
+            format!(
+                "`--starts {}` and `--steps {}` must both be at least 1",
+                args.starts, args.steps
+            ),
+            Some("leave them out for 100 runs of 2000 steps".to_string()),
+        ));
+    }
+    if persistent && args.burn_in >= args.steps {
+        return Err(CliError::new(
+            format!(
+                "`--burn-in {}` leaves no step of `--steps {}` to count",
+                args.burn_in, args.steps
+            ),
+            Some("use a `--burn-in` smaller than `--steps`".to_string()),
+        ));
+    }
+    Ok(())
 }
 
 /// The spec that `policy.json` was trained from, checked and lowered again.

@@ -9,6 +9,7 @@ mod cli_error;
 mod eval;
 mod explain;
 mod fmt;
+mod input;
 mod lsp;
 mod monitor;
 mod render;

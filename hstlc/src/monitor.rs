@@ -5,14 +5,15 @@
 //! run: an unreadable file, a malformed trace, an unknown `--formula` or `--spec`. On 1 and 2
 //! nothing is printed to standard output.
 
-use std::io::Write;
-use std::path::PathBuf;
+use std::io::{BufReader, Write};
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use hstl::lang::{CheckedSpec, Domain, VarType};
 use hstl::robustness::offline;
 
-use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::trace_csv::{Column, ColumnKind, ReadError, TraceRead};
 use crate::{CmdResult, Status, spec_file, trace_csv};
 
 /// Arguments of `hstlc monitor`.
@@ -47,7 +48,6 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
         return Ok(Status::Errors);
     };
-    let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
     let (spec, name) = (&loaded.spec, &loaded.file);
     let formula = match &args.formula {
         None => hstl::lower::task(spec),
@@ -62,10 +62,17 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
-    let vars: Vec<&str> = spec.state_vars.iter().map(|v| v.name.as_str()).collect();
-    let trace = trace_csv::read_trace(&trace_text, &vars).map_err(|e| {
-        CliError::new(format!("{trace_name}:{}:{}: {}", e.line, e.column, e.message), e.help)
-    })?;
+    let read = read_trace(&args.trace, spec)?;
+    if !read.ignored.is_empty() {
+        let names: Vec<String> = read.ignored.iter().map(|n| format!("`{n}`")).collect();
+        let (what, verb) = if names.len() == 1 {
+            ("column", "is not a state variable")
+        } else {
+            ("columns", "are not state variables")
+        };
+        eprintln!("note: {what} {} {verb} of `{}`: ignored", names.join(", "), spec.name);
+    }
+    let trace = read.trace;
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
@@ -84,4 +91,33 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         }
         _ => Ok(Status::Clean),
     }
+}
+
+/// Reads the trace at `path` (standard input for `-`) for the state variables of `spec`.
+fn read_trace(path: &Path, spec: &CheckedSpec) -> Result<TraceRead, CliError> {
+    let columns: Vec<Column<'_>> = spec
+        .state_vars
+        .iter()
+        .map(|v| Column {
+            name: &v.name,
+            kind: match (v.ty, &v.domain) {
+                (_, Domain::Int { lo, hi }) => ColumnKind::Int(Some((*lo, *hi))),
+                (VarType::Int, _) => ColumnKind::Int(None),
+                _ => ColumnKind::Real,
+            },
+        })
+        .collect();
+    let (name, read) = if path == Path::new("-") {
+        ("<stdin>".to_string(), trace_csv::read_trace(std::io::stdin().lock(), &columns))
+    } else {
+        let file = std::fs::File::open(path)
+            .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+        (path.display().to_string(), trace_csv::read_trace(BufReader::new(file), &columns))
+    };
+    read.map_err(|e| match e {
+        ReadError::Io(source) => CliError::Read { path: PathBuf::from(&name), source },
+        ReadError::Csv(e) => {
+            CliError::new(format!("{name}:{}:{}: {}", e.line, e.column, e.message), e.help)
+        }
+    })
 }

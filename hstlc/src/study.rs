@@ -10,7 +10,7 @@ use hstl::runtime::eval::RegionTable;
 use hstl::runtime::optimum::{SolveConfig, solve};
 use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpec, seeded_rng};
 
-use crate::artifacts::{self, OutFile};
+use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
 use crate::train::{self, PICTURE_SEED, env_words, tail_mean};
 use crate::{CmdResult, Status, spec_file};
@@ -70,6 +70,12 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         }
         loaded.push((path.clone(), l, spec));
     }
+    // Each spec's folder, taken before the long part: a folder another run holds is
+    // refused at once, and two specs of one name get folders of their own.
+    let outs = spec_dirs(&args.out, &args.specs)
+        .iter()
+        .map(|d| OutDir::lock(d))
+        .collect::<Result<Vec<_>, _>>()?;
     let env = GridWorld::default();
     let threads = args
         .threads
@@ -83,7 +89,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     );
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, RewardKind)> = None;
-    for (path, l, spec) in &loaded {
+    for ((path, l, spec), out) in loaded.iter().zip(outs) {
         let results = run_seeds(spec, &env, args.seeds, threads, &l.file)?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
             None
@@ -130,8 +136,8 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             println!("  with intra: {} instead:", intra_word(other.learn.intra));
             print_table(&alt, w_star);
         }
-        let dir = args.out.join(stem(path));
-        write_outputs(&dir, spec, &env, l, &results)?;
+        let dir = out.path().to_path_buf();
+        write_outputs(out, spec, &env, l, &results)?;
         println!("  wrote {}", dir.display());
     }
     Ok(Status::Clean)
@@ -234,7 +240,7 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) {
 /// Seed 0's policy, curve and pictures, the learning curves of all seeds, and
 /// `seeds.csv` with each seed's figures.
 fn write_outputs(
-    dir: &Path,
+    out: OutDir,
     spec: &TaskSpec,
     env: &GridWorld,
     loaded: &spec_file::LoadedSpec,
@@ -261,7 +267,27 @@ fn write_outputs(
         &format!("Learning curve of {} over {} seeds", spec.name, curves.len()),
         &curves,
     )?);
-    artifacts::write_all(dir, &files).map(|_| ())
+    out.write(&files).map(|_| ())
+}
+
+/// Each spec's folder under `out`: its file's stem, and `-2`, `-3`, ... after a stem that an
+/// earlier spec of the list has (ignoring case): `study a/spec.hstl b/spec.hstl` writes
+/// `spec` and `spec-2`.
+fn spec_dirs(out: &Path, specs: &[PathBuf]) -> Vec<PathBuf> {
+    let mut taken = std::collections::HashSet::new();
+    specs
+        .iter()
+        .map(|path| {
+            let stem = stem(path);
+            let mut name = stem.clone();
+            let mut k = 2;
+            while !taken.insert(name.to_lowercase()) {
+                name = format!("{stem}-{k}");
+                k += 1;
+            }
+            out.join(name)
+        })
+        .collect()
 }
 
 fn stem(path: &Path) -> String {

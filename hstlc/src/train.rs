@@ -8,7 +8,7 @@ use clap::{Args, ValueEnum};
 use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
 use hstl::runtime::{GridWorld, Learner, Policy, TaskSpec, seeded_rng};
 
-use crate::artifacts::{self, OutFile};
+use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
 use crate::{CmdResult, Status, spec_file};
 
@@ -27,8 +27,9 @@ pub struct TrainArgs {
     /// Training episodes (overrides the spec's `learn { episodes }`).
     #[arg(long, value_name = "N")]
     pub episodes: Option<usize>,
-    /// The folder to write `policy.json`, `curve.csv` and the pictures into.
-    #[arg(long, value_name = "DIR", default_value = "out")]
+    /// The folder to write `policy.json`, `curve.csv` and the pictures into (replaced as a
+    /// whole: it must be new, empty, or an earlier run's).
+    #[arg(long, value_name = "DIR", default_value = "out/train")]
     pub out: PathBuf,
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
@@ -71,6 +72,8 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     let env = match args.env {
         EnvName::Gridworld => GridWorld::default(),
     };
+    // Before the long part: a folder another run holds is refused at once.
+    let out = OutDir::lock(&args.out)?;
     let bar = progress_bar(spec.learn.episodes as u64);
     let outcome = train(&spec, &env, args.seed, &loaded.file, |episode, reward| {
         bar.set_position(episode as u64 + 1);
@@ -89,7 +92,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         std::slice::from_ref(&outcome.curve),
     )?);
     let window = window_report(&spec, &env, &outcome.agent, args.seed)?;
-    let written = artifacts::write_all(&args.out, &files)?;
+    let written = out.write(&files)?;
 
     let tail = tail_mean(&outcome.curve, 100);
     println!(

@@ -187,7 +187,7 @@ pub fn options_policy_slices(
             let title =
                 if label.is_empty() { title.to_owned() } else { format!("{title}, {label}") };
             options_policy(grid, &title, choices, &order)
-                .map_err(|e| PictureError::new(format!("memory slice {label:?}: {}", e.message())))
+                .map_err(|e| PictureError::new(format!("memory slice `{label}`: {}", e.message())))
         })
         .collect()
 }
