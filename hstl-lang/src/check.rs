@@ -206,7 +206,7 @@ fn distance_within(a: &[char], b: &[char], limit: usize, rows: &mut Vec<usize>) 
 /// enough to be a typo: at most a third of the name's characters differ. Each compared
 /// character pair and candidate costs one unit of `budget`; with the budget spent, nothing
 /// is suggested.
-fn closest<'a>(
+pub(crate) fn closest<'a>(
     name: &str,
     candidates: impl Iterator<Item = &'a str>,
     budget: &mut u64,

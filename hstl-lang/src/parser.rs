@@ -246,9 +246,14 @@ impl Splitter<'_, '_> {
             } else {
                 (t.end..t.end, "end of file".to_string())
             };
+            let help = if found == "`;`" {
+                "remove this `;`: a spec ends at its `}`"
+            } else {
+                "a file holds specs: `spec Name { ... }`"
+            };
             self.diagnostics.push(
                 Diagnostic::new("HSTL001", range, format!("expected `spec`, found {found}"))
-                    .with_help("a file holds specs: `spec Name { ... }`"),
+                    .with_help(help),
             );
             self.i = k + 1;
             while self.i < self.toks.len() && !self.is(self.i, "spec") {
@@ -567,7 +572,8 @@ impl Splitter<'_, '_> {
         };
         // What was found: the next token in the whole file after the error position.
         // The tokens are in source order: a binary search keeps many errors linear.
-        let next = self.toks.get(self.toks.partition_point(|t| t.start < pos));
+        let k = self.toks.partition_point(|t| t.start < pos);
+        let next = self.toks.get(k);
         let (range, found) = match next {
             Some(t) if t.start < piece.end => {
                 (t.start..t.end, format!("`{}`", &self.src[t.start..t.end]))
@@ -582,7 +588,45 @@ impl Splitter<'_, '_> {
         } else {
             format!("expected {what}, found {found}")
         };
-        Diagnostic::new("HSTL001", range, message)
+        let d = Diagnostic::new("HSTL001", range, message);
+        match self.hint(k, &expected, &piece) {
+            Some(help) if !limit => d.with_help(help),
+            _ => d,
+        }
+    }
+
+    /// Help for a syntax error found at token `k` (`expected` in words): a misspelt
+    /// keyword, an interval written with a comma, a `;` too many.
+    fn hint(&self, k: usize, expected: &[String], piece: &Range<usize>) -> Option<String> {
+        let text = |j: usize| self.toks.get(j).map(|t| &self.src[t.start..t.end]);
+        let found = text(k)?;
+        let expects = |w: &str| expected.iter().any(|e| e == w);
+        if found == ";" && expects("`let`") {
+            return Some("remove this `;`: an item ends with its own".into());
+        }
+        if found == "," && expects("`..`") {
+            let number =
+                |j: usize| self.toks.get(j).filter(|t| t.kind == TokKind::Number).map(|_| text(j));
+            let (a, b) = (number(k.wrapping_sub(1)).flatten()?, number(k + 1).flatten()?);
+            return Some(format!(
+                "an interval is a Rust range: `[{a}..={b}]` holds the steps {a} to {b}, \
+                 `[{a}..{b}]` leaves out {b}"
+            ));
+        }
+        // A word just before the error, or at it, that is a keyword misspelt.
+        for j in [k.wrapping_sub(1), k] {
+            let Some(t) = self.toks.get(j).filter(|t| t.kind == TokKind::Word) else { continue };
+            if t.start < piece.start || KEYWORDS.contains(&&self.src[t.start..t.end]) {
+                continue;
+            }
+            let word = &self.src[t.start..t.end];
+            if let Some(kw) =
+                crate::check::closest(word, KEYWORDS.iter().copied(), &mut u64::MAX.clone())
+            {
+                return Some(format!("did you mean `{kw}`?"));
+            }
+        }
+        None
     }
 }
 

@@ -32,7 +32,8 @@ pub fn full(files: &[Checked], colour: bool) -> String {
     out
 }
 
-/// The `concise` format: `path:line:col: CODE message`, then a summary line.
+/// The `concise` format: `path:line:col: CODE message`, the help (if any) indented on the
+/// next line, then a summary line.
 pub fn concise(files: &[Checked]) -> String {
     let mut out = String::new();
     for file in files {
@@ -44,6 +45,9 @@ pub fn concise(files: &[Checked]) -> String {
                 "{}:{}:{}: {} {kind}: {}\n",
                 file.name, start.line, start.column, d.code, d.message
             ));
+            if let Some(help) = &d.help {
+                out.push_str(&format!("  help: {help}\n"));
+            }
         }
     }
     out.push_str(&summary(files));
