@@ -8,7 +8,8 @@
 //!   into typed Rust;
 //!
 //! and [`lower`] turns a checked spec into the runtime's data at run time (the path the
-//! command line takes).
+//! command line takes); [`world`] reads grid worlds and checks specs against them, and
+//! [`train`] trains a spec as `hstlc train` does.
 //!
 //! ```
 //! let src = "spec S { state { x: int in 0..=9 } let Goal = x > 6; task eventually[0..5] Goal;
@@ -20,6 +21,8 @@
 //! ```
 
 pub mod lower;
+pub mod train;
+pub mod world;
 
 pub use hstl_lang as lang;
 pub use hstl_robustness as robustness;

@@ -1,10 +1,32 @@
 //! Every spec in docs/LANGUAGE.md, README.md and examples/specs checks without errors, as
-//! `hstlc check` would report them (warnings allowed, exit status 0).
+//! `hstlc check` would report them (warnings allowed, exit status 0): against the world its
+//! doc comment names (`--world NAME|FILE.toml`), or the default `paper`.
 
 use std::path::Path;
 
+use hstl::world::GridWorld;
+
+/// The world a spec's text names with `--world`, as `hstlc` resolves it (paths are relative
+/// to the package root).
+fn world_of(src: &str) -> (GridWorld, String) {
+    let Some(arg) = src.split("--world").nth(1).and_then(|rest| rest.split_whitespace().next())
+    else {
+        return (GridWorld::default(), "world `paper`".into());
+    };
+    let arg = arg.trim_end_matches(['`', ')', '.', ',']);
+    if let Some(world) = GridWorld::builtin(arg) {
+        return (world, format!("world `{arg}`"));
+    }
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(arg);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{arg}: {e}"));
+    let world = GridWorld::from_toml(&text, "world").unwrap_or_else(|e| panic!("{arg}: {e}"));
+    let label = format!("world `{}` ({arg})", world.world_name());
+    (world, label)
+}
+
 fn assert_checks(name: &str, src: &str) {
-    let checked = hstl::lang::check(src);
+    let (world, label) = world_of(src);
+    let checked = hstl::world::check(src, &world, &label);
     assert!(
         !checked.has_errors(),
         "{name} has errors:\n{}",

@@ -45,6 +45,7 @@ use crate::checked::*;
 use crate::diagnostic::{self, Diagnostic};
 use crate::parser::parse;
 use crate::syntax::{self, FieldValue, Formula, FormulaKind, Item, OptionsKind, ParamValue};
+use crate::world::{DomainMask, WorldFacts};
 
 /// At most this many diagnostics are reported per file.
 pub const MAX_DIAGNOSTICS: usize = 200;
@@ -91,6 +92,15 @@ pub fn check(src: &str) -> Checked {
 /// `src` (an editor that re-parses only what changed, see [`crate::incremental`], builds
 /// it without parsing the whole text). Never fails and never panics.
 pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
+    check_parsed_in(src, parsed, None)
+}
+
+/// [`check_parsed`], with each spec that has options also checked against `world`.
+pub(crate) fn check_parsed_in(
+    src: &str,
+    parsed: crate::parser::Parsed,
+    world: Option<&WorldFacts>,
+) -> Checked {
     let mut diags = parsed.diagnostics;
     let mut specs = Vec::new();
     let mut seen: HashMap<String, Range<usize>> = HashMap::new();
@@ -114,6 +124,7 @@ pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
         }
         let mut cx = Cx {
             src,
+            world,
             diags: Vec::new(),
             names: HashMap::default(),
             let_refs: Vec::new(),
@@ -141,6 +152,8 @@ enum NameRef {
 /// Per-spec checking state.
 struct Cx<'s> {
     src: &'s str,
+    /// The world the specs with options are checked against, if any.
+    world: Option<&'s WorldFacts>,
     diags: Vec<Diagnostic>,
     names: HashMap<String, (NameRef, Range<usize>), BuildHasherDefault<NameHasher>>,
     /// Let references found while resolving the current formula: (let index, range).
@@ -361,6 +374,9 @@ impl Cx<'_> {
             self.learn(l, &mut out);
         }
         self.persistent_needs(learn, &out);
+        if let Some(l) = learn {
+            self.diags.extend(crate::budget::learning(self.src, l, &out));
+        }
         self.mark_used(&mut out);
         // A broken item or an invalid part may have used any let: stay quiet then.
         if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {
@@ -378,8 +394,17 @@ impl Cx<'_> {
                 }
             }
         }
+        let mask = match self.world {
+            Some(world) if self.error_count() == 0 && !out.primitives.is_empty() => {
+                let mut found = Vec::new();
+                let mask = world.fit(&out, &mut |d| found.push(d));
+                self.diags.append(&mut found);
+                mask
+            }
+            _ => None,
+        };
         if self.error_count() == 0 {
-            self.finite_domain(&out, options_item, spec);
+            self.finite_domain(&out, options_item, spec, mask.as_ref());
         }
         out
     }
@@ -1446,6 +1471,7 @@ impl Cx<'_> {
         out: &CheckedSpec,
         item: Option<&syntax::OptionsItem>,
         spec: &syntax::Spec,
+        mask: Option<&DomainMask>,
     ) {
         let Some(size) = out.domain_size() else { return };
         if out.state_vars.is_empty() {
@@ -1484,9 +1510,12 @@ impl Cx<'_> {
         for p in &out.primitives {
             add_region(&p.reach, &mut regions);
         }
+        // The regions before this index are reached by an option.
+        let reached = regions.len();
         for c in out.persistent_conjuncts(self.src).unwrap_or_default() {
             add_region(&c.region, &mut regions);
         }
+        let present = |k: usize| mask.is_none_or(|m| m.present[k]);
         let np = out.primitives.len();
         let mut roots: Vec<&CFormula> = regions.iter().map(|(f, _, _)| f).collect();
         for p in &out.primitives {
@@ -1536,14 +1565,22 @@ impl Cx<'_> {
         // threads, merged in state order (the same counts, maxima and sets).
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut region_sat = vec![0u64; regions.len()];
+            let mut region_reachable = vec![0u64; regions.len()];
             let mut reach_max = vec![f64::NEG_INFINITY; np];
             let mut init_set = vec![Vec::with_capacity(ks.len()); np];
             for k in ks {
+                if !present(k) {
+                    // A wall: no state, so in no set.
+                    init_set.iter_mut().for_each(|set| set.push(false));
+                    continue;
+                }
                 let s = states(k);
                 ev.load(&s);
+                let reachable = mask.is_none_or(|m| m.reachable[k]);
                 for (r, (f, _, _)) in regions.iter().enumerate() {
                     if ev.robustness(f, &s) > 0.0 {
                         region_sat[r] += 1;
+                        region_reachable[r] += u64::from(reachable);
                     }
                 }
                 for (p, prim) in out.primitives.iter().enumerate() {
@@ -1554,13 +1591,17 @@ impl Cx<'_> {
                     init_set[p].push(ev.robustness(&prim.init, &s) > 0.0);
                 }
             }
-            (region_sat, reach_max, init_set)
+            (region_sat, region_reachable, reach_max, init_set)
         });
         let mut region_sat = vec![0u64; regions.len()];
+        let mut region_reachable = vec![0u64; regions.len()];
         let mut reach_max = vec![f64::NEG_INFINITY; np];
         let mut init_set: Vec<Vec<bool>> = vec![Vec::with_capacity(n); np];
-        for (sat, max, init) in chunks {
+        for (sat, reachable, max, init) in chunks {
             for (total, c) in region_sat.iter_mut().zip(sat) {
+                *total += c;
+            }
+            for (total, c) in region_reachable.iter_mut().zip(reachable) {
                 *total += c;
             }
             // Chunks in state order, and only a larger value replaces: the first maximum.
@@ -1573,8 +1614,45 @@ impl Cx<'_> {
                 set.extend(part);
             }
         }
+        let size = match mask {
+            Some(m) => m.present.iter().filter(|&&p| p).count() as u64,
+            None => size,
+        };
+        let world = self.world.filter(|_| mask.is_some());
         for (r, (_, range, name)) in regions.iter().enumerate() {
-            if region_sat[r] == 0 {
+            if let Some(world) = world
+                && region_sat[r] == 0
+            {
+                let (code, what) = if r < reached {
+                    ("HSTL031", "an option reaches it, so the option cannot succeed")
+                } else {
+                    ("HSTL102", "the task cannot be kept")
+                };
+                self.push(
+                    Diagnostic::new(
+                        code,
+                        range.clone(),
+                        format!(
+                            "no free cell of {} satisfies region `{name}`: {what}",
+                            world.label
+                        ),
+                    )
+                    .with_help(
+                        "check the bounds against the map: walls are not cells the robot can be in",
+                    ),
+                );
+            } else if let Some(world) = world
+                && region_reachable[r] == 0
+            {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL131",
+                        range.clone(),
+                        format!("no start of {} can reach region `{name}`: walls cut it off", world.label),
+                    )
+                    .with_help("open a way through the walls, add a start cell (`S`) on its side, or move the region"),
+                );
+            } else if region_sat[r] == 0 {
                 self.push(
                     Diagnostic::new(
                         "HSTL102",
@@ -1601,6 +1679,10 @@ impl Cx<'_> {
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut term_set = vec![Vec::with_capacity(ks.len()); np];
             for k in ks {
+                if !present(k) {
+                    term_set.iter_mut().for_each(|set| set.push(false));
+                    continue;
+                }
                 let s = states(k);
                 ev.load(&s);
                 for (p, prim) in out.primitives.iter().enumerate() {
@@ -1618,11 +1700,30 @@ impl Cx<'_> {
                 set.extend(part);
             }
         }
+        // HSTL032: a termination set with no state (argmax sets never are empty).
+        for (p, prim) in out.primitives.iter().enumerate() {
+            if let Terminate::Formula(f) = &prim.terminate
+                && !term_set[p].iter().any(|&t| t)
+            {
+                let place = world.map_or("state of the domain".to_string(), |w| {
+                    format!("free cell of {}", w.label)
+                });
+                self.push(
+                    Diagnostic::new(
+                        "HSTL032",
+                        f.range.clone(),
+                        format!("option `{}` can never stop: no {place} satisfies its `terminate`", prim.name),
+                    )
+                    .with_label(prim.name_range.clone(), format!("`{}` is declared here", prim.name))
+                    .with_help("widen the `terminate` formula, or leave it out to stop where the region is most robust"),
+                );
+            }
+        }
         // HSTL018: states where no option of the set can start.
         let firsts: Vec<usize> =
             out.options.iter().filter_map(|o| o.sequence.first().copied()).collect();
         let stuck: Vec<usize> =
-            (0..n).filter(|&k| !firsts.iter().any(|&p| init_set[p][k])).collect();
+            (0..n).filter(|&k| present(k) && !firsts.iter().any(|&p| init_set[p][k])).collect();
         if let Some(&k) = stuck.first() {
             let r = item.map_or(spec.name.range.clone(), |i| i.range.clone());
             self.push(
@@ -1675,7 +1776,7 @@ impl Cx<'_> {
 }
 
 /// `1234567` as `1,234,567`.
-fn thousands(n: u64) -> String {
+pub(crate) fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {

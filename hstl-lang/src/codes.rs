@@ -292,6 +292,53 @@ there were (it is an error when some of those were errors).\n\n\
 Fix: fix the reported ones and check again.",
     },
     CodeInfo {
+        code: "HSTL030",
+        name: "state-does-not-fit-world",
+        severity: E,
+        summary: "the state variables do not match the grid world",
+        explanation: "A spec with options is trained in a grid world (`hstlc train --world`, \
+`paper` by default), whose state is the robot's cell: `x` from 0 (left) to W-1 and `y` from \
+0 (bottom) to H-1. The spec must declare exactly these two variables, as `int`s with exactly \
+these ranges, so that every cell of the map is a state of the spec and back. `hstlc check \
+--world FILE` checks against that world; without `--world` against `paper` (15 x 15).\n\n\
+Example (for the 13 x 13 `four-rooms`):\n    state { x: int in 0..=14, y: int in 0..=14 }\n\n\
+Fix: `state { x: int in 0..=12, y: int in 0..=12 }` (the help gives the ranges).",
+    },
+    CodeInfo {
+        code: "HSTL031",
+        name: "option-region-outside-world",
+        severity: E,
+        summary: "an option reaches a region with no free cell of the world",
+        explanation: "The region an option reaches (its `reach`, or the `let` its name names) \
+holds in no free cell of the map: every cell where it holds is a wall, or lies outside the \
+map. The option could never succeed, so training it is pointless.\n\n\
+Example (the wall row y = 6 of a map):\n    let Door = y == 6 && x < 2;   // every such cell is `#`\n    option Door;\n\n\
+Fix: move the region onto free cells (`.` or `S`), or change the map.",
+    },
+    CodeInfo {
+        code: "HSTL032",
+        name: "option-never-stops",
+        severity: E,
+        summary: "an option's termination set holds in no state",
+        explanation: "An option stops at the first state where its `terminate` formula holds \
+(robustness > 0). No state of the domain, or with a world no free cell of its map, satisfies \
+this one, so every leg runs until it is cut off after `max_steps` steps.\n\n\
+Example:\n    option A { terminate: x > 20 }   // x runs over 0..=14\n\n\
+Fix: widen `terminate`, or leave it out: the option then stops where its region is most robust.",
+    },
+    CodeInfo {
+        code: "HSTL033",
+        name: "memory-too-large",
+        severity: E,
+        summary: "memory or the window reward would need more than the stated limits",
+        explanation: "`memory: B` gives the options level one observation per state and memory \
+value, (B + 1)^k memory values for k regions; `policy.json` holds an entry for each. At most \
+2,097,152 observations (states times memory values) are allowed. Memory and `reward: window` \
+also keep a table entry per step of each window: windows of at most 1,000,000 steps.\n\n\
+Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 million\n\n\
+Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
+    },
+    CodeInfo {
         code: "HSTL050",
         name: "constant-formula",
         severity: E,
@@ -346,6 +393,18 @@ Fix: correct the bounds (on an integer grid `3 < x < 4` is empty).",
 what a region is), so reaching it needs no learning.\n\n\
 Example:\n    state { x: int in 0..=14 }\n    let A = x >= 0;\n\n\
 Fix: tighten the formula.",
+    },
+    CodeInfo {
+        code: "HSTL131",
+        name: "region-unreachable",
+        severity: W,
+        summary: "no start of the world can reach a region",
+        explanation: "Walls cut the map into parts, and every cell of this region lies in a part \
+that no start cell reaches: episodes start on the `S` cells (or on every free cell of a map \
+without `S`), and the robot never crosses a wall. The task's windows that need the region can \
+then never be kept.\n\n\
+Example: a region inside a closed room of the map.\n\n\
+Fix: open a doorway (`.`) in the wall, add a start cell on the region's side, or move the region.",
     },
     CodeInfo {
         code: "HSTL150",

@@ -50,6 +50,7 @@
 // generated parser then names `crate::alloc`.
 extern crate alloc;
 
+pub mod budget;
 pub mod check;
 pub mod checked;
 pub mod codes;
@@ -61,6 +62,7 @@ pub mod parser;
 pub mod position;
 pub mod render;
 pub mod syntax;
+pub mod world;
 
 pub use check::{Checked, check, check_parsed};
 
@@ -73,3 +75,4 @@ pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Position};
 pub use render::render_plain;
+pub use world::{WorldFacts, check_in_world};

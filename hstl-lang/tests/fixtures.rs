@@ -7,8 +7,57 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use hstl_lang::{
-    CFormula, CFormulaKind, CheckedSpec, Domain, Terminate, check, codes, render_plain,
+    CFormula, CFormulaKind, Checked, CheckedSpec, Domain, Terminate, WorldFacts, codes,
+    render_plain,
 };
+
+/// Checks a fixture: against the grid world its leading `// world:` comment draws (one
+/// `// ` line per row, top first, `.` free, `#` wall, `S` start), or on its own.
+fn check(src: &str) -> Checked {
+    match world_of(src) {
+        Some(world) => hstl_lang::check_in_world(src, &world),
+        None => hstl_lang::check(src),
+    }
+}
+
+fn world_of(src: &str) -> Option<WorldFacts> {
+    let mut lines = src.lines();
+    if lines.next()?.trim() != "// world:" {
+        return None;
+    }
+    let rows: Vec<&str> =
+        lines.map_while(|l| l.strip_prefix("// ")).filter(|l| !l.is_empty()).collect();
+    let (width, height) = (rows.first()?.len(), rows.len());
+    let at = |x: usize, y: usize| rows[height - 1 - y].as_bytes()[x];
+    let cell = |x: usize, y: usize| y * width + x;
+    let mut free = vec![false; width * height];
+    let mut queue = Vec::new();
+    for y in 0..height {
+        for x in 0..width {
+            free[cell(x, y)] = at(x, y) != b'#';
+            if at(x, y) == b'S' {
+                queue.push((x, y));
+            }
+        }
+    }
+    if queue.is_empty() {
+        queue = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).collect();
+        queue.retain(|&(x, y)| free[cell(x, y)]);
+    }
+    let mut reachable = vec![false; width * height];
+    while let Some((x, y)) = queue.pop() {
+        if std::mem::replace(&mut reachable[cell(x, y)], true) {
+            continue;
+        }
+        let next = [(x + 1, y), (x, y + 1), (x.wrapping_sub(1), y), (x, y.wrapping_sub(1))];
+        for (nx, ny) in next {
+            if nx < width && ny < height && free[cell(nx, ny)] {
+                queue.push((nx, ny));
+            }
+        }
+    }
+    Some(WorldFacts { label: "world `fixture`".into(), width, height, free, reachable })
+}
 
 /// `(file name, source)` of every `.hstl` file in `tests/fixtures/<dir>`, sorted.
 fn fixtures(dir: &str) -> Vec<(String, String)> {

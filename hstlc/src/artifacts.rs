@@ -8,7 +8,10 @@ use hstl::runtime::eval::{AgentController, sample_runs};
 use hstl::runtime::{Agent, Env, GridWorld, Rng, TaskSpec};
 use hstl_pictures as pic;
 
+use hstl::lang::{LetKind, visit_lets};
+
 use crate::cli_error::CliError;
+use crate::spec_file::LoadedSpec;
 
 /// A file to write: its name inside the output folder and its bytes.
 pub struct OutFile {
@@ -277,29 +280,20 @@ pub fn curve_csv(curve: &[f64]) -> String {
     out
 }
 
-/// The paper's Figure 2 for a trained agent on the grid world: one arrow field per primitive
+/// The paper's Figure 2 for a trained agent in a grid world: one arrow field per primitive
 /// option with its termination states, the options policy (one map per region visited last
-/// when the agent has memory), and two sample runs.
+/// when the agent has memory), and two sample runs, over the world's walls, start cells and
+/// `regions` (see [`pictured_regions`]).
 pub fn agent_pictures(
     spec: &TaskSpec,
     env: &GridWorld,
+    regions: &[(String, Formula)],
     agent: &Agent,
     rng: &mut Rng,
 ) -> Result<Vec<OutFile>, CliError> {
     let cells = cells(env);
     let states = state_trace(spec, env)?;
-    let grid = pic::Grid {
-        width: env.width(),
-        height: env.height(),
-        regions: spec
-            .primitives
-            .iter()
-            .map(|p| pic::Region {
-                name: p.name.clone(),
-                cells: holding(&p.reach, &states, &cells),
-            })
-            .collect(),
-    };
+    let grid = picture_grid(env, regions, &states, &cells);
     let actions = env.actions();
     let action = |a: usize| match actions.get(a).map(String::as_str) {
         Some("Up") => Some(pic::Action::Up),
@@ -384,6 +378,81 @@ fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usi
             )
         })
         .collect()
+}
+
+/// The grid under every picture: the world's walls and start cells, and the regions.
+fn picture_grid(
+    env: &GridWorld,
+    regions: &[(String, Formula)],
+    states: &Trace,
+    cells: &[(i64, i64)],
+) -> pic::Grid {
+    let (w, h) = (env.width() as i64, env.height() as i64);
+    let walls = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| !env.is_free(x as usize, y as usize))
+        .collect();
+    let starts = if env.has_start_cells() {
+        env.starts().into_iter().filter_map(|s| cells.get(s).copied()).collect()
+    } else {
+        Vec::new()
+    };
+    pic::Grid {
+        width: env.width(),
+        height: env.height(),
+        regions: regions
+            .iter()
+            .map(|(name, f)| pic::Region { name: name.clone(), cells: holding(f, states, cells) })
+            .collect(),
+        walls,
+        starts,
+    }
+}
+
+/// The regions a picture shows: each option's region (named by the option), then every
+/// state `let` the task names, directly or through temporal lets (an obstacle in
+/// `always !Obstacle`, say). Lets used only inside other state lets are not drawn.
+pub fn pictured_regions(loaded: &LoadedSpec) -> Result<Vec<(String, Formula)>, CliError> {
+    let spec = &loaded.spec;
+    let lower_err =
+        |e: hstl::lower::LowerError| CliError::new(format!("{}: {e}", loaded.file), None);
+    let mut out: Vec<(String, Formula)> = Vec::new();
+    for p in &spec.primitives {
+        let f = hstl::lower::formula(spec, &p.reach).ok_or_else(|| {
+            lower_err(hstl::lower::LowerError::Invalid { spec: spec.name.clone() })
+        })?;
+        out.push((p.name.clone(), f));
+    }
+    let mut drawn: Vec<Formula> = out.iter().map(|(_, f)| f.clone()).collect();
+    let mut stack = Vec::new();
+    let mut seen = vec![false; spec.lets.len()];
+    if let Some(task) = &spec.task {
+        visit_lets(&task.formula, &mut |i| stack.push(i));
+    }
+    // Depth first, so that lets come out in the order the task names them.
+    stack.reverse();
+    while let Some(i) = stack.pop() {
+        let Some(l) = spec.lets.get(i) else { continue };
+        if std::mem::replace(&mut seen[i], true) {
+            continue;
+        }
+        match l.kind {
+            LetKind::Temporal => {
+                let mut inner = Vec::new();
+                visit_lets(&l.formula, &mut |j| inner.push(j));
+                stack.extend(inner.into_iter().rev());
+            }
+            LetKind::State => {
+                let f = hstl::lower::let_formula(spec, &l.name).map_err(lower_err)?;
+                // An option's region drawn already under the option's name.
+                if !drawn.contains(&f) {
+                    drawn.push(f.clone());
+                    out.push((l.name.clone(), f));
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// `(x, y)` of every state index.

@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use hstl::lang::{Diagnostic, Severity};
 
 use crate::cli_error::CliError;
+use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc check`.
@@ -21,6 +22,9 @@ pub struct CheckArgs {
     /// The name to report for standard input.
     #[arg(long, value_name = "NAME", default_value = "<stdin>")]
     pub stdin_filename: String,
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
+    /// The grid world the specs with options are checked against.
+    pub world: String,
 }
 
 /// How `check` prints diagnostics.
@@ -49,6 +53,7 @@ pub struct Checked {
 /// Runs `hstlc check`.
 pub fn run(args: &CheckArgs) -> CmdResult {
     // Read every input first: an unreadable file stops the run before anything prints.
+    let world = LoadedWorld::load(&args.world)?;
     let inputs = args
         .files
         .iter()
@@ -57,7 +62,7 @@ pub fn run(args: &CheckArgs) -> CmdResult {
     let checked: Vec<Checked> = inputs
         .into_iter()
         .map(|(name, source)| {
-            let diagnostics = hstl::lang::check(&source).diagnostics;
+            let diagnostics = hstl::world::check(&source, &world.world, &world.label).diagnostics;
             Checked { name, source, diagnostics }
         })
         .collect();

@@ -5,14 +5,17 @@ use std::time::Instant;
 
 use clap::Args;
 use hstl::robustness::{Trace, offline};
-use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, rollout, window_rate};
+use hstl::runtime::eval::{
+    AgentController, EntryCycle, RegionTable, WindowConfig, rollout, window_rate,
+};
 use hstl::runtime::optimum::{SolveConfig, solve};
+use hstl::runtime::policy::EnvInfo;
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts;
 use crate::cli_error::CliError;
 use crate::study::{mean, range};
-use crate::train::env_words;
+use crate::world_arg::world_words;
 use crate::{CmdResult, Status, input};
 
 /// Arguments of `hstlc eval`.
@@ -21,11 +24,11 @@ pub struct EvalArgs {
     /// The `policy.json` that `hstlc train` wrote.
     #[arg(value_name = "POLICY.json")]
     pub policy: PathBuf,
-    /// Greedy runs, each from a random start.
-    #[arg(long, default_value_t = 100)]
+    /// Greedy runs, each from a random start (at most 100,000).
+    #[arg(long, default_value_t = 100, value_parser = count(100_000))]
     pub starts: usize,
-    /// Steps per run.
-    #[arg(long, default_value_t = 2000)]
+    /// Steps per run (at most 1,000,000; a run is kept whole for its robustness).
+    #[arg(long, default_value_t = 2000, value_parser = count(1_000_000))]
     pub steps: usize,
     /// Steps at the start of each run that the window rate does not count.
     #[arg(long, default_value_t = 100)]
@@ -38,8 +41,26 @@ pub struct EvalArgs {
     pub no_optimum: bool,
 }
 
+/// At most this many steps over all runs of one evaluation.
+const MAX_EVAL_STEPS: usize = 200_000_000;
+
+/// A count flag from 1 to `max`.
+fn count(max: u64) -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(1..=max)
+}
+
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
+    // The flags first: nothing is read or printed for a run that cannot happen.
+    if args.starts.saturating_mul(args.steps) > MAX_EVAL_STEPS {
+        return Err(CliError::new(
+            format!(
+                "{} runs of {} steps are more than the {MAX_EVAL_STEPS} steps an evaluation may take",
+                args.starts, args.steps
+            ),
+            Some("lower `--starts` or `--steps`".into()),
+        ));
+    }
     let input::Input { name, text, .. } =
         input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
     let bad = |message: String, help: &str| {
@@ -49,24 +70,40 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         .map_err(|e| bad(e.to_string(), "pass the policy.json that `hstlc train` wrote"))?;
     let spec = spec_of(&text, &policy.spec)
         .map_err(|m| bad(m, "train the policy again with `hstlc train`"))?;
-    if policy.env.name != "gridworld" {
-        return Err(bad(
-            format!("unknown environment `{}`", policy.env.name),
-            "this hstlc replays `gridworld` policies",
+    let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
+        bad(
+            format!("its world: {e}"),
+            "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)",
+        )
+    })?;
+    let mut policy = policy;
+    if policy.env.params.get("map").is_none() {
+        // Written before world files: the open grid it was, in today's terms.
+        policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };
+    }
+    policy.check_against(&spec, &env).map_err(|e| {
+        bad(
+            e.to_string(),
+            "the file was edited or damaged: train the policy again with `hstlc train`",
+        )
+    })?;
+    let agent =
+        policy.agent(&env).map_err(|e| bad(e.to_string(), "the policy does not fit its world"))?;
+    let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
+    if !spec.regions.is_empty() && args.burn_in >= args.steps {
+        return Err(CliError::new(
+            format!(
+                "a burn-in of {} steps leaves nothing of {}-step runs",
+                args.burn_in, args.steps
+            ),
+            Some("use `--burn-in` smaller than `--steps`".into()),
         ));
     }
-    let env = GridWorld::from_params(&policy.env.params)
-        .map_err(|e| bad(e.to_string(), "the `env` entry must hold the grid world's parameters"))?;
-    let agent = policy
-        .agent(&env)
-        .map_err(|e| bad(e.to_string(), "the policy does not fit its environment"))?;
-    check_flags(args, !spec.regions.is_empty())?;
-    let config = WindowConfig { starts: args.starts, steps: args.steps, burn_in: args.burn_in };
     let mut rng = seeded_rng(args.seed);
     println!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
-        env_words(&env),
+        world_words(&env, None),
         spec.options.len(),
         args.starts,
         args.steps,
@@ -90,7 +127,12 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     }
     let regions = RegionTable::new(&spec, &env).map_err(|e| CliError::new(e.to_string(), None))?;
     let report = window_rate(&env, &mut AgentController::new(&agent), &regions, config, &mut rng)
-        .map_err(|e| CliError::new(e.to_string(), None))?;
+        .map_err(|e| {
+        CliError::new(
+            e.to_string(),
+            Some("use --burn-in smaller than --steps, and --starts > 0".into()),
+        )
+    })?;
     let (lo, hi) = range(&report.per_rollout);
     println!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
@@ -103,6 +145,16 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             .join(", ")
     );
     print_robustness(&report.robustness);
+    // A hand-written yardstick over the same starts and slips: a learned policy below it has
+    // not learned the legs.
+    if let Ok(mut cycle) = EntryCycle::new(&env, &regions) {
+        let base = window_rate(&env, &mut cycle, &regions, config, &mut seeded_rng(args.seed))
+            .map_err(|e| CliError::new(e.to_string(), None))?;
+        println!(
+            "  hand-written baseline (the regions in turn, each by a shortest path around the walls): window rate {:.4}",
+            base.rate
+        );
+    }
     if !args.no_optimum {
         let start = Instant::now();
         let optimum = solve(&env, &regions, SolveConfig::default())
@@ -118,30 +170,6 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         );
     }
     Ok(Status::Clean)
-}
-
-/// Refuses flags that cannot make a report, before anything is printed: every run needs a
-/// step, and the window rate (of a persistent task) needs steps after the burn-in.
-fn check_flags(args: &EvalArgs, persistent: bool) -> Result<(), CliError> {
-    if args.starts == 0 || args.steps == 0 {
-        return Err(CliError::new(
-            format!(
-                "`--starts {}` and `--steps {}` must both be at least 1",
-                args.starts, args.steps
-            ),
-            Some("leave them out for 100 runs of 2000 steps".to_string()),
-        ));
-    }
-    if persistent && args.burn_in >= args.steps {
-        return Err(CliError::new(
-            format!(
-                "`--burn-in {}` leaves no step of `--steps {}` to count",
-                args.burn_in, args.steps
-            ),
-            Some("use a `--burn-in` smaller than `--steps`".to_string()),
-        ));
-    }
-    Ok(())
 }
 
 /// The spec that `policy.json` was trained from, checked and lowered again.

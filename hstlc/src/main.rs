@@ -17,6 +17,7 @@ mod spec_file;
 mod study;
 mod trace_csv;
 mod train;
+mod world_arg;
 
 use std::process::ExitCode;
 

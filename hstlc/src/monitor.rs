@@ -45,7 +45,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             Some("pass at least one of them as a file".to_string()),
         ));
     }
-    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
+    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), None)? else {
         return Ok(Status::Errors);
     };
     let (spec, name) = (&loaded.spec, &loaded.file);

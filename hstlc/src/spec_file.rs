@@ -9,6 +9,7 @@ use hstl::runtime::TaskSpec;
 use crate::check::{Checked, read_input};
 use crate::cli_error::CliError;
 use crate::render;
+use crate::world_arg::LoadedWorld;
 
 /// A spec that checked without errors.
 pub struct LoadedSpec {
@@ -54,7 +55,7 @@ impl LoadedSpec {
                     v.name
                 ),
                 Some(format!(
-                    "declare it like `{}: int in 0..=14`, to match the grid world",
+                    "declare it like `{}: int in 0..=14`, matching the world's size",
                     v.name
                 )),
             ));
@@ -69,12 +70,20 @@ impl LoadedSpec {
     }
 }
 
-/// Reads and checks `path` and picks the spec named `wanted` (or the only one). A file with
+/// Reads and checks `path` (against `world`, for the commands that train) and picks the
+/// spec named `wanted` (or the only one). A file with
 /// errors has its diagnostics printed to standard error, as `check` renders them, and gives
 /// `Ok(None)`: the caller exits with status 1.
-pub fn load(path: &Path, wanted: Option<&str>) -> Result<Option<LoadedSpec>, CliError> {
+pub fn load(
+    path: &Path,
+    wanted: Option<&str>,
+    world: Option<&LoadedWorld>,
+) -> Result<Option<LoadedSpec>, CliError> {
     let (file, source) = read_input(path, "<stdin>")?;
-    let mut checked = hstl::lang::check(&source);
+    let mut checked = match world {
+        Some(w) => hstl::world::check(&source, &w.world, &w.label),
+        None => hstl::lang::check(&source),
+    };
     if checked.has_errors() {
         let report = Checked { name: file, source, diagnostics: checked.diagnostics };
         eprint!("{}", render::full(std::slice::from_ref(&report), std::io::stderr().is_terminal()));

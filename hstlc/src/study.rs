@@ -12,7 +12,8 @@ use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpe
 
 use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
-use crate::train::{self, PICTURE_SEED, env_words, tail_mean};
+use crate::train::{self, PICTURE_SEED, tail_mean};
+use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
 /// Arguments of `hstlc study`.
@@ -22,11 +23,11 @@ pub struct StudyArgs {
     /// comparison.
     #[arg(required = true, value_name = "SPEC")]
     pub specs: Vec<PathBuf>,
-    /// Seeds per spec: 0, 1, ... N-1.
-    #[arg(long, default_value_t = 20)]
+    /// Seeds per spec: 0, 1, ... N-1 (at most 100,000).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub seeds: u64,
-    /// Training episodes (overrides each spec's `learn { episodes }`).
-    #[arg(long, value_name = "N")]
+    /// Training episodes (overrides each spec's `learn { episodes }`; at most 10,000,000).
+    #[arg(long, value_name = "N", value_parser = train::episodes_flag())]
     pub episodes: Option<usize>,
     /// Also train each spec with the other `intra` crediting rule, and report both.
     #[arg(long)]
@@ -34,8 +35,11 @@ pub struct StudyArgs {
     /// Skip the optimum W* (value iteration takes a few seconds per region set).
     #[arg(long)]
     pub no_optimum: bool,
-    /// Worker threads (default: every core).
-    #[arg(long)]
+    /// The grid world to train in.
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
+    pub world: String,
+    /// Worker threads (default: every core; at most 256).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=256))]
     pub threads: Option<usize>,
     /// The folder for each spec's policy (first seed), curves, pictures and per-seed
     /// figures (`seeds.csv`).
@@ -57,16 +61,16 @@ struct RunResult {
 
 /// Runs `hstlc study`.
 pub fn run(args: &StudyArgs) -> CmdResult {
-    if args.seeds == 0 {
-        return Err(CliError::new("`--seeds` must be at least 1", None));
-    }
-    // Check every spec before the long part starts.
+    // Check every spec against the world before the long part starts.
+    let world = LoadedWorld::load(&args.world)?;
     let mut loaded = Vec::new();
     for path in &args.specs {
-        let Some(l) = spec_file::load(path, None)? else { return Ok(Status::Errors) };
+        let Some(l) = spec_file::load(path, None, Some(&world))? else {
+            return Ok(Status::Errors);
+        };
         let mut spec = l.trainable()?;
         if let Some(e) = args.episodes {
-            spec.learn.episodes = e.max(1);
+            spec.learn.episodes = e;
         }
         loaded.push((path.clone(), l, spec));
     }
@@ -76,7 +80,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         .iter()
         .map(|d| OutDir::lock(d))
         .collect::<Result<Vec<_>, _>>()?;
-    let env = GridWorld::default();
+    let env = &world.world;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
@@ -85,16 +89,16 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         "study: {} specs x {} seeds on {}, {threads} threads",
         loaded.len(),
         args.seeds,
-        env_words(&env)
+        world.words()
     );
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, RewardKind)> = None;
     for ((path, l, spec), out) in loaded.iter().zip(outs) {
-        let results = run_seeds(spec, &env, args.seeds, threads, &l.file)?;
+        let results = run_seeds(spec, env, args.seeds, threads, &l.file)?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
             None
         } else {
-            Some(optimum(&mut optima, spec, &env)?)
+            Some(optimum(&mut optima, spec, env)?)
         };
         let label = path.file_name().map_or(l.file.clone(), |n| n.to_string_lossy().into_owned());
         println!();
@@ -132,12 +136,12 @@ pub fn run(args: &StudyArgs) -> CmdResult {
                 Intra::Paper => Intra::Remaining,
                 Intra::Remaining => Intra::Paper,
             };
-            let alt = run_seeds(&other, &env, args.seeds, threads, &l.file)?;
+            let alt = run_seeds(&other, env, args.seeds, threads, &l.file)?;
             println!("  with intra: {} instead:", intra_word(other.learn.intra));
             print_table(&alt, w_star);
         }
         let dir = out.path().to_path_buf();
-        write_outputs(out, spec, &env, l, &results)?;
+        write_outputs(out, spec, env, l, &results)?;
         println!("  wrote {}", dir.display());
     }
     Ok(Status::Clean)
@@ -152,18 +156,26 @@ fn run_seeds(
     file: &str,
 ) -> Result<Vec<RunResult>, CliError> {
     let threads = threads.min(seeds as usize).max(1) as u64;
+    let share = |w: u64| {
+        (0..seeds)
+            .filter(|s| s % threads == w)
+            .map(|seed| (seed, one_run(spec, env, seed, file)))
+            .collect::<Vec<_>>()
+    };
     let mut all: Vec<(u64, Result<RunResult, CliError>)> = std::thread::scope(|scope| {
+        let share = &share;
         let workers: Vec<_> = (0..threads)
-            .map(|w| {
-                scope.spawn(move || {
-                    (0..seeds)
-                        .filter(|s| s % threads == w)
-                        .map(|seed| (seed, one_run(spec, env, seed, file)))
-                        .collect::<Vec<_>>()
-                })
-            })
+            .map(|w| (w, std::thread::Builder::new().spawn_scoped(scope, move || share(w))))
             .collect();
-        workers.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+        let mut all = Vec::new();
+        for (w, worker) in workers {
+            match worker {
+                Ok(handle) => all.extend(handle.join().unwrap_or_default()),
+                // A thread the system would not start: its seeds run here.
+                Err(_) => all.extend(share(w)),
+            }
+        }
+        all
     });
     if all.len() as u64 != seeds {
         return Err(CliError::new("a training thread failed", None));
@@ -255,7 +267,8 @@ fn write_outputs(
         OutFile::text("curve.csv", artifacts::curve_csv(curve)),
     ];
     let mut rng = seeded_rng(PICTURE_SEED);
-    files.extend(artifacts::agent_pictures(spec, env, agent, &mut rng)?);
+    let regions = artifacts::pictured_regions(loaded)?;
+    files.extend(artifacts::agent_pictures(spec, env, &regions, agent, &mut rng)?);
     let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
     for (seed, r) in results.iter().enumerate() {
         let window = r.window.map_or(String::new(), |w| w.to_string());

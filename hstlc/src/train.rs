@@ -4,12 +4,13 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
-use hstl::runtime::eval::{AgentController, RegionTable, WindowConfig, window_rate};
-use hstl::runtime::{GridWorld, Learner, Policy, TaskSpec, seeded_rng};
+use clap::Args;
+use hstl::runtime::eval::WindowConfig;
+use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
+use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
 /// Arguments of `hstlc train`.
@@ -18,14 +19,14 @@ pub struct TrainArgs {
     /// The spec file (`-` reads standard input).
     #[arg(value_name = "SPEC")]
     pub spec: PathBuf,
-    /// The environment.
-    #[arg(long, value_enum, default_value_t = EnvName::Gridworld)]
-    pub env: EnvName,
+    /// The grid world to train in.
+    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
+    pub world: String,
     /// The seed of the one random generator every draw comes from.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Training episodes (overrides the spec's `learn { episodes }`).
-    #[arg(long, value_name = "N")]
+    /// Training episodes (overrides the spec's `learn { episodes }`; at most 10,000,000).
+    #[arg(long, value_name = "N", value_parser = episodes_flag())]
     pub episodes: Option<usize>,
     /// The folder to write `policy.json`, `curve.csv` and the pictures into (replaced as a
     /// whole: it must be new, empty, or an earlier run's).
@@ -34,13 +35,6 @@ pub struct TrainArgs {
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
     pub spec_name: Option<String>,
-}
-
-/// The environments `train` knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EnvName {
-    /// The paper's grid world: 15 x 15, each action taken with probability 0.7.
-    Gridworld,
 }
 
 /// One trained policy and what was measured while training it.
@@ -59,23 +53,19 @@ pub struct Outcome {
 
 /// Runs `hstlc train`.
 pub fn run(args: &TrainArgs) -> CmdResult {
-    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
+    let world = LoadedWorld::load(&args.world)?;
+    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), Some(&world))? else {
         return Ok(Status::Errors);
     };
     let mut spec = loaded.trainable()?;
     if let Some(e) = args.episodes {
-        if e == 0 {
-            return Err(CliError::new("`--episodes` must be at least 1", None));
-        }
         spec.learn.episodes = e;
     }
-    let env = match args.env {
-        EnvName::Gridworld => GridWorld::default(),
-    };
+    let env = &world.world;
     // Before the long part: a folder another run holds is refused at once.
     let out = OutDir::lock(&args.out)?;
     let bar = progress_bar(spec.learn.episodes as u64);
-    let outcome = train(&spec, &env, args.seed, &loaded.file, |episode, reward| {
+    let outcome = train(&spec, env, args.seed, &loaded.file, |episode, reward| {
         bar.set_position(episode as u64 + 1);
         bar.set_message(format!("reward {reward:.1}"));
     })?;
@@ -86,19 +76,20 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         OutFile::text("curve.csv", artifacts::curve_csv(&outcome.curve)),
     ];
     let mut rng = seeded_rng(args.seed ^ PICTURE_SEED);
-    files.extend(artifacts::agent_pictures(&spec, &env, &outcome.agent, &mut rng)?);
+    let regions = artifacts::pictured_regions(&loaded)?;
+    files.extend(artifacts::agent_pictures(&spec, env, &regions, &outcome.agent, &mut rng)?);
     files.push(artifacts::curve_picture(
         &format!("Learning curve of {} (seed {})", spec.name, args.seed),
         std::slice::from_ref(&outcome.curve),
     )?);
-    let window = window_report(&spec, &env, &outcome.agent, args.seed)?;
+    let window = window_report(&spec, env, &outcome.agent, args.seed)?;
     let written = out.write(&files)?;
 
     let tail = tail_mean(&outcome.curve, 100);
     println!(
         "trained `{}` on {} (seed {}): {} episodes, {} steps in {:.2} s ({:.1}M steps/s)",
         spec.name,
-        env_words(&env),
+        world.words(),
         args.seed,
         outcome.curve.len(),
         outcome.steps,
@@ -120,12 +111,14 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     Ok(Status::Clean)
 }
 
-/// The seed offset of the generator that draws the sample runs of the pictures.
-pub const PICTURE_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
-/// The seed offset of the generator that draws the evaluation's starts.
-pub const EVAL_SEED: u64 = 0x5eed;
+/// `--episodes`: 1 to the limit a spec's `learn { episodes }` has.
+pub fn episodes_flag() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::new().range(1..=hstl::lang::budget::MAX_EPISODES)
+}
 
-/// Trains `spec` on `env` from `seed`; `progress` sees each episode and its reward.
+pub use hstl::train::PICTURE_SEED;
+
+/// Trains `spec` in `env` from `seed`, timed; `progress` sees each episode and its reward.
 pub fn train(
     spec: &TaskSpec,
     env: &GridWorld,
@@ -133,29 +126,21 @@ pub fn train(
     file: &str,
     progress: impl FnMut(usize, f64),
 ) -> Result<Outcome, CliError> {
-    let mut learner = Learner::new(spec, env).map_err(|e| {
+    let start = Instant::now();
+    let trained = hstl::train::train(spec, env, seed, progress).map_err(|e| {
         CliError::new(
             format!("{file}: cannot train `{}`: {e}", spec.name),
-            Some(
-                "options need `int` state variables with ranges that fit the environment, and \
-                 at least one option"
-                    .to_string(),
-            ),
+            Some("run `hstlc check` with the same `--world` to see where the spec and the world differ".to_string()),
         )
     })?;
-    let mut rng = seeded_rng(seed);
-    let start = Instant::now();
-    let trained = learner.train(&mut rng, progress);
     let secs = start.elapsed().as_secs_f64();
-    let policy = Policy::new(&learner);
-    Ok(Outcome { policy, curve: trained.curve, steps: trained.steps, secs, agent: learner.agent() })
+    let hstl::train::Trained { policy, curve, steps, agent } = trained;
+    Ok(Outcome { policy, curve, steps, secs, agent })
 }
 
-/// `policy.json`: the runtime's document, plus the spec's source and the seed, so that
-/// `eval` needs nothing else.
+/// `policy.json`, as every front end writes it.
 pub fn policy_json(policy: &Policy, source: &str, seed: u64) -> Result<String, CliError> {
-    let extra = [("spec_source", source.into()), ("seed", seed.into())];
-    policy.to_json_with(&extra).map_err(|e| CliError::new(e.to_string(), None))
+    hstl::train::policy_json(policy, source, seed).map_err(|e| CliError::new(e.to_string(), None))
 }
 
 /// The window rate and mean task robustness of the greedy agent, for persistent tasks.
@@ -165,32 +150,15 @@ pub fn window_report(
     agent: &hstl::runtime::Agent,
     seed: u64,
 ) -> Result<Option<(f64, f64)>, CliError> {
-    if spec.regions.is_empty() {
-        return Ok(None);
-    }
-    let regions = RegionTable::new(spec, env).map_err(|e| CliError::new(e.to_string(), None))?;
-    let mut rng = seeded_rng(seed ^ EVAL_SEED);
-    let report = window_rate(
-        env,
-        &mut AgentController::new(agent),
-        &regions,
-        WindowConfig::default(),
-        &mut rng,
-    )
-    .map_err(|e| CliError::new(e.to_string(), None))?;
-    let robustness = report.robustness.iter().sum::<f64>() / report.robustness.len() as f64;
-    Ok(Some((report.rate, robustness)))
+    let summary = hstl::train::window_summary(spec, env, agent, seed)
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    Ok(summary.map(|s| (s.rate, s.robustness)))
 }
 
 /// The mean of the last `n` values.
 pub fn tail_mean(curve: &[f64], n: usize) -> f64 {
     let tail = &curve[curve.len().saturating_sub(n)..];
     tail.iter().sum::<f64>() / tail.len().max(1) as f64
-}
-
-/// `gridworld 15 x 15, p = 0.7`.
-pub fn env_words(env: &GridWorld) -> String {
-    format!("gridworld {} x {}, p = {}", env.width(), env.height(), env.p())
 }
 
 fn names(files: &[OutFile]) -> String {

@@ -76,12 +76,29 @@ const CASES: &[Case] = &[
     // train and eval: the errors (successful runs are in tests/train_eval.rs)
     case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
     case("train_float_state", &["train", "float_state.hstl", "--out", "unused"]),
-    case("train_unknown_env", &["train", "small.hstl", "--env", "mars", "--out", "unused"]),
+    case("train_unknown_world", &["train", "small.hstl", "--world", "mars", "--out", "unused"]),
+    case(
+        "train_missing_world_file",
+        &["train", "small.hstl", "--world", "mars.toml", "--out", "unused"],
+    ),
+    // worlds: the spec against the map (world file errors are in `world_file_errors`)
+    case("check_world_mismatch", &["check", "--world", "four-rooms", "surveillance.hstl"]),
+    case("check_world_file", &["check", "--world", "worlds/nook.toml", "nook.hstl"]),
+    case("check_world_mismatch_default_paper", &["check", "nook.hstl"]),
     case("train_zero_episodes", &["train", "small.hstl", "--episodes", "0", "--out", "unused"]),
     case("train_spec_errors", &["train", "errors.hstl", "--out", "unused"]),
     case("eval_not_a_policy", &["eval", "not_a_policy.json"]),
     case("eval_missing_file", &["eval", "nowhere.json"]),
     case("study_no_seeds", &["study", "small.hstl", "--seeds", "0"]),
+    // sizes a user controls are checked before anything is allocated (issue 11, class 5)
+    case("train_huge_episodes", &["train", "small.hstl", "--episodes", "4611686018427387904"]),
+    case("train_episodes_not_a_count", &["train", "small.hstl", "--episodes", "1e12"]),
+    case("eval_huge_steps", &["eval", "nowhere.json", "--steps", "18446744073709551615"]),
+    case(
+        "eval_too_many_steps_in_all",
+        &["eval", "nowhere.json", "--starts", "100000", "--steps", "1000000"],
+    ),
+    case("study_too_many_threads", &["study", "small.hstl", "--threads", "5000"]),
 ];
 
 #[test]
@@ -114,6 +131,39 @@ fn cli_cases() {
                     case.args.join(" ")
                 )
             );
+        }
+    });
+}
+
+/// Every malformed world file in `tests/cli/worlds/invalid` is an error at its file, line
+/// and column, with a help, exit status 2 and nothing on standard output.
+#[test]
+fn world_file_errors() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli");
+    let mut files: Vec<_> = std::fs::read_dir(format!("{dir}/worlds/invalid"))
+        .expect("the fixtures")
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert!(files.len() >= 8, "{files:?}");
+    let mut settings = insta::Settings::clone_current();
+    settings.set_snapshot_path("snapshots/cli");
+    settings.set_prepend_module_to_snapshot(false);
+    settings.bind(|| {
+        for file in files {
+            let world = format!("worlds/invalid/{file}");
+            let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+                .args(["check", "small.hstl", "--world", &world])
+                .current_dir(dir)
+                .output()
+                .expect("hstlc runs");
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(out.status.code(), Some(2), "{file}: {stderr}");
+            assert!(out.stdout.is_empty(), "{file}");
+            assert!(stderr.starts_with(&format!("error: {world}:")), "{file}: {stderr}");
+            assert!(stderr.contains("\n  help: "), "{file}: {stderr}");
+            insta::assert_snapshot!(format!("world_{}", file.trim_end_matches(".toml")), stderr);
         }
     });
 }

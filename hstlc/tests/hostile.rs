@@ -211,24 +211,25 @@ fn sarif_locations_are_uris() {
     assert!(!uri.contains(' '), "{uri}");
 }
 
-/// Class 11: `eval` refuses flags that cannot make a report before printing anything.
+/// Class 11: `eval` refuses flags that cannot make a report before printing anything, in
+/// words (no Rust value such as `WindowConfig { .. }`).
 #[test]
 fn eval_checks_its_flags_first() {
     let dir = tempfile::tempdir().expect("temp dir");
     write(dir.path(), "small.hstl", SMALL);
     let run = hstlc_in(dir.path(), &["train", "small.hstl", "--out", "run"], b"");
     assert_eq!(run.status, Some(0), "{}", run.stderr);
-    for (flags, message) in [
-        (&["--burn-in", "5000"][..], "`--burn-in 5000` leaves no step of `--steps 2000` to count"),
-        (&["--starts", "0"], "`--starts 0` and `--steps 2000` must both be at least 1"),
-        (&["--steps", "0"], "`--starts 100` and `--steps 0` must both be at least 1"),
+    for (flags, words) in [
+        (&["--burn-in", "5000"][..], "burn-in"),
+        (&["--starts", "0"], "--starts"),
+        (&["--steps", "0"], "--steps"),
     ] {
         let mut args = vec!["eval", "run/policy.json", "--no-optimum"];
         args.extend(flags);
         let run = hstlc_in(dir.path(), &args, b"");
         assert_eq!((run.status, run.stdout.as_str()), (Some(2), ""), "{flags:?}");
-        assert!(run.stderr.contains(message), "{flags:?}: {}", run.stderr);
-        assert!(!run.stderr.contains("WindowConfig"), "{}", run.stderr);
+        assert!(run.stderr.contains(words), "{flags:?}: {}", run.stderr);
+        assert!(!run.stderr.contains("Config"), "{}", run.stderr);
     }
 }
 

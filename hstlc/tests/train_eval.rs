@@ -153,3 +153,123 @@ fn study_writes_seed_zero_as_train_does() {
     let seeds = read(&study.join("small/seeds.csv"));
     assert_eq!(seeds.lines().count(), 3, "{seeds}");
 }
+
+/// A world file with walls and start cells: `train --world` obeys it, `policy.json` holds
+/// it whole, `eval` replays it from `policy.json` alone, and the pictures draw the walls.
+#[test]
+fn a_world_file_trains_and_eval_replays_it_from_the_policy() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("nook");
+    let o = hstlc(&[
+        "train",
+        "nook.hstl",
+        "--world",
+        "worlds/nook.toml",
+        "--out",
+        out.to_str().expect("utf-8 path"),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("world `nook` (worlds/nook.toml; 5 x 4, 15 walls, slip 0.1)"),
+        "{stdout}"
+    );
+    let policy: serde_json::Value =
+        serde_json::from_str(&read(&out.join("policy.json"))).expect("policy.json is JSON");
+    assert_eq!(policy["env"]["name"], "nook");
+    assert_eq!(policy["env"]["params"]["slip"], 0.1);
+    assert_eq!(
+        policy["env"]["params"]["map"],
+        serde_json::json!(["#####", "#S#.#", "#...#", "#####"])
+    );
+    // Only the five free cells are states; the walls are not.
+    assert_eq!(policy["flat_policies"]["Corner"].as_array().map(Vec::len), Some(5));
+    let svg = read(&out.join("flat_Corner.svg"));
+    assert!(
+        svg.contains("wall") && svg.contains("start cell"),
+        "the legend names walls and starts"
+    );
+    // The world travels in policy.json: eval needs no world file, from any folder.
+    let e = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["eval", out.join("policy.json").to_str().expect("utf-8"), "--starts", "3"])
+        .args(["--steps", "200", "--no-optimum"])
+        .current_dir(dir.path())
+        .output()
+        .expect("hstlc runs");
+    assert_eq!(e.status.code(), Some(0), "{}", String::from_utf8_lossy(&e.stderr));
+    let report = String::from_utf8_lossy(&e.stdout);
+    assert!(report.contains("world `nook` (5 x 4, 15 walls, slip 0.1)"), "{report}");
+}
+
+/// A `policy.json` written before world files (`env` `gridworld` with `width`, `height`
+/// and `p`) still replays, as the open grid it was, with the same figures.
+#[test]
+fn a_policy_from_before_worlds_still_replays() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    let o = train(&out, "1");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let path = out.join("policy.json");
+    let mut doc: serde_json::Value = serde_json::from_str(&read(&path)).expect("JSON");
+    doc["env"] = serde_json::json!({ "name": "gridworld", "params": { "width": 15, "height": 15, "p": 0.7 } });
+    let old = dir.path().join("old.json");
+    std::fs::write(&old, doc.to_string()).expect("write");
+    let eval = |p: &Path| {
+        let e = hstlc(&[
+            "eval",
+            p.to_str().expect("utf-8"),
+            "--starts",
+            "5",
+            "--steps",
+            "300",
+            "--no-optimum",
+        ]);
+        assert_eq!(e.status.code(), Some(0), "{}", String::from_utf8_lossy(&e.stderr));
+        String::from_utf8_lossy(&e.stdout).into_owned()
+    };
+    let (new, old) = (eval(&path), eval(&old));
+    assert!(old.contains("world `gridworld` (15 x 15, slip 0.3)"), "{old}");
+    // Everything after the first line (the world's name) is the same.
+    let tail = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
+    assert_eq!(tail(&new), tail(&old));
+}
+
+/// `eval` validates a policy whole before using it: a document edited by hand, damaged or
+/// paired with another spec of the same name is an error (exit 2) that says what is wrong.
+#[test]
+fn eval_refuses_tampered_policies() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    let o = train(&out, "2");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let good: serde_json::Value =
+        serde_json::from_str(&read(&out.join("policy.json"))).expect("JSON");
+    type Edit = fn(&mut serde_json::Value);
+    let cases: [(&str, Edit); 5] = [
+        ("holds NaN", |d| d["q_tables"]["options"][3] = "7ff8000000000001".into()),
+        ("not 16 hex digits", |d| d["q_tables"]["flat"]["A"][5] = "garbage".into()),
+        ("shape", |d| {
+            d["q_tables"]["options"].as_array_mut().expect("a list").pop();
+        }),
+        ("`flat_policies` is not what its `q_tables` give", |d| {
+            let choice = &mut d["flat_policies"]["A"][40]["choice"];
+            *choice = if choice == "Up" { "Down".into() } else { "Up".into() };
+        }),
+        // Same name, other regions: the termination sets no longer match.
+        ("`primitives` is not what its `q_tables` give", |d| {
+            let src = d["spec_source"].as_str().expect("source").replace("x < 3", "x < 4");
+            d["spec_source"] = src.into();
+        }),
+    ];
+    for (want, edit) in cases {
+        let mut doc = good.clone();
+        edit(&mut doc);
+        let path = dir.path().join("edited.json");
+        std::fs::write(&path, doc.to_string()).expect("write");
+        let e = hstlc(&["eval", path.to_str().expect("utf-8"), "--no-optimum"]);
+        let stderr = String::from_utf8_lossy(&e.stderr);
+        assert_eq!(e.status.code(), Some(2), "{want}: {stderr}");
+        assert!(e.stdout.is_empty(), "{want}: printed before failing");
+        assert!(stderr.contains(want), "{want}: {stderr}");
+    }
+}

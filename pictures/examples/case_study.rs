@@ -74,6 +74,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rect("B", 2..=4, 2..=4),
             rect("C", 10..=12, 2..=6),
         ],
+        walls: vec![],
+        starts: vec![],
     };
     let mut rng = Lcg(7);
     let cells: Vec<(i64, i64)> = (0..15).flat_map(|x| (0..15).map(move |y| (x, y))).collect();

@@ -5,7 +5,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::PictureError;
-use crate::palette::{INK, REGION, TERMINATE};
+use crate::palette::{INK, REGION, START_CELL, TERMINATE, WALL};
 
 /// The drawing area every picture draws on.
 pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
@@ -42,6 +42,10 @@ pub(crate) enum Mark {
     Start,
     /// The end marker of a sample run.
     End,
+    /// A wall cell.
+    Wall,
+    /// A start cell's corner triangle.
+    StartCell,
     /// No mark: a note.
     Blank,
 }
@@ -180,9 +184,23 @@ fn draw_mark(area: &Area<'_>, mark: Mark, centre: (i32, i32), size: i32) -> crat
             draw_cased_line(area, ends, colour, 4)
         }
         Mark::Start => draw_start(area, (cx, cy), half),
+        Mark::Wall => area.draw(&Rectangle::new(square, WALL.filled())).map_err(draw_err),
+        Mark::StartCell => {
+            area.draw(&Rectangle::new(square, INK.stroke_width(1))).map_err(draw_err)?;
+            draw_start_cell(area, square[0], size)
+        }
         Mark::End => draw_end(area, (cx, cy), half),
         Mark::Blank => Ok(()),
     }
+}
+
+/// Marks a start cell whose top-left pixel is `corner` and side `cell`: a filled
+/// triangle in its top-left corner.
+pub(crate) fn draw_start_cell(area: &Area<'_>, corner: (i32, i32), cell: i32) -> crate::Result<()> {
+    let (l, t) = corner;
+    let leg = (cell * 2 / 5).max(3);
+    let tri = vec![(l + 1, t + 1), (l + 1 + leg, t + 1), (l + 1, t + 1 + leg)];
+    area.draw(&Polygon::new(tri, START_CELL.filled())).map_err(draw_err)
 }
 
 /// Opacity of region shading.

@@ -7,10 +7,10 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, REGION_ALPHA, clean_text, draw_arrow, draw_cased_line,
-    draw_end, draw_err, draw_legend, draw_start, draw_terminate, draw_text, draw_title,
-    legend_size, shorten, text_style, text_width, title_text,
+    draw_end, draw_err, draw_legend, draw_start, draw_start_cell, draw_terminate, draw_text,
+    draw_title, legend_size, shorten, text_style, text_width, title_text,
 };
-use crate::palette::{GRID_LINE, INK, REGION, option_color};
+use crate::palette::{GRID_LINE, INK, REGION, WALL, option_color};
 use crate::{Action, Cell, Grid, MAX_GRID_SIDE, PictureError, Result};
 
 /// Pixel geometry of the grid on the canvas.
@@ -344,6 +344,12 @@ fn check_grid(grid: &Grid) -> Result<()> {
             check_cell(grid, cell, &format!("region `{}`", clean_text(&region.name)))?;
         }
     }
+    for &cell in &grid.walls {
+        check_cell(grid, cell, "wall")?;
+    }
+    for &cell in &grid.starts {
+        check_cell(grid, cell, "start")?;
+    }
     Ok(())
 }
 
@@ -373,13 +379,19 @@ fn option_order<'a>(preferred: &'a [String], used: impl Iterator<Item = &'a str>
     order
 }
 
-/// The legend row for the regions, if the grid has any.
+/// The legend rows for the regions, walls and start cells the grid has.
 fn region_legend(grid: &Grid) -> Vec<LegendEntry> {
+    let mut rows = Vec::new();
     if grid.regions.iter().any(|r| !r.cells.is_empty()) {
-        vec![LegendEntry::new(Mark::Region, "region")]
-    } else {
-        Vec::new()
+        rows.push(LegendEntry::new(Mark::Region, "region"));
     }
+    if !grid.walls.is_empty() {
+        rows.push(LegendEntry::new(Mark::Wall, "wall"));
+    }
+    if !grid.starts.is_empty() {
+        rows.push(LegendEntry::new(Mark::StartCell, "start cell"));
+    }
+    rows
 }
 
 /// Lays out and draws a grid picture: title, shaded regions, the layers, cell boundaries,
@@ -416,7 +428,13 @@ fn render(
             }
         }
         (layers.under)(&area, &canvas)?;
+        for &(x, y) in &grid.walls {
+            area.draw(&Rectangle::new(canvas.rect(x, y), WALL.filled())).map_err(draw_err)?;
+        }
         draw_cell_lines(&area, &canvas)?;
+        for &(x, y) in &grid.starts {
+            draw_start_cell(&area, canvas.corner(x, y), canvas.cell)?;
+        }
         for region in &grid.regions {
             draw_region(&area, &canvas, &region.name, &region.cells)?;
         }
@@ -498,7 +516,8 @@ fn draw_region(area: &Area<'_>, canvas: &Canvas, name: &str, cells: &[(i64, i64)
             .unwrap_or(&first);
         (canvas.centre(x, y), canvas.cell as f64, canvas.cell as f64)
     };
-    let pixels = (box_h * 0.8).min(box_w * 0.9 / (chars * 0.62)).clamp(12.0, 120.0);
+    // As large as fits the region's box (a one-cell region gets a small label), at most 120.
+    let pixels = (box_h * 0.8).min(box_w * 0.9 / (chars * 0.62)).clamp(4.0, 120.0);
     let faint = REGION.mix(0.45);
     let style = TextStyle::from((crate::draw::FONT, pixels * 1.24, FontStyle::Bold).into_font())
         .color(&faint)

@@ -16,6 +16,8 @@
 //!     width: 3,
 //!     height: 2,
 //!     regions: vec![Region { name: "A".into(), cells: vec![(2, 1)] }],
+//!     walls: vec![(1, 0)],
+//!     starts: vec![],
 //! };
 //! let arrows = [Cell { x: 0, y: 1, action: Action::Right }, Cell { x: 1, y: 1, action: Action::Right }];
 //! let svg = flat_policy(&grid, "Go to A", &arrows, &[(2, 1)])?;
@@ -50,6 +52,11 @@ pub struct Grid {
     pub height: usize,
     /// Regions drawn as shaded, outlined and labelled cells.
     pub regions: Vec<Region>,
+    /// Wall cells as `(x, y)`, drawn filled dark; the robot is never on one.
+    pub walls: Vec<(i64, i64)>,
+    /// Start cells as `(x, y)`, marked with a small corner triangle; leave it empty when
+    /// every free cell is a start.
+    pub starts: Vec<(i64, i64)>,
 }
 
 /// A named set of cells, drawn shaded with its name written over it.

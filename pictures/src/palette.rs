@@ -33,6 +33,10 @@ pub(crate) const INK: RGBColor = RGBColor(0x22, 0x22, 0x22);
 pub(crate) const GRID_LINE: RGBColor = RGBColor(0xcc, 0xcc, 0xcc);
 /// Region shading (drawn with transparency) and outline.
 pub(crate) const REGION: RGBColor = RGBColor(0x55, 0x55, 0x55);
+/// Walls.
+pub(crate) const WALL: RGBColor = RGBColor(0x4a, 0x4a, 0x4a);
+/// Start-cell markers.
+pub(crate) const START_CELL: RGBColor = RGBColor(0x2c, 0x7f, 0xb8);
 /// Termination markers.
 pub(crate) const TERMINATE: RGBColor = RGBColor(0xd6, 0x27, 0x28);
 /// The learning curve's line and band.

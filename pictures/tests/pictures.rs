@@ -22,6 +22,8 @@ fn small_grid() -> Grid {
         width: 4,
         height: 3,
         regions: vec![region("A", &[(0, 2), (1, 2)]), region("Base", &[(3, 0)])],
+        walls: vec![],
+        starts: vec![],
     }
 }
 
@@ -203,7 +205,7 @@ fn is_neutral(fill: &str) -> bool {
 
 #[test]
 fn options_policy_tells_sixteen_options_apart() {
-    let grid = Grid { width: 4, height: 4, regions: Vec::new() };
+    let grid = Grid { width: 4, height: 4, regions: Vec::new(), walls: vec![], starts: vec![] };
     let order: Vec<String> = (0..16).map(|i| format!("option {i}")).collect();
     let choices: Vec<((i64, i64), String)> =
         (0..16).map(|i| ((i % 4, i / 4), order[i as usize].clone())).collect();
@@ -337,7 +339,13 @@ fn long_curves_are_thinned() {
 
 #[test]
 fn odd_text_is_escaped_and_control_characters_replaced() {
-    let grid = Grid { width: 2, height: 2, regions: vec![region("<&\"'\u{1}>", &[(0, 0)])] };
+    let grid = Grid {
+        width: 2,
+        height: 2,
+        regions: vec![region("<&\"'\u{1}>", &[(0, 0)])],
+        walls: vec![],
+        starts: vec![],
+    };
     let svg = flat_policy(&grid, "a\u{0}b <tag> & \"quote\"", &[], &[]).expect("draws");
     let doc = parse(&svg);
     assert!(has_text(&doc, "a\u{fffd}b <tag> & \"quote\""), "{:?}", texts(&doc));
@@ -350,6 +358,8 @@ fn irregular_and_empty_regions_are_drawn() {
         width: 5,
         height: 5,
         regions: vec![region("L", &[(0, 0), (0, 1), (0, 2), (1, 0), (2, 0)]), region("none", &[])],
+        walls: vec![],
+        starts: vec![],
     };
     let svg = flat_policy(&grid, "Shapes", &[], &[]).expect("draws");
     let doc = parse(&svg);
@@ -360,9 +370,16 @@ fn irregular_and_empty_regions_are_drawn() {
 #[test]
 fn bad_input_is_an_error_with_a_clear_message() {
     let grid = small_grid();
-    let empty = Grid { width: 0, height: 3, regions: Vec::new() };
-    let huge = Grid { width: 10_000, height: 2, regions: Vec::new() };
-    let stray = Grid { width: 2, height: 2, regions: vec![region("R", &[(2, 0)])] };
+    let empty = Grid { width: 0, height: 3, regions: Vec::new(), walls: vec![], starts: vec![] };
+    let huge =
+        Grid { width: 10_000, height: 2, regions: Vec::new(), walls: vec![], starts: vec![] };
+    let stray = Grid {
+        width: 2,
+        height: 2,
+        regions: vec![region("R", &[(2, 0)])],
+        walls: vec![],
+        starts: vec![],
+    };
     let up = |x, y| Cell { x, y, action: Action::Up };
     let cases: Vec<(&str, hstl_pictures::Result<String>, &str)> = vec![
         ("empty grid", flat_policy(&empty, "t", &[], &[]), "the grid is empty (0 x 3 cells)"),
@@ -461,7 +478,13 @@ fn extreme_rewards_still_draw() {
 #[test]
 fn huge_titles_and_names_are_cut() {
     let long = "x".repeat(100_000);
-    let grid = Grid { width: 2, height: 1, regions: vec![region(&long, &[(0, 0)])] };
+    let grid = Grid {
+        width: 2,
+        height: 1,
+        regions: vec![region(&long, &[(0, 0)])],
+        walls: vec![],
+        starts: vec![],
+    };
     let choices = vec![((1, 0), long.clone())];
     let pictures = [
         options_policy(&grid, &long, &choices, &[]).expect("draws"),

@@ -101,15 +101,22 @@ pub struct LegCycle<'a> {
 }
 
 /// The hand-written "nearest-cell entry cycle" on a [`crate::GridWorld`]: visit the regions in
-/// turn; in each phase head for the nearest cell (Manhattan) of the current region, moving
-/// along x first, and switch to the next region on entering it.
+/// turn; in each phase head for the nearest cell of the current region (by shortest path
+/// around the walls; the first such cell, row by row from the bottom, on a tie), along a
+/// shortest path that moves along x first where it can, and switch to the next region on
+/// entering it. On a map without walls the paths are the Manhattan moves.
 #[derive(Clone, Debug)]
 pub struct EntryCycle {
-    targets: Vec<Vec<(usize, usize)>>,
+    /// Per region, its cells' states and each one's distance from every state.
+    targets: Vec<Vec<(usize, Vec<u32>)>>,
     holds: Vec<Vec<bool>>,
-    width: usize,
+    /// Per state and action, the state it leads to without slipping.
+    dest: Vec<[usize; 4]>,
     phase: usize,
 }
+
+/// At most this many distances (region cells times states) for an [`EntryCycle`].
+pub const MAX_ENTRY_CYCLE_DISTANCES: usize = 1 << 26;
 
 impl Default for WindowConfig {
     /// 100 rollouts of 2000 steps, the first 100 not counted.
@@ -287,21 +294,29 @@ impl Controller for LegCycle<'_> {
 }
 
 impl EntryCycle {
-    /// The cycle through `regions` on `grid`, in region order.
+    /// The cycle through `regions` on `grid`, in region order. Fails when a region holds in
+    /// no state of the grid, or the distance tables would be too large.
     pub fn new(grid: &crate::GridWorld, regions: &RegionTable) -> Result<EntryCycle, Error> {
-        let width = grid.width();
-        if regions.holds.iter().any(|h| h.len() != grid.width() * grid.height()) {
+        let n = grid.num_states();
+        if regions.holds.iter().any(|h| h.len() != n) {
             return Err(Error::Config("the regions were not computed on this grid".into()));
         }
-        let targets: Vec<Vec<(usize, usize)>> = regions
+        let cells: usize = regions.holds.iter().map(|h| h.iter().filter(|&&b| b).count()).sum();
+        if cells.saturating_mul(n) > MAX_ENTRY_CYCLE_DISTANCES {
+            return Err(Error::Config(format!(
+                "the entry cycle needs {cells} region cells x {n} states of distances, more than {MAX_ENTRY_CYCLE_DISTANCES}"
+            )));
+        }
+        let targets: Vec<Vec<(usize, Vec<u32>)>> = regions
             .holds
             .iter()
-            .map(|h| (0..h.len()).filter(|&s| h[s]).map(|s| (s % width, s / width)).collect())
+            .map(|h| (0..n).filter(|&s| h[s]).map(|s| (s, grid.distances_to(s))).collect())
             .collect();
         if targets.iter().any(Vec::is_empty) {
             return Err(Error::Config("a region holds in no cell of the grid".into()));
         }
-        Ok(EntryCycle { targets, holds: regions.holds.clone(), width, phase: 0 })
+        let dest = (0..n).map(|s| std::array::from_fn(|a| grid.dest(s, a))).collect();
+        Ok(EntryCycle { targets, holds: regions.holds.clone(), dest, phase: 0 })
     }
 }
 
@@ -311,18 +326,19 @@ impl Controller for EntryCycle {
     }
 
     fn act(&mut self, s: usize) -> Decision {
-        let (x, y) = (s % self.width, s / self.width);
-        let dist = |&(tx, ty): &(usize, usize)| tx.abs_diff(x) + ty.abs_diff(y);
-        let (tx, ty) = self.targets[self.phase].iter().copied().min_by_key(dist).unwrap_or((x, y));
-        let action = if tx > x {
-            3
-        } else if tx < x {
-            2
-        } else if ty > y {
-            0
-        } else {
-            1
-        };
+        let targets = &self.targets[self.phase];
+        let at = |d: &Vec<u32>, s: usize| d.get(s).copied().unwrap_or(u32::MAX);
+        // The first nearest cell: `min_by_key` keeps the first of equal keys.
+        let target = targets.iter().min_by_key(|(_, d)| at(d, s));
+        // Right, Left, Up, Down: along x first.
+        const ORDER: [usize; 4] = [3, 2, 0, 1];
+        let action = target
+            .and_then(|(_, d)| {
+                let here = at(d, s);
+                let dest = self.dest.get(s)?;
+                ORDER.into_iter().find(|&a| at(d, dest[a]) < here)
+            })
+            .unwrap_or(1);
         Decision { action, option: self.phase, leg: 0 }
     }
 

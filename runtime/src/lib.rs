@@ -3,7 +3,8 @@
 //!
 //! - [`spec`]: the plain data a checked spec lowers into ([`TaskSpec`]) and the [`Spec`]
 //!   trait generated code implements.
-//! - [`env`](mod@env): the [`Env`] trait (gymnasium conventions) and the [`GridWorld`] of the paper.
+//! - [`env`](mod@env): the [`Env`] trait (gymnasium conventions) and the [`GridWorld`]: the
+//!   paper's open grid or a map with walls.
 //! - [`learn`]: Algorithm 1: flat Q-learning per primitive option, options Q-learning with
 //!   intra-option updates, seeded and bit-for-bit reproducible.
 //! - [`memory`]: the counters and buckets of `memory: B` and the step signal of
@@ -11,6 +12,7 @@
 //! - [`policy`]: greedy policies and the `policy.json` document.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
 //! - [`optimum`]: the exact optimal window rate by relative value iteration.
+//! - [`world`]: world files (TOML maps with walls and start cells) and the built-in worlds.
 //!
 //! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
 
@@ -23,13 +25,19 @@ pub mod optimum;
 pub mod policy;
 pub mod spec;
 mod tables;
+pub mod world;
 
-pub use env::{Env, GridWorld};
+pub use env::{Cell, Env, GridWorld, Tile};
 pub use error::Error;
 pub use hstl_robustness as robustness;
 pub use learn::{Learner, QTables, Trained};
 pub use memory::Memory;
 pub use policy::{Agent, Policy};
+/// What an [`Env`] implementation needs from `rand` and `serde_json`, re-exported so that it
+/// needs neither in its own `Cargo.toml`: the draws of the one generator ([`Rng`]) and the
+/// parameters' JSON ([`Value`], [`json!`]).
+pub use rand::RngExt;
+pub use serde_json::{Value, json};
 pub use spec::{
     CombinedOption, Intra, LearnParams, LevelParams, PrimitiveOption, Region, RewardKind, Spec,
     StateVar, TaskSpec, Terminate,

@@ -31,6 +31,10 @@ pub struct Memory {
     pub holds: Vec<Vec<bool>>,
 }
 
+/// The longest window a memory counts over: the learner keeps a table entry per step of
+/// each window. The front end holds specs to the same limit (`hstl_lang::budget`).
+pub const MAX_WINDOW: usize = 1_000_000;
+
 impl Memory {
     /// A memory over `holds[j][s]` with horizons `N_j` and `B` buckets. Fails when the
     /// lists disagree in length, a horizon is 0, or there would be too many memory values.
@@ -55,6 +59,12 @@ impl Memory {
         }
         if let Some(j) = horizons.iter().position(|&n| n == 0) {
             return err(format!("region {} has a zero-step window", regions[j]));
+        }
+        if let Some(j) = horizons.iter().position(|&n| n > MAX_WINDOW) {
+            return err(format!(
+                "region {} has a {}-step window; memory counts windows of at most {MAX_WINDOW} steps",
+                regions[j], horizons[j]
+            ));
         }
         if holds.iter().any(|h| h.len() != holds[0].len()) {
             return err("the region membership tables cover different numbers of states".into());

@@ -25,7 +25,7 @@ use serde_json::{Map, Value};
 use crate::learn::{argmax, best_of};
 use crate::memory::Memory;
 use crate::tables::Tables;
-use crate::{Env, Error, Learner, QTables};
+use crate::{Env, Error, Learner, QTables, TaskSpec};
 
 /// Greedy policies over state indices: what a rollout follows.
 #[derive(Clone, Debug, PartialEq)]
@@ -336,17 +336,57 @@ impl Policy {
         })
     }
 
+    /// Checks the document whole against the spec and environment it claims: its Q-tables
+    /// decode, have the spec's shape and hold no NaN, and every other entry (options,
+    /// termination sets, greedy choices, memory) is what those Q-tables give for this spec
+    /// on `env`. A document edited by hand, truncated or paired with another spec fails.
+    pub fn check_against<E: Env>(&self, spec: &TaskSpec, env: &E) -> Result<(), Error> {
+        let err = |m: String| Err(Error::Policy(m));
+        let q = self.q_tables()?;
+        let tables =
+            q.flat.iter().zip(&self.primitives).map(|(t, p)| (format!("flat table {}", p.name), t));
+        let all = tables.chain(std::iter::once(("the options table".to_string(), &q.options)));
+        for (what, table) in all {
+            if let Some(i) = table.iter().position(|v| v.is_nan()) {
+                return err(format!("{what} holds NaN at entry {i}"));
+            }
+        }
+        let learner = Learner::new(spec, env)?.with_tables(q)?;
+        let rebuilt = Policy::new(&learner);
+        if rebuilt.spec != self.spec {
+            return err(format!("it names spec `{}`, not `{}`", self.spec, rebuilt.spec));
+        }
+        let parts = [
+            ("options", rebuilt.options == self.options),
+            ("primitives", rebuilt.primitives == self.primitives),
+            ("memory", rebuilt.memory == self.memory),
+            ("max_steps", rebuilt.max_steps == self.max_steps),
+            ("flat_policies", rebuilt.flat_policies == self.flat_policies),
+            ("options_policy", rebuilt.options_policy == self.options_policy),
+        ];
+        match parts.iter().find(|(_, same)| !same) {
+            Some((part, _)) => err(format!(
+                "its `{part}` is not what its `q_tables` give for the spec it was trained on"
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// The greedy policies on `env`'s state indices. Fails when the document does not fit
     /// `env`: another environment, a state it does not cover, an unknown name.
     pub fn agent<E: Env>(&self, env: &E) -> Result<Agent, Error> {
         let err = |m: String| Err(Error::Policy(m));
-        if self.env.name != env.name() || self.env.params != env.params() {
+        if self.env.name != env.name() {
             return err(format!(
-                "the policy was trained on {} {}, not on {} {}",
+                "the policy was trained on `{}`, not on `{}`",
                 self.env.name,
-                self.env.params,
-                env.name(),
-                env.params()
+                env.name()
+            ));
+        }
+        if self.env.params != env.params() {
+            return err(format!(
+                "the policy was trained on another `{}` (its parameters differ)",
+                env.name()
             ));
         }
         if self.state_vars != env.state_vars() || self.actions != env.actions() {

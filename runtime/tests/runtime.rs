@@ -106,7 +106,7 @@ fn bad_environments_are_errors() {
         assert!(matches!(GridWorld::new(w, h, p), Err(Error::Env(_))), "{w} {h} {p}");
     }
     let params = serde_json::json!({ "width": 15, "height": "15", "p": 0.7 });
-    assert!(GridWorld::from_params(&params).is_err());
+    assert!(GridWorld::from_params("gridworld", &params).is_err());
     // Evaluation and value-iteration settings.
     let env = GridWorld::default();
     let spec = small(false, false);
@@ -186,7 +186,9 @@ fn policy_json_round_trips_bit_for_bit() {
     // The contract's fields, as scripts read them.
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(doc["spec"], "Surveillance");
-    assert_eq!(doc["env"]["name"], "gridworld");
+    assert_eq!(doc["env"]["name"], "paper");
+    assert_eq!(doc["env"]["params"]["slip"], 0.3);
+    assert_eq!(doc["env"]["params"]["map"][14], "...............");
     assert_eq!(doc["state_vars"], serde_json::json!(["x", "y"]));
     assert_eq!(doc["actions"], serde_json::json!(["Up", "Down", "Left", "Right"]));
     assert_eq!(
@@ -210,7 +212,7 @@ fn bad_policy_documents_say_what_is_wrong() {
     let good: serde_json::Value =
         serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap();
     type Break = fn(&mut serde_json::Value);
-    let cases: [(&str, Break); 6] = [
+    let cases: [(&str, Break); 7] = [
         ("missing field `spec`", |d| {
             d.as_object_mut().unwrap().remove("spec");
         }),
@@ -220,7 +222,8 @@ fn bad_policy_documents_say_what_is_wrong() {
         }),
         ("chooses unknown", |d| d["flat_policies"]["A"][0]["choice"] = "Jump".into()),
         ("which the environment lacks", |d| d["options_policy"][0]["state"]["x"] = 99.into()),
-        ("trained on gridworld", |d| d["env"]["params"]["p"] = 0.9.into()),
+        ("trained on another `paper`", |d| d["env"]["params"]["slip"] = 0.1.into()),
+        ("trained on `office`", |d| d["env"]["name"] = "office".into()),
     ];
     for (want, change) in cases {
         let mut doc = good.clone();

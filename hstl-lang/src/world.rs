@@ -1,0 +1,150 @@
+//! Checking a spec against the grid world it is trained in.
+//!
+//! The front end knows nothing of the runtime: the facade describes a world as plain data
+//! ([`WorldFacts`]) and [`check_in_world`] runs every check of [`crate::check()`] plus
+//! these, on each spec that has options (a spec without options is never trained):
+//! - `HSTL030`: the state variables must be `x: int in 0..=W-1` and `y: int in 0..=H-1`;
+//! - `HSTL031`: a region an option reaches has no free cell (an error; a region only the
+//!   task names stays the warning `HSTL102`);
+//! - `HSTL032`: an option's termination set has no free cell;
+//! - `HSTL131`: no start can reach a region (walls cut it off).
+//!
+//! With a world, the finite-domain checks (`HSTL018`, `HSTL020`, `HSTL102`, `HSTL103`)
+//! range over the free cells only: walls are not states.
+
+use crate::check::{Checked, check_parsed_in};
+use crate::checked::{CheckedSpec, Domain, VarType};
+use crate::diagnostic::Diagnostic;
+use crate::parse;
+
+/// What the checks know of a grid world.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WorldFacts {
+    /// How messages name the world, such as ``world `office` (office.toml)``.
+    pub label: String,
+    /// Columns; `x` runs over `0..width`.
+    pub width: usize,
+    /// Rows; `y` runs over `0..height`.
+    pub height: usize,
+    /// Per cell `y * width + x`: whether it is free (not a wall).
+    pub free: Vec<bool>,
+    /// Per cell `y * width + x`: whether some start can reach it.
+    pub reachable: Vec<bool>,
+}
+
+/// Parses and checks `src` as [`crate::check()`] does, and checks each spec with options
+/// against `world`. Never fails and never panics.
+pub fn check_in_world(src: &str, world: &WorldFacts) -> Checked {
+    check_parsed_in(src, parse(src), Some(world))
+}
+
+/// Per state of a spec's declared domain (in the order the finite-domain checks number
+/// them): whether it is a free cell, and whether a start reaches it.
+pub(crate) struct DomainMask {
+    pub present: Vec<bool>,
+    pub reachable: Vec<bool>,
+}
+
+impl WorldFacts {
+    /// The state block a spec needs for this world.
+    fn declaration(&self) -> String {
+        format!(
+            "`x: int in 0..={}, y: int in 0..={}`",
+            self.width.saturating_sub(1),
+            self.height.saturating_sub(1)
+        )
+    }
+
+    fn cell(&self, x: usize, y: usize) -> Option<usize> {
+        (x < self.width && y < self.height)
+            .then(|| y * self.width + x)
+            .filter(|&c| c < self.free.len())
+    }
+
+    /// `HSTL030` for each state variable that does not fit, or the mask of the domain's
+    /// states when they all fit.
+    pub(crate) fn fit(
+        &self,
+        spec: &CheckedSpec,
+        push: &mut impl FnMut(Diagnostic),
+    ) -> Option<DomainMask> {
+        let help = format!(
+            "declare the state as {} to match {} ({} x {})",
+            self.declaration(),
+            self.label,
+            self.width,
+            self.height
+        );
+        let mut fits = true;
+        let wanted = [("x", self.width, "wide"), ("y", self.height, "high")];
+        for v in &spec.state_vars {
+            let Some(&(_, n, along)) = wanted.iter().find(|w| w.0 == v.name) else {
+                fits = false;
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        v.name_range.start..v.range.end,
+                        format!(
+                            "state variable `{}` is not a variable of {}: a grid world's state is its cell `x`, `y`",
+                            v.name, self.label
+                        ),
+                    )
+                    .with_help(help.clone()),
+                );
+                continue;
+            };
+            let hi = n.saturating_sub(1) as i64;
+            let right = v.ty == VarType::Int && v.domain == Domain::Int { lo: 0, hi };
+            if !right {
+                fits = false;
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        v.name_range.start..v.range.end,
+                        format!(
+                            "state variable `{}` must be `int in 0..={hi}`: {} is {n} cells {along}",
+                            v.name, self.label
+                        ),
+                    )
+                    .with_help(help.clone()),
+                );
+            }
+        }
+        for (name, _, _) in wanted {
+            if !spec.state_vars.iter().any(|v| v.name == name) {
+                fits = false;
+                let at = spec
+                    .state_vars
+                    .first()
+                    .map_or(spec.name_range.clone(), |v| v.name_range.start..v.range.end);
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        at,
+                        format!("the state has no variable `{name}`, which {} needs", self.label),
+                    )
+                    .with_help(help.clone()),
+                );
+            }
+        }
+        if !fits {
+            return None;
+        }
+        // The finite-domain checks number states with the last declared variable fastest.
+        let x_first = spec.state_vars.first().is_some_and(|v| v.name == "x");
+        let n = self.width.checked_mul(self.height)?;
+        let mut present = Vec::with_capacity(n);
+        let mut reachable = Vec::with_capacity(n);
+        for k in 0..n {
+            let (x, y) = if x_first {
+                (k / self.height, k % self.height)
+            } else {
+                (k % self.width, k / self.width)
+            };
+            let cell = self.cell(x, y);
+            present.push(cell.is_some_and(|c| self.free[c]));
+            reachable.push(cell.is_some_and(|c| self.reachable.get(c).copied().unwrap_or(false)));
+        }
+        Some(DomainMask { present, reachable })
+    }
+}
