@@ -7,6 +7,7 @@ use clap::{Args, ValueEnum};
 use hstl::lang::{Diagnostic, Severity};
 
 use crate::cli_error::CliError;
+use crate::output::out;
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, input, render};
 
@@ -72,7 +73,7 @@ pub fn run(args: &CheckArgs) -> CmdResult {
         Format::Json => render::json(&checked),
         Format::Sarif => render::sarif(&checked),
     };
-    print!("{out}");
+    out!("{out}")?;
     let errors = checked.iter().flat_map(|c| &c.diagnostics).any(|d| d.severity == Severity::Error);
     Ok(if errors { Status::Errors } else { Status::Clean })
 }

@@ -16,6 +16,7 @@ use clap::Args;
 
 use crate::check::Checked;
 use crate::cli_error::CliError;
+use crate::output::{err, out, outln};
 use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc fmt`.
@@ -60,7 +61,7 @@ pub fn run(args: &FmtArgs) -> CmdResult {
         let is_stdin = path.as_path() == Path::new("-");
         if args.check {
             if formatted != source {
-                println!("{name}");
+                outln!("{name}")?;
                 status = Status::Errors;
             }
         } else if args.write && !is_stdin {
@@ -68,11 +69,11 @@ pub fn run(args: &FmtArgs) -> CmdResult {
                 write_whole(path, &formatted, bom)?;
             }
         } else {
-            print!("{formatted}");
+            out!("{formatted}")?;
         }
     }
     if !broken.is_empty() {
-        eprint!("{}", render::full(&broken, std::io::stderr().is_terminal()));
+        err!("{}", render::full(&broken, std::io::stderr().is_terminal()));
     }
     Ok(status)
 }

@@ -13,6 +13,7 @@ use hstl::lang::{CheckedSpec, Domain, VarType};
 use hstl::robustness::offline;
 
 use crate::cli_error::CliError;
+use crate::output::errln;
 use crate::trace_csv::{Column, ColumnKind, ReadError, TraceRead};
 use crate::{CmdResult, Status, spec_file, trace_csv};
 
@@ -70,7 +71,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         } else {
             ("columns", "are not state variables")
         };
-        eprintln!("note: {what} {} {verb} of `{}`: ignored", names.join(", "), spec.name);
+        errln!("note: {what} {} {verb} of `{}`: ignored", names.join(", "), spec.name);
     }
     let trace = read.trace;
 
@@ -84,13 +85,9 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         writeln!(out, "{}", offline::robustness(&formula, &trace))
     }
     .and_then(|()| out.flush());
-    match written {
-        // A reader that stopped early (`| head`) is not an error.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(CliError::Write { path: PathBuf::from("<stdout>"), source: e })
-        }
-        _ => Ok(Status::Clean),
-    }
+    // A signal can be long: it goes through its own buffer, its errors as all output's.
+    written.map_err(crate::output::stdout_error)?;
+    Ok(Status::Clean)
 }
 
 /// Reads the trace at `path` (standard input for `-`) for the state variables of `spec`.

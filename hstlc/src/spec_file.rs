@@ -8,6 +8,7 @@ use hstl::runtime::TaskSpec;
 
 use crate::check::{Checked, read_input};
 use crate::cli_error::CliError;
+use crate::output::err;
 use crate::render;
 use crate::world_arg::LoadedWorld;
 
@@ -86,7 +87,7 @@ pub fn load(
     };
     if checked.has_errors() {
         let report = Checked { name: file, source, diagnostics: checked.diagnostics };
-        eprint!("{}", render::full(std::slice::from_ref(&report), std::io::stderr().is_terminal()));
+        err!("{}", render::full(std::slice::from_ref(&report), std::io::stderr().is_terminal()));
         return Ok(None);
     }
     let index = pick(&checked.specs, wanted, &file)?;

@@ -12,6 +12,7 @@ use hstl::runtime::{Agent, GridWorld, Intra, Policy, Region, RewardKind, TaskSpe
 
 use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::train::{self, PICTURE_SEED, tail_mean};
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
@@ -85,12 +86,12 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
         .max(1);
-    println!(
+    outln!(
         "study: {} specs x {} seeds on {}, {threads} threads",
         loaded.len(),
         args.seeds,
         world.words()
-    );
+    )?;
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, RewardKind)> = None;
     for ((path, l, spec), out) in loaded.iter().zip(outs) {
@@ -101,8 +102,8 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             Some(optimum(&mut optima, spec, env)?)
         };
         let label = path.file_name().map_or(l.file.clone(), |n| n.to_string_lossy().into_owned());
-        println!();
-        println!(
+        outln!()?;
+        outln!(
             "{label}: `{}`, {} options, intra: {}, {} seeds x {} episodes x {} choices",
             spec.name,
             spec.options.len(),
@@ -110,26 +111,24 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             args.seeds,
             spec.learn.episodes,
             spec.learn.choices
-        );
-        print_table(&results, w_star);
+        )?;
+        print_table(&results, w_star)?;
         let reward = mean(&results.iter().map(|r| r.tail_reward).collect::<Vec<_>>());
         // Rewards compare only under the same options-level reward.
         match &baseline {
             None => baseline = Some((label.clone(), reward, spec.learn.reward)),
-            Some((base, b, kind)) if *kind == spec.learn.reward => println!(
+            Some((base, b, kind)) if *kind == spec.learn.reward => outln!(
                 "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
                 100.0 * (reward - b) / b.abs()
-            ),
-            Some((base, _, _)) => {
-                println!(
-                    "  reward not compared with {base}: its options earn another kind of reward"
-                )
-            }
+            )?,
+            Some((base, _, _)) => outln!(
+                "  reward not compared with {base}: its options earn another kind of reward"
+            )?,
         }
         let one_leg = spec.options.iter().all(|o| o.sequence.len() == 1);
         if args.both_intra && one_leg {
             // The rules differ only on suffixes inside a later leg.
-            println!("  intra: paper and remaining agree here: every option has one leg");
+            outln!("  intra: paper and remaining agree here: every option has one leg")?;
         } else if args.both_intra {
             let mut other = spec.clone();
             other.learn.intra = match spec.learn.intra {
@@ -137,12 +136,12 @@ pub fn run(args: &StudyArgs) -> CmdResult {
                 Intra::Remaining => Intra::Paper,
             };
             let alt = run_seeds(&other, env, args.seeds, threads, &l.file)?;
-            println!("  with intra: {} instead:", intra_word(other.learn.intra));
-            print_table(&alt, w_star);
+            outln!("  with intra: {} instead:", intra_word(other.learn.intra))?;
+            print_table(&alt, w_star)?;
         }
         let dir = out.path().to_path_buf();
         write_outputs(out, spec, env, l, &results)?;
-        println!("  wrote {}", dir.display());
+        outln!("  wrote {}", dir.display())?;
     }
     Ok(Status::Clean)
 }
@@ -210,19 +209,19 @@ fn optimum(
     let start = Instant::now();
     let o = solve(env, &regions, SolveConfig::default())
         .map_err(|e| CliError::new(e.to_string(), None))?;
-    println!(
+    outln!(
         "optimum for regions {}: W* = {:.4} (value iteration, {} sweeps, {:.1} s{})",
         spec.regions.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
         o.gain,
         o.iterations,
         start.elapsed().as_secs_f64(),
         if o.converged { "" } else { ", not converged" }
-    );
+    )?;
     cache.push((spec.regions.clone(), o.gain));
     Ok(o.gain)
 }
 
-fn print_table(results: &[RunResult], w_star: Option<f64>) {
+fn print_table(results: &[RunResult], w_star: Option<f64>) -> Result<(), CliError> {
     let row = |name: &str, values: Vec<f64>, digits: usize| {
         let (lo, hi) = range(&values);
         let m = mean(&values);
@@ -230,23 +229,24 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) {
         let sd = (values.iter().map(|v| (v - m) * (v - m)).sum::<f64>()
             / (values.len().max(2) - 1) as f64)
             .sqrt();
-        println!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}");
+        outln!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}")
     };
-    println!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max");
-    row("training time (s)", results.iter().map(|r| r.secs).collect(), 3);
+    outln!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max")?;
+    row("training time (s)", results.iter().map(|r| r.secs).collect(), 3)?;
     row(
         "primitive steps/s (millions)",
         results.iter().map(|r| r.steps as f64 / r.secs.max(1e-9) / 1e6).collect(),
         2,
-    );
-    row("reward per episode (last 100)", results.iter().map(|r| r.tail_reward).collect(), 2);
+    )?;
+    row("reward per episode (last 100)", results.iter().map(|r| r.tail_reward).collect(), 2)?;
     let windows: Vec<f64> = results.iter().filter_map(|r| r.window).collect();
     if windows.len() == results.len() {
-        row("window rate W", windows.clone(), 3);
+        row("window rate W", windows.clone(), 3)?;
         if let Some(w) = w_star {
-            row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3);
+            row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3)?;
         }
     }
+    Ok(())
 }
 
 /// Seed 0's policy, curve and pictures, the learning curves of all seeds, and

@@ -10,6 +10,7 @@ use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
@@ -86,7 +87,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     let written = out.write(&files)?;
 
     let tail = tail_mean(&outcome.curve, 100);
-    println!(
+    outln!(
         "trained `{}` on {} (seed {}): {} episodes, {} steps in {:.2} s ({:.1}M steps/s)",
         spec.name,
         world.words(),
@@ -95,19 +96,19 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         outcome.steps,
         outcome.secs,
         outcome.steps as f64 / outcome.secs.max(1e-9) / 1e6
-    );
-    println!(
+    )?;
+    outln!(
         "  reward per episode: {tail:.2} (mean of the last {} episodes)",
         outcome.curve.len().min(100)
-    );
+    )?;
     if let Some((rate, robustness)) = window {
-        println!(
+        outln!(
             "  window rate {rate:.3} over {} greedy runs of {} steps; task robustness {robustness:.2} (mean over runs)",
             WindowConfig::default().starts,
             WindowConfig::default().steps
-        );
+        )?;
     }
-    println!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files));
+    outln!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files))?;
     Ok(Status::Clean)
 }
 

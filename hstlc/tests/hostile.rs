@@ -401,3 +401,65 @@ fn fmt_write_keeps_the_file() {
     let left: Vec<String> = listing(d).into_iter().filter(|f| f.contains("hstlc-fmt-")).collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
+
+/// Runs `hstlc` in `dir` with standard output going to `stdout`; status and standard error.
+fn hstlc_to(dir: &Path, args: &[&str], stdout: Stdio) -> (Option<i32>, String) {
+    let child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let out = child.wait_with_output().expect("hstlc ends");
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Class 8: output errors are errors. A full disk (`/dev/full`) stops every command with
+/// status 2 and one line; a reader that went away (`| head`) ends it quietly with 141.
+#[test]
+fn write_errors_are_errors_and_a_closed_pipe_ends_quietly() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    write(d, "t.csv", "x,y\n1,1\n2,2\n");
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let commands: [&[&str]; 11] = [
+        &["check", "small.hstl"],
+        &["check", "--format", "json", "small.hstl"],
+        &["explain", "HSTL003"],
+        &["fmt", "small.hstl"],
+        &["monitor", "small.hstl", "--trace", "t.csv", "--signal"],
+        &["train", "small.hstl", "--out", "again"],
+        &["eval", "run/policy.json", "--no-optimum", "--starts", "2", "--steps", "200"],
+        &["study", "small.hstl", "--seeds", "1", "--no-optimum", "--out", "st"],
+        &["--help"],
+        &["--version"],
+        &["check", "--help"],
+    ];
+    if Path::new("/dev/full").exists() {
+        for args in commands {
+            let full =
+                std::fs::OpenOptions::new().write(true).open("/dev/full").expect("/dev/full");
+            let (status, stderr) = hstlc_to(d, args, Stdio::from(full));
+            assert_eq!(status, Some(2), "{args:?}: {stderr}");
+            assert_eq!(
+                stderr, "error: cannot write `<stdout>`: no space left on device\n",
+                "{args:?}"
+            );
+        }
+    }
+    // The reader closes its end before hstlc starts.
+    write(d, "b.hstl", SMALL);
+    write(d, "c.hstl", SMALL);
+    for args in
+        [&["fmt", "small.hstl", "b.hstl", "c.hstl"][..], &["check", "small.hstl"], &["--help"]]
+    {
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let (status, stderr) = hstlc_to(d, args, Stdio::from(writer));
+        assert_eq!((status, stderr.as_str()), (Some(141), ""), "{args:?}");
+    }
+}
