@@ -304,6 +304,9 @@ struct Excerpt {
     text: String,
     lines: Vec<ShownLine>,
     spans: Vec<SourceSpan>,
+    /// The file's 0-based line and character column of the primary range's start: the
+    /// header's position (a start inside a line break has no place in the excerpt's text).
+    start: (usize, usize),
 }
 
 /// One line of the file in an excerpt.
@@ -404,7 +407,9 @@ impl Excerpt {
                 lines.push(line);
             }
         }
-        let mut excerpt = Excerpt { name: name.to_string(), text, lines, spans: Vec::new() };
+        let p = index.position(src, marks[0].0);
+        let start = (p.line - 1, p.column - 1);
+        let mut excerpt = Excerpt { name: name.to_string(), text, lines, spans: Vec::new(), start };
         excerpt.spans = marks
             .iter()
             .map(|&(s, e, _, _)| {
@@ -540,7 +545,12 @@ impl miette::SourceCode for Excerpt {
         let b = (last + after).min(block_end);
         let data_start = self.lines[a].range.start;
         let data_end = self.lines[b].range.end + usize::from(self.lines[b].has_break);
-        let column = if before == 0 { self.column(first, start) } else { 0 };
+        let primary = self.spans.first().is_some_and(|p| p.offset() == start);
+        let (line, column) = match before {
+            0 if primary => self.start,
+            0 => (self.lines[a].number, self.column(first, start)),
+            _ => (self.lines[a].number, 0),
+        };
         // Miette joins two snippets when the first one's line plus its line count reaches
         // the second one's line: counting to the end of the block joins exactly the
         // snippets of one block.
@@ -549,9 +559,53 @@ impl miette::SourceCode for Excerpt {
             self.name.clone(),
             &self.text.as_bytes()[data_start..data_end],
             SourceSpan::new(data_start.into(), data_end - data_start),
-            self.lines[a].number,
+            line,
             column,
             line_count,
         )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every diagnostic range over texts with long lines, every line end and wide
+    /// characters renders without a panic, in bounded size, with the position `concise`
+    /// gives in its header, and underlines on the line it names.
+    #[test]
+    fn excerpts_show_every_range_at_its_position() {
+        let long = format!("let A = {}x > 1;", "é && ".repeat(300));
+        let texts = [
+            "spec S {\n  let A = x;\n}\n".to_string(),
+            "a\r\nbb\r\n\r\nccc".to_string(),
+            "a\rbb\r\rccc\r".to_string(),
+            format!("spec S {{\n{long}\n  task A;\n}}"),
+            format!("{long}\r{long}"),
+        ];
+        for text in &texts {
+            let index = LineIndex::new(text);
+            let bounds: Vec<usize> =
+                (0..=text.len()).filter(|&o| text.is_char_boundary(o)).collect();
+            let step = (bounds.len() / 40).max(1);
+            for &start in bounds.iter().step_by(step) {
+                for &end in bounds.iter().filter(|&&e| e >= start).step_by(step * 3) {
+                    let mut d = Diagnostic::new("HSTL002", start..end, "a message");
+                    d = d.with_label(end..end, "here").with_label(0..1.min(text.len()), "first");
+                    let file = Checked {
+                        name: "t.hstl".into(),
+                        source: text.clone(),
+                        diagnostics: vec![d],
+                    };
+                    let shown = full(std::slice::from_ref(&file), false);
+                    let p = index.position(text, start);
+                    assert!(
+                        shown.contains(&format!("[t.hstl:{}:{}]", p.line, p.column)),
+                        "{start}..{end} of {text:?}:\n{shown}"
+                    );
+                    assert!(shown.len() < 3_000, "{start}..{end}: {} bytes", shown.len());
+                }
+            }
+        }
     }
 }
