@@ -57,6 +57,7 @@ pub mod codes;
 pub mod diagnostic;
 pub mod format;
 pub mod incremental;
+pub mod lints;
 pub mod parser;
 pub mod position;
 pub mod render;
@@ -64,6 +65,10 @@ pub mod syntax;
 pub mod world;
 
 pub use check::{Checked, check, check_parsed};
+
+/// The largest spec text the tools read, in bytes (64 MiB): `hstlc` and the macro's
+/// `include "path"` refuse a larger file before reading all of it.
+pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
 pub use checked::*;
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use format::format;

@@ -1,5 +1,5 @@
 //! What `train` and `study` write: pictures of a trained agent, the learning curve, and the
-//! all-or-nothing write of an output folder.
+//! all-or-nothing write of an output folder ([`OutDir`]).
 
 use std::path::{Path, PathBuf};
 
@@ -28,46 +28,280 @@ impl OutFile {
     }
 }
 
-/// Writes every file into `dir`, whole or not at all: each goes to a temporary file in
-/// `dir` first, and only when all of them are written are they renamed into place. On an
-/// error the temporary files are removed and nothing in `dir` has changed.
-pub fn write_all(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
-    std::fs::create_dir_all(dir)
-        .map_err(|source| CliError::Write { path: dir.to_path_buf(), source })?;
-    // A rename can only fail on a target we can see now (a folder in the way): refuse
-    // before anything is written, so the renames below all go through.
-    for file in files {
-        let target = dir.join(&file.name);
-        if target.is_dir() {
+/// The file that marks a folder as one run's output: a later run may replace the folder.
+pub const MARKER: &str = ".hstlc-run";
+
+/// An output folder that this run holds (see [`OutDir::lock`]) and will write whole.
+///
+/// The files go to a hidden sibling folder first, each one synced to disk; then the folder
+/// is synced and renamed into place. A folder an earlier run wrote is moved aside just
+/// before and removed just after, so at every moment `dir` is the old run's folder, no
+/// folder, or the new run's folder, never a mix. A run killed on the way leaves only hidden
+/// siblings (`.NAME.tmp-*`, `.NAME.old-*`), which the next run into `dir` removes. Another
+/// run into the same folder is refused while this one holds it: the lock is the operating
+/// system's lock on `.NAME.lock` beside the folder, released when the process ends however
+/// it ends, so a killed run leaves no stale lock.
+pub struct OutDir {
+    dir: PathBuf,
+    parent: PathBuf,
+    name: String,
+    /// Holds the lock while this value lives.
+    _lock: std::fs::File,
+}
+
+impl OutDir {
+    /// Takes the folder `dir` for this run: refuses it when another run holds it, or when
+    /// it holds files no run writes (it will be replaced as a whole). Call it before the
+    /// long work, so that a refusal comes at once.
+    pub fn lock(dir: &Path) -> Result<OutDir, CliError> {
+        let write_err = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| CliError::Write { path, source }
+        };
+        // `--out .`, or a symbolic link: the folder it names.
+        let dir = if dir.file_name().is_none() || dir.is_symlink() {
+            std::fs::canonicalize(dir).map_err(write_err(dir))?
+        } else {
+            dir.to_path_buf()
+        };
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let parent = match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent).map_err(write_err(&dir))?;
+        let lock_path = parent.join(format!(".{name}.lock"));
+        let lock = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&lock_path)
+            .map_err(write_err(&lock_path))?;
+        match lock.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                return Err(CliError::new(
+                    format!("`{}` is being written by another hstlc run", dir.display()),
+                    Some("wait for that run to finish, or choose another `--out`".to_string()),
+                ));
+            }
+            // A file system without locks: go on without one.
+            Err(std::fs::TryLockError::Error(_)) => {}
+        }
+        // This run holds the folder: hidden siblings left by killed runs are stale.
+        if let Ok(entries) = std::fs::read_dir(&parent) {
+            let (tmp, old) = (format!(".{name}.tmp-"), format!(".{name}.old-"));
+            for entry in entries.flatten() {
+                let n = entry.file_name().to_string_lossy().into_owned();
+                if n.starts_with(&tmp) || n.starts_with(&old) {
+                    let _ = std::fs::remove_dir_all(entry.path());
+                }
+            }
+        }
+        let out = OutDir { dir, parent, name, _lock: lock };
+        out.replaceable()?;
+        Ok(out)
+    }
+
+    /// Writes `files` as the folder, whole or not at all (see [`OutDir`]); the paths
+    /// written, in order.
+    pub fn write(self, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
+        check_names(files)?;
+        self.replaceable()?;
+        let tmp = unique_sibling(&self.parent, &format!(".{}.tmp-", self.name), true)
+            .map_err(|source| CliError::Write { path: self.dir.clone(), source })?;
+        let guard = RemoveOnDrop(Some(tmp.clone()));
+        for file in files {
+            let path = tmp.join(&file.name);
+            write_synced(&path, &file.contents)
+                .map_err(|source| CliError::Write { path: self.dir.join(&file.name), source })?;
+        }
+        let marker = "This folder is one run of hstlc, written as a whole; the next run into it \
+                      replaces it.\n";
+        write_synced(&tmp.join(MARKER), marker.as_bytes())
+            .map_err(|source| CliError::Write { path: self.dir.join(MARKER), source })?;
+        sync_dir(&tmp);
+        let swap_err = |source| CliError::Write { path: self.dir.clone(), source };
+        if std::fs::symlink_metadata(&self.dir).is_ok() {
+            let old = unique_sibling(&self.parent, &format!(".{}.old-", self.name), false)
+                .map_err(swap_err)?;
+            std::fs::rename(&self.dir, &old).map_err(swap_err)?;
+            if let Err(source) = std::fs::rename(&tmp, &self.dir) {
+                // Put the old run back.
+                let _ = std::fs::rename(&old, &self.dir);
+                return Err(swap_err(source));
+            }
+            sync_dir(&self.parent);
+            let _ = std::fs::remove_dir_all(&old);
+        } else {
+            std::fs::rename(&tmp, &self.dir).map_err(swap_err)?;
+            sync_dir(&self.parent);
+        }
+        std::mem::forget(guard);
+        Ok(files.iter().map(|f| self.dir.join(&f.name)).collect())
+    }
+
+    /// The folder to be written.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Refuses a folder this run may not replace: a file, or a folder holding anything
+    /// that is not a run's output (a folder that an older hstlc wrote, before the marker,
+    /// holds only files named as a run's).
+    fn replaceable(&self) -> Result<(), CliError> {
+        let meta = match std::fs::symlink_metadata(&self.dir) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(source) => return Err(CliError::Write { path: self.dir.clone(), source }),
+            Ok(meta) => meta,
+        };
+        if !meta.is_dir() {
             return Err(CliError::new(
-                format!("cannot write `{}`: a folder of that name is in the way", target.display()),
-                Some("move the folder away or choose another `--out`".to_string()),
+                format!("`{}` is a file, not a folder", self.dir.display()),
+                Some("choose another `--out`".to_string()),
+            ));
+        }
+        let entries = std::fs::read_dir(&self.dir)
+            .map_err(|source| CliError::Write { path: self.dir.clone(), source })?;
+        let mut foreign = Vec::new();
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name == MARKER {
+                return Ok(());
+            }
+            let is_file = entry.file_type().is_ok_and(|t| t.is_file());
+            if !(is_file && is_run_file(&name)) {
+                foreign.push(format!("`{name}`"));
+            }
+        }
+        if foreign.is_empty() {
+            return Ok(());
+        }
+        foreign.sort();
+        let shown = foreign.len().min(5);
+        let more = if foreign.len() > shown {
+            format!(" and {} more", foreign.len() - shown)
+        } else {
+            String::new()
+        };
+        Err(CliError::new(
+            format!(
+                "`{}` holds {}{more}, which no hstlc run writes",
+                self.dir.display(),
+                foreign[..shown].join(", ")
+            ),
+            Some(
+                "hstlc replaces its output folder as a whole: choose a new or empty `--out`, \
+                 or move those out of it"
+                    .to_string(),
+            ),
+        ))
+    }
+}
+
+/// Writes `files` into the folder `dir` (made if missing) beside what it holds, each file
+/// whole or not at all (written to a hidden temporary file, synced, renamed over the old
+/// one): for files such as a study's `curves.svg` that sit beside the runs' folders.
+pub fn write_beside(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
+    check_names(files)?;
+    let err = |path: PathBuf| move |source| CliError::Write { path, source };
+    std::fs::create_dir_all(dir).map_err(err(dir.to_path_buf()))?;
+    let mut written = Vec::new();
+    for file in files {
+        let path = dir.join(&file.name);
+        let tmp = (0..1000)
+            .map(|n| dir.join(format!(".{}.{}-{n}.tmp", file.name, std::process::id())))
+            .find(|p| std::fs::symlink_metadata(p).is_err())
+            .ok_or_else(|| {
+                err(path.clone())(std::io::Error::new(
+                    std::io::ErrorKind::AlreadyExists,
+                    "no free temporary name",
+                ))
+            })?;
+        if let Err(source) = write_synced(&tmp, &file.contents) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(CliError::Write { path, source });
+        }
+        if let Err(source) = std::fs::rename(&tmp, &path) {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(CliError::Write { path, source });
+        }
+        written.push(path);
+    }
+    sync_dir(dir);
+    Ok(written)
+}
+
+/// Removes a folder when dropped (a write that failed half way), unless forgotten.
+struct RemoveOnDrop(Option<PathBuf>);
+
+impl Drop for RemoveOnDrop {
+    fn drop(&mut self) {
+        if let Some(path) = self.0.take() {
+            let _ = std::fs::remove_dir_all(path);
+        }
+    }
+}
+
+/// Whether a run of this or an earlier hstlc writes a file of this name.
+fn is_run_file(name: &str) -> bool {
+    matches!(name, "policy.json" | "curve.csv" | "seeds.csv")
+        || name.ends_with(".svg")
+        || (name.starts_with('.') && name.ends_with(".tmp"))
+}
+
+/// Refuses names that are not plain file names, or that two files share (also when they
+/// differ only in case, as they would on a case-insensitive file system).
+fn check_names(files: &[OutFile]) -> Result<(), CliError> {
+    let mut seen = std::collections::HashSet::new();
+    for f in files {
+        let plain = !f.name.is_empty()
+            && f.name != "."
+            && f.name != ".."
+            && f.name != MARKER
+            && f.name.len() <= 255
+            && !f.name.contains(['/', '\\', '\0']);
+        if !plain || !seen.insert(f.name.to_lowercase()) {
+            return Err(CliError::new(
+                format!("cannot write `{}`: the name is not a plain file name of its own", f.name),
+                None,
             ));
         }
     }
-    let mut temps: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
-    let cleanup = |temps: &[(PathBuf, PathBuf)]| {
-        for (tmp, _) in temps {
-            let _ = std::fs::remove_file(tmp);
-        }
-    };
-    for file in files {
-        let target = dir.join(&file.name);
-        let tmp = dir.join(format!(".{}.{}.tmp", file.name, std::process::id()));
-        if let Err(source) = std::fs::write(&tmp, &file.contents) {
-            let _ = std::fs::remove_file(&tmp);
-            cleanup(&temps);
-            return Err(CliError::Write { path: target, source });
-        }
-        temps.push((tmp, target));
+    Ok(())
+}
+
+/// Creates a new, empty file (never an existing one), writes `bytes` and syncs them.
+fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()
+}
+
+/// Syncs a folder's entries to disk, where the file system allows it.
+pub fn sync_dir(dir: &Path) {
+    if let Ok(d) = std::fs::File::open(dir) {
+        let _ = d.sync_all();
     }
-    for (i, (tmp, target)) in temps.iter().enumerate() {
-        if let Err(source) = std::fs::rename(tmp, target) {
-            cleanup(&temps[i..]);
-            return Err(CliError::Write { path: target.clone(), source });
+}
+
+/// A path `parent/PREFIX<pid>-<n>` that no entry has, created as a folder when `create`.
+fn unique_sibling(parent: &Path, prefix: &str, create: bool) -> std::io::Result<PathBuf> {
+    for n in 0..1000 {
+        let path = parent.join(format!("{prefix}{}-{n}", std::process::id()));
+        if create {
+            match std::fs::create_dir(&path) {
+                Ok(()) => return Ok(path),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(e),
+            }
+        } else if std::fs::symlink_metadata(&path).is_err() {
+            return Ok(path);
         }
     }
-    Ok(temps.into_iter().map(|(_, target)| target).collect())
+    Err(std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name"))
 }
 
 /// What the pictures of a trained agent say about where they come from.
@@ -193,6 +427,7 @@ pub fn agent_pictures(
         let svg = pic::sample_run(&grid, &title, &steps, &names).map_err(picture_error)?;
         out.push(OutFile::text(format!("run_{}.svg", i + 1), svg));
     }
+    uniquify(&mut out);
     Ok(out)
 }
 
@@ -415,9 +650,34 @@ fn holding(f: &Formula, states: &Trace, cells: &[(i64, i64)]) -> Vec<(i64, i64)>
         .collect()
 }
 
-/// A name fit for a file name: letters, digits, `-` and `_` kept, the rest `_`.
+/// A name fit for a file name: letters, digits, `-` and `_` kept, the rest `_`, at most 64
+/// characters (names are at most 64 characters; an inline region's formula may be longer).
 pub fn file_safe(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect()
+    name.chars()
+        .take(64)
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' })
+        .collect()
+}
+
+/// Makes the names of `files` unique, ignoring case (as a case-insensitive file system
+/// would): a later file whose name is taken gets `_2`, `_3`, ... before its extension. Two
+/// inline regions such as `x > 3` and `x < 3` both read `x___3`.
+fn uniquify(files: &mut [OutFile]) {
+    let mut taken = std::collections::HashSet::new();
+    for f in files {
+        if taken.insert(f.name.to_lowercase()) {
+            continue;
+        }
+        let (stem, ext) = match f.name.rsplit_once('.') {
+            Some((s, e)) => (s.to_string(), format!(".{e}")),
+            None => (f.name.clone(), String::new()),
+        };
+        let mut k = 2;
+        while !taken.insert(format!("{stem}_{k}{ext}").to_lowercase()) {
+            k += 1;
+        }
+        f.name = format!("{stem}_{k}{ext}");
+    }
 }
 
 fn picture_error(e: pic::PictureError) -> CliError {

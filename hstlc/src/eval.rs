@@ -13,11 +13,11 @@ use hstl::runtime::policy::EnvInfo;
 use hstl::runtime::{Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::artifacts;
-use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::study::{mean, range};
 use crate::world_arg::world_words;
-use crate::{CmdResult, Status};
+use crate::{CmdResult, Status, input};
 
 /// Arguments of `hstlc eval`.
 #[derive(Args, Debug)]
@@ -65,7 +65,8 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             Some("lower `--starts` or `--steps`".into()),
         ));
     }
-    let (name, text) = read_input(&args.policy, "<stdin>")?;
+    let input::Input { name, text, .. } =
+        input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
     let bad = |message: String, help: &str| {
         CliError::new(format!("{name}: {message}"), Some(help.to_string()))
     };
@@ -103,7 +104,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         ));
     }
     let mut rng = seeded_rng(args.seed);
-    println!(
+    outln!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
         world_words(&env, None),
@@ -111,7 +112,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         args.starts,
         args.steps,
         args.seed
-    );
+    )?;
     if spec.regions.is_empty() {
         // Not a persistent task: the task's robustness over each run is the measure.
         let all_states = artifacts::state_trace(&spec, &env)?;
@@ -125,7 +126,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                 .collect();
             values.push(robustness_of_run(&spec, &all_states, &states)?);
         }
-        print_robustness(&values);
+        print_robustness(&values)?;
         return Ok(Status::Clean);
     }
     let regions = RegionTable::new(&spec, &env).map_err(|e| CliError::new(e.to_string(), None))?;
@@ -137,7 +138,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         )
     })?;
     let (lo, hi) = range(&report.per_rollout);
-    println!(
+    outln!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
         report.rate,
         args.burn_in,
@@ -146,23 +147,23 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             .map(|r| format!("{} within {}", r.name, r.horizon))
             .collect::<Vec<_>>()
             .join(", ")
-    );
-    print_robustness(&report.robustness);
+    )?;
+    print_robustness(&report.robustness)?;
     // A hand-written yardstick over the same starts and slips: a learned policy below it has
     // not learned the legs.
     if let Ok(mut cycle) = EntryCycle::new(&env, &regions) {
         let base = window_rate(&env, &mut cycle, &regions, config, &mut seeded_rng(args.seed))
             .map_err(|e| CliError::new(e.to_string(), None))?;
-        println!(
+        outln!(
             "  hand-written baseline (the regions in turn, each by a shortest path around the walls): window rate {:.4}",
             base.rate
-        );
+        )?;
     }
     if !args.no_optimum {
         let start = Instant::now();
         let optimum = solve(&Moves::of(&env), &regions, SolveConfig::default())
             .map_err(|e| CliError::new(e.to_string(), Some(SKIP_OPTIMUM.into())))?;
-        println!(
+        outln!(
             "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
             optimum.gain,
             optimum.lower,
@@ -170,7 +171,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             start.elapsed().as_secs_f64(),
             if optimum.converged { "" } else { ", not converged" },
             report.rate / optimum.gain
-        );
+        )?;
     }
     Ok(Status::Clean)
 }
@@ -205,12 +206,12 @@ fn robustness_of_run(spec: &TaskSpec, states: &Trace, run: &[usize]) -> Result<f
     Ok(offline::robustness(&spec.task, &trace))
 }
 
-fn print_robustness(values: &[f64]) {
+fn print_robustness(values: &[f64]) -> Result<(), CliError> {
     let mean = mean(values);
     let (lo, hi) = range(values);
     let satisfied = values.iter().filter(|&&v| v > 0.0).count();
-    println!(
+    outln!(
         "  task robustness over each run: mean {mean:.3}, min {lo:.3}, max {hi:.3}; satisfied in {satisfied} of {} runs",
         values.len()
-    );
+    )
 }

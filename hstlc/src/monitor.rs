@@ -5,14 +5,16 @@
 //! run: an unreadable file, a malformed trace, an unknown `--formula` or `--spec`. On 1 and 2
 //! nothing is printed to standard output.
 
-use std::io::Write;
-use std::path::PathBuf;
+use std::io::{BufReader, Write};
+use std::path::{Path, PathBuf};
 
 use clap::Args;
+use hstl::lang::{CheckedSpec, Domain, VarType};
 use hstl::monitor::Monitor;
 
-use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::output::errln;
+use crate::trace_csv::{Column, ColumnKind, ReadError, TraceRead};
 use crate::{CmdResult, Status, spec_file, trace_csv};
 
 /// Arguments of `hstlc monitor`.
@@ -47,7 +49,6 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), None)? else {
         return Ok(Status::Errors);
     };
-    let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
     let (spec, name) = (&loaded.spec, &loaded.file);
     let monitor = Monitor::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {
@@ -58,10 +59,17 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
-    let vars: Vec<&str> = monitor.state_vars().iter().map(String::as_str).collect();
-    let trace = trace_csv::read_trace(&trace_text, &vars).map_err(|e| {
-        CliError::new(format!("{trace_name}:{}:{}: {}", e.line, e.column, e.message), e.help)
-    })?;
+    let read = read_trace(&args.trace, spec)?;
+    if !read.ignored.is_empty() {
+        let names: Vec<String> = read.ignored.iter().map(|n| format!("`{n}`")).collect();
+        let (what, verb) = if names.len() == 1 {
+            ("column", "is not a state variable")
+        } else {
+            ("columns", "are not state variables")
+        };
+        errln!("note: {what} {} {verb} of `{}`: ignored", names.join(", "), spec.name);
+    }
+    let trace = read.trace;
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
@@ -73,11 +81,36 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         writeln!(out, "{}", monitor.robustness_of_trace(&trace))
     }
     .and_then(|()| out.flush());
-    match written {
-        // A reader that stopped early (`| head`) is not an error.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(CliError::Write { path: PathBuf::from("<stdout>"), source: e })
+    // A signal can be long: it goes through its own buffer, its errors as all output's.
+    written.map_err(crate::output::stdout_error)?;
+    Ok(Status::Clean)
+}
+
+/// Reads the trace at `path` (standard input for `-`) for the state variables of `spec`.
+fn read_trace(path: &Path, spec: &CheckedSpec) -> Result<TraceRead, CliError> {
+    let columns: Vec<Column<'_>> = spec
+        .state_vars
+        .iter()
+        .map(|v| Column {
+            name: &v.name,
+            kind: match (v.ty, &v.domain) {
+                (_, Domain::Int { lo, hi }) => ColumnKind::Int(Some((*lo, *hi))),
+                (VarType::Int, _) => ColumnKind::Int(None),
+                _ => ColumnKind::Real,
+            },
+        })
+        .collect();
+    let (name, read) = if path == Path::new("-") {
+        ("<stdin>".to_string(), trace_csv::read_trace(std::io::stdin().lock(), &columns))
+    } else {
+        let file = std::fs::File::open(path)
+            .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+        (path.display().to_string(), trace_csv::read_trace(BufReader::new(file), &columns))
+    };
+    read.map_err(|e| match e {
+        ReadError::Io(source) => CliError::Read { path: PathBuf::from(&name), source },
+        ReadError::Csv(e) => {
+            CliError::new(format!("{name}:{}:{}: {}", e.line, e.column, e.message), e.help)
         }
-        _ => Ok(Status::Clean),
-    }
+    })
 }

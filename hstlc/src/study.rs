@@ -11,8 +11,9 @@ use hstl::runtime::eval::RegionTable;
 use hstl::runtime::optimum::{Moves, SolveConfig, solve};
 use hstl::runtime::{Agent, GridWorld, Intra, Region, RewardKind, TaskSpec, seeded_rng};
 
-use crate::artifacts::{self, OutFile};
+use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::train::{self, PICTURE_SEED, tail_mean};
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
@@ -90,23 +91,29 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         }
         loaded.push((path.clone(), l, spec));
     }
+    // Each spec's folder, taken before the long part: a folder another run holds is
+    // refused at once, and two specs of one name get folders of their own.
+    let outs = spec_dirs(&args.out, &args.specs)
+        .iter()
+        .map(|d| OutDir::lock(d))
+        .collect::<Result<Vec<_>, _>>()?;
     let env = &world.world;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
         .max(1);
-    println!(
+    outln!(
         "study: {} specs x {} seeds on {}, {threads} threads",
         loaded.len(),
         args.seeds,
         world.words()
-    );
+    )?;
     let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, RewardKind)> = None;
     let labels = labels(&args.specs);
     // Every spec's (and variant's) curves, for the figure of all of them.
     let mut all_curves: Vec<(String, RewardKind, Vec<Vec<f64>>)> = Vec::new();
-    for ((path, l, spec), label) in loaded.iter().zip(&labels) {
+    for (((_, l, spec), label), out) in loaded.iter().zip(&labels).zip(outs) {
         let budget = AtomicUsize::new(KEEP_BUDGET);
         let results = run_seeds(spec, env, args.seeds, threads, l, Some(&budget))?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
@@ -114,8 +121,8 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         } else {
             Some(optimum(&mut optima, spec, env)?)
         };
-        println!();
-        println!(
+        outln!()?;
+        outln!(
             "{label}: `{}`, {} options, intra: {}, {} seeds x {} episodes x {} choices",
             spec.name,
             spec.options.len(),
@@ -123,27 +130,25 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             args.seeds,
             spec.learn.episodes,
             spec.learn.choices
-        );
-        print_table(&results, w_star);
+        )?;
+        print_table(&results, w_star)?;
         let reward = mean(&results.iter().map(|r| r.tail_reward).collect::<Vec<_>>());
         // Rewards compare only under the same options-level reward.
         match &baseline {
             None => baseline = Some((label.clone(), reward, spec.learn.reward)),
-            Some((base, b, kind)) if *kind == spec.learn.reward => println!(
+            Some((base, b, kind)) if *kind == spec.learn.reward => outln!(
                 "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
                 100.0 * (reward - b) / b.abs()
-            ),
-            Some((base, _, _)) => {
-                println!(
-                    "  reward not compared with {base}: its options earn another kind of reward"
-                )
-            }
+            )?,
+            Some((base, _, _)) => outln!(
+                "  reward not compared with {base}: its options earn another kind of reward"
+            )?,
         }
         let one_leg = spec.options.iter().all(|o| o.sequence.len() == 1);
         let mut variant = None;
         if args.both_intra && one_leg {
             // The rules differ only on suffixes inside a later leg.
-            println!("  intra: paper and remaining agree here: every option has one leg");
+            outln!("  intra: paper and remaining agree here: every option has one leg")?;
         } else if args.both_intra {
             let mut other = spec.clone();
             other.learn.intra = match spec.learn.intra {
@@ -151,19 +156,19 @@ pub fn run(args: &StudyArgs) -> CmdResult {
                 Intra::Remaining => Intra::Paper,
             };
             let alt = run_seeds(&other, env, args.seeds, threads, l, None)?;
-            println!("  with intra: {} instead:", intra_word(other.learn.intra));
-            print_table(&alt, w_star);
+            outln!("  with intra: {} instead:", intra_word(other.learn.intra))?;
+            print_table(&alt, w_star)?;
             variant = Some((
                 format!("{label}, intra {}", intra_word(other.learn.intra)),
                 other.learn.reward,
                 alt.into_iter().map(|r| r.curve).collect(),
             ));
         }
-        let dir = args.out.join(stem(path));
+        let dir = out.path().to_path_buf();
         let median = median(&results);
-        println!("  policy.json and pictures: {}", median.note);
-        write_outputs(&dir, spec, env, l, label, &results, &median)?;
-        println!("  wrote {}", dir.display());
+        outln!("  policy.json and pictures: {}", median.note)?;
+        write_outputs(out, spec, env, l, label, &results, &median)?;
+        outln!("  wrote {}", dir.display())?;
         // The variant's curves follow the spec's in the figure.
         all_curves.push((
             label.clone(),
@@ -173,13 +178,13 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         all_curves.extend(variant);
     }
     let files = all_curves_files(&all_curves, args.seeds)?;
-    artifacts::write_all(&args.out, &files)?;
-    println!();
-    println!(
+    artifacts::write_beside(&args.out, &files)?;
+    outln!()?;
+    outln!(
         "wrote {} and {}: the learning curves of every spec",
         args.out.join("curves.svg").display(),
         args.out.join("curves.csv").display()
-    );
+    )?;
     Ok(Status::Clean)
 }
 
@@ -384,19 +389,19 @@ fn optimum(
     let start = Instant::now();
     let o = solve(&Moves::of(env), &regions, SolveConfig::default())
         .map_err(|e| CliError::new(e.to_string(), Some(crate::eval::SKIP_OPTIMUM.into())))?;
-    println!(
+    outln!(
         "optimum for regions {}: W* = {:.4} (value iteration, {} sweeps, {:.1} s{})",
         spec.regions.iter().map(|r| r.name.as_str()).collect::<Vec<_>>().join(", "),
         o.gain,
         o.iterations,
         start.elapsed().as_secs_f64(),
         if o.converged { "" } else { ", not converged" }
-    );
+    )?;
     cache.push((spec.regions.clone(), o.gain));
     Ok(o.gain)
 }
 
-fn print_table(results: &[RunResult], w_star: Option<f64>) {
+fn print_table(results: &[RunResult], w_star: Option<f64>) -> Result<(), CliError> {
     let row = |name: &str, values: Vec<f64>, digits: usize| {
         let (lo, hi) = range(&values);
         let m = mean(&values);
@@ -404,29 +409,30 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) {
         let sd = (values.iter().map(|v| (v - m) * (v - m)).sum::<f64>()
             / (values.len().max(2) - 1) as f64)
             .sqrt();
-        println!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}");
+        outln!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}")
     };
-    println!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max");
-    row("training time (s)", results.iter().map(|r| r.secs).collect(), 3);
+    outln!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max")?;
+    row("training time (s)", results.iter().map(|r| r.secs).collect(), 3)?;
     row(
         "primitive steps/s (millions)",
         results.iter().map(|r| r.steps as f64 / r.secs.max(1e-9) / 1e6).collect(),
         2,
-    );
-    row("reward per episode (last 100)", results.iter().map(|r| r.tail_reward).collect(), 2);
+    )?;
+    row("reward per episode (last 100)", results.iter().map(|r| r.tail_reward).collect(), 2)?;
     let windows: Vec<f64> = results.iter().filter_map(|r| r.window).collect();
     if windows.len() == results.len() {
-        row("window rate W", windows.clone(), 3);
+        row("window rate W", windows.clone(), 3)?;
         if let Some(w) = w_star {
-            row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3);
+            row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3)?;
         }
     }
+    Ok(())
 }
 
 /// The median seed's policy, curve and pictures, the learning curves of all seeds, and
 /// `seeds.csv` with each seed's figures.
 fn write_outputs(
-    dir: &Path,
+    out: OutDir,
     spec: &TaskSpec,
     env: &GridWorld,
     loaded: &spec_file::LoadedSpec,
@@ -469,7 +475,27 @@ fn write_outputs(
         &format!("{label}: learning curves\n{} seeds of `{}`", curves.len(), spec.name),
         &curves,
     )?);
-    artifacts::write_all(dir, &files).map(|_| ())
+    out.write(&files).map(|_| ())
+}
+
+/// Each spec's folder under `out`: its file's stem, and `-2`, `-3`, ... after a stem that an
+/// earlier spec of the list has (ignoring case): `study a/spec.hstl b/spec.hstl` writes
+/// `spec` and `spec-2`.
+fn spec_dirs(out: &Path, specs: &[PathBuf]) -> Vec<PathBuf> {
+    let mut taken = std::collections::HashSet::new();
+    specs
+        .iter()
+        .map(|path| {
+            let stem = stem(path);
+            let mut name = stem.clone();
+            let mut k = 2;
+            while !taken.insert(name.to_lowercase()) {
+                name = format!("{stem}-{k}");
+                k += 1;
+            }
+            out.join(name)
+        })
+        .collect()
 }
 
 fn stem(path: &Path) -> String {
@@ -528,7 +554,8 @@ mod tests {
             assert_eq!(results.iter().all(|r| r.kept.is_some()), name == "kept");
             let median = median(&results);
             let out = dir.path().join(name);
-            write_outputs(&out, &spec, &world.world, &loaded, "small.hstl", &results, &median)
+            let dir = OutDir::lock(&out).expect("locks");
+            write_outputs(dir, &spec, &world.world, &loaded, "small.hstl", &results, &median)
                 .expect("writes");
             written.push(files(&out));
         }

@@ -43,7 +43,8 @@ const CASES: &[Case] = &[
         "monitor_let_signal",
         &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "A", "--signal"],
     ),
-    case("monitor_infinite", &["monitor", "surveillance.hstl", "--trace", "infinite.csv"]),
+    case("monitor_infinite", &["monitor", "reals.hstl", "--trace", "infinite.csv"]),
+    case("monitor_int_not_whole", &["monitor", "surveillance.hstl", "--trace", "infinite.csv"]),
     case(
         "monitor_unknown_formula",
         &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "Nope"],

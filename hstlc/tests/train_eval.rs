@@ -441,5 +441,5 @@ fn a_world_too_large_to_draw_trains_without_grid_pictures() {
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
         .collect();
     written.sort();
-    assert_eq!(written, ["curve.csv", "curve.svg", "policy.json"]);
+    assert_eq!(written, [".hstlc-run", "curve.csv", "curve.svg", "policy.json"]);
 }

@@ -74,8 +74,8 @@ impl LegendEntry {
 }
 
 /// Turns a plotters drawing error into a picture error.
-pub(crate) fn draw_err<E: std::fmt::Debug>(error: E) -> PictureError {
-    PictureError::new(format!("cannot draw the picture: {error:?}"))
+pub(crate) fn draw_err<E: std::fmt::Display>(error: E) -> PictureError {
+    PictureError::new(format!("cannot draw the picture: {error}"))
 }
 
 /// Replaces characters XML cannot hold (control characters) so the SVG always parses.

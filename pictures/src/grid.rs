@@ -256,7 +256,7 @@ pub fn options_policy_slices(
                 (false, None) => format!("{title}, {label}"),
             };
             options_policy(grid, &title, choices, &order)
-                .map_err(|e| PictureError::new(format!("memory slice {label:?}: {}", e.message())))
+                .map_err(|e| PictureError::new(format!("memory slice `{label}`: {}", e.message())))
         })
         .collect()
 }

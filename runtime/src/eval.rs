@@ -402,7 +402,9 @@ pub fn window_rate<E: Env, C: Controller>(
 ) -> Result<WindowReport, Error> {
     if config.starts == 0 || config.burn_in >= config.steps {
         return Err(Error::Config(format!(
-            "the window rate needs starts > 0 and burn_in < steps, not {config:?}"
+            "the window rate needs starts > 0 and burn_in < steps, not starts = {}, steps = {}, \
+             burn_in = {}",
+            config.starts, config.steps, config.burn_in
         )));
     }
     if regions.holds.iter().any(|h| h.len() != env.num_states()) {
