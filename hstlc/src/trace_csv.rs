@@ -90,47 +90,15 @@ impl From<CsvError> for ReadError {
 
 /// Reads a trace whose column `i` is `vars[i]` from `reader`.
 pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead, ReadError> {
-    let mut lines = Lines::new(reader);
-    let names: Vec<String> = loop {
-        let Some((line, bytes)) = lines.next()? else {
-            return Err(csv(
-                1,
-                1,
-                "the file is empty",
-                format!(
-                    "the first line must name the columns, such as `{}`",
-                    vars.iter().map(|v| v.name).collect::<Vec<_>>().join(",")
-                ),
-            )
-            .into());
-        };
-        let text = utf8(line, bytes)?;
-        if text.trim().is_empty() {
-            continue;
-        }
-        break header(line, text, vars)?;
-    };
-    let header_line = lines.number;
-    let picks: Vec<usize> =
-        vars.iter().map(|v| names.iter().position(|n| n == v.name).unwrap_or(0)).collect();
-    let ignored = names
-        .iter()
-        .filter(|n| !n.is_empty() && !vars.iter().any(|v| v.name == *n))
-        .cloned()
-        .collect();
+    let mut rows = TraceRows::new(reader, vars, Limit::File)?;
     let mut columns = vec![Vec::new(); vars.len()];
-    // Each field of a row: its column and its byte range in the line (reused between rows).
-    let mut row: Vec<(usize, std::ops::Range<usize>)> = Vec::with_capacity(names.len());
-    let mut rows = 0usize;
-    while let Some((i, bytes)) = lines.next()? {
-        let line = utf8(i, bytes)?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        rows += 1;
-        if rows.saturating_mul(vars.len()) > MAX_TRACE_VALUES {
+    let mut state = vec![0.0; vars.len()];
+    let mut count = 0usize;
+    while let Some(line) = rows.next_row(&mut state)? {
+        count += 1;
+        if count.saturating_mul(vars.len()) > MAX_TRACE_VALUES {
             return Err(csv(
-                i,
+                line,
                 1,
                 format!(
                     "the trace holds more than {} values (rows times state variables)",
@@ -140,38 +108,132 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
             )
             .into());
         }
-        row.clear();
-        row.extend(field_ranges(line));
-        if row.len() != names.len() {
-            let column = match row.get(names.len()) {
-                Some((column, _)) => *column,
-                None => line.chars().count() + 1,
-            };
-            return Err(csv(
-                i,
-                column,
-                format!("this row has {}, the header has {}", fields_word(row.len()), names.len()),
-                "every row needs one value per header column".to_string(),
-            )
-            .into());
-        }
-        for ((col, &pick), var) in columns.iter_mut().zip(&picks).zip(vars) {
-            let (column, field) = (row[pick].0, &line[row[pick].1.clone()]);
-            col.push(value(field, var).map_err(|(message, help)| csv(i, column, message, help))?);
+        for (col, &v) in columns.iter_mut().zip(&state) {
+            col.push(v);
         }
     }
-    if rows == 0 {
-        return Err(csv(
+    if count == 0 {
+        return Err(rows.no_samples().into());
+    }
+    let ignored = rows.ignored;
+    let trace =
+        Trace::from_columns(columns).map_err(|e| csv(1, 1, e.to_string(), String::new()))?;
+    Ok(TraceRead { trace, ignored })
+}
+
+/// How much of a stream the reader takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// A file: at most [`MAX_TRACE_BYTES`].
+    File,
+    /// An endless stream (`monitor --online`): any length, one line at a time.
+    Stream,
+}
+
+/// A CSV trace read row by row: the header first, then one state per call, so that a
+/// caller can act on each row as it arrives on a pipe.
+pub struct TraceRows<'v, R> {
+    lines: Lines<R>,
+    vars: &'v [Column<'v>],
+    /// The header's column count.
+    width: usize,
+    /// The header column of each state variable.
+    picks: Vec<usize>,
+    /// The header's names that are no state variable, in header order.
+    pub ignored: Vec<String>,
+    header_line: usize,
+    /// Each field of the current row: its column and its byte range in the line.
+    row: Vec<(usize, std::ops::Range<usize>)>,
+}
+
+impl<'v, R: BufRead> TraceRows<'v, R> {
+    /// Reads the header (blank lines before it are skipped) and checks it against `vars`.
+    pub fn new(reader: R, vars: &'v [Column<'v>], limit: Limit) -> Result<Self, ReadError> {
+        let mut lines = Lines::new(reader, limit);
+        let names: Vec<String> = loop {
+            let Some((line, bytes)) = lines.next()? else {
+                return Err(csv(
+                    1,
+                    1,
+                    "the file is empty",
+                    format!(
+                        "the first line must name the columns, such as `{}`",
+                        vars.iter().map(|v| v.name).collect::<Vec<_>>().join(",")
+                    ),
+                )
+                .into());
+            };
+            let text = utf8(line, bytes)?;
+            if text.trim().is_empty() {
+                continue;
+            }
+            break header(line, text, vars)?;
+        };
+        let picks =
+            vars.iter().map(|v| names.iter().position(|n| n == v.name).unwrap_or(0)).collect();
+        let ignored = names
+            .iter()
+            .filter(|n| !n.is_empty() && !vars.iter().any(|v| v.name == *n))
+            .cloned()
+            .collect();
+        let header_line = lines.number;
+        Ok(TraceRows {
+            lines,
+            vars,
+            width: names.len(),
+            picks,
+            ignored,
             header_line,
+            row: Vec::with_capacity(names.len()),
+        })
+    }
+
+    /// Reads the next row into `state` (`state[i]` is `vars[i]`) and returns its line
+    /// number, or `None` at the end of the input. Blank lines are skipped.
+    pub fn next_row(&mut self, state: &mut [f64]) -> Result<Option<usize>, ReadError> {
+        loop {
+            let Some((i, bytes)) = self.lines.next()? else { return Ok(None) };
+            let line = utf8(i, bytes)?;
+            if line.trim().is_empty() {
+                continue;
+            }
+            self.row.clear();
+            self.row.extend(field_ranges(line));
+            if self.row.len() != self.width {
+                let column = match self.row.get(self.width) {
+                    Some((column, _)) => *column,
+                    None => line.chars().count() + 1,
+                };
+                return Err(csv(
+                    i,
+                    column,
+                    format!(
+                        "this row has {}, the header has {}",
+                        fields_word(self.row.len()),
+                        self.width
+                    ),
+                    "every row needs one value per header column".to_string(),
+                )
+                .into());
+            }
+            for ((out, &pick), var) in state.iter_mut().zip(&self.picks).zip(self.vars) {
+                let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
+                *out =
+                    value(field, var).map_err(|(message, help)| csv(i, column, message, help))?;
+            }
+            return Ok(Some(i));
+        }
+    }
+
+    /// The error for a trace that ended right after its header.
+    pub fn no_samples(&self) -> CsvError {
+        csv(
+            self.header_line,
             1,
             "the trace has no samples",
             "add one row per time step below the header".to_string(),
         )
-        .into());
     }
-    let trace =
-        Trace::from_columns(columns).map_err(|e| csv(1, 1, e.to_string(), String::new()))?;
-    Ok(TraceRead { trace, ignored })
 }
 
 /// The header's names, checked: each variable present, no name twice.
@@ -265,11 +327,12 @@ struct Lines<R> {
     read: u64,
     /// The 1-based number of the line last returned.
     number: usize,
+    limit: Limit,
 }
 
 impl<R: BufRead> Lines<R> {
-    fn new(reader: R) -> Self {
-        Lines { reader, line: Vec::new(), after_cr: false, read: 0, number: 0 }
+    fn new(reader: R, limit: Limit) -> Self {
+        Lines { reader, line: Vec::new(), after_cr: false, read: 0, number: 0, limit }
     }
 
     /// The next line and its number, or `None` at the end; a byte order mark at the start
@@ -318,7 +381,7 @@ impl<R: BufRead> Lines<R> {
 
     fn within_limits(&self) -> Result<(), CsvError> {
         let line = self.number + 1;
-        if self.read > MAX_TRACE_BYTES {
+        if self.limit == Limit::File && self.read > MAX_TRACE_BYTES {
             return Err(csv(
                 line,
                 1,
