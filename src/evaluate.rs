@@ -29,12 +29,14 @@ use hstl_robustness::{Trace, offline};
 use hstl_runtime::eval::{
     AgentController, EntryCycle, RegionTable, WindowConfig, WindowReport, rollout, window_rate,
 };
-use hstl_runtime::optimum::{Optimum, SolveConfig, solve};
+use hstl_runtime::optimum::{Moves, Optimum, SolveConfig, solve};
 use hstl_runtime::policy::EnvInfo;
 use hstl_runtime::{Agent, Env, GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::Problem;
 
+/// The largest `policy.json` the front ends read: 1 GiB.
+pub const MAX_POLICY_BYTES: u64 = 1 << 30;
 /// At most this many runs in one evaluation.
 pub const MAX_STARTS: usize = 100_000;
 /// At most this many steps in one run (a run is kept whole for its robustness).
@@ -280,7 +282,9 @@ pub fn optimum(
         return Ok(None);
     }
     let regions = RegionTable::new(spec, env).map_err(|e| Problem::new(e.to_string(), None))?;
-    solve(env, &regions, config).map(Some).map_err(|e| Problem::new(e.to_string(), None))
+    solve(&Moves::of(env), &regions, config)
+        .map(Some)
+        .map_err(|e| Problem::new(e.to_string(), None))
 }
 
 /// Row `s`: the values of the spec's state variables in state `s` of `env`.

@@ -57,6 +57,9 @@ pub const MAX_DOMAIN_STATES: u64 = 1_000_000;
 /// formulas and lets evaluated per state).
 pub const MAX_DOMAIN_WORK: u64 = 20_000_000;
 
+/// The fields an option may have.
+const OPTION_FIELDS: [&str; 3] = ["reach", "init", "terminate"];
+
 /// The expanded options set may hold at most this many options.
 pub const MAX_OPTIONS: u64 = 10_000;
 
@@ -101,6 +104,7 @@ pub(crate) fn check_parsed_in(
     let mut diags = parsed.diagnostics;
     let mut specs = Vec::new();
     let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+    let mut suggest_budget = SUGGEST_BUDGET;
     for spec in &parsed.file.specs {
         if spec.name.name.is_empty() {
             continue;
@@ -125,9 +129,14 @@ pub(crate) fn check_parsed_in(
             names: HashMap::default(),
             let_refs: Vec::new(),
             broken_names: spec.broken.iter().flat_map(|b| b.names.iter().cloned()).collect(),
+            suggest_budget,
         };
         let checked = cx.spec(spec);
+        suggest_budget = cx.suggest_budget;
         diags.append(&mut cx.diags);
+        crate::lints::long_names(spec, &mut diags);
+        crate::lints::constant_formulas(&checked, &mut diags);
+        crate::lints::inclusive_int_bounds(&checked, src, &mut diags);
         specs.push(checked);
     }
     let diagnostics = diagnostic::finish(diags, MAX_DIAGNOSTICS, src.len());
@@ -152,34 +161,111 @@ struct Cx<'s> {
     /// Names declared by items that did not parse: unknown-name errors about them would
     /// only repeat the syntax error.
     broken_names: std::collections::HashSet<String>,
+    /// What is left of the file's [`SUGGEST_BUDGET`].
+    suggest_budget: u64,
 }
 
 fn doc_text(d: &Option<syntax::Doc>) -> Option<String> {
     d.as_ref().map(syntax::Doc::text)
 }
 
-/// Levenshtein distance, for "did you mean" help.
-fn distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        prev = cur;
+/// Names longer than this many characters get no "did you mean" help (and are never
+/// suggested): a comparison costs the product of the two lengths.
+pub const MAX_SUGGEST_CHARS: usize = 64;
+
+/// The "did you mean" searches of one file compare at most this many pairs of characters
+/// (and candidates) in all; past that they suggest nothing, so that a file with many
+/// unknown names among many declared ones still checks in linear time.
+pub const SUGGEST_BUDGET: u64 = 20_000_000;
+
+/// The edit distance of `a` and `b` (insertions, deletions, substitutions and swaps of two
+/// neighbours, each costing 1), if it is at most `limit`. `rows` is scratch space, reused
+/// between calls.
+fn distance_within(a: &[char], b: &[char], limit: usize, rows: &mut Vec<usize>) -> Option<usize> {
+    if a.len().abs_diff(b.len()) > limit {
+        return None;
     }
-    prev[b.len()]
+    let w = b.len() + 1;
+    rows.clear();
+    rows.resize(3 * w, 0);
+    // Three rows: the one before the previous (for swaps), the previous and the current.
+    let (mut older, mut prev, mut cur) = (0, w, 2 * w);
+    for (j, cell) in rows[prev..prev + w].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for (i, &ca) in a.iter().enumerate() {
+        rows[cur] = i + 1;
+        let mut best = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let mut d = (rows[prev + j] + usize::from(ca != cb))
+                .min(rows[prev + j + 1] + 1)
+                .min(rows[cur + j] + 1);
+            if i > 0 && j > 0 && ca == b[j - 1] && a[i - 1] == cb {
+                d = d.min(rows[older + j - 1] + 1);
+            }
+            rows[cur + j + 1] = d;
+            best = best.min(d);
+        }
+        if best > limit {
+            return None;
+        }
+        (older, prev, cur) = (prev, cur, older);
+    }
+    let d = rows[prev + b.len()];
+    (d <= limit).then_some(d)
 }
 
-fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
-    let len = name.chars().count();
+/// The candidate closest to `name` (ties: the first in alphabetical order), if it is close
+/// enough to be a typo: at most a third of the name's characters differ. Each compared
+/// character pair and candidate costs one unit of `budget`; with the budget spent, nothing
+/// is suggested.
+pub(crate) fn closest<'a>(
+    name: &str,
+    candidates: impl Iterator<Item = &'a str>,
+    budget: &mut u64,
+) -> Option<&'a str> {
+    let a: Vec<char> = name.chars().take(MAX_SUGGEST_CHARS + 1).collect();
+    if a.len() > MAX_SUGGEST_CHARS || *budget == 0 {
+        return None;
+    }
+    let len = a.len();
     let limit = (len / 3).max(1);
-    candidates
-        .map(|c| (distance(name, c), c))
-        .filter(|(d, _)| *d <= limit && *d < len)
-        .min()
-        .map(|(_, c)| c)
+    let mut rows = Vec::new();
+    let mut b: Vec<char> = Vec::with_capacity(MAX_SUGGEST_CHARS + 1);
+    let mut best: Option<(usize, &str)> = None;
+    for c in candidates {
+        if *budget == 0 {
+            // A partial search could miss the closest name: suggest none.
+            return None;
+        }
+        *budget -= 1;
+        // A character takes one to four bytes: most candidates fail on their byte length.
+        if c.len() + limit < len || c.len() > 4 * (len + limit) {
+            continue;
+        }
+        b.clear();
+        b.extend(c.chars().take(MAX_SUGGEST_CHARS + 1));
+        if b.len() > MAX_SUGGEST_CHARS || b.len().abs_diff(len) > limit {
+            continue;
+        }
+        *budget = budget.saturating_sub((len * b.len()) as u64);
+        if let Some(d) = distance_within(&a, &b, limit, &mut rows)
+            && d < len
+            && best.is_none_or(|old| (d, c) < old)
+        {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
+/// At most `shown` names joined by commas, then how many there are in all.
+fn some_names(names: &[&str], shown: usize) -> String {
+    if names.len() <= shown {
+        names.join(", ")
+    } else {
+        format!("{}, ... ({} in all)", names[..shown].join(", "), names.len())
+    }
 }
 
 fn state_text(spec_vars: &[StateVarInfo], s: &[f64]) -> String {
@@ -730,13 +816,10 @@ impl Cx<'_> {
                 (NameRef::Let(_), NameRef::Let(_)) | (NameRef::Var(_), NameRef::Var(_))
             )
         };
-        let cands: Vec<&str> =
-            self.names.iter().filter(|(_, (r, _))| same_kind(r)).map(|(n, _)| n.as_str()).collect();
-        let mut sorted = cands.clone();
-        sorted.sort_unstable();
+        let cands = self.names.iter().filter(|(_, (r, _))| same_kind(r)).map(|(n, _)| n.as_str());
         let mut d =
             Diagnostic::new("HSTL002", id.range.clone(), format!("unknown name `{}`", id.name));
-        d = match closest(&id.name, sorted.iter().copied()) {
+        d = match closest(&id.name, cands, &mut self.suggest_budget) {
             Some(c) => d.with_help(format!("did you mean `{c}`?")),
             None if formula => d.with_help(format!("declare it: `let {} = ...;`", id.name)),
             None => d.with_help(format!("declare it in `state {{ {}: int in 0..=9 }}`", id.name)),
@@ -858,13 +941,13 @@ impl Cx<'_> {
             let mut seen: HashMap<String, Range<usize>> = HashMap::new();
             for f in o.fields.iter().flatten() {
                 let key = f.name.name.as_str();
-                if !["reach", "init", "terminate"].contains(&key) {
+                if !OPTION_FIELDS.contains(&key) {
                     let mut d = Diagnostic::new(
                         "HSTL019",
                         f.name.range.clone(),
                         format!("unknown option field `{key}`"),
                     );
-                    d = match closest(key, ["reach", "init", "terminate"].into_iter()) {
+                    d = match closest(key, OPTION_FIELDS.into_iter(), &mut u64::MAX.clone()) {
                         Some(c) => d.with_help(format!("did you mean `{c}`?")),
                         None => d.with_help("an option has `reach`, `init` and `terminate`"),
                     };
@@ -934,14 +1017,13 @@ impl Cx<'_> {
                         }
                         None if self.broken_names.contains(&o.name.name) => CFormulaKind::Invalid,
                         None => {
-                            let lets: Vec<&str> =
-                                out.lets.iter().map(|l| l.name.as_str()).collect();
+                            let lets = out.lets.iter().map(|l| l.name.as_str());
                             let mut d = Diagnostic::new(
                                 "HSTL010",
                                 o.name.range.clone(),
                                 format!("option `{}` names no `let`", o.name.name),
                             );
-                            d = match closest(&o.name.name, lets.into_iter()) {
+                            d = match closest(&o.name.name, lets, &mut self.suggest_budget) {
                                 Some(c) => d.with_help(format!("did you mean `{c}`?")),
                                 None => d.with_help(format!(
                                     "declare `let {} = ...;` or give the option a `reach` field",
@@ -994,7 +1076,7 @@ impl Cx<'_> {
         let names: Vec<String> = out.primitives.iter().map(|p| p.name.clone()).collect();
         let mut declared: Vec<&str> = names.iter().map(String::as_str).collect();
         declared.sort_unstable();
-        let declared_list = declared.join(", ");
+        let declared_list = some_names(&declared, 10);
         let resolve = |cx: &mut Self, legs: &[syntax::Ident]| -> Option<Vec<usize>> {
             let mut seq: Vec<usize> = Vec::new();
             let mut firsts: HashMap<usize, Range<usize>> = HashMap::new();
@@ -1008,7 +1090,11 @@ impl Cx<'_> {
                             leg.range.clone(),
                             format!("unknown option `{}`", leg.name),
                         );
-                        d = match closest(&leg.name, declared.iter().copied()) {
+                        d = match closest(
+                            &leg.name,
+                            declared.iter().copied(),
+                            &mut cx.suggest_budget,
+                        ) {
                             Some(c) => d.with_help(format!("did you mean `{c}`?")),
                             None if declared.is_empty() => {
                                 d.with_help(format!("declare it: `option {};`", leg.name))
@@ -1174,7 +1260,7 @@ impl Cx<'_> {
                 p.name.range.clone(),
                 format!("unknown parameter `{key}`"),
             );
-            d = match closest(key, known.iter().copied()) {
+            d = match closest(key, known.iter().copied(), &mut u64::MAX.clone()) {
                 Some(c) => d.with_help(format!("did you mean `{c}`?")),
                 None => d.with_help(format!("known parameters: {}", known.join(", "))),
             };
@@ -1244,10 +1330,12 @@ impl Cx<'_> {
                     format!("`{key}` must be {options}, found `{}`", self.text(&value_range(v))),
                 );
                 d = match v {
-                    ParamValue::Word(w) => match closest(&w.name, allowed.iter().copied()) {
-                        Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                        None => d.with_help(format!("write {options}")),
-                    },
+                    ParamValue::Word(w) => {
+                        match closest(&w.name, allowed.iter().copied(), &mut u64::MAX.clone()) {
+                            Some(c) => d.with_help(format!("did you mean `{c}`?")),
+                            None => d.with_help(format!("write {options}")),
+                        }
+                    }
                     _ => d.with_help(format!("write {options}")),
                 };
                 self.push(d);
@@ -1893,5 +1981,25 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn did_you_mean_counts_swaps_and_stays_bounded() {
+        let unlimited = || u64::MAX;
+        let params = ["alpha", "decay", "epsilon", "gamma", "min_epsilon"];
+        let suggest = |name: &str| closest(name, params.iter().copied(), &mut unlimited());
+        assert_eq!(suggest("gama"), Some("gamma"));
+        assert_eq!(suggest("alpah"), Some("alpha"), "a swap of two neighbours costs one");
+        assert_eq!(suggest("epsilno"), Some("epsilon"));
+        assert_eq!(suggest("zzz"), None);
+        // Too long to compare, and no budget: no suggestion, no work.
+        let long = "a".repeat(100_000);
+        assert_eq!(closest(&long, [long.as_str()].into_iter(), &mut unlimited()), None);
+        assert_eq!(closest("gama", params.iter().copied(), &mut 0), None);
+        // A search the budget cannot finish suggests nothing rather than a worse name.
+        assert_eq!(closest("gama", params.iter().copied(), &mut 2), None);
+        let mut budget = 1_000;
+        assert_eq!(closest("gama", params.iter().copied(), &mut budget), Some("gamma"));
+        assert!(budget < 1_000, "the search was charged");
     }
 }

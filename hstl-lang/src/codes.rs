@@ -339,6 +339,30 @@ Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 mil
 Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
     },
     CodeInfo {
+        code: "HSTL050",
+        name: "constant-formula",
+        severity: E,
+        summary: "a task or an option's `reach` that refers to no state variable",
+        explanation: "Robustness measures how far the state is from flipping a formula. A \
+task, or the `reach` formula of a primitive option, that refers to no state variable \
+(directly or through the lets it uses) has the same robustness at every step: `inf` for \
+`true`, `-inf` for `false`, a constant for `3 > 2`. There is nothing to monitor, and \
+training would have no reward to learn from (an infinite one at that).\n\n\
+Example:\n    let A = true;\n    task always[0..] eventually[0..40] A;\n    option A;\n\n\
+Fix: write the formula over the state, such as `let A = x > 3 && y < 5;`.",
+    },
+    CodeInfo {
+        code: "HSTL051",
+        name: "name-too-long",
+        severity: E,
+        summary: "a name longer than 64 characters",
+        explanation: "Spec, state variable, `let` and option names are at most 64 characters \
+long. Names become file names (`hstlc train` writes `flat_NAME.svg` for each option, and \
+file systems cap a file name at 255 bytes) and labels in tables and pictures.\n\n\
+Example:\n    option ReachTheLoadingDockOnTheFarSideOfTheWarehouseWithoutTouchingShelves;\n\n\
+Fix: shorten the name, and say the rest in a doc comment (`/// ...`).",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,
@@ -381,5 +405,17 @@ without `S`), and the robot never crosses a wall. The task's windows that need t
 then never be kept.\n\n\
 Example: a region inside a closed room of the map.\n\n\
 Fix: open a doorway (`.`) in the wall, add a start cell on the region's side, or move the region.",
+    },
+    CodeInfo {
+        code: "HSTL150",
+        name: "inclusive-bound-on-int",
+        severity: W,
+        summary: "`<=` or `>=` between an `int` variable and a whole number",
+        explanation: "The robustness of `x <= 3` is `3 - x`, the same as that of `x < 3`, and a \
+formula holds where its robustness is above 0. On an `int` variable the bound itself is a \
+cell, where the robustness is exactly 0: `x <= 3` does not hold at `x = 3`, and \
+`2 <= y <= 3` holds in no cell at all, though it reads as the cells 2 and 3.\n\n\
+Example:\n    state { y: int in 0..=14 }\n    let Door = 2 <= y <= 3;\n\n\
+Fix: write strict comparisons one step outside the cells you mean: `1 < y < 4`.",
     },
 ];

@@ -57,6 +57,7 @@ pub mod codes;
 pub mod diagnostic;
 pub mod format;
 pub mod incremental;
+pub mod lints;
 pub mod parser;
 pub mod position;
 pub mod render;
@@ -64,10 +65,14 @@ pub mod syntax;
 pub mod world;
 
 pub use check::{Checked, check, check_parsed};
+
+/// The largest spec text the tools read, in bytes (64 MiB): `hstlc` and the macro's
+/// `include "path"` refuse a larger file before reading all of it.
+pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
 pub use checked::*;
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Location, Position};
 pub use render::{FileDiagnostics, render_concise, render_plain};
-pub use world::{WorldFacts, check_in_world};
+pub use world::{WorldFacts, check_in_world, check_parsed_in_world};

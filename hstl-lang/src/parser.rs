@@ -5,7 +5,7 @@
 use std::ops::Range;
 
 use pest::Parser as _;
-use pest::iterators::Pair;
+use pest::iterators::{Pair, Pairs};
 
 use crate::diagnostic::Diagnostic;
 use crate::syntax::*;
@@ -80,7 +80,11 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
     let deep_comments = diagnostics
         .iter()
         .filter(|d| d.message.starts_with("block comments nested"))
-        .filter_map(|d| comments.iter().find(|c| c.range.start == d.range.start))
+        .filter_map(|d| {
+            // Comments are in source order.
+            let k = comments.partition_point(|c| c.range.start < d.range.start);
+            comments.get(k).filter(|c| c.range.start == d.range.start)
+        })
         .map(|c| c.range.clone())
         .collect();
     let mut p = Splitter {
@@ -100,6 +104,9 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
     Parsed { file: File { specs, comments }, diagnostics }
 }
 
+/// U+FEFF in UTF-8.
+const BOM: &[u8] = "\u{feff}".as_bytes();
+
 pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> Vec<Tok> {
     let b = src.as_bytes();
     let mut toks = Vec::new();
@@ -109,8 +116,11 @@ pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagno
         let start = i;
         if c.is_ascii_whitespace() {
             i += 1;
+        } else if b[i..].starts_with(BOM) {
+            // The grammar reads a byte order mark as whitespace (editors on Windows write one).
+            i += BOM.len();
         } else if b[i..].starts_with(b"//") {
-            while i < b.len() && b[i] != b'\n' {
+            while i < b.len() && b[i] != b'\n' && b[i] != b'\r' {
                 i += 1;
             }
             let is_doc = b[start..].starts_with(b"///") && !b[start..].starts_with(b"////");
@@ -236,9 +246,14 @@ impl Splitter<'_, '_> {
             } else {
                 (t.end..t.end, "end of file".to_string())
             };
+            let help = if found == "`;`" {
+                "remove this `;`: a spec ends at its `}`"
+            } else {
+                "a file holds specs: `spec Name { ... }`"
+            };
             self.diagnostics.push(
                 Diagnostic::new("HSTL001", range, format!("expected `spec`, found {found}"))
-                    .with_help("a file holds specs: `spec Name { ... }`"),
+                    .with_help(help),
             );
             self.i = k + 1;
             while self.i < self.toks.len() && !self.is(self.i, "spec") {
@@ -265,7 +280,7 @@ impl Splitter<'_, '_> {
         let head = if self.has_deep_comment(&head_range) {
             Err(None)
         } else {
-            HstlParser::parse(Rule::spec_head, &self.src[head_range.clone()]).map_err(Some)
+            parse_detailed(Rule::spec_head, &self.src[head_range.clone()]).map_err(Some)
         };
         match head {
             Ok(mut pairs) => {
@@ -283,8 +298,6 @@ impl Splitter<'_, '_> {
             }
             Err(None) => {}
             Err(Some(e)) => {
-                let text = &self.src[head_range.clone()];
-                let e = reparse_with_detail(Rule::spec_head, text).unwrap_or(e);
                 self.diagnostics.push(self.syntax_error(&e, head_range.clone()));
             }
         }
@@ -420,7 +433,9 @@ impl Splitter<'_, '_> {
     /// Whether a block comment nested too deeply for pest lies inside `range` (it was
     /// reported by the lexer).
     fn has_deep_comment(&self, range: &Range<usize>) -> bool {
-        self.deep_comments.iter().any(|c| c.start < range.end && range.start < c.end)
+        // The comments are in source order and do not overlap.
+        let k = self.deep_comments.partition_point(|c| c.end <= range.start);
+        self.deep_comments.get(k).is_some_and(|c| c.start < range.end)
     }
 
     /// Parses the items of `bounds` (token ranges), on several threads when there are
@@ -498,7 +513,7 @@ impl Splitter<'_, '_> {
             return Some(item);
         }
         let text = &self.src[range.clone()];
-        match HstlParser::parse(Rule::item_entry, text) {
+        match parse_detailed(Rule::item_entry, text) {
             Ok(mut pairs) => {
                 let entry = pairs.next()?;
                 let inner = entry.into_inner().find(|p| p.as_rule() != Rule::EOI)?;
@@ -519,7 +534,6 @@ impl Splitter<'_, '_> {
                 }
             }
             Err(e) => {
-                let e = reparse_with_detail(Rule::item_entry, text).unwrap_or(e);
                 diagnostics.push(self.syntax_error(&e, range));
                 None
             }
@@ -557,7 +571,9 @@ impl Splitter<'_, '_> {
             n => format!("{} or {}", expected[..n - 1].join(", "), expected[n - 1]),
         };
         // What was found: the next token in the whole file after the error position.
-        let next = self.toks.iter().find(|t| t.start >= pos);
+        // The tokens are in source order: a binary search keeps many errors linear.
+        let k = self.toks.partition_point(|t| t.start < pos);
+        let next = self.toks.get(k);
         let (range, found) = match next {
             Some(t) if t.start < piece.end => {
                 (t.start..t.end, format!("`{}`", &self.src[t.start..t.end]))
@@ -565,12 +581,52 @@ impl Splitter<'_, '_> {
             Some(t) => (pos..pos, format!("`{}`", &self.src[t.start..t.end])),
             None => (pos..pos, "end of file".to_string()),
         };
-        let message = if e.to_string().contains("limit reached") {
+        let limit = matches!(&e.variant,
+            pest::error::ErrorVariant::CustomError { message } if message.contains("limit reached"));
+        let message = if limit {
             "input too deeply nested to parse".to_string()
         } else {
             format!("expected {what}, found {found}")
         };
-        Diagnostic::new("HSTL001", range, message)
+        let d = Diagnostic::new("HSTL001", range, message);
+        match self.hint(k, &expected, &piece) {
+            Some(help) if !limit => d.with_help(help),
+            _ => d,
+        }
+    }
+
+    /// Help for a syntax error found at token `k` (`expected` in words): a misspelt
+    /// keyword, an interval written with a comma, a `;` too many.
+    fn hint(&self, k: usize, expected: &[String], piece: &Range<usize>) -> Option<String> {
+        let text = |j: usize| self.toks.get(j).map(|t| &self.src[t.start..t.end]);
+        let found = text(k)?;
+        let expects = |w: &str| expected.iter().any(|e| e == w);
+        if found == ";" && expects("`let`") {
+            return Some("remove this `;`: an item ends with its own".into());
+        }
+        if found == "," && expects("`..`") {
+            let number =
+                |j: usize| self.toks.get(j).filter(|t| t.kind == TokKind::Number).map(|_| text(j));
+            let (a, b) = (number(k.wrapping_sub(1)).flatten()?, number(k + 1).flatten()?);
+            return Some(format!(
+                "an interval is a Rust range: `[{a}..={b}]` holds the steps {a} to {b}, \
+                 `[{a}..{b}]` leaves out {b}"
+            ));
+        }
+        // A word just before the error, or at it, that is a keyword misspelt.
+        for j in [k.wrapping_sub(1), k] {
+            let Some(t) = self.toks.get(j).filter(|t| t.kind == TokKind::Word) else { continue };
+            if t.start < piece.start || KEYWORDS.contains(&&self.src[t.start..t.end]) {
+                continue;
+            }
+            let word = &self.src[t.start..t.end];
+            if let Some(kw) =
+                crate::check::closest(word, KEYWORDS.iter().copied(), &mut u64::MAX.clone())
+            {
+                return Some(format!("did you mean `{kw}`?"));
+            }
+        }
+        None
     }
 }
 
@@ -580,7 +636,20 @@ impl Splitter<'_, '_> {
 /// error has been seen; they cost time only on the slow path of reporting.
 fn reparse_with_detail(rule: Rule, text: &str) -> Option<pest::error::Error<Rule>> {
     pest::set_error_detail(true);
+    DETAILS_ON.store(true, std::sync::atomic::Ordering::Release);
     HstlParser::parse(rule, text).err()
+}
+
+/// Whether pest collects error details: set right after pest's own switch, so a parse
+/// that starts after reading `true` here has them.
+static DETAILS_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Parses `text` as `rule`; an error comes with pest's details (parsed a second time with
+/// them if they were off).
+fn parse_detailed(rule: Rule, text: &str) -> Result<Pairs<'_, Rule>, pest::error::Error<Rule>> {
+    let detailed = DETAILS_ON.load(std::sync::atomic::Ordering::Acquire);
+    HstlParser::parse(rule, text)
+        .map_err(|e| if detailed { e } else { reparse_with_detail(rule, text).unwrap_or(e) })
 }
 
 /// Groups the literal tokens pest expected into a few readable words.

@@ -26,8 +26,8 @@ pub struct Location {
     pub end_column: usize,
 }
 
-/// Maps byte offsets of one source text to [`Position`]s. Lines end at `\n`; a `\r`
-/// before it counts as a character of the line.
+/// Maps byte offsets of one source text to [`Position`]s. Lines end at `\n`, `\r\n` or a
+/// lone `\r` (as in LSP); a `\r` before `\n` counts as a character of the line.
 #[derive(Clone, Debug)]
 pub struct LineIndex {
     starts: Vec<usize>,
@@ -37,9 +37,21 @@ pub struct LineIndex {
 impl LineIndex {
     /// Indexes `src`.
     pub fn new(src: &str) -> Self {
+        let bytes = src.as_bytes();
         let mut starts = vec![0];
-        starts.extend(src.bytes().enumerate().filter(|(_, b)| *b == b'\n').map(|(i, _)| i + 1));
+        starts.extend(
+            bytes
+                .iter()
+                .enumerate()
+                .filter(|&(i, &b)| b == b'\n' || b == b'\r' && bytes.get(i + 1) != Some(&b'\n'))
+                .map(|(i, _)| i + 1),
+        );
         LineIndex { starts, len: src.len() }
+    }
+
+    /// How many lines the text has (one more than its line breaks).
+    pub fn line_count(&self) -> usize {
+        self.starts.len()
     }
 
     /// The position of byte `offset` in `src` (the text given to [`LineIndex::new`]).
@@ -88,7 +100,8 @@ impl LineIndex {
         let end = self.starts.get(l + 1).copied().unwrap_or(src.len()).min(src.len());
         let mut units = 0;
         for (i, c) in src[start..end].char_indices() {
-            if units >= utf16_column || c == '\n' {
+            let lone_cr = c == '\r' && src.as_bytes().get(start + i + 1) != Some(&b'\n');
+            if units >= utf16_column || c == '\n' || lone_cr {
                 return start + i;
             }
             units += c.len_utf16();
@@ -106,5 +119,33 @@ impl LineIndex {
             end -= 1;
         }
         start..end
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LineIndex;
+
+    /// `(line, column)` of every byte offset of `src`.
+    fn positions(src: &str) -> Vec<(usize, usize)> {
+        let index = LineIndex::new(src);
+        (0..=src.len()).map(|o| index.position(src, o)).map(|p| (p.line, p.column)).collect()
+    }
+
+    #[test]
+    fn every_line_break_style_starts_a_line() {
+        let want = vec![(1, 1), (1, 2), (2, 1), (2, 2), (3, 1)];
+        assert_eq!(positions("a\nb\n"), want);
+        assert_eq!(positions("a\rb\r"), want);
+        // In `\r\n` the `\r` is the line's last character.
+        assert_eq!(positions("a\r\nb"), vec![(1, 1), (1, 2), (1, 3), (2, 1), (2, 2)]);
+        let src = "a\rb\r\nc\nd";
+        let index = LineIndex::new(src);
+        assert_eq!(index.line_count(), 4);
+        assert_eq!(&src[index.line_range(src, 2)], "b");
+        assert_eq!(index.offset_utf16(src, 0, 5), 1);
+        // Past the end of a `\r\n` line: its `\n`, as LSP clients count.
+        assert_eq!(index.offset_utf16(src, 1, 5), src.find('\n').unwrap());
+        assert_eq!(index.offset(src, 3, 1), src.find('c').unwrap());
     }
 }

@@ -20,7 +20,8 @@ pub struct FileDiagnostics<'a> {
 }
 
 /// The `concise` format: one line per diagnostic, `path:line:col: CODE severity: message`
-/// (1-based, columns in characters), then the [`summary`] line; every line ends with `\n`.
+/// (1-based, columns in characters), its help (if any) indented on the next line as
+/// `  help: ...`, then the [`summary`] line; every line ends with `\n`.
 pub fn render_concise(files: &[FileDiagnostics<'_>]) -> String {
     let mut out = String::new();
     for file in files {
@@ -37,6 +38,9 @@ pub fn render_concise(files: &[FileDiagnostics<'_>]) -> String {
                 d.severity.as_str(),
                 d.message
             );
+            if let Some(help) = &d.help {
+                let _ = writeln!(out, "  help: {help}");
+            }
         }
     }
     out.push_str(&summary(files));

@@ -15,7 +15,7 @@
 use crate::check::{Checked, check_parsed_in};
 use crate::checked::{CheckedSpec, Domain, VarType};
 use crate::diagnostic::Diagnostic;
-use crate::parse;
+use crate::{Parsed, parse};
 
 /// What the checks know of a grid world.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -36,6 +36,12 @@ pub struct WorldFacts {
 /// against `world`. Never fails and never panics.
 pub fn check_in_world(src: &str, world: &WorldFacts) -> Checked {
     check_parsed_in(src, parse(src), Some(world))
+}
+
+/// [`check_in_world`] on a text that is already parsed (see [`crate::check_parsed`]): what
+/// an editor that re-parses only what changed calls.
+pub fn check_parsed_in_world(src: &str, parsed: Parsed, world: &WorldFacts) -> Checked {
+    check_parsed_in(src, parsed, Some(world))
 }
 
 /// Per state of a spec's declared domain (in the order the finite-domain checks number

@@ -190,6 +190,8 @@ fn locations_and_the_concise_format_count_characters() {
     }];
     assert_eq!(
         hstl_lang::render_concise(&files),
-        "s.hstl:2:15: HSTL015 error: spec `S` has no `task`\nchecked 1 file: 1 error, 0 warnings\n"
+        "s.hstl:2:15: HSTL015 error: spec `S` has no `task`\n  \
+         help: add the task, such as `task always[0..] eventually[0..40] A;`\n\
+         checked 1 file: 1 error, 0 warnings\n"
     );
 }

@@ -1,14 +1,15 @@
 //! `hstlc check`: diagnostics of spec files in four formats.
 
-use std::io::{IsTerminal, Read};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
 use hstl::lang::{Diagnostic, Severity};
 
 use crate::cli_error::CliError;
+use crate::output::out;
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
-use crate::{CmdResult, Status, render};
+use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc check`.
 #[derive(Args, Debug)]
@@ -72,21 +73,15 @@ pub fn run(args: &CheckArgs) -> CmdResult {
         Format::Json => render::json(&checked),
         Format::Sarif => render::sarif(&checked),
     };
-    print!("{out}");
+    out!("{out}")?;
     let errors = checked.iter().flat_map(|c| &c.diagnostics).any(|d| d.severity == Severity::Error);
     Ok(if errors { Status::Errors } else { Status::Clean })
 }
 
-/// Reads a file, or standard input for `-`, and names it for reports.
+/// Reads a spec file, or standard input for `-`, and names it for reports (see
+/// [`input::read_text`]: at most [`hstl::lang::MAX_SOURCE_BYTES`], UTF-8, a byte order
+/// mark dropped).
 pub fn read_input(path: &Path, stdin_name: &str) -> Result<(String, String), CliError> {
-    if path == Path::new("-") {
-        let mut text = String::new();
-        std::io::stdin()
-            .read_to_string(&mut text)
-            .map_err(|source| CliError::Read { path: PathBuf::from(stdin_name), source })?;
-        return Ok((stdin_name.to_string(), text));
-    }
-    let text = std::fs::read_to_string(path)
-        .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
-    Ok((path.display().to_string(), text))
+    let input = input::read_text(path, stdin_name, hstl::lang::MAX_SOURCE_BYTES, "spec")?;
+    Ok((input.name, input.text))
 }

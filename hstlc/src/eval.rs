@@ -7,10 +7,11 @@ use clap::Args;
 use hstl::evaluate::{self, Evaluation, MAX_STARTS, MAX_STEPS, Runs};
 use hstl::runtime::optimum::SolveConfig;
 
-use crate::check::read_input;
+use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::study::{mean, range};
 use crate::world_arg::world_words;
-use crate::{CmdResult, Status};
+use crate::{CmdResult, Status, input};
 
 /// Arguments of `hstlc eval`.
 #[derive(Args, Debug)]
@@ -45,17 +46,21 @@ fn flag(name: &str) -> String {
     format!("`--{}`", name.replace('_', "-"))
 }
 
+/// The help of an optimum that cannot be computed.
+pub const SKIP_OPTIMUM: &str = "pass --no-optimum to skip the optimum W*";
+
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
     let runs =
         Runs { starts: args.starts, steps: args.steps, burn_in: args.burn_in, seed: args.seed };
     // The flags first: nothing is read or printed for a run that cannot happen.
     runs.check_budget(flag)?;
-    let (name, text) = read_input(&args.policy, "<stdin>")?;
+    let input::Input { name, text, .. } =
+        input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
     runs.check_burn_in(spec, flag)?;
-    println!(
+    outln!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
         world_words(env, None),
@@ -63,16 +68,16 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         args.starts,
         args.steps,
         args.seed
-    );
+    )?;
     let report = match evaluate::evaluate(&replay, runs)? {
         Evaluation::Robustness { values } => {
-            print_robustness(&values);
+            print_robustness(&values)?;
             return Ok(Status::Clean);
         }
         Evaluation::Window { report } => report,
     };
     let (lo, hi) = range(&report.per_rollout);
-    println!(
+    outln!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
         report.rate,
         args.burn_in,
@@ -81,17 +86,19 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             .map(|r| format!("{} within {}", r.name, r.horizon))
             .collect::<Vec<_>>()
             .join(", ")
-    );
-    print_robustness(&report.robustness);
+    )?;
+    print_robustness(&report.robustness)?;
     if let Some(rate) = evaluate::baseline(&replay, runs)? {
-        println!(
+        outln!(
             "  hand-written baseline (the regions in turn, each by a shortest path around the walls): window rate {rate:.4}"
-        );
+        )?;
     }
     if !args.no_optimum {
         let start = Instant::now();
-        if let Some(optimum) = evaluate::optimum(&replay, SolveConfig::default())? {
-            println!(
+        let optimum = evaluate::optimum(&replay, SolveConfig::default())
+            .map_err(|p| CliError::new(p.message, Some(SKIP_OPTIMUM.into())))?;
+        if let Some(optimum) = optimum {
+            outln!(
                 "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
                 optimum.gain,
                 optimum.lower,
@@ -99,18 +106,18 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                 start.elapsed().as_secs_f64(),
                 if optimum.converged { "" } else { ", not converged" },
                 report.rate / optimum.gain
-            );
+            )?;
         }
     }
     Ok(Status::Clean)
 }
 
-fn print_robustness(values: &[f64]) {
+fn print_robustness(values: &[f64]) -> Result<(), CliError> {
     let mean = mean(values);
     let (lo, hi) = range(values);
     let satisfied = values.iter().filter(|&&v| v > 0.0).count();
-    println!(
+    outln!(
         "  task robustness over each run: mean {mean:.3}, min {lo:.3}, max {hi:.3}; satisfied in {satisfied} of {} runs",
         values.len()
-    );
+    )
 }

@@ -3,6 +3,7 @@
 use clap::Args;
 
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::{CmdResult, Status};
 
 /// Arguments of `hstlc explain`.
@@ -23,6 +24,6 @@ pub fn run(args: &ExplainArgs) -> CmdResult {
             Some(format!("known codes: {}", known.join(", "))),
         ));
     };
-    println!("{} ({}): {}\n\n{}", info.code, info.name, info.summary, info.explanation.trim_end());
+    outln!("{} ({}): {}\n\n{}", info.code, info.name, info.summary, info.explanation.trim_end())?;
     Ok(Status::Clean)
 }

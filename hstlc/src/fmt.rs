@@ -2,19 +2,22 @@
 //!
 //! Without flags it prints the formatted text of each input to standard output. `--check`
 //! prints nothing but the names of the files that would change and exits 1 when there
-//! is one; `--write` rewrites the files that change in place (a whole new file or none).
+//! is one; `--write` rewrites the files that change, whole or not at all, as the same
+//! files: a symbolic link's target is rewritten, permissions and hard links are kept (see
+//! `write_whole`), and a byte order mark stays.
 //! A file with syntax errors is left as it is: its errors go to standard error, rendered
 //! as `hstlc check` renders them, and the exit status is 1. An unreadable input stops the
 //! run before anything is printed (exit status 2).
 
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use crate::check::{Checked, read_input};
+use crate::check::Checked;
 use crate::cli_error::CliError;
-use crate::{CmdResult, Status, render};
+use crate::output::{err, out, outln};
+use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc fmt`.
 #[derive(Args, Debug)]
@@ -39,11 +42,14 @@ pub fn run(args: &FmtArgs) -> CmdResult {
     let inputs = args
         .files
         .iter()
-        .map(|path| read_input(path, &args.stdin_filename).map(|(name, text)| (path, name, text)))
+        .map(|path| {
+            input::read_text(path, &args.stdin_filename, hstl::lang::MAX_SOURCE_BYTES, "spec")
+                .map(|i| (path, i))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let mut status = Status::Clean;
     let mut broken = Vec::new();
-    for (path, name, source) in inputs {
+    for (path, input::Input { name, text: source, bom }) in inputs {
         let formatted = match hstl::lang::format(&source) {
             Ok(text) => text,
             Err(diagnostics) => {
@@ -55,30 +61,138 @@ pub fn run(args: &FmtArgs) -> CmdResult {
         let is_stdin = path.as_path() == Path::new("-");
         if args.check {
             if formatted != source {
-                println!("{name}");
+                outln!("{name}")?;
                 status = Status::Errors;
             }
         } else if args.write && !is_stdin {
             if formatted != source {
-                write_whole(path, &formatted)?;
+                write_whole(path, &formatted, bom)?;
             }
         } else {
-            print!("{formatted}");
+            out!("{formatted}")?;
         }
     }
     if !broken.is_empty() {
-        eprint!("{}", render::full(&broken, std::io::stderr().is_terminal()));
+        err!("{}", render::full(&broken, std::io::stderr().is_terminal()));
     }
     Ok(status)
 }
 
-/// Writes `text` to a temporary file beside `path`, then renames it over `path`.
-fn write_whole(path: &Path, text: &str) -> Result<(), CliError> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.hstlc-fmt.tmp"));
-    let result = std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, path));
-    result.map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        CliError::Write { path: path.to_path_buf(), source }
-    })
+/// Rewrites the file `path` with `text` (after the byte order mark it had), whole or not at
+/// all, as the same file:
+/// - through a symbolic link the file it points to is rewritten, and the link stays;
+/// - the file keeps its permissions (and its owner and group, where that is allowed);
+/// - a file with one name gets the text in a new temporary file beside it (created
+///   exclusively, under a name no other file has), synced, then renamed over it;
+/// - a file with several hard links is rewritten in place, so that all its names see the
+///   new text; its old text waits in a hidden backup beside it until the new text is on
+///   disk, and the error names the backup if the rewrite fails.
+fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
+    let fail = |source| CliError::Write { path: path.to_path_buf(), source };
+    let real = std::fs::canonicalize(path).map_err(fail)?;
+    let meta = std::fs::metadata(&real).map_err(fail)?;
+    let mut bytes = Vec::with_capacity(text.len() + 3);
+    if bom {
+        bytes.extend_from_slice("\u{feff}".as_bytes());
+    }
+    bytes.extend_from_slice(text.as_bytes());
+    if links(&meta) > 1 {
+        return rewrite_in_place(path, &real, &bytes);
+    }
+    let (mut tmp, tmp_path) = create_beside(&real, "tmp").map_err(fail)?;
+    let written = (|| {
+        tmp.write_all(&bytes)?;
+        std::fs::set_permissions(&tmp_path, meta.permissions())?;
+        keep_owner(&tmp, &meta);
+        tmp.sync_all()?;
+        std::fs::rename(&tmp_path, &real)
+    })();
+    if let Err(source) = written {
+        let _ = std::fs::remove_file(&tmp_path);
+        return Err(fail(source));
+    }
+    if let Some(dir) = real.parent() {
+        crate::artifacts::sync_dir(dir);
+    }
+    Ok(())
+}
+
+/// Overwrites a hard-linked file in place, its old text kept in a backup until done.
+fn rewrite_in_place(path: &Path, real: &Path, bytes: &[u8]) -> Result<(), CliError> {
+    let fail = |source| CliError::Write { path: path.to_path_buf(), source };
+    let old = std::fs::read(real).map_err(fail)?;
+    let (mut backup, backup_path) = create_beside(real, "orig").map_err(fail)?;
+    if let Err(source) = backup.write_all(&old).and_then(|()| backup.sync_all()) {
+        let _ = std::fs::remove_file(&backup_path);
+        return Err(fail(source));
+    }
+    let rewritten = (|| {
+        let mut file = std::fs::OpenOptions::new().write(true).open(real)?;
+        file.write_all(bytes)?;
+        file.set_len(bytes.len() as u64)?;
+        file.sync_all()
+    })();
+    match rewritten {
+        Ok(()) => {
+            let _ = std::fs::remove_file(&backup_path);
+            Ok(())
+        }
+        Err(source) => Err(CliError::new(
+            format!("cannot write `{}`: {source}", path.display()),
+            Some(format!("its text before formatting is in `{}`", backup_path.display())),
+        )),
+    }
+}
+
+/// A new file beside `real`, `.NAME.hstlc-fmt-<pid>-<n>.<ext>`, created exclusively (with
+/// the permissions of `real` on Unix, so that its text is never more readable).
+fn create_beside(real: &Path, ext: &str) -> std::io::Result<(std::fs::File, PathBuf)> {
+    let dir = real.parent().unwrap_or(Path::new("."));
+    let name = real.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true).create_new(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
+        let mode = std::fs::metadata(real).map_or(0o600, |m| m.permissions().mode() & 0o777);
+        options.mode(mode);
+    }
+    for n in 0..1000 {
+        let path = dir.join(format!(".{name}.hstlc-fmt-{}-{n}.{ext}", std::process::id()));
+        match options.open(&path) {
+            Ok(file) => return Ok((file, path)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name"))
+}
+
+/// How many hard links the file has (1 where the platform does not say).
+fn links(meta: &std::fs::Metadata) -> u64 {
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::MetadataExt::nlink(meta)
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = meta;
+        1
+    }
+}
+
+/// Gives `file` the owner and group of `meta`, where this process may (root may; others
+/// keep their own user, and the group when they belong to it).
+fn keep_owner(file: &std::fs::File, meta: &std::fs::Metadata) {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if std::os::unix::fs::fchown(file, Some(meta.uid()), Some(meta.gid())).is_err() {
+            let _ = std::os::unix::fs::fchown(file, None, Some(meta.gid()));
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (file, meta);
+    }
 }

@@ -1,7 +1,8 @@
 //! `hstlc`: the hstl command line.
 //!
 //! Exit status: 0 when the command succeeded (warnings allowed), 1 when the input has
-//! errors, 2 when the command could not run (a missing file, a bad flag).
+//! errors, 2 when the command could not run (a missing file, a bad flag, a failed write),
+//! 141 when the reader of standard output stopped reading (see [`output`]).
 
 mod artifacts;
 mod check;
@@ -9,8 +10,9 @@ mod cli_error;
 mod eval;
 mod explain;
 mod fmt;
-mod lsp;
+mod input;
 mod monitor;
+mod output;
 mod render;
 mod spec_file;
 mod study;
@@ -57,27 +59,48 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => {
             // clap prints help and version to stdout with status 0, usage errors with 2.
-            let _ = e.print();
-            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+            let status = if e.use_stderr() { 2 } else { 0 };
+            return match e.print() {
+                Ok(()) => ExitCode::from(status),
+                Err(source) => exit_on(&output::stdout_error(source)),
+            };
         }
     };
     let result = match cli.command {
         Command::Check(args) => check::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Fmt(args) => fmt::run(&args),
-        Command::Lsp => lsp::run(),
+        Command::Lsp => lsp(),
         Command::Monitor(args) => monitor::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Eval(args) => eval::run(&args),
         Command::Study(args) => study::run(&args),
     };
-    match result {
+    // What standard output still buffers is written before the status is decided.
+    match result.and_then(|status| output::flush().map(|()| status)) {
         Ok(status) => status.into(),
-        Err(e) => {
-            eprintln!("{}", render::cli_error(&e));
-            ExitCode::from(2)
-        }
+        Err(e) => exit_on(&e),
     }
+}
+
+/// `hstlc lsp`: status 0 after `shutdown` then `exit`, 1 when the client exits without
+/// `shutdown` or goes away.
+fn lsp() -> CmdResult {
+    match hstlc::lsp::run() {
+        Ok(ending) if ending.is_clean() => Ok(Status::Clean),
+        Ok(_) => Ok(Status::Errors),
+        Err(e) => Err(CliError::new(format!("cannot start the language server: {e}"), None)),
+    }
+}
+
+/// The exit status for an error that stopped a command: quiet status 141 when the reader of
+/// standard output went away (see [`output`]), else the error on standard error and 2.
+fn exit_on(e: &CliError) -> ExitCode {
+    if output::is_broken_pipe(e) {
+        return ExitCode::from(output::BROKEN_PIPE_STATUS);
+    }
+    output::errln!("{}", render::cli_error(e));
+    ExitCode::from(2)
 }
 
 /// How a command that ran went.

@@ -1,18 +1,30 @@
-//! `hstlc monitor`: the robustness of a recorded trace.
+//! `hstlc monitor`: the robustness of recorded traces, or of a stream as it arrives.
+//!
+//! One trace: the value at step 0, or `t,robustness` rows with `--signal`. Several traces
+//! (or a folder of `.csv` files): one `trace,robustness` row each, scored on every core.
+//! `--online`: one trace read row by row (a pipe), each step's row printed and flushed as
+//! soon as its value is final; the same rows as `--signal`.
 //!
 //! Exit status: 0 with the result on standard output; 1 when the spec has errors (its
 //! diagnostics go to standard error, as `check` renders them); 2 when the command could not
 //! run: an unreadable file, a malformed trace, an unknown `--formula` or `--spec`. On 1 and 2
-//! nothing is printed to standard output.
+//! nothing is printed to standard output, except that `--online` has already printed the
+//! rows it could before a malformed row.
 
-use std::io::Write;
-use std::path::PathBuf;
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use clap::Args;
+use hstl::lang::{CheckedSpec, Domain, VarType};
 use hstl::monitor::Monitor;
 
-use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::output::{errln, outln};
+use crate::trace_csv::{
+    Column, ColumnKind, Limit, MAX_TRACE_VALUES, ReadError, TraceRead, TraceRows,
+};
 use crate::{CmdResult, Status, spec_file, trace_csv};
 
 /// Arguments of `hstlc monitor`.
@@ -22,32 +34,58 @@ pub struct MonitorArgs {
     #[arg(value_name = "SPEC")]
     pub spec: PathBuf,
     /// The trace: a CSV file whose header names the state variables (`-` reads standard
-    /// input).
-    #[arg(long, value_name = "FILE.csv")]
-    pub trace: PathBuf,
+    /// input). Give it more than once, or a folder (its `.csv` files), to score many
+    /// traces: one `trace,robustness` row each.
+    #[arg(long, value_name = "FILE.csv|DIR", required = true)]
+    pub trace: Vec<PathBuf>,
     /// Score this `let` instead of the task.
     #[arg(long, value_name = "NAME")]
     pub formula: Option<String>,
     /// Print `t,robustness` rows for every step instead of the value at step 0.
     #[arg(long)]
     pub signal: bool,
+    /// Read the trace as a stream (a pipe from a live system) and print each step's
+    /// `t,robustness` row as soon as its value is final, in memory bounded by the formula's
+    /// horizon.
+    #[arg(long, conflicts_with = "signal")]
+    pub online: bool,
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
     pub spec_name: Option<String>,
+    /// Threads that score a batch of traces (default: one per core).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
+    pub threads: Option<u16>,
 }
+
+/// The most trace files one batch scores.
+pub const MAX_BATCH_TRACES: usize = 100_000;
 
 /// Runs `hstlc monitor`.
 pub fn run(args: &MonitorArgs) -> CmdResult {
-    if args.spec.as_os_str() == "-" && args.trace.as_os_str() == "-" {
+    let stdin_traces = args.trace.iter().filter(|t| t.as_os_str() == "-").count();
+    if args.spec.as_os_str() == "-" && stdin_traces > 0 {
         return Err(CliError::new(
             "the spec and the trace cannot both come from standard input",
             Some("pass at least one of them as a file".to_string()),
         ));
     }
+    if stdin_traces > 1 {
+        return Err(CliError::new(
+            "standard input (`--trace -`) can be read only once",
+            Some("give `--trace -` once, and the other traces as files".to_string()),
+        ));
+    }
+    let traces = trace_paths(&args.trace)?;
+    let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
+    if args.online && batch {
+        return Err(CliError::new(
+            "`--online` reads one trace as a stream",
+            Some("give one `--trace` (a file or `-` for a pipe) with `--online`".to_string()),
+        ));
+    }
     let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), None)? else {
         return Ok(Status::Errors);
     };
-    let (trace_name, trace_text) = read_input(&args.trace, "<stdin>")?;
     let (spec, name) = (&loaded.spec, &loaded.file);
     let monitor = Monitor::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {
@@ -58,10 +96,20 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
-    let vars: Vec<&str> = monitor.state_vars().iter().map(String::as_str).collect();
-    let trace = trace_csv::read_trace(&trace_text, &vars).map_err(|e| {
-        CliError::new(format!("{trace_name}:{}:{}: {}", e.line, e.column, e.message), e.help)
-    })?;
+    let columns = columns(spec);
+    if args.online {
+        return online(&monitor, &columns, &traces[0], spec, args.formula.as_deref());
+    }
+    if batch {
+        let threads = args.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, usize::from),
+            usize::from,
+        );
+        return score_batch(&monitor, &columns, &traces, args.signal, threads, spec);
+    }
+    let read = read_trace(&traces[0], &columns)?;
+    note_ignored(&read.ignored, spec);
+    let trace = read.trace;
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
@@ -73,11 +121,258 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         writeln!(out, "{}", monitor.robustness_of_trace(&trace))
     }
     .and_then(|()| out.flush());
-    match written {
-        // A reader that stopped early (`| head`) is not an error.
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(CliError::Write { path: PathBuf::from("<stdout>"), source: e })
+    // A signal can be long: it goes through its own buffer, its errors as all output's.
+    written.map_err(crate::output::stdout_error)?;
+    Ok(Status::Clean)
+}
+
+/// The trace files to score: each `--trace` as given, a folder as its `.csv` files in name
+/// order.
+fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+    let mut paths = Vec::new();
+    for path in given {
+        if !path.is_dir() {
+            paths.push(path.clone());
+            continue;
         }
-        _ => Ok(Status::Clean),
+        let entries = std::fs::read_dir(path)
+            .map_err(|source| CliError::Read { path: path.clone(), source })?;
+        let mut found = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|source| CliError::Read { path: path.clone(), source })?;
+            let p = entry.path();
+            if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) && !p.is_dir() {
+                found.push(p);
+            }
+            if found.len() > MAX_BATCH_TRACES {
+                break;
+            }
+        }
+        if found.is_empty() {
+            return Err(CliError::new(
+                format!("`{}` holds no `.csv` file", path.display()),
+                Some("pass a folder of CSV traces, or the trace files themselves".to_string()),
+            ));
+        }
+        found.sort();
+        paths.extend(found);
+    }
+    if paths.len() > MAX_BATCH_TRACES {
+        return Err(CliError::new(
+            format!("more than {MAX_BATCH_TRACES} traces in one batch"),
+            Some("score them in several runs".to_string()),
+        ));
+    }
+    Ok(paths)
+}
+
+/// The CSV columns the spec's state variables need.
+fn columns(spec: &CheckedSpec) -> Vec<Column<'_>> {
+    spec.state_vars
+        .iter()
+        .map(|v| Column {
+            name: &v.name,
+            kind: match (v.ty, &v.domain) {
+                (_, Domain::Int { lo, hi }) => ColumnKind::Int(Some((*lo, *hi))),
+                (VarType::Int, _) => ColumnKind::Int(None),
+                _ => ColumnKind::Real,
+            },
+        })
+        .collect()
+}
+
+/// Says once which columns of a trace the spec does not name.
+fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
+    if ignored.is_empty() {
+        return;
+    }
+    let names: Vec<String> = ignored.iter().map(|n| format!("`{n}`")).collect();
+    let (what, verb) = if names.len() == 1 {
+        ("column", "is not a state variable")
+    } else {
+        ("columns", "are not state variables")
+    };
+    errln!("note: {what} {} {verb} of `{}`: ignored", names.join(", "), spec.name);
+}
+
+/// The name a trace path is reported by.
+fn trace_name(path: &Path) -> String {
+    if path == Path::new("-") { "<stdin>".to_string() } else { path.display().to_string() }
+}
+
+/// A reader's error, at the trace's `name:line:column`.
+fn read_error(name: &str, e: ReadError) -> CliError {
+    match e {
+        ReadError::Io(source) => CliError::Read { path: PathBuf::from(name), source },
+        ReadError::Csv(e) => {
+            CliError::new(format!("{name}:{}:{}: {}", e.line, e.column, e.message), e.help)
+        }
+    }
+}
+
+/// Reads the trace at `path` (standard input for `-`) for the state variables of `spec`.
+fn read_trace(path: &Path, columns: &[Column<'_>]) -> Result<TraceRead, CliError> {
+    let name = trace_name(path);
+    let read = if path == Path::new("-") {
+        trace_csv::read_trace(std::io::stdin().lock(), columns)
+    } else {
+        let file = std::fs::File::open(path)
+            .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+        trace_csv::read_trace(BufReader::new(file), columns)
+    };
+    read.map_err(|e| read_error(&name, e))
+}
+
+/// Scores every trace on `threads` threads, then prints one `trace,robustness` row per
+/// trace in the order given (`trace,t,robustness` per step with `--signal`). A trace that
+/// cannot be read stops the batch before anything is printed.
+fn score_batch(
+    monitor: &Monitor,
+    columns: &[Column<'_>],
+    traces: &[PathBuf],
+    signal: bool,
+    threads: usize,
+    spec: &CheckedSpec,
+) -> CmdResult {
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    type Scored = Result<(Vec<f64>, Vec<String>), CliError>;
+    let results: Vec<Mutex<Option<Scored>>> = traces.iter().map(|_| Mutex::new(None)).collect();
+    let work = || {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= traces.len() || failed.load(Ordering::Relaxed) {
+                break;
+            }
+            let scored = read_trace(&traces[i], columns).map(|read| {
+                let values = if signal {
+                    monitor.signal_of_trace(&read.trace)
+                } else {
+                    vec![monitor.robustness_of_trace(&read.trace)]
+                };
+                (values, read.ignored)
+            });
+            failed.fetch_or(scored.is_err(), Ordering::Relaxed);
+            *results[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(scored);
+        }
+    };
+    std::thread::scope(|scope| {
+        for _ in 1..threads.min(traces.len()) {
+            // A thread that cannot start leaves its share to the others.
+            let _ = std::thread::Builder::new().spawn_scoped(scope, work);
+        }
+        work();
+    });
+    let mut rows = Vec::with_capacity(traces.len());
+    let mut ignored: Vec<String> = Vec::new();
+    for (path, slot) in traces.iter().zip(results) {
+        match slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(Ok((values, names))) => {
+                for n in names {
+                    if !ignored.contains(&n) {
+                        ignored.push(n);
+                    }
+                }
+                rows.push((path, values));
+            }
+            Some(Err(e)) => return Err(e),
+            // Not scored: an earlier error stopped the batch; it is reported above.
+            None => {}
+        }
+    }
+    note_ignored(&ignored, spec);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let written = if signal {
+        writeln!(out, "trace,t,robustness").and_then(|()| {
+            rows.iter().try_for_each(|(path, values)| {
+                let name = csv_field(&trace_name(path));
+                values.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{name},{t},{v}"))
+            })
+        })
+    } else {
+        writeln!(out, "trace,robustness").and_then(|()| {
+            rows.iter().try_for_each(|(path, values)| {
+                writeln!(out, "{},{}", csv_field(&trace_name(path)), values[0])
+            })
+        })
+    }
+    .and_then(|()| out.flush());
+    written.map_err(crate::output::stdout_error)?;
+    Ok(Status::Clean)
+}
+
+/// `--online`: reads the trace row by row and prints each step's `t,robustness` as soon
+/// as it is final, flushed per line; at the end of the input, the steps still open (their
+/// windows clipped at the end, as `--signal` computes them).
+fn online(
+    monitor: &Monitor,
+    columns: &[Column<'_>],
+    path: &Path,
+    spec: &CheckedSpec,
+    formula: Option<&str>,
+) -> CmdResult {
+    let name = trace_name(path);
+    let stdin;
+    let file;
+    let reader: Box<dyn BufRead> = if path == Path::new("-") {
+        stdin = std::io::stdin();
+        Box::new(stdin.lock())
+    } else {
+        file = std::fs::File::open(path)
+            .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+        Box::new(BufReader::new(file))
+    };
+    let mut rows =
+        TraceRows::new(reader, columns, Limit::Stream).map_err(|e| read_error(&name, e))?;
+    note_ignored(&rows.ignored, spec);
+    let mut live = monitor.online();
+    let what = formula.map_or_else(|| "the task".to_string(), |f| format!("`{f}`"));
+    if live.horizon().is_none() {
+        errln!(
+            "note: {what} has an unbounded future operator (such as `always[0..]`): no step's \
+             value is final before the input ends, so the values follow at its end, and the \
+             stream may hold at most {} values",
+            MAX_TRACE_VALUES
+        );
+    }
+    outln!("t,robustness")?;
+    let mut state = vec![0.0; columns.len()];
+    let bounded = live.horizon().is_some();
+    while let Some(line) = rows.next_row(&mut state).map_err(|e| read_error(&name, e))? {
+        if !bounded && (live.steps() + 1).saturating_mul(columns.len().max(1)) > MAX_TRACE_VALUES {
+            return Err(CliError::new(
+                format!(
+                    "{name}:{line}:1: the stream holds more than {MAX_TRACE_VALUES} values, and \
+                     {what} keeps every state until the input ends"
+                ),
+                Some(
+                    "monitor a formula with bounded windows (`--formula` with a `let`), or \
+                     end the stream sooner"
+                        .to_string(),
+                ),
+            ));
+        }
+        let verdict = live
+            .push(&state)
+            .map_err(|e| CliError::new(format!("{name}:{line}:1: {e}"), e.help()))?;
+        if let Some(v) = verdict {
+            outln!("{},{}", v.step, v.value)?;
+        }
+    }
+    if live.steps() == 0 {
+        return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
+    }
+    for v in live.finish() {
+        outln!("{},{}", v.step, v.value)?;
+    }
+    Ok(Status::Clean)
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
     }
 }

@@ -9,6 +9,7 @@ use hstl::runtime::TaskSpec;
 
 use crate::check::{Checked, read_input};
 use crate::cli_error::CliError;
+use crate::output::err;
 use crate::render;
 use crate::world_arg::LoadedWorld;
 
@@ -49,8 +50,10 @@ pub fn load(
         Ok(loaded) => Ok(Some(LoadedSpec { file, source, spec: loaded.spec })),
         Err(LoadError::Invalid(diagnostics)) => {
             let report = Checked { name: file, source, diagnostics };
-            let colour = std::io::stderr().is_terminal();
-            eprint!("{}", render::full(std::slice::from_ref(&report), colour));
+            err!(
+                "{}",
+                render::full(std::slice::from_ref(&report), std::io::stderr().is_terminal())
+            );
             Ok(None)
         }
         Err(e) => Err(CliError::new(format!("{file}: {e}"), e.help("`--spec NAME`"))),

@@ -8,8 +8,9 @@ use clap::Args;
 use hstl::runtime::eval::WindowConfig;
 use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
-use crate::artifacts::{self, OutFile};
+use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
+use crate::output::outln;
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
 
@@ -28,8 +29,9 @@ pub struct TrainArgs {
     /// Training episodes (overrides the spec's `learn { episodes }`; at most 10,000,000).
     #[arg(long, value_name = "N", value_parser = episodes_flag())]
     pub episodes: Option<usize>,
-    /// The folder to write `policy.json`, `curve.csv` and the pictures into.
-    #[arg(long, value_name = "DIR", default_value = "out")]
+    /// The folder to write `policy.json`, `curve.csv` and the pictures into (replaced as a
+    /// whole: it must be new, empty, or an earlier run's).
+    #[arg(long, value_name = "DIR", default_value = "out/train")]
     pub out: PathBuf,
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
@@ -61,6 +63,8 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         spec.learn.episodes = e;
     }
     let env = &world.world;
+    // Before the long part: a folder another run holds is refused at once.
+    let out = OutDir::lock(&args.out)?;
     let bar = progress_bar(spec.learn.episodes as u64);
     let outcome = train(&spec, env, args.seed, &loaded.file, |episode, reward| {
         bar.set_position(episode as u64 + 1);
@@ -74,16 +78,30 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     ];
     let mut rng = seeded_rng(args.seed ^ PICTURE_SEED);
     let regions = artifacts::pictured_regions(&loaded)?;
-    files.extend(artifacts::agent_pictures(&spec, env, &regions, &outcome.agent, &mut rng)?);
+    let captions = artifacts::Captions {
+        subject: artifacts::subject(&loaded.file, args.spec_name.as_deref()),
+        note: format!("seed {}", args.seed),
+    };
+    let skipped = artifacts::too_large_to_draw(env);
+    if skipped.is_none() {
+        files.extend(artifacts::agent_pictures(
+            &spec,
+            env,
+            &regions,
+            &outcome.agent,
+            &captions,
+            &mut rng,
+        )?);
+    }
     files.push(artifacts::curve_picture(
-        &format!("Learning curve of {} (seed {})", spec.name, args.seed),
+        &format!("{}: learning curve\n{}", captions.subject, captions.note),
         std::slice::from_ref(&outcome.curve),
     )?);
     let window = window_report(&spec, env, &outcome.agent, args.seed)?;
-    let written = artifacts::write_all(&args.out, &files)?;
+    let written = out.write(&files)?;
 
     let tail = tail_mean(&outcome.curve, 100);
-    println!(
+    outln!(
         "trained `{}` on {} (seed {}): {} episodes, {} steps in {:.2} s ({:.1}M steps/s)",
         spec.name,
         world.words(),
@@ -92,19 +110,22 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         outcome.steps,
         outcome.secs,
         outcome.steps as f64 / outcome.secs.max(1e-9) / 1e6
-    );
-    println!(
+    )?;
+    outln!(
         "  reward per episode: {tail:.2} (mean of the last {} episodes)",
         outcome.curve.len().min(100)
-    );
+    )?;
     if let Some((rate, robustness)) = window {
-        println!(
+        outln!(
             "  window rate {rate:.3} over {} greedy runs of {} steps; task robustness {robustness:.2} (mean over runs)",
             WindowConfig::default().starts,
             WindowConfig::default().steps
-        );
+        )?;
     }
-    println!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files));
+    outln!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files))?;
+    if let Some(why) = skipped {
+        outln!("  {why}")?;
+    }
     Ok(Status::Clean)
 }
 

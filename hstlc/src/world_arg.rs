@@ -4,8 +4,8 @@ use std::path::Path;
 
 use hstl::world::GridWorld;
 
-use crate::check::read_input;
 use crate::cli_error::CliError;
+use crate::input;
 
 /// A world and how messages name it.
 pub struct LoadedWorld {
@@ -35,8 +35,16 @@ impl LoadedWorld {
             let unknown = hstl::world::unknown(arg);
             return Err(CliError::new(unknown.message, unknown.help));
         }
-        let (file, text) = read_input(path, "<stdin>")
-            .map_err(|e| CliError::new(e.to_string(), Some(hstl::world::read_help())))?;
+        let input::Input { name: file, text, .. } =
+            input::read_text(path, "<stdin>", hstl::lang::MAX_SOURCE_BYTES, "world file").map_err(
+                |e| match e {
+                    // Too large or not UTF-8 say how to fix it already.
+                    CliError::Read { .. } => {
+                        CliError::new(e.to_string(), Some(hstl::world::read_help()))
+                    }
+                    other => other,
+                },
+            )?;
         let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
         let world = hstl::world::from_file(&text, &file, &stem)
             .map_err(|p| CliError::new(p.message, p.help))?;

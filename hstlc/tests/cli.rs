@@ -43,7 +43,8 @@ const CASES: &[Case] = &[
         "monitor_let_signal",
         &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "A", "--signal"],
     ),
-    case("monitor_infinite", &["monitor", "surveillance.hstl", "--trace", "infinite.csv"]),
+    case("monitor_infinite", &["monitor", "reals.hstl", "--trace", "infinite.csv"]),
+    case("monitor_int_not_whole", &["monitor", "surveillance.hstl", "--trace", "infinite.csv"]),
     case(
         "monitor_unknown_formula",
         &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--formula", "Nope"],
@@ -72,6 +73,35 @@ const CASES: &[Case] = &[
         args: &["monitor", "two_specs.hstl", "--spec", "First", "--trace", "-", "--signal"],
         stdin: "x\n0\n9\n1\n",
     },
+    // many traces: one row each, in the order given (a folder: its `.csv` files by name)
+    case(
+        "monitor_batch",
+        &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--trace", "traces"],
+    ),
+    case(
+        "monitor_batch_signal",
+        &["monitor", "surveillance.hstl", "--trace", "traces", "--formula", "A", "--signal"],
+    ),
+    case(
+        "monitor_batch_bad_trace",
+        &["monitor", "surveillance.hstl", "--trace", "traces", "--trace", "missing_column.csv"],
+    ),
+    case("monitor_batch_empty_folder", &["monitor", "surveillance.hstl", "--trace", "worlds"]),
+    case("monitor_stdin_twice", &["monitor", "surveillance.hstl", "--trace", "-", "--trace", "-"]),
+    // a stream: `t,robustness` rows as soon as they are final
+    Case {
+        name: "monitor_online_let",
+        args: &["monitor", "surveillance.hstl", "--trace", "-", "--online", "--formula", "A"],
+        stdin: "x,y\n5,12\n0,0\n6,11\n",
+    },
+    case(
+        "monitor_online_unbounded",
+        &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--online"],
+    ),
+    case(
+        "monitor_online_batch",
+        &["monitor", "surveillance.hstl", "--trace", "traces", "--online"],
+    ),
     // train and eval: the errors (successful runs are in tests/train_eval.rs)
     case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
     case("train_float_state", &["train", "float_state.hstl", "--out", "unused"]),
@@ -214,4 +244,81 @@ fn json_and_sarif_are_valid() {
     let sarif = run("sarif");
     assert_eq!(sarif["version"], "2.1.0");
     assert_eq!(sarif["runs"][0]["results"].as_array().map(Vec::len), Some(items.len()));
+}
+
+/// `monitor --online` prints a step's row as soon as its value is final: the first rows
+/// arrive while the input is still open (a pipe from a live system).
+#[test]
+fn online_rows_arrive_before_the_input_ends() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/cli");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["monitor", "surveillance.hstl", "--trace", "-", "--online", "--formula", "A"])
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let mut stdin = child.stdin.take().expect("piped");
+    let stdout = child.stdout.take().expect("piped");
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stdout).lines() {
+            if tx.send(line.expect("utf-8")).is_err() {
+                break;
+            }
+        }
+    });
+    let wait = std::time::Duration::from_secs(60);
+    stdin.write_all(b"x,y\n5,12\n").expect("write");
+    stdin.flush().expect("flush");
+    assert_eq!(rx.recv_timeout(wait).expect("the header while the input is open"), "t,robustness");
+    assert_eq!(rx.recv_timeout(wait).expect("step 0 while the input is open"), "0,2");
+    stdin.write_all(b"0,0\n").expect("write");
+    stdin.flush().expect("flush");
+    assert_eq!(rx.recv_timeout(wait).expect("step 1 while the input is open"), "1,-10");
+    drop(stdin);
+    assert_eq!(child.wait().expect("ends").code(), Some(0));
+}
+
+/// `--online` prints exactly the rows of `--signal`, for bounded and unbounded formulas,
+/// `until` and nested windows, on a trace longer than every window.
+#[test]
+fn online_rows_are_the_signal() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let spec = "spec S {
+        state { x: float, y: float }
+        let P = x > 0.5;
+        let Q = y < -0.2;
+        let W = always[0..=3] (eventually[2..=5] P || Q);
+        let U = P until[1..=4] Q;
+        let F = eventually[0..] (P && Q);
+        task always[0..] eventually[0..=6] (P && !Q);
+    }";
+    std::fs::write(dir.path().join("s.hstl"), spec).expect("write spec");
+    // A deterministic wiggle: no random numbers needed.
+    let mut csv = String::from("x,y\n");
+    for t in 0..200u32 {
+        let t = f64::from(t);
+        csv.push_str(&format!("{},{}\n", (t * 0.37).sin(), (t * 0.11).cos() * 0.6));
+    }
+    std::fs::write(dir.path().join("t.csv"), &csv).expect("write trace");
+    let run = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+            .args(["monitor", "s.hstl", "--trace", "t.csv"])
+            .args(extra)
+            .current_dir(dir.path())
+            .output()
+            .expect("hstlc runs");
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).expect("utf-8")
+    };
+    for formula in [None, Some("W"), Some("U"), Some("F"), Some("P")] {
+        let pick: Vec<&str> = formula.map_or(vec![], |f| vec!["--formula", f]);
+        let signal = run(&[pick.as_slice(), &["--signal"]].concat());
+        let online = run(&[pick.as_slice(), &["--online"]].concat());
+        assert_eq!(online, signal, "{formula:?}");
+        assert_eq!(signal.lines().count(), 201);
+    }
 }

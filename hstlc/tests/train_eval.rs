@@ -132,26 +132,161 @@ fn eval_scores_other_tasks_by_their_robustness() {
     assert!(!report.contains("window rate"), "{report}");
 }
 
+/// An SVG without its texts: what a picture draws, whatever its titles say.
+fn drawing(svg: &str) -> String {
+    let mut out = String::new();
+    let mut rest = svg;
+    while let Some(start) = rest.find("<text") {
+        out.push_str(&rest[..start]);
+        let end = rest[start..].find("</text>").map_or(rest.len(), |e| start + e + "</text>".len());
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// `study` writes each spec's policy and pictures from its median seed by window rate (the
+/// lower seed on a tie), says which in `policy.json` and under the pictures' titles, and
+/// they are what `train --seed` of that seed draws.
 #[test]
-fn study_writes_seed_zero_as_train_does() {
+fn study_writes_the_median_seed_as_train_does() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (study, single) = (dir.path().join("study"), dir.path().join("single"));
     let s = hstlc(&[
         "study",
         "small.hstl",
         "--seeds",
-        "2",
+        "3",
         "--no-optimum",
         "--out",
         study.to_str().expect("utf-8"),
     ]);
     assert_eq!(s.status.code(), Some(0), "{}", String::from_utf8_lossy(&s.stderr));
-    assert_eq!(train(&single, "0").status.code(), Some(0));
-    for file in ["policy.json", "curve.csv", "options.svg", "run_1.svg"] {
+    let seeds = read(&study.join("small/seeds.csv"));
+    assert_eq!(seeds.lines().count(), 4, "{seeds}");
+    let mut by_window: Vec<(f64, u64)> = seeds
+        .lines()
+        .skip(1)
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            (fields[4].parse().expect("a window rate"), fields[0].parse().expect("a seed"))
+        })
+        .collect();
+    by_window.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let (w, median) = by_window[1];
+    let policy: serde_json::Value =
+        serde_json::from_str(&read(&study.join("small/policy.json"))).expect("JSON");
+    assert_eq!(policy["seed"], median, "{seeds}");
+    assert_eq!(train(&single, &median.to_string()).status.code(), Some(0));
+    for file in ["policy.json", "curve.csv"] {
         assert_eq!(read(&study.join("small").join(file)), read(&single.join(file)), "{file}");
     }
-    let seeds = read(&study.join("small/seeds.csv"));
-    assert_eq!(seeds.lines().count(), 3, "{seeds}");
+    for file in ["flat_A.svg", "options.svg", "run_1.svg", "run_2.svg"] {
+        let (a, b) = (read(&study.join("small").join(file)), read(&single.join(file)));
+        assert_eq!(drawing(&a), drawing(&b), "{file}");
+    }
+    let run = read(&study.join("small/run_1.svg"));
+    let note = format!("seed {median}, the median of 3 seeds by window rate (W = {w:.3})");
+    assert!(run.contains("small.hstl: sample run 1"), "{run}");
+    assert!(run.contains(&note), "{note} is not in {run}");
+    assert!(read(&single.join("run_1.svg")).contains(&format!("seed {median}; 120 steps")));
+}
+
+/// `study` on two specs draws their curves in one figure, one mean line each, and writes
+/// every seed's rewards in `curves.csv`.
+#[test]
+fn study_overlays_the_curves_of_every_spec_and_writes_every_seed() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("study");
+    let s = hstlc(&[
+        "study",
+        "small.hstl",
+        "small_other.hstl",
+        "--seeds",
+        "2",
+        "--episodes",
+        "7",
+        "--no-optimum",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(s.status.code(), Some(0), "{}", String::from_utf8_lossy(&s.stderr));
+    let csv = read(&out.join("curves.csv"));
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "spec,seed,episode,reward");
+    assert_eq!(lines.len(), 1 + 2 * 2 * 7, "{csv}");
+    for (spec, folder) in [("small.hstl", "small"), ("small_other.hstl", "small_other")] {
+        for seed in 0..2 {
+            let rows: Vec<&str> = lines
+                .iter()
+                .filter(|l| l.starts_with(&format!("{spec},{seed},")))
+                .copied()
+                .collect();
+            let episodes: Vec<String> =
+                rows.iter().map(|l| l.split(',').nth(2).unwrap_or("").to_owned()).collect();
+            assert_eq!(episodes, (1..=7).map(|e| e.to_string()).collect::<Vec<_>>());
+            // The rewards are the spec's own: its median seed's match its curve.csv.
+            let policy: serde_json::Value =
+                serde_json::from_str(&read(&out.join(folder).join("policy.json"))).expect("JSON");
+            if policy["seed"] == seed {
+                let own: Vec<String> = read(&out.join(folder).join("curve.csv"))
+                    .lines()
+                    .skip(1)
+                    .map(|l| l.split(',').nth(1).unwrap_or("").to_owned())
+                    .collect();
+                let here: Vec<String> =
+                    rows.iter().map(|l| l.split(',').nth(3).unwrap_or("").to_owned()).collect();
+                assert_eq!(here, own, "{spec} seed {seed}");
+            }
+        }
+    }
+    let svg = read(&out.join("curves.svg"));
+    let doc = roxmltree::Document::parse(&svg).expect("SVG parses");
+    let texts: Vec<String> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .map(|n| n.text().unwrap_or("").trim().to_owned())
+        .collect();
+    for wanted in
+        ["small.hstl (2 seeds)", "small_other.hstl (2 seeds)", "Learning curves of 2 specs"]
+    {
+        assert!(texts.iter().any(|t| t == wanted), "{wanted:?} not in {texts:?}");
+    }
+    // One mean line of 7 points per spec, in two colours.
+    let lines: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("polyline"))
+        .filter(|n| n.attribute("points").is_some_and(|p| p.split_whitespace().count() == 7))
+        .filter_map(|n| n.attribute("stroke"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    assert_ne!(lines[0], lines[1]);
+}
+
+/// The sample runs mark every slip of the rollout they draw: replaying it from
+/// `policy.json` with the pictures' generator finds as many slips as the picture counts.
+#[test]
+fn sample_runs_count_the_slips_of_their_rollout() {
+    use hstl::runtime::eval::{AgentController, sample_runs};
+    use hstl::runtime::{GridWorld, Policy, seeded_rng};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("run");
+    assert_eq!(train(&out, "5").status.code(), Some(0));
+    let policy = Policy::from_json(&read(&out.join("policy.json"))).expect("a policy");
+    let env = GridWorld::from_params(&policy.env.name, &policy.env.params).expect("its world");
+    let agent = policy.agent(&env).expect("its agent");
+    let mut rng = seeded_rng(5 ^ hstl::train::PICTURE_SEED);
+    let runs = sample_runs(&env, &mut AgentController::new(&agent), 2, 120, &mut rng);
+    for (i, run) in runs.iter().enumerate() {
+        let slips = run.iter().filter(|s| s.next != env.dest(s.state, s.decision.action)).count();
+        let svg = read(&out.join(format!("run_{}.svg", i + 1)));
+        assert!(
+            svg.contains(&format!("120 moves, {slips} slip")),
+            "run {}: {slips} slips, but the picture says otherwise",
+            i + 1
+        );
+        assert!(slips > 0, "slip 0.3 over 120 steps");
+    }
 }
 
 /// A world file with walls and start cells: `train --world` obeys it, `policy.json` holds
@@ -272,4 +407,39 @@ fn eval_refuses_tampered_policies() {
         assert!(e.stdout.is_empty(), "{want}: printed before failing");
         assert!(stderr.contains(want), "{want}: {stderr}");
     }
+}
+
+/// A world too large to draw still trains: the policy and curve are written, the grid
+/// pictures are left out, and the summary says why.
+#[test]
+fn a_world_too_large_to_draw_trains_without_grid_pictures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let row = ".".repeat(300);
+    let world = format!("name = \"strip\"\nslip = 0.1\nmap = \"\"\"\n{row}\n{row}\n\"\"\"\n");
+    std::fs::write(dir.path().join("strip.toml"), world).expect("write the world");
+    let spec = "spec Strip {\n    state { x: int in 0..=299, y: int in 0..=1 }\n    let A = x < 3;\n    \
+                let B = x > 296;\n    task always[0..] (eventually[0..400] A && eventually[0..400] B);\n    \
+                option A;\n    option B;\n    learn { episodes: 2, choices: 3 }\n}\n";
+    std::fs::write(dir.path().join("strip.hstl"), spec).expect("write the spec");
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["train", "strip.hstl", "--world", "strip.toml", "--out"])
+        .arg(&out)
+        .current_dir(dir.path())
+        .output()
+        .expect("hstlc runs");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains(
+            "no grid pictures: the world is 300 x 2 cells, and pictures are drawn up to 256 a side"
+        ),
+        "{stdout}"
+    );
+    let mut written: Vec<String> = std::fs::read_dir(&out)
+        .expect("out")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    written.sort();
+    assert_eq!(written, [".hstlc-run", "curve.csv", "curve.svg", "policy.json"]);
 }

@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use hstl_pictures::{
-    Action, Cell, Grid, Region, flat_policy, learning_curve, options_policy, sample_run_ordered,
+    Action, Cell, Grid, Panel, Region, RegionKind, RunStep, Series, flat_policy, learning_curve,
+    learning_curves, options_policy, sample_run,
 };
 
 /// A small seeded generator so the example is deterministic without extra dependencies.
@@ -24,7 +25,7 @@ fn rect(
     ys: std::ops::RangeInclusive<i64>,
 ) -> Region {
     let cells = xs.flat_map(|x| ys.clone().map(move |y| (x, y))).collect();
-    Region { name: name.to_owned(), cells }
+    Region::new(name, cells)
 }
 
 /// The greedy action towards the region, or `None` inside it.
@@ -46,7 +47,18 @@ fn towards(region: &Region, (x, y): (i64, i64)) -> Option<Action> {
     })
 }
 
-fn step((x, y): (i64, i64), action: Action, rng: &mut Lcg) -> (i64, i64) {
+/// Where `action` leads from `(x, y)` without a slip.
+fn intended((x, y): (i64, i64), action: Action) -> (i64, i64) {
+    let (nx, ny) = match action {
+        Action::Up => (x, y + 1),
+        Action::Down => (x, y - 1),
+        Action::Left => (x - 1, y),
+        Action::Right => (x + 1, y),
+    };
+    if (0..15).contains(&nx) && (0..15).contains(&ny) { (nx, ny) } else { (x, y) }
+}
+
+fn step(at: (i64, i64), action: Action, rng: &mut Lcg) -> (i64, i64) {
     let all = [Action::Up, Action::Down, Action::Left, Action::Right];
     let taken = if rng.next_f64() < 0.7 {
         action
@@ -54,13 +66,7 @@ fn step((x, y): (i64, i64), action: Action, rng: &mut Lcg) -> (i64, i64) {
         let others: Vec<Action> = all.into_iter().filter(|a| *a != action).collect();
         others[((rng.next_f64() * 3.0) as usize).min(2)]
     };
-    let (nx, ny) = match taken {
-        Action::Up => (x, y + 1),
-        Action::Down => (x, y - 1),
-        Action::Left => (x - 1, y),
-        Action::Right => (x + 1, y),
-    };
-    if (0..15).contains(&nx) && (0..15).contains(&ny) { (nx, ny) } else { (x, y) }
+    intended(at, taken)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -77,6 +83,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         walls: vec![],
         starts: vec![],
     };
+    // An obstacle to avoid, drawn hatched red.
+    let mut grid = grid;
+    grid.regions.push(rect("Obstacle", 7..=8, 6..=8).with_kind(RegionKind::Avoid));
     let mut rng = Lcg(7);
     let cells: Vec<(i64, i64)> = (0..15).flat_map(|x| (0..15).map(move |y| (x, y))).collect();
     for region in &grid.regions {
@@ -113,19 +122,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         options_policy(&grid, "Options policy with 16 options", &choices, &many)?,
     )?;
     for run in 0..2 {
-        let mut at = (7, 7);
+        let mut at = (6, 7);
         let mut steps = Vec::new();
         let mut target = run;
         for _ in 0..90 {
             let region = &grid.regions[target % 3];
-            steps.push((at, names[target % 3].clone()));
+            let option = names[target % 3].clone();
             match towards(region, at) {
-                Some(action) => at = step(at, action, &mut rng),
-                None => target += 1,
+                Some(action) => {
+                    steps.push(RunStep { cell: at, option, intended: Some(intended(at, action)) });
+                    at = step(at, action, &mut rng);
+                }
+                None => {
+                    steps.push(RunStep { cell: at, option, intended: None });
+                    target += 1;
+                }
             }
         }
-        steps.push((at, names[target % 3].clone()));
-        let svg = sample_run_ordered(&grid, &format!("Sample run {}", run + 1), &steps, &names)?;
+        steps.push(RunStep { cell: at, option: names[target % 3].clone(), intended: None });
+        let title = format!("Sample run {}\nan example of 90 steps", run + 1);
+        let svg = sample_run(&grid, &title, &steps, &names)?;
         std::fs::write(dir.join(format!("run_{}.svg", run + 1)), svg)?;
     }
     let seeds: Vec<Vec<f64>> = (0..5)
@@ -139,6 +155,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     std::fs::write(dir.join("curve.svg"), learning_curve("Learning curve", &seeds, 20)?)?;
+    let shifted: Vec<Vec<f64>> =
+        seeds.iter().map(|s| s.iter().map(|v| v * 0.8 + 12.0).collect()).collect();
+    let panel = Panel {
+        y_label: "reward per episode".into(),
+        series: vec![
+            Series { label: "first.hstl".into(), seeds: seeds.clone() },
+            Series { label: "second.hstl".into(), seeds: shifted },
+        ],
+    };
+    let overlay = learning_curves("Learning curves\n5 seeds each", &[panel], 20)?;
+    std::fs::write(dir.join("curves.svg"), overlay)?;
     println!("wrote pictures to {}", dir.display());
     Ok(())
 }

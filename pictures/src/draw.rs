@@ -1,11 +1,12 @@
 //! Drawing helpers shared by the pictures: text, markers and the legend.
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::PictureError;
-use crate::palette::{INK, REGION, START_CELL, TERMINATE, WALL};
+use crate::palette::{AVOID, INK, NOTE, REGION, START_CELL, TERMINATE, WALL, shade};
+use crate::{PictureError, RegionKind};
 
 /// The drawing area every picture draws on.
 pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
@@ -14,6 +15,10 @@ pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub(crate) const TITLE_SIZE: f64 = 26.0;
 /// Font size of labels and the legend, in plotters units.
 pub(crate) const LABEL_SIZE: f64 = 18.0;
+/// Font size of the note under a title, in plotters units.
+pub(crate) const NOTE_SIZE: f64 = 17.0;
+/// The height a title's note line adds, in pixels.
+pub(crate) const NOTE_HEIGHT: i32 = 20;
 /// Height of one legend row in pixels.
 pub(crate) const LEGEND_ROW: i32 = 24;
 /// Width reserved for a legend mark in pixels.
@@ -30,14 +35,12 @@ pub(crate) const FONT: &str = "sans-serif";
 pub(crate) enum Mark {
     /// A filled square of the colour.
     Swatch(RGBColor),
-    /// A shaded, outlined square like a region.
-    Region,
+    /// A square drawn like a region of the kind.
+    Region(RegionKind),
     /// A right-pointing arrow like a flat-policy action.
     Arrow,
     /// A termination dot.
     Terminate,
-    /// A short cased line of the colour, like a sample-run segment.
-    Line(RGBColor),
     /// The start marker of a sample run.
     Start,
     /// The end marker of a sample run.
@@ -46,6 +49,10 @@ pub(crate) enum Mark {
     Wall,
     /// A start cell's corner triangle.
     StartCell,
+    /// A bar of the sample runs' shading over time, light to dark.
+    Ramp,
+    /// A slip: the dotted intended move ending in a cross.
+    Slip,
     /// No mark: a note.
     Blank,
 }
@@ -67,8 +74,8 @@ impl LegendEntry {
 }
 
 /// Turns a plotters drawing error into a picture error.
-pub(crate) fn draw_err<E: std::fmt::Debug>(error: E) -> PictureError {
-    PictureError::new(format!("cannot draw the picture: {error:?}"))
+pub(crate) fn draw_err<E: std::fmt::Display>(error: E) -> PictureError {
+    PictureError::new(format!("cannot draw the picture: {error}"))
 }
 
 /// Replaces characters XML cannot hold (control characters) so the SVG always parses.
@@ -121,12 +128,38 @@ pub(crate) fn draw_text(
     area.draw(&Text::new(clean_text(text), at, style.clone())).map_err(draw_err)
 }
 
-/// Draws the title centred at the top of the picture.
-pub(crate) fn draw_title(area: &Area<'_>, title: &str, centre_x: i32) -> crate::Result<()> {
+/// A title split into its first line and the note after the first newline (empty when
+/// there is none), each printable and cut to a bounded length.
+pub(crate) fn title_parts(title: &str) -> (String, String) {
+    let (head, note) = title.split_once('\n').unwrap_or((title, ""));
+    (title_text(head), title_text(&note.replace('\n', " ")))
+}
+
+/// The pixel width a title and its note need.
+pub(crate) fn title_width((head, note): &(String, String)) -> i32 {
+    text_width(head, TITLE_SIZE).max(text_width(note, NOTE_SIZE)) + 32
+}
+
+/// The pixel height a title and its note take at the top of a picture.
+pub(crate) fn title_height((_, note): &(String, String)) -> i32 {
+    if note.is_empty() { 0 } else { NOTE_HEIGHT }
+}
+
+/// Draws the title centred at the top of the picture, and its note under it.
+pub(crate) fn draw_title(
+    area: &Area<'_>,
+    (head, note): &(String, String),
+    centre_x: i32,
+) -> crate::Result<()> {
     let style = TextStyle::from((FONT, TITLE_SIZE, FontStyle::Bold).into_font())
         .color(&INK)
         .pos(Pos::new(HPos::Center, VPos::Top));
-    draw_text(area, title, (centre_x, 12), &style)
+    draw_text(area, head, (centre_x, 12), &style)?;
+    if !note.is_empty() {
+        let style = text_style(NOTE_SIZE, &NOTE, HPos::Center, VPos::Top);
+        draw_text(area, note, (centre_x, 40), &style)?;
+    }
+    Ok(())
 }
 
 /// The pixel size of a legend with `entries`.
@@ -172,17 +205,31 @@ fn draw_mark(area: &Area<'_>, mark: Mark, centre: (i32, i32), size: i32) -> crat
             area.draw(&Rectangle::new(square, colour.filled())).map_err(draw_err)?;
             area.draw(&Rectangle::new(square, INK.stroke_width(1))).map_err(draw_err)
         }
-        Mark::Region => {
-            area.draw(&Rectangle::new(square, REGION.mix(REGION_ALPHA).filled()))
-                .map_err(draw_err)?;
-            area.draw(&Rectangle::new(square, REGION.stroke_width(2))).map_err(draw_err)
+        Mark::Region(kind) => {
+            draw_region_fill(area, kind, square)?;
+            draw_region_hatch(area, kind, square)?;
+            draw_region_box(area, kind, square)
+        }
+        Mark::Ramp => {
+            let steps = 8;
+            let (left, right) = (cx - half - 4, cx + half + 4);
+            for i in 0..steps {
+                let l = left + (right - left) * i / steps;
+                let r = left + (right - left) * (i + 1) / steps;
+                let colour = shade(REGION, i as f64 / (steps - 1) as f64);
+                area.draw(&Rectangle::new([(l, cy - 5), (r, cy + 5)], colour.filled()))
+                    .map_err(draw_err)?;
+            }
+            area.draw(&Rectangle::new([(left, cy - 5), (right, cy + 5)], INK.stroke_width(1)))
+                .map_err(draw_err)
+        }
+        Mark::Slip => {
+            let from = (cx - half - 2, cy);
+            let to = (cx + half - 4, cy);
+            draw_slip(area, from, to, 5)
         }
         Mark::Arrow => draw_arrow(area, (cx as f64, cy as f64), (1.0, 0.0), size as f64 * 1.4),
         Mark::Terminate => draw_terminate(area, (cx, cy), size as f64 * 1.4),
-        Mark::Line(colour) => {
-            let ends = vec![(cx - half - 4, cy), (cx + half + 4, cy)];
-            draw_cased_line(area, ends, colour, 4)
-        }
         Mark::Start => draw_start(area, (cx, cy), half),
         Mark::Wall => area.draw(&Rectangle::new(square, WALL.filled())).map_err(draw_err),
         Mark::StartCell => {
@@ -205,6 +252,106 @@ pub(crate) fn draw_start_cell(area: &Area<'_>, corner: (i32, i32), cell: i32) ->
 
 /// Opacity of region shading.
 pub(crate) const REGION_ALPHA: f64 = 0.16;
+/// Opacity of the shading of a region to avoid.
+const AVOID_ALPHA: f64 = 0.10;
+
+/// Shades the pixel rectangle `rect` as part of a region of `kind`: grey for a region to
+/// reach, light red for one to avoid, nothing for other regions.
+pub(crate) fn draw_region_fill(
+    area: &Area<'_>,
+    kind: RegionKind,
+    rect: [(i32, i32); 2],
+) -> crate::Result<()> {
+    let colour = match kind {
+        RegionKind::Reach => REGION.mix(REGION_ALPHA),
+        RegionKind::Avoid => AVOID.mix(AVOID_ALPHA),
+        RegionKind::Other => return Ok(()),
+    };
+    area.draw(&Rectangle::new(rect, colour.filled())).map_err(draw_err)
+}
+
+/// Hatches the pixel rectangle `rect` red when it is part of a region to avoid; drawn over
+/// cell colours, so an obstacle shows on the options map too.
+pub(crate) fn draw_region_hatch(
+    area: &Area<'_>,
+    kind: RegionKind,
+    rect: [(i32, i32); 2],
+) -> crate::Result<()> {
+    if kind == RegionKind::Avoid { draw_hatching(area, rect, 9) } else { Ok(()) }
+}
+
+/// Red diagonal lines (`/`) every `spacing` pixels across `rect`, clipped to it; the lines of
+/// neighbouring rectangles meet, since they lie on one lattice of the whole picture.
+fn draw_hatching(area: &Area<'_>, rect: [(i32, i32); 2], spacing: i32) -> crate::Result<()> {
+    let [(l, t), (r, b)] = rect;
+    let style = AVOID.mix(0.55).stroke_width(1);
+    // Lines x + y = c for c on the lattice, between the rectangle's corners.
+    let first = (l + t).div_euclid(spacing) * spacing;
+    let mut c = first;
+    while c <= r + b {
+        if c > l + t {
+            // Enter at the left or bottom edge, leave at the top or right edge.
+            let start = if c - l <= b { (l, c - l) } else { (c - b, b) };
+            let end = if c - t <= r { (c - t, t) } else { (r, c - r) };
+            area.draw(&PathElement::new(vec![start, end], style)).map_err(draw_err)?;
+        }
+        c += spacing;
+    }
+    Ok(())
+}
+
+/// Draws the outline of a lone square of a region of `kind` (for the legend).
+fn draw_region_box(area: &Area<'_>, kind: RegionKind, rect: [(i32, i32); 2]) -> crate::Result<()> {
+    let [(l, t), (r, b)] = rect;
+    let corners = [(l, t), (r, t), (r, b), (l, b), (l, t)];
+    match kind {
+        RegionKind::Reach => {
+            area.draw(&Rectangle::new(rect, REGION.stroke_width(2))).map_err(draw_err)
+        }
+        RegionKind::Avoid => {
+            area.draw(&Rectangle::new(rect, AVOID.stroke_width(2))).map_err(draw_err)
+        }
+        RegionKind::Other => {
+            for pair in corners.windows(2) {
+                draw_dashed(area, pair[0], pair[1], REGION.stroke_width(2))?;
+            }
+            Ok(())
+        }
+    }
+}
+
+/// A dashed line from `from` to `to` (dashes of 5 pixels with gaps of 4).
+pub(crate) fn draw_dashed(
+    area: &Area<'_>,
+    from: (i32, i32),
+    to: (i32, i32),
+    style: ShapeStyle,
+) -> crate::Result<()> {
+    area.draw(&DashedPathElement::new(vec![from, to], 5, 4, style)).map_err(draw_err)
+}
+
+/// Draws a slip from the pixel `from` (the cell the robot slipped in) towards `to` (where
+/// the chosen action would have led): a dotted line ending in a cross of half-size `arm`,
+/// dark on a white halo so it shows over any colour.
+pub(crate) fn draw_slip(
+    area: &Area<'_>,
+    from: (i32, i32),
+    to: (i32, i32),
+    arm: i32,
+) -> crate::Result<()> {
+    let (x, y) = to;
+    let cross =
+        [[(x - arm, y - arm), (x + arm, y + arm)], [(x - arm, y + arm), (x + arm, y - arm)]];
+    for line in &cross {
+        area.draw(&PathElement::new(line.to_vec(), WHITE.stroke_width(5))).map_err(draw_err)?;
+    }
+    area.draw(&DashedPathElement::new(vec![from, to], 2, 3, INK.stroke_width(2)))
+        .map_err(draw_err)?;
+    for line in &cross {
+        area.draw(&PathElement::new(line.to_vec(), INK.stroke_width(2))).map_err(draw_err)?;
+    }
+    Ok(())
+}
 
 /// Draws an arrow centred at `centre` pointing along the unit screen vector `dir`, sized for
 /// a cell of `cell` pixels, as one filled polygon so each arrow is one SVG element.
@@ -246,18 +393,6 @@ pub(crate) fn draw_terminate(area: &Area<'_>, centre: (i32, i32), cell: f64) -> 
     let radius = (cell * 0.22).round().max(3.0) as i32;
     area.draw(&Circle::new(centre, radius + 2, WHITE.filled())).map_err(draw_err)?;
     area.draw(&Circle::new(centre, radius, TERMINATE.filled())).map_err(draw_err)
-}
-
-/// Draws a polyline in `colour` over a dark casing so light colours stay visible on white.
-pub(crate) fn draw_cased_line(
-    area: &Area<'_>,
-    points: Vec<(i32, i32)>,
-    colour: RGBColor,
-    width: u32,
-) -> crate::Result<()> {
-    area.draw(&PathElement::new(points.clone(), INK.mix(0.9).stroke_width(width + 2)))
-        .map_err(draw_err)?;
-    area.draw(&PathElement::new(points, colour.stroke_width(width))).map_err(draw_err)
 }
 
 /// Draws the start marker: a white disc with a thick dark ring.

@@ -4,7 +4,11 @@
 //! `String`, in the style of Figures 2 and 3 of Li & Belta (2016): flat policies as arrow
 //! fields, the options policy as a coloured map, sample runs as coloured paths and the
 //! learning curve as a mean line over a band of seeds. An options policy with memory is
-//! drawn as one map per memory slice ([`options_policy_slices`]).
+//! drawn as one map per memory slice ([`options_policy_slices`]); the learning curves of
+//! several specs overlay in one figure ([`learning_curves`]).
+//!
+//! A title may hold a second line after a newline: a note drawn smaller under it (which
+//! seed a picture shows, say).
 //!
 //! Grid coordinates follow the GridWorld contract: `x` is the column from left to right, `y`
 //! the row from bottom to top, and `(0, 0)` is the bottom-left cell.
@@ -15,7 +19,7 @@
 //! let grid = Grid {
 //!     width: 3,
 //!     height: 2,
-//!     regions: vec![Region { name: "A".into(), cells: vec![(2, 1)] }],
+//!     regions: vec![Region::new("A", vec![(2, 1)])],
 //!     walls: vec![(1, 0)],
 //!     starts: vec![],
 //! };
@@ -31,14 +35,15 @@
 mod curve;
 mod draw;
 mod grid;
+mod label;
 mod palette;
+mod run;
 
 use std::fmt;
 
-pub use curve::learning_curve;
-pub use grid::{
-    Slice, flat_policy, options_policy, options_policy_slices, sample_run, sample_run_ordered,
-};
+pub use curve::{Panel, Series, learning_curve, learning_curves};
+pub use grid::{Slice, flat_policy, options_policy, options_policy_slices};
+pub use run::{RunStep, sample_run};
 
 /// The largest grid side that can be drawn; larger grids would give unreadable pictures.
 pub const MAX_GRID_SIDE: usize = 256;
@@ -66,6 +71,33 @@ pub struct Region {
     pub name: String,
     /// The cells of the region as `(x, y)`; any shape is allowed, an empty region is not drawn.
     pub cells: Vec<(i64, i64)>,
+    /// What the region is to the task, which decides how it is drawn.
+    pub kind: RegionKind,
+}
+
+/// What a region is to the task.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum RegionKind {
+    /// A region to reach (an option's region): shaded grey with a solid outline.
+    #[default]
+    Reach,
+    /// A region to avoid (an obstacle the task forbids, as in `always !Obstacle`): hatched
+    /// red with a red outline.
+    Avoid,
+    /// Any other region the task names: a dashed outline, unshaded.
+    Other,
+}
+
+impl Region {
+    /// A region to reach with the given name and cells.
+    pub fn new(name: impl Into<String>, cells: Vec<(i64, i64)>) -> Region {
+        Region { name: name.into(), cells, kind: RegionKind::Reach }
+    }
+
+    /// The same region as another kind.
+    pub fn with_kind(self, kind: RegionKind) -> Region {
+        Region { kind, ..self }
+    }
 }
 
 /// A primitive action of the grid world.

@@ -8,6 +8,7 @@
 //! the facade's errors into Python exceptions with the command line's words.
 
 mod errors;
+mod files;
 mod gym;
 mod online;
 mod policy;

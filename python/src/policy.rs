@@ -20,6 +20,9 @@ use crate::spec::Spec;
 use crate::trace::state_values;
 use crate::world::World;
 
+/// The help of an optimum that cannot be computed (`hstlc eval` says `--no-optimum`).
+const SKIP_OPTIMUM: &str = "pass `optimum=False` to skip the optimum W*";
+
 /// A trained policy: the options policy and one flat policy per primitive option, with
 /// the Q-tables they are greedy in, as `policy.json` holds them.
 ///
@@ -290,7 +293,10 @@ impl Policy {
     /// `FileNotFoundError` (or another `OSError`) when it cannot be read.
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Policy> {
-        let text = std::fs::read_to_string(&path).map_err(|e| errors::read_error(&path, &e))?;
+        let text =
+            crate::files::read_text(&path, hstl::evaluate::MAX_POLICY_BYTES, "policy", |e| {
+                errors::read_error(&path, e)
+            })?;
         Policy::from_text(py, text, &path.display().to_string(), None, None)
     }
 
@@ -485,7 +491,8 @@ impl Policy {
                     let evaluation = evaluate::evaluate(replay, runs)?;
                     let baseline = evaluate::baseline(replay, runs)?;
                     let best = match optimum {
-                        true => evaluate::optimum(replay, SolveConfig::default())?,
+                        true => evaluate::optimum(replay, SolveConfig::default())
+                            .map_err(|p| Problem::new(p.message, SKIP_OPTIMUM.to_string()))?,
                         false => None,
                     };
                     Ok((evaluation, baseline, best))

@@ -165,7 +165,9 @@ impl Spec {
     #[staticmethod]
     #[pyo3(signature = (path, name=None))]
     fn load(py: Python<'_>, path: PathBuf, name: Option<String>) -> PyResult<Spec> {
-        let source = std::fs::read_to_string(&path).map_err(|e| errors::read_error(&path, &e))?;
+        let source = crate::files::read_text(&path, hstl::lang::MAX_SOURCE_BYTES, "spec", |e| {
+            errors::read_error(&path, e)
+        })?;
         Spec::from_source(py, source, path.display().to_string(), name)
     }
 

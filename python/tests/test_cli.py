@@ -68,20 +68,33 @@ def walk_csv(tmp_path_factory):
     return path
 
 
+@pytest.fixture(scope="module")
+def surveillance_reals(tmp_path_factory):
+    """The surveillance task over `float` state variables, without options: what `hstlc
+    monitor` takes traces with fractions and infinities for (an `int` variable holds whole
+    numbers)."""
+    lines = [line.strip() for line in SURVEILLANCE.read_text().splitlines()]
+    items = [line for line in lines if line.startswith(("let ", "task "))]
+    path = tmp_path_factory.mktemp("reals") / "surveillance_reals.hstl"
+    path.write_text("spec Surveillance {\n    state { x: float, y: float }\n" + "".join(f"    {i}\n" for i in items) + "}\n")
+    return path
+
+
 @pytest.mark.parametrize("formula", [None, "A", "B", "C"])
 @pytest.mark.parametrize("trace", ["trace.csv", "infinite.csv", "walk"])
-def test_signal_and_robustness_equal_hstlc_monitor(hstlc, walk_csv, trace, formula):
+def test_signal_and_robustness_equal_hstlc_monitor(hstlc, walk_csv, surveillance_reals, trace, formula):
     path = walk_csv if trace == "walk" else CLI_FIXTURES / trace
-    spec = hstl.Spec.load(SURVEILLANCE)
+    spec_file = SURVEILLANCE if trace == "trace.csv" else surveillance_reals
+    spec = hstl.Spec.load(spec_file)
     columns = read_csv(path, spec.state_vars)
-    want = cli_signal(hstlc, SURVEILLANCE, path, formula)
+    want = cli_signal(hstlc, spec_file, path, formula)
     got = spec.signal(columns, formula)
     assert bits(got) == bits(want)
     assert bits(spec.signal(pd.DataFrame(columns), formula)) == bits(want)
     rows = np.stack([columns["x"], columns["y"]], axis=1)
     assert bits(spec.signal(rows, formula)) == bits(want)
     assert bits(spec.signal_batch([columns, columns], formula).ravel()) == bits(want) * 2
-    assert bits([spec.robustness(columns, formula)]) == bits([cli_robustness(hstlc, SURVEILLANCE, path, formula)])
+    assert bits([spec.robustness(columns, formula)]) == bits([cli_robustness(hstlc, spec_file, path, formula)])
 
 
 def test_spec_error_is_check_concise_and_json(hstlc, monkeypatch):

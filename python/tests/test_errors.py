@@ -7,12 +7,14 @@ import collections
 
 import os
 import random
+import subprocess
 
 import numpy as np
 import pandas as pd
 import pytest
 
 import hstl
+from conftest import CLI_FIXTURES
 
 SPEC = hstl.Spec.parse(
     "spec S { state { x: int in 0..=9, y: float } let A = x > 3; let B = y < 2;"
@@ -405,12 +407,12 @@ def test_unreadable_files(tmp_path):
     )
     with pytest.raises(IsADirectoryError) as e:
         hstl.Spec.load(tmp_path)
-    assert str(e.value) == f"cannot read `{tmp_path}`: is a directory"
+    assert str(e.value) == f"cannot read `{tmp_path}`: is a folder"
     latin1 = tmp_path / "latin1.hstl"
-    latin1.write_bytes(b"// caf\xe9\n")
+    latin1.write_bytes(b"spec S {}\n// caf\xe9\n")
     with pytest.raises(ValueError) as e:
         hstl.Spec.load(latin1)
-    assert str(e.value) == f"cannot read `{latin1}`: stream did not contain valid UTF-8\n  help: save it as UTF-8"
+    assert str(e.value) == f"{latin1}:2:7: the file is not UTF-8 text\n  help: save it as UTF-8; hstl reads no other encoding"
     if os.geteuid() != 0:  # root reads any file
         locked = tmp_path / "locked.hstl"
         locked.write_text("spec S {}")
@@ -419,6 +421,42 @@ def test_unreadable_files(tmp_path):
             hstl.Spec.load(locked)
     with pytest.raises(TypeError):
         hstl.Spec.load(3)
+
+
+def cli_first_line(hstlc, *args):
+    result = subprocess.run([str(hstlc), *args], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 2, result.stderr
+    line = result.stderr.splitlines()[0]
+    assert line.startswith("error: "), result.stderr
+    return line[len("error: "):]
+
+
+def test_files_past_the_clis_limits_are_refused_as_it_refuses_them(hstlc, tmp_path):
+    """A spec or world file over 64 MiB and a policy over 1 GiB (sparse files: refused by
+    their size, nothing is read), a folder, and text that is not UTF-8."""
+    big_spec, big_world, big_policy = tmp_path / "big.hstl", tmp_path / "big.toml", tmp_path / "big.json"
+    for path, size in [(big_spec, (64 << 20) + 1), (big_world, (64 << 20) + 1), (big_policy, (1 << 30) + 1)]:
+        with open(path, "wb") as f:
+            f.truncate(size)
+    small = str(CLI_FIXTURES / "small.hstl")
+    cases = [
+        (lambda: hstl.Spec.load(big_spec), ValueError, ["check", str(big_spec)]),
+        (lambda: hstl.World.load(big_world), ValueError, ["check", small, "--world", str(big_world)]),
+        (lambda: hstl.Policy.load(big_policy), ValueError, ["eval", str(big_policy)]),
+        (lambda: hstl.World.load(tmp_path), IsADirectoryError, ["check", small, "--world", f"{tmp_path}/"]),
+        (lambda: hstl.Policy.load(tmp_path), IsADirectoryError, ["eval", str(tmp_path)]),
+    ]
+    latin1 = tmp_path / "latin1.toml"
+    latin1.write_bytes(b'map = """\n..\n"""\n# caf\xe9\n')
+    cases.append((lambda: hstl.World.load(latin1), ValueError, ["check", small, "--world", str(latin1)]))
+    for call, kind, cli in cases:
+        with pytest.raises(kind) as e:
+            call()
+        assert str(e.value).splitlines()[0] == cli_first_line(hstlc, *cli).replace(f"`{tmp_path}/`", f"`{tmp_path}`"), cli
+    # A byte order mark (as some Windows editors write) is no part of the text.
+    bom = tmp_path / "bom.hstl"
+    bom.write_bytes(b"\xef\xbb\xbf" + (CLI_FIXTURES / "small.hstl").read_bytes())
+    assert hstl.Spec.load(bom).source == (CLI_FIXTURES / "small.hstl").read_text()
 
 
 def random_value(rng: random.Random):

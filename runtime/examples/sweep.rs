@@ -22,7 +22,7 @@ use std::time::Instant;
 use hstl_runtime::eval::{
     AgentController, EntryCycle, LegCycle, RegionTable, WindowConfig, window_rate,
 };
-use hstl_runtime::optimum::{SolveConfig, solve};
+use hstl_runtime::optimum::{Moves, SolveConfig, solve};
 use hstl_runtime::{GridWorld, Learner, TaskSpec, seeded_rng};
 
 /// Seconds this thread has spent on a CPU (Linux `schedstat`), which a busy machine
@@ -111,7 +111,8 @@ fn main() {
     let spec = common::case_study(false, false);
     let regions = RegionTable::new(&spec, &env).expect("the case study has regions");
     let t = Instant::now();
-    let optimum = solve(&env, &regions, SolveConfig::default()).expect("the optimum is solvable");
+    let optimum =
+        solve(&Moves::of(&env), &regions, SolveConfig::default()).expect("the optimum is solvable");
     println!(
         "W* = {:.4} in [{:.5}, {:.5}], {} sweeps over {} states, {:.1} s (converged: {})",
         optimum.gain,

@@ -33,13 +33,16 @@ pub struct Decision {
     pub leg: usize,
 }
 
-/// One step of a rollout: the state and what was decided there.
+/// One step of a rollout: the state, what was decided there, and where it led.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Step {
     /// The state index.
     pub state: usize,
     /// The decision taken in it.
     pub decision: Decision,
+    /// The state the decision's action led to (the next step's state); comparing it with
+    /// where the action leads without slipping shows the slips.
+    pub next: usize,
 }
 
 /// How the window rate is measured.
@@ -377,8 +380,8 @@ impl Controller for EntryCycle {
     }
 }
 
-/// A rollout of `steps` states from `start` (a state index): the state and decision at each
-/// step; the last decision is taken but its outcome not recorded.
+/// A rollout of `steps` states from `start` (a state index): the state, the decision and the
+/// state it led to at each step.
 pub fn rollout<E: Env, C: Controller>(
     env: &E,
     controller: &mut C,
@@ -391,9 +394,9 @@ pub fn rollout<E: Env, C: Controller>(
     let mut s = start;
     for _ in 0..steps {
         let decision = controller.act(s);
-        out.push(Step { state: s, decision });
         let next =
             env.state(s).map_or(s, |state| env.index(&env.step(&state, decision.action, rng)));
+        out.push(Step { state: s, decision, next });
         controller.observe(next);
         s = next;
     }
@@ -427,7 +430,9 @@ pub fn window_rate<E: Env, C: Controller>(
 ) -> Result<WindowReport, Error> {
     if config.starts == 0 || config.burn_in >= config.steps {
         return Err(Error::Config(format!(
-            "the window rate needs starts > 0 and burn_in < steps, not {config:?}"
+            "the window rate needs starts > 0 and burn_in < steps, not starts = {}, steps = {}, \
+             burn_in = {}",
+            config.starts, config.steps, config.burn_in
         )));
     }
     if regions.holds.iter().any(|h| h.len() != env.num_states()) {

@@ -11,7 +11,8 @@
 //!   `reward: window` (beyond the paper).
 //! - [`policy`]: greedy policies and the `policy.json` document.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
-//! - [`optimum`]: the exact optimal window rate by relative value iteration.
+//! - [`optimum`]: the exact optimal window rate `W*` of a persistent task on any grid world.
+//! - [`reach_avoid`]: the exact optimal probability of a reach-avoid task.
 //! - [`world`]: world files (TOML maps with walls and start cells) and the built-in worlds.
 //!
 //! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
@@ -23,6 +24,7 @@ pub mod learn;
 pub mod memory;
 pub mod optimum;
 pub mod policy;
+pub mod reach_avoid;
 pub mod spec;
 mod tables;
 pub mod world;

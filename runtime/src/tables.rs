@@ -134,8 +134,17 @@ pub(crate) fn valuations<E: Env>(spec: &TaskSpec, env: &E) -> Result<Trace, Erro
                 value.fract() == 0.0 && value >= *d.start() as f64 && value <= *d.end() as f64
             });
             if !in_domain {
+                let cell: Vec<String> =
+                    env_vars.iter().zip(&env_row).map(|(n, x)| format!("{n} = {x}")).collect();
+                let range = v
+                    .domain
+                    .as_ref()
+                    .map_or(String::from("none"), |d| format!("{}..={}", d.start(), d.end()));
                 return Err(Error::Spec(format!(
-                    "state {state:?} gives {} = {value}, outside its declared domain",
+                    "the state {} of environment {} gives {} = {value}, outside its declared \
+                     domain ({range})",
+                    cell.join(", "),
+                    env.name(),
                     v.name
                 )));
             }

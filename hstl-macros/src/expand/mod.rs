@@ -52,12 +52,9 @@ fn expand_tokens_with(input: TokenStream, root: &TokenStream) -> TokenStream {
 /// `spans` (the `include "..."` tokens).
 fn expand_file_with(path: &str, spans: (Span, Span), root: &TokenStream) -> TokenStream {
     let full = resolve(path);
-    let text = match std::fs::read_to_string(&full) {
+    let text = match read_spec(&full) {
         Ok(t) => t,
-        Err(e) => {
-            let msg = format!("cannot read `{}`: {e}", full.display());
-            return report::spanned_error(spans.0, spans.1, &msg).to_compile_error();
-        }
+        Err(msg) => return report::spanned_error(spans.0, spans.1, &msg).to_compile_error(),
     };
     let checked = hstl_lang::check(&text);
     // Ties the crate to the file, so cargo rebuilds when it changes.
@@ -66,6 +63,29 @@ fn expand_file_with(path: &str, spans: (Span, Span), root: &TokenStream) -> Toke
         const _: &str = ::core::include_str!(#abs);
     );
     emit(&Target::File { path, text: &text, spans }, &text, &checked, track, root)
+}
+
+/// The text of the spec file at `path`, read within [`hstl_lang::MAX_SOURCE_BYTES`] (a
+/// larger file, or an endless one such as `/dev/zero`, is refused after one byte more),
+/// or the error to report.
+fn read_spec(path: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let limit = hstl_lang::MAX_SOURCE_BYTES;
+    let too_large =
+        || format!("`{}` is larger than {} MiB, the limit for a spec", path.display(), limit >> 20);
+    let cannot = |e: std::io::Error| format!("cannot read `{}`: {e}", path.display());
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    if file.metadata().is_ok_and(|m| m.is_file() && m.len() > limit) {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::new();
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(cannot)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large());
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        format!("`{}` is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to())
+    })
 }
 
 fn emit(
@@ -278,5 +298,17 @@ mod tests {
         assert!(!out.contains("compile_error"), "{out}");
         assert_eq!(out.matches("deprecated").count(), 1, "{out}");
         assert!(out.contains("unused `let` `Spare`"), "{out}");
+    }
+
+    #[test]
+    fn an_endless_include_is_refused_at_the_limit() {
+        if !Path::new("/dev/zero").exists() {
+            return;
+        }
+        let out =
+            expand_file_with("/dev/zero", (Span::call_site(), Span::call_site()), &quote!(::hstl))
+                .to_string();
+        assert!(out.contains("`/dev/zero` is larger than 64 MiB, the limit for a spec"), "{out}");
+        assert!(!out.contains("include_str"), "{out}");
     }
 }

@@ -52,9 +52,15 @@ pub struct Occurrence {
     pub decl: bool,
 }
 
-/// Parts of a previous analysis, to be dropped when the server is idle.
+/// Parts of a previous analysis, to be dropped once the server has answered.
 pub struct Leftovers {
-    _parts: (String, Vec<CheckedSpec>, Vec<hstl::lang::Diagnostic>, OnceCell<Vec<Occurrence>>),
+    _parts: Box<dyn std::any::Any>,
+}
+
+/// The default world of `hstlc check`, as the checks see it.
+fn paper() -> &'static hstl::lang::WorldFacts {
+    static PAPER: std::sync::OnceLock<hstl::lang::WorldFacts> = std::sync::OnceLock::new();
+    PAPER.get_or_init(|| hstl::world::facts(&hstl::world::GridWorld::default(), "world `paper`"))
 }
 
 /// Everything the server knows about one version of a document.
@@ -91,12 +97,18 @@ impl Analysis {
         let prev = hstl::lang::Parsed { file, diagnostics: parse_diagnostics };
         let (parsed, _) = hstl::lang::incremental::reparse(prev, &old, &text);
         let next = Self::from_parsed(text, parsed, enc);
-        (next, Leftovers { _parts: (old, specs, diagnostics, occurrences) })
+        (next, Leftovers { _parts: Box::new((old, specs, diagnostics, occurrences)) })
+    }
+
+    /// The whole analysis, to be dropped later.
+    pub fn into_leftovers(self) -> Leftovers {
+        Leftovers { _parts: Box::new(self) }
     }
 
     fn from_parsed(text: String, parsed: hstl::lang::Parsed, enc: Encoding) -> Self {
         let parse_diagnostics = parsed.diagnostics.clone();
-        let checked = hstl::lang::check_parsed(&text, parsed);
+        // The same diagnostics as `hstlc check`, whose default world is `paper`.
+        let checked = hstl::lang::check_parsed_in_world(&text, parsed, paper());
         let conv = Converter::new(&text, enc);
         Analysis { text, checked, parse_diagnostics, occurrences: OnceCell::new(), conv }
     }
@@ -218,37 +230,47 @@ fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
     }
 }
 
-/// Every name in a formula: `(range, name, in formula position)`.
+/// Every name in a formula: `(range, name, in formula position)`, in source order. The
+/// walk keeps its own stack, so a tall tree cannot overflow the thread's.
 fn formula_names(f: &Formula, out: &mut Vec<(Range<usize>, String, bool)>) {
-    match &f.kind {
-        FormulaKind::True | FormulaKind::False => {}
-        FormulaKind::Name(id) => out.push((id.range.clone(), id.name.clone(), true)),
-        FormulaKind::Compare { first, rest } => {
-            expr_names(first, out);
-            for (_, _, e) in rest {
-                expr_names(e, out);
-            }
-        }
-        FormulaKind::Not(a)
-        | FormulaKind::Always(_, a)
-        | FormulaKind::Eventually(_, a)
-        | FormulaKind::Paren(a) => formula_names(a, out),
-        FormulaKind::Until(a, _, b) | FormulaKind::Implies(a, b) => {
-            formula_names(a, out);
-            formula_names(b, out);
-        }
-        FormulaKind::And(v) | FormulaKind::Or(v) => v.iter().for_each(|g| formula_names(g, out)),
+    enum Node<'a> {
+        Formula(&'a Formula),
+        Expr(&'a Expr),
     }
-}
-
-fn expr_names(e: &Expr, out: &mut Vec<(Range<usize>, String, bool)>) {
-    match &e.kind {
-        ExprKind::Number(_) => {}
-        ExprKind::Name(id) => out.push((id.range.clone(), id.name.clone(), false)),
-        ExprKind::Neg(a) | ExprKind::Call(_, a) | ExprKind::Paren(a) => expr_names(a, out),
-        ExprKind::Binary(_, a, b) => {
-            expr_names(a, out);
-            expr_names(b, out);
+    let mut stack = vec![Node::Formula(f)];
+    // Children are pushed last first, so that they are visited in source order.
+    while let Some(node) = stack.pop() {
+        match node {
+            Node::Formula(f) => match &f.kind {
+                FormulaKind::True | FormulaKind::False => {}
+                FormulaKind::Name(id) => out.push((id.range.clone(), id.name.clone(), true)),
+                FormulaKind::Compare { first, rest } => {
+                    stack.extend(rest.iter().rev().map(|(_, _, e)| Node::Expr(e)));
+                    stack.push(Node::Expr(first));
+                }
+                FormulaKind::Not(a)
+                | FormulaKind::Always(_, a)
+                | FormulaKind::Eventually(_, a)
+                | FormulaKind::Paren(a) => stack.push(Node::Formula(a)),
+                FormulaKind::Until(a, _, b) | FormulaKind::Implies(a, b) => {
+                    stack.push(Node::Formula(b));
+                    stack.push(Node::Formula(a));
+                }
+                FormulaKind::And(v) | FormulaKind::Or(v) => {
+                    stack.extend(v.iter().rev().map(Node::Formula));
+                }
+            },
+            Node::Expr(e) => match &e.kind {
+                ExprKind::Number(_) => {}
+                ExprKind::Name(id) => out.push((id.range.clone(), id.name.clone(), false)),
+                ExprKind::Neg(a) | ExprKind::Call(_, a) | ExprKind::Paren(a) => {
+                    stack.push(Node::Expr(a));
+                }
+                ExprKind::Binary(_, a, b) => {
+                    stack.push(Node::Expr(b));
+                    stack.push(Node::Expr(a));
+                }
+            },
         }
     }
 }
@@ -500,8 +522,8 @@ fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)>
                 _ => {}
             }
             for f in formulas {
-                if f.range.start <= offset && offset <= f.range.end {
-                    find_operator(&a.text, f, offset, &mut found);
+                if found.is_none() {
+                    found = find_operator(&a.text, f, offset);
                 }
             }
         }
@@ -509,10 +531,29 @@ fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)>
     found
 }
 
-fn find_operator(text: &str, f: &Formula, at: usize, found: &mut Option<(Range<usize>, String)>) {
-    if found.is_some() || at < f.range.start || at > f.range.end {
-        return;
+/// The first operator, in a pre-order walk of `root`, whose token(s) cover `at`. The walk
+/// keeps its own stack, so a tall tree cannot overflow the thread's.
+fn find_operator(text: &str, root: &Formula, at: usize) -> Option<(Range<usize>, String)> {
+    let mut stack = vec![root];
+    while let Some(f) = stack.pop() {
+        if at < f.range.start || at > f.range.end {
+            continue;
+        }
+        if let Some(found) = operator_of(text, f, at, &mut stack) {
+            return Some(found);
+        }
     }
+    None
+}
+
+/// The operator of `f` itself when its token(s) cover `at`; otherwise pushes the
+/// operands onto `stack`, last first.
+fn operator_of<'a>(
+    text: &str,
+    f: &'a Formula,
+    at: usize,
+    stack: &mut Vec<&'a Formula>,
+) -> Option<(Range<usize>, String)> {
     let kw_end = |start: usize, kw: &str| start + kw.len();
     let hit = |r: &Range<usize>| r.start <= at && at <= r.end;
     match &f.kind {
@@ -527,28 +568,28 @@ fn find_operator(text: &str, f: &Formula, at: usize, found: &mut Option<(Range<u
                 } else {
                     "the maximum of the operand's robustness over the window (`-inf` if the window is empty): positive when the operand holds at some step of it"
                 };
-                *found =
-                    Some((span, format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref()))));
-                return;
+                return Some((
+                    span,
+                    format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref())),
+                ));
             }
-            find_operator(text, g, at, found);
+            stack.push(g);
         }
         FormulaKind::Until(l, iv, r) => {
             let span = l.range.end..r.range.start;
             if hit(&span) && text.get(span.clone()).is_some_and(|s| s.contains("until")) {
                 let start = span.start + text[span.clone()].find("until").unwrap_or(0);
                 let end = iv.as_ref().map_or(start + "until".len(), |i| i.range.end);
-                *found = Some((
+                return Some((
                     start..end,
                     format!(
                         "**until**: `f until[I] g` is the maximum, over the steps `t'` of the window, of the minimum of `g`'s robustness at `t'` and `f`'s robustness at every step from now up to (not including) `t'`: positive when `g` holds at some step of the window and `f` holds until then.\n\n{}",
                         window_words(iv.as_ref())
                     ),
                 ));
-                return;
             }
-            find_operator(text, l, at, found);
-            find_operator(text, r, at, found);
+            stack.push(r);
+            stack.push(l);
         }
         FormulaKind::And(v) | FormulaKind::Or(v) => {
             let and = matches!(f.kind, FormulaKind::And(_));
@@ -563,35 +604,32 @@ fn find_operator(text: &str, f: &Formula, at: usize, found: &mut Option<(Range<u
                     } else {
                         "**||** (or): the maximum of the operands' robustness: positive when some operand holds."
                     };
-                    *found = Some((start..start + 2, meaning.to_string()));
-                    return;
+                    return Some((start..start + 2, meaning.to_string()));
                 }
             }
-            v.iter().for_each(|g| find_operator(text, g, at, found));
+            stack.extend(v.iter().rev());
         }
         FormulaKind::Implies(l, r) => {
             let span = l.range.end..r.range.start;
             if hit(&span) {
                 let start =
                     span.start + text.get(span.clone()).and_then(|s| s.find("->")).unwrap_or(0);
-                *found = Some((
+                return Some((
                     start..start + 2,
                     "**->** (implies): `f -> g` is `!f || g`: the maximum of minus `f`'s robustness and `g`'s robustness.".to_string(),
                 ));
-                return;
             }
-            find_operator(text, l, at, found);
-            find_operator(text, r, at, found);
+            stack.push(r);
+            stack.push(l);
         }
         FormulaKind::Not(g) => {
             let span = f.range.start..f.range.start + 1;
             if hit(&span) && at < span.end {
-                *found = Some((span, "**!** (not): minus the operand's robustness.".to_string()));
-                return;
+                return Some((span, "**!** (not): minus the operand's robustness.".to_string()));
             }
-            find_operator(text, g, at, found);
+            stack.push(g);
         }
-        FormulaKind::Paren(g) => find_operator(text, g, at, found),
+        FormulaKind::Paren(g) => stack.push(g),
         FormulaKind::Compare { rest, .. } => {
             for (op, r, _) in rest {
                 if hit(r) {
@@ -611,13 +649,13 @@ fn find_operator(text: &str, f: &Formula, at: usize, found: &mut Option<(Range<u
                             op.as_str()
                         ),
                     };
-                    *found = Some((r.clone(), meaning));
-                    return;
+                    return Some((r.clone(), meaning));
                 }
             }
         }
         FormulaKind::True | FormulaKind::False | FormulaKind::Name(_) => {}
     }
+    None
 }
 
 /// A time interval in words.

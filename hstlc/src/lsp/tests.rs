@@ -1,20 +1,26 @@
-//! In-process protocol tests: a client talks to [`super::serve`] over
-//! `Connection::memory()`.
+//! In-process protocol tests: a client talks to [`super::serve`] over pipes.
 
+use std::io::BufReader;
 use std::path::Path;
+use std::sync::mpsc::{Receiver, channel};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
 use hstl::lang::LineIndex;
-use lsp_server::{Connection, Message, Notification, Request, RequestId, ResponseError};
+use lsp_server::{Message, Notification, Request, RequestId, ResponseError};
 use serde_json::{Value, json};
 
+use super::transport::{Frame, FrameReader, Incoming, Problem, decode};
+
 const URI: &str = "file:///tmp/spec.hstl";
+
+/// Guards the tests against a server that never answers (a failure, not a measurement).
+const STUCK: Duration = Duration::from_secs(120);
 
 /// A spec with a missing `;` after `let B = ...` (HSTL001 after `x > 3`) and a
 /// duplicate `let` (HSTL003 with a related location).
 const BROKEN: &str = "spec S {
-    state { x: int in 0..=4, y: int in 0..=2 }
+    state { x: int in 0..=14, y: int in 0..=14 }
     let A = x > 1 && y < 2;
     let A = x < 3;
     let B = x > 3
@@ -25,13 +31,13 @@ const BROKEN: &str = "spec S {
 
 const FIXED: &str = "/// A spec.
 spec S {
-    state { x: int in 0..=4, y: int in 0..=2 }
+    state { x: int in 0..=14, y: int in 0..=14 }
     /// Where x is large and y small.
     let A = x > 1 && y < 2;
     let B = x > 3;
     task always[0..10] (eventually[0..=3] A || B);
     option A;
-    option B { reach: B, init: x < 5, terminate: B }
+    option B { reach: B, init: x < 15, terminate: B }
     options sequences(A, B);
 }
 ";
@@ -43,9 +49,12 @@ struct Reply {
     error: Option<ResponseError>,
 }
 
+/// A client of [`super::serve`] over in-memory pipes, framing with `lsp-server`'s own
+/// reader and writer.
 struct Client {
-    conn: Connection,
-    server: Option<JoinHandle<Result<bool, String>>>,
+    to_server: Option<std::io::PipeWriter>,
+    from_server: Receiver<Message>,
+    server: Option<JoinHandle<std::io::Result<super::Ending>>>,
     next_id: i32,
     notifications: Vec<Notification>,
 }
@@ -53,21 +62,41 @@ struct Client {
 impl Client {
     /// Starts a server and initialises it; returns the client and the `initialize` result.
     fn start(capabilities: Value) -> (Client, Value) {
-        let (client, server) = Connection::memory();
-        let handle = std::thread::spawn(move || super::serve(&server));
-        let mut c =
-            Client { conn: client, server: Some(handle), next_id: 0, notifications: vec![] };
+        let (server_in, to_server) = std::io::pipe().expect("pipe");
+        let (from_server, server_out) = std::io::pipe().expect("pipe");
+        let handle = std::thread::spawn(move || super::serve(server_in, server_out));
+        let (tx, messages) = channel();
+        std::thread::spawn(move || {
+            let mut input = BufReader::new(from_server);
+            while let Ok(Some(m)) = Message::read(&mut input) {
+                if tx.send(m).is_err() {
+                    return;
+                }
+            }
+        });
+        let mut c = Client {
+            to_server: Some(to_server),
+            from_server: messages,
+            server: Some(handle),
+            next_id: 0,
+            notifications: vec![],
+        };
         let init = c.request("initialize", json!({ "capabilities": capabilities }));
         let result = init.result.expect("initialize succeeds");
         c.notify("initialized", json!({}));
         (c, result)
     }
 
+    fn send(&mut self, message: Message) {
+        let out = self.to_server.as_mut().expect("the client is connected");
+        message.write(out).expect("server is up");
+    }
+
     fn request(&mut self, method: &str, params: Value) -> Reply {
         self.next_id += 1;
         let id = RequestId::from(self.next_id);
         let req = Request { id: id.clone(), method: method.into(), params };
-        self.conn.sender.send(Message::Request(req)).expect("server is up");
+        self.send(Message::Request(req));
         loop {
             match self.recv() {
                 Message::Response(r) if r.id == id => {
@@ -82,13 +111,13 @@ impl Client {
         }
     }
 
-    fn notify(&self, method: &str, params: Value) {
+    fn notify(&mut self, method: &str, params: Value) {
         let n = Notification { method: method.into(), params };
-        self.conn.sender.send(Message::Notification(n)).expect("server is up");
+        self.send(Message::Notification(n));
     }
 
-    fn recv(&self) -> Message {
-        self.conn.receiver.recv_timeout(Duration::from_secs(20)).expect("the server answers")
+    fn recv(&mut self) -> Message {
+        self.from_server.recv_timeout(STUCK).expect("the server answers")
     }
 
     /// The next `publishDiagnostics` for the document.
@@ -134,7 +163,7 @@ impl Client {
         assert!(r.error.is_none(), "{r:?}");
         self.notify("exit", Value::Null);
         let result = self.server.take().map(|h| h.join().expect("server thread ends"));
-        assert_eq!(result, Some(Ok(true)));
+        assert_eq!(result.map(|r| r.expect("threads start")), Some(super::Ending::Exit));
     }
 }
 
@@ -163,7 +192,8 @@ fn a_session_from_initialize_to_shutdown() {
 
     // Open: exactly the diagnostics of `check`, with codes and related locations.
     let diags = c.open(BROKEN);
-    let expected = hstl::lang::check(BROKEN).diagnostics;
+    let expected =
+        hstl::world::check(BROKEN, &hstl::world::GridWorld::default(), "world `paper`").diagnostics;
     assert_eq!(diags.len(), expected.len(), "{diags:#?}");
     for (got, want) in diags.iter().zip(&expected) {
         assert_eq!(got["code"], want.code);
@@ -200,13 +230,13 @@ fn a_session_from_initialize_to_shutdown() {
     let text =
         c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
     assert!(text.contains("minimum"), "{text}");
-    // On the let A: its definition and how many of the 15 states satisfy it
-    // (x in 2..=4 and y in 0..=1: 6 states).
+    // On the let A: its definition and how many of the 225 states satisfy it
+    // (x in 2..=14 and y in 0..=1: 26 states).
     let (line, col) = pos_of(FIXED, "A =", 0, 0);
     let text =
         c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
     assert!(text.contains("let A = x > 1 && y < 2;"), "{text}");
-    assert!(text.contains("in 6 of the 15 states"), "{text}");
+    assert!(text.contains("in 26 of the 225 states"), "{text}");
     assert!(text.contains("Where x is large and y small."), "{text}");
     // On `option A;`: the option, and the let it reaches.
     let (line, col) = pos_of(FIXED, "option A", 0, 7);
@@ -218,7 +248,7 @@ fn a_session_from_initialize_to_shutdown() {
     let (line, col) = pos_of(FIXED, "option B", 0, 7);
     let text =
         c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
-    assert!(text.contains("init: `x < 5`") && text.contains("terminate: `B`"), "{text}");
+    assert!(text.contains("init: `x < 15`") && text.contains("terminate: `B`"), "{text}");
     assert!(text.contains("`[A, B]`"), "{text}");
     // On blank space: nothing.
     let r = c.at("textDocument/hover", 0, 0);
@@ -340,7 +370,8 @@ fn diagnostics_match_check_on_every_invalid_fixture() {
         let text = std::fs::read_to_string(&path).unwrap();
         version += 1;
         let got = c.change(version, &text);
-        let want = hstl::lang::check(&text).diagnostics;
+        let want = hstl::world::check(&text, &hstl::world::GridWorld::default(), "world `paper`")
+            .diagnostics;
         assert_eq!(got.len(), want.len(), "{}", path.display());
         for (g, w) in got.iter().zip(&want) {
             assert_eq!(g["code"], w.code, "{}", path.display());
@@ -374,7 +405,8 @@ fn keystrokes_publish_checks_diagnostics() {
         next.insert_str(at, &typed[..k]);
         version += 1;
         let got = c.change(version, &next);
-        let want = hstl::lang::check(&next).diagnostics;
+        let want = hstl::world::check(&next, &hstl::world::GridWorld::default(), "world `paper`")
+            .diagnostics;
         let got: Vec<(String, Value)> = got
             .iter()
             .map(|d| (d["code"].as_str().unwrap_or("").to_string(), d["range"].clone()))
@@ -386,4 +418,280 @@ fn keystrokes_publish_checks_diagnostics() {
     }
     assert!(text.contains("let D"));
     c.shutdown();
+}
+
+/// A tall formula (250 nested `!`, under the parser's height limit) and a long `&&`
+/// chain: hover, references and symbols answer from the innermost name outwards (the
+/// walks keep their own stacks).
+#[test]
+fn tall_formulas_are_walked_without_recursion() {
+    let nots = "!".repeat(250);
+    let chain = vec!["x > 1"; 2000].join(" && ");
+    let text = format!(
+        "spec S {{\n    state {{ x: int in 0..=3 }}\n    let A = {nots}(x > 2);\n    let B = {chain};\n    task always (A || B);\n}}\n"
+    );
+    assert!(
+        hstl::world::check(&text, &hstl::world::GridWorld::default(), "world `paper`")
+            .diagnostics
+            .iter()
+            .all(|d| !d.is_error())
+    );
+    let (mut c, _) = Client::start(json!({}));
+    c.open(&text);
+    // On the `>` inside the 250 `!`.
+    let (line, col) = pos_of(&text, "> 2", 0, 0);
+    let r = c.at("textDocument/hover", line, col);
+    let hover = r.result.unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("how far `e1` is above `e2`"), "{hover}");
+    // On a `!` half way in.
+    let (line, col) = pos_of(&text, "!", 125, 0);
+    let hover =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("(not)"), "{hover}");
+    // `x`: declared once, used once in A and 2,000 times in B.
+    let (line, col) = pos_of(&text, "x > 2", 0, 0);
+    let refs = c.at("textDocument/references", line, col).result.unwrap();
+    assert_eq!(refs.as_array().map(Vec::len), Some(2002));
+    c.shutdown();
+}
+
+/// What [`super::transport::FrameReader`] reads from `input`, frame by frame, up to the
+/// end.
+fn check_frames(input: &[u8], expect: &[Frame]) {
+    let mut reader = FrameReader::new(input);
+    let mut got = Vec::new();
+    loop {
+        let frame = reader.next_frame();
+        let end = matches!(frame, Frame::End(_));
+        got.push(frame);
+        if end {
+            break;
+        }
+        assert!(got.len() <= input.len() + 1, "every frame consumes input");
+    }
+    assert_eq!(got, expect, "input {:?}", String::from_utf8_lossy(input));
+}
+
+#[test]
+fn the_frame_reader_skips_what_it_cannot_read_and_finds_the_next_frame() {
+    use Frame::*;
+    let msg = |s: &str| Message(s.as_bytes().to_vec());
+    check_frames(b"", &[End(None)]);
+    check_frames(b"Content-Length: 2\r\n\r\n{}", &[msg("{}"), End(None)]);
+    // Blank lines between frames, bare LF, any case, spaces, other headers.
+    check_frames(
+        b"\r\n\r\ncontent-length:2\n\n{}CONTENT-LENGTH :  3 \r\nContent-Type: x\r\n\r\n[1]",
+        &[msg("{}"), msg("[1]"), End(None)],
+    );
+    // The next frame after a bad length starts at the next `Content-Length:`, even one
+    // glued to the body before it.
+    check_frames(
+        b"Content-Length: 2x\r\n\r\n{ ... }Content-Length: 2\r\n\r\n{}",
+        &[Skipped(Problem::BadLength("2x".into())), msg("{}"), End(None)],
+    );
+    check_frames(
+        b"Content-Length: 99999999999999999999\r\n\r\n{}",
+        &[Skipped(Problem::LengthOverflow), End(None)],
+    );
+    check_frames(
+        b"Content-Type: a\r\n\r\n{}content-LENGTH: 1\r\n\r\n1",
+        &[Skipped(Problem::MissingLength), msg("1"), End(None)],
+    );
+    check_frames(
+        b"Content-Length: 2\r\nContent-Length: 3\r\n\r\n{}Content-Length: 1\r\n\r\n1",
+        &[Skipped(Problem::ConflictingLengths(2, 3)), msg("1"), End(None)],
+    );
+    // A wrong header with a usable length: the body is read, to find its id.
+    check_frames(
+        b"Content-Length: 2\r\nContent-Length: 2\r\n\r\n{}",
+        &[BadHeader { problem: Problem::DuplicateLength, body: b"{}".to_vec() }, End(None)],
+    );
+    check_frames(
+        b"Content-Length: 2\r\nno colon\r\n\r\n{}",
+        &[
+            BadHeader {
+                problem: Problem::MalformedHeader("no colon".into()),
+                body: b"{}".to_vec(),
+            },
+            End(None),
+        ],
+    );
+    // Too large: refused at once, the body skipped (up to the end of the input here).
+    check_frames(
+        b"Content-Length: 67108865\r\n\r\n{}",
+        &[
+            Skipped(Problem::TooLarge(67_108_865)),
+            End(Some(Problem::EndInBody { read: 2, expected: 67_108_865 })),
+        ],
+    );
+    let mut huge = b"Content-Length: 67108865\r\n\r\n".to_vec();
+    huge.resize(huge.len() + 67_108_865, b'x');
+    huge.extend_from_slice(b"Content-Length: 2\r\n\r\n{}");
+    check_frames(&huge, &[Skipped(Problem::TooLarge(67_108_865)), msg("{}"), End(None)]);
+    // Headers past 8 KiB.
+    let mut long = b"Content-Length: 2\r\nX: ".to_vec();
+    long.resize(9000, b'a');
+    long.extend_from_slice(b"\r\n\r\n{}Content-Length: 1\r\n\r\n1");
+    check_frames(&long, &[Skipped(Problem::HeadersTooLong), msg("1"), End(None)]);
+    // Ends inside a frame.
+    check_frames(b"Content-Length: 5\r\n", &[End(Some(Problem::EndInHeaders))]);
+    check_frames(
+        b"Content-Length: 5\r\n\r\n{}",
+        &[End(Some(Problem::EndInBody { read: 2, expected: 5 }))],
+    );
+}
+
+/// `decode(body)` in words.
+fn check_decode(body: &[u8], expect: &str) {
+    let got = match decode(body) {
+        Incoming::Request { id, method, .. } => format!("request {id} {method}"),
+        Incoming::Notification { method, .. } => format!("notification {method}"),
+        Incoming::Response => "response".to_string(),
+        Incoming::Invalid { id: Some(id), code, message } => {
+            format!("invalid {} to {id}: {message}", code as i32)
+        }
+        Incoming::Invalid { id: None, code, message } => {
+            format!("invalid {}: {message}", code as i32)
+        }
+    };
+    assert!(got.starts_with(expect), "{:?}: {got}", String::from_utf8_lossy(body));
+}
+
+#[test]
+fn bodies_decode_to_messages_or_to_errors_with_the_id_when_it_can_be_read() {
+    check_decode(br#"{"jsonrpc":"2.0","id":1,"method":"m"}"#, "request 1 m");
+    check_decode(br#"{"id":"a","method":"m","params":[]}"#, "request \"a\" m");
+    check_decode(
+        br#"{"jsonrpc":"2.0","id":18446744073709551615,"method":"m"}"#,
+        "request 18446744073709551615 m",
+    );
+    check_decode(br#"{"jsonrpc":"2.0","method":"exit"}"#, "notification exit");
+    check_decode(br#"{"jsonrpc":"2.0","id":1,"result":null}"#, "response");
+    check_decode(
+        br#"{"jsonrpc":"2.0","id":2,"method":"m"} {"#,
+        "invalid -32700 to 2: the message is not valid JSON: trailing characters",
+    );
+    check_decode(
+        b"{\"id\":3,\"method\":\"\xc0\"}",
+        "invalid -32700 to 3: the message is not valid UTF-8 (at byte 18)",
+    );
+    check_decode(b"{\"id\":3,", "invalid -32700: the message is not valid JSON: EOF");
+    check_decode(
+        br#"{"id":{"x":1},"method":"m"}"#,
+        "invalid -32600: the id must be an integer or a string",
+    );
+    check_decode(br#"{"id":1e3,"method":"m"}"#, "invalid -32600: the id must be");
+    check_decode(br#"{"id":-1.5,"method":"m"}"#, "invalid -32600: the id must be");
+    check_decode(br#"{"id":4,"method":null}"#, "invalid -32600 to 4: `method` must be a string");
+    check_decode(br#"{"id":5,"method":"m","params":1}"#, "invalid -32600 to 5: `params` must be");
+    check_decode(br#"{"jsonrpc":2,"id":6,"method":"m"}"#, "invalid -32600 to 6: `jsonrpc` must be");
+    check_decode(br#"{"jsonrpc":"2.0"}"#, "invalid -32600: a message needs a `method`");
+    check_decode(b"[]", "invalid -32600: a message must be a JSON object");
+    check_decode(
+        "[".repeat(10_000).as_bytes(),
+        "invalid -32700: the message is not valid JSON: recursion limit exceeded",
+    );
+}
+
+/// Runs `messages` as one stream through [`super::serve_bytes`] (one thread, no timing):
+/// how it ended, and each message written, in words, with the messages.
+fn session(messages: &[Value]) -> (super::Ending, Vec<String>, Vec<Message>) {
+    let mut input = Vec::new();
+    for m in messages {
+        super::transport::write_frame(&mut input, m.to_string().as_bytes()).unwrap();
+    }
+    let (output, ending) = super::serve_bytes(&input);
+    let mut out = BufReader::new(&output[..]);
+    let mut written = Vec::new();
+    while let Some(m) = Message::read(&mut out).expect("the server writes frames") {
+        written.push(m);
+    }
+    let words = written
+        .iter()
+        .map(|m| match m {
+            Message::Response(r) => format!("response {}", r.id),
+            Message::Notification(n) => {
+                let uri =
+                    n.params["uri"].as_str().unwrap_or_default().trim_start_matches("file:///");
+                format!("{} {uri} {}", n.method, n.params["version"])
+            }
+            Message::Request(r) => format!("request {}", r.method),
+        })
+        .collect();
+    (ending, words, written)
+}
+
+fn open_doc(uri: &str, text: &str) -> Value {
+    json!({ "jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {
+        "textDocument": { "uri": uri, "languageId": "hstl", "version": 1, "text": text } } })
+}
+
+const INIT: [&str; 2] = [
+    r#"{"jsonrpc":"2.0","id":1,"method":"initialize","params":{"capabilities":{}}}"#,
+    r#"{"jsonrpc":"2.0","method":"initialized","params":{}}"#,
+];
+
+/// A session as one stream, on one thread: 200 changes queued behind each other cost
+/// one analysis, of the newest text, before the hover behind them is answered.
+#[test]
+fn queued_changes_are_coalesced_into_one_analysis() {
+    let text = |v: i32| {
+        format!(
+            "spec S {{\n    state {{ x: int in 0..=3 }}\n    let A = x > {v};\n    task always B{v};\n}}\n"
+        )
+    };
+    let mut messages: Vec<Value> = INIT.iter().map(|m| serde_json::from_str(m).unwrap()).collect();
+    messages.push(open_doc(URI, &text(1)));
+    for v in 2..=201 {
+        messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+            "textDocument": { "uri": URI, "version": v }, "contentChanges": [{ "text": text(v) }] } }));
+    }
+    messages.push(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params": {
+        "textDocument": { "uri": URI }, "position": { "line": 2, "character": 8 } } }));
+    messages.push(json!({ "jsonrpc": "2.0", "id": 3, "method": "shutdown" }));
+    messages.push(json!({ "jsonrpc": "2.0", "method": "exit" }));
+    let (ending, words, written) = session(&messages);
+    assert_eq!(ending, super::Ending::Exit);
+    assert_eq!(
+        words,
+        [
+            "response 1",
+            "textDocument/publishDiagnostics tmp/spec.hstl 201",
+            "response 2",
+            "response 3"
+        ]
+    );
+    let Message::Response(hover) = &written[2] else { unreachable!() };
+    let hover = hover.response_result.as_ref().unwrap()["contents"]["value"].to_string();
+    assert!(hover.contains("let A = x > 201;"), "{hover}");
+}
+
+/// Idle work follows the documents: a document closed before it was analysed is never
+/// analysed, the others are, in the order they changed, once the input is drained.
+#[test]
+fn idle_analysis_skips_closed_documents_and_keeps_the_order_of_changes() {
+    let spec =
+        "spec S {\n    state { x: int in 0..=3 }\n    let A = x > 1;\n    task always A;\n}\n";
+    let mut messages: Vec<Value> = INIT.iter().map(|m| serde_json::from_str(m).unwrap()).collect();
+    for name in ["a", "b", "c", "d"] {
+        messages.push(open_doc(&format!("file:///{name}"), spec));
+    }
+    messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didClose", "params": { "textDocument": { "uri": "file:///b" } } }));
+    // A request analyses its document now; the rest wait for the idle work.
+    messages.push(json!({ "jsonrpc": "2.0", "id": 2, "method": "textDocument/documentSymbol", "params": { "textDocument": { "uri": "file:///c" } } }));
+    messages.push(json!({ "jsonrpc": "2.0", "method": "textDocument/didChange", "params": {
+        "textDocument": { "uri": "file:///a", "version": 2 }, "contentChanges": [{ "text": spec }] } }));
+    let (ending, words, _) = session(&messages);
+    assert_eq!(ending, super::Ending::InputClosed);
+    assert_eq!(
+        words,
+        [
+            "response 1",
+            "textDocument/publishDiagnostics b null",
+            "textDocument/publishDiagnostics c 1",
+            "response 2",
+            "textDocument/publishDiagnostics a 2",
+            "textDocument/publishDiagnostics d 1",
+        ]
+    );
 }

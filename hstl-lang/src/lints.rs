@@ -1,0 +1,271 @@
+//! Checks that keep a spec from failing later, in `train` or in files it names, or from
+//! meaning something else than it seems: `HSTL050` (a task or reach formula that refers
+//! to no state variable), `HSTL051` (a name longer than [`MAX_NAME_CHARS`]) and `HSTL150`
+//! (`<=` or `>=` against a whole number on an `int` variable).
+
+use crate::checked::{
+    CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Terminate, VarType,
+};
+use crate::diagnostic::Diagnostic;
+use crate::syntax;
+
+/// The longest name a spec may declare, in characters. Names become file names (the
+/// pictures `train` writes, such as `flat_NAME.svg`), which most file systems cap at 255
+/// bytes, and they are shown in tables and pictures.
+pub const MAX_NAME_CHARS: usize = 64;
+
+/// `HSTL051` for every declared name (spec, state variables, lets, options) longer than
+/// [`MAX_NAME_CHARS`].
+pub(crate) fn long_names(spec: &syntax::Spec, out: &mut Vec<Diagnostic>) {
+    let mut names: Vec<(&syntax::Ident, &str)> = vec![(&spec.name, "spec")];
+    for item in &spec.items {
+        match item {
+            syntax::Item::State(b) => {
+                names.extend(b.vars.iter().map(|v| (&v.name, "state variable")))
+            }
+            syntax::Item::Let(l) => names.push((&l.name, "`let`")),
+            syntax::Item::Option(o) => names.push((&o.name, "option")),
+            _ => {}
+        }
+    }
+    for (ident, what) in names {
+        let chars = ident.name.chars().count();
+        if chars > MAX_NAME_CHARS {
+            out.push(
+                Diagnostic::new(
+                    "HSTL051",
+                    ident.range.clone(),
+                    format!(
+                        "this {what} name is {chars} characters long, more than {MAX_NAME_CHARS}"
+                    ),
+                )
+                .with_help(format!("shorten it to at most {MAX_NAME_CHARS} characters")),
+            );
+        }
+    }
+}
+
+/// `HSTL050` for a task, or a primitive option's `reach`, that refers to no state
+/// variable, directly or through lets: its robustness is the same at every step (`inf` for
+/// `true`), so there is nothing to monitor, and no reward to learn from.
+pub(crate) fn constant_formulas(spec: &CheckedSpec, out: &mut Vec<Diagnostic>) {
+    // Whether each let refers to the state, in an order where a let's lets come first;
+    // lets left out of the order (cycles, reported already) count as referring to it.
+    let mut reads_state = vec![true; spec.lets.len()];
+    for &i in &spec.let_order {
+        reads_state[i] = refers_to_state(&spec.lets[i].formula, &reads_state);
+    }
+    if let Some(task) = &spec.task
+        && !refers_to_state(&task.formula, &reads_state)
+    {
+        out.push(
+            Diagnostic::new(
+                "HSTL050",
+                task.formula.range.clone(),
+                "the task refers to no state variable: its robustness is the same at every step",
+            )
+            .with_help(
+                "write the task over the state, such as `task always[0..] eventually[0..40] A;` \
+                 with `let A = x > 3;`",
+            ),
+        );
+    }
+    for p in &spec.primitives {
+        if !refers_to_state(&p.reach, &reads_state) {
+            out.push(
+                Diagnostic::new(
+                    "HSTL050",
+                    p.reach.range.clone(),
+                    format!(
+                        "option `{}` reaches a formula that refers to no state variable: its \
+                         reward is the same in every state",
+                        p.name
+                    ),
+                )
+                .with_help("reach a region of the state, such as `let A = x > 3;`"),
+            );
+        }
+    }
+}
+
+/// Whether `f` reads a state variable (an invalid part counts as reading one: it was
+/// reported already). Walks the tree with a stack, not recursion.
+fn refers_to_state(f: &CFormula, lets: &[bool]) -> bool {
+    let mut formulas = vec![f];
+    let mut exprs: Vec<&CExpr> = Vec::new();
+    while let Some(f) = formulas.pop() {
+        match &f.kind {
+            CFormulaKind::True | CFormulaKind::False => {}
+            CFormulaKind::Invalid => return true,
+            CFormulaKind::Let(i) => {
+                if lets.get(*i).copied().unwrap_or(true) {
+                    return true;
+                }
+            }
+            CFormulaKind::Cmp(_, a, b) => exprs.extend([a, b]),
+            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
+                formulas.push(g);
+            }
+            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => formulas.extend(gs),
+            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+                formulas.extend([&**a, &**b]);
+            }
+        }
+    }
+    while let Some(e) = exprs.pop() {
+        match &e.kind {
+            CExprKind::Const(_) => {}
+            CExprKind::Var(_) | CExprKind::Invalid => return true,
+            CExprKind::Neg(a) | CExprKind::Abs(a) | CExprKind::Sqrt(a) => exprs.push(a),
+            CExprKind::Add(a, b)
+            | CExprKind::Sub(a, b)
+            | CExprKind::Mul(a, b)
+            | CExprKind::Div(a, b) => exprs.extend([&**a, &**b]),
+        }
+    }
+    false
+}
+
+/// `HSTL150` for each comparison (or chain of comparisons) that puts `<=` or `>=` between
+/// an `int` state variable and a whole number: robustness is a difference, so at the
+/// bound it is exactly 0, which does not satisfy the comparison, and `2 <= y <= 3` holds
+/// in no cell. The help rewrites it with strict comparisons, which mean what was meant.
+pub(crate) fn inclusive_int_bounds(spec: &CheckedSpec, src: &str, out: &mut Vec<Diagnostic>) {
+    let mut roots: Vec<&CFormula> = spec.lets.iter().map(|l| &l.formula).collect();
+    roots.extend(spec.task.iter().map(|t| &t.formula));
+    for p in &spec.primitives {
+        roots.extend([&p.reach, &p.init]);
+        if let Terminate::Formula(f) = &p.terminate {
+            roots.push(f);
+        }
+    }
+    let mut stack = roots;
+    while let Some(f) = stack.pop() {
+        match &f.kind {
+            CFormulaKind::And(parts) if is_chain(parts) => {
+                chain_warning(spec, src, f, parts, out);
+            }
+            CFormulaKind::Cmp(..) => chain_warning(spec, src, f, std::slice::from_ref(f), out),
+            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
+                stack.push(g);
+            }
+            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs),
+            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+                stack.extend([&**a, &**b]);
+            }
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Let(_)
+            | CFormulaKind::Invalid => {}
+        }
+    }
+}
+
+/// Whether `parts` came from one chain such as `1 < x <= 4`: comparisons where each one's
+/// right side is the next one's left side.
+fn is_chain(parts: &[CFormula]) -> bool {
+    parts.windows(2).all(|w| match (&w[0].kind, &w[1].kind) {
+        (CFormulaKind::Cmp(_, _, r), CFormulaKind::Cmp(_, l, _)) => r.range == l.range,
+        _ => false,
+    })
+}
+
+/// One warning for the comparisons of `parts` (a chain, or one comparison) if any of them
+/// puts `<=` or `>=` between an `int` variable and a whole number.
+fn chain_warning(
+    spec: &CheckedSpec,
+    src: &str,
+    f: &CFormula,
+    parts: &[CFormula],
+    out: &mut Vec<Diagnostic>,
+) {
+    // The chain as operands and the operators between them.
+    let mut operands: Vec<&CExpr> = Vec::with_capacity(parts.len() + 1);
+    let mut ops: Vec<CmpOp> = Vec::with_capacity(parts.len());
+    for part in parts {
+        let CFormulaKind::Cmp(op, lhs, rhs) = &part.kind else { return };
+        if operands.is_empty() {
+            operands.push(lhs);
+        }
+        operands.push(rhs);
+        ops.push(*op);
+    }
+    // A whole-number operand next to an `int` variable moves by one where `<=` or `>=`
+    // becomes strict: `x <= 3` is `x < 4`, `2 <= x` is `1 < x`.
+    let mut moved: Vec<Option<i64>> = vec![None; operands.len()];
+    let mut strict = vec![false; ops.len()];
+    let mut trapped: Option<(&str, i64)> = None;
+    for (k, op) in ops.iter().enumerate() {
+        let up = match op {
+            CmpOp::Le => true,
+            CmpOp::Ge => false,
+            CmpOp::Lt | CmpOp::Gt => continue,
+        };
+        let (var, bound, at, step) = match (
+            int_var(spec, operands[k]),
+            whole(operands[k + 1]),
+            whole(operands[k]),
+            int_var(spec, operands[k + 1]),
+        ) {
+            // `x <= b`: b + 1; `x >= b`: b - 1.
+            (Some(v), Some(b), _, _) => (v, b, k + 1, if up { 1 } else { -1 }),
+            // `b <= x`: b - 1; `b >= x`: b + 1.
+            (_, _, Some(b), Some(v)) => (v, b, k, if up { -1 } else { 1 }),
+            _ => continue,
+        };
+        let Some(new) = bound.checked_add(step) else { return };
+        if moved[at].is_some_and(|m| m != new) {
+            // One number bounds two comparisons in opposite ways: no simple rewrite.
+            return;
+        }
+        moved[at] = Some(new);
+        strict[k] = true;
+        trapped.get_or_insert((var, bound));
+    }
+    let Some((var, bound)) = trapped else { return };
+    let mut rewritten = String::new();
+    for (k, e) in operands.iter().enumerate() {
+        if k > 0 {
+            rewritten.push_str(match (ops[k - 1], strict[k - 1]) {
+                (CmpOp::Lt, _) | (CmpOp::Le, true) => " < ",
+                (CmpOp::Le, false) => " <= ",
+                (CmpOp::Gt, _) | (CmpOp::Ge, true) => " > ",
+                (CmpOp::Ge, false) => " >= ",
+            });
+        }
+        match moved[k] {
+            Some(v) => rewritten.push_str(&v.to_string()),
+            None => rewritten.push_str(src.get(e.range.clone()).unwrap_or("...").trim()),
+        }
+    }
+    out.push(
+        Diagnostic::new(
+            "HSTL150",
+            f.range.clone(),
+            format!(
+                "`<=` or `>=` on the `int` variable `{var}`: at `{var} = {bound}` the robustness \
+                 is 0, which does not satisfy the comparison"
+            ),
+        )
+        .with_help(format!("on integer cells write `{rewritten}`")),
+    );
+}
+
+/// The name of the `int` state variable `e` is, if it is one.
+fn int_var<'s>(spec: &'s CheckedSpec, e: &CExpr) -> Option<&'s str> {
+    match e.kind {
+        CExprKind::Var(i) => {
+            spec.state_vars.get(i).filter(|v| v.ty == VarType::Int).map(|v| v.name.as_str())
+        }
+        _ => None,
+    }
+}
+
+/// The whole number `e` is, if it is one.
+fn whole(e: &CExpr) -> Option<i64> {
+    match e.kind {
+        CExprKind::Const(c) if c.fract() == 0.0 && c.abs() < 1e15 => Some(c as i64),
+        CExprKind::Neg(ref a) => whole(a).map(|v| -v),
+        _ => None,
+    }
+}

@@ -1,0 +1,83 @@
+//! Hostile input to the front end, generated in the tests (issue 11): byte order marks and
+//! old Mac line ends, tens of thousands of errors, huge names. `check` stays exact, and its
+//! diagnostics stay few enough to print.
+
+use hstl_lang::{LineIndex, Severity, check};
+
+/// `(line, column, code)` of each diagnostic.
+fn places(src: &str) -> Vec<(usize, usize, &'static str)> {
+    let index = LineIndex::new(src);
+    check(src)
+        .diagnostics
+        .iter()
+        .map(|d| {
+            let p = index.position(src, d.range.start);
+            (p.line, p.column, d.code)
+        })
+        .collect()
+}
+
+const SPEC: &str = "spec S {
+    state { x: int in 0..=9 }
+    // A comment.
+    let A = x > 3;
+    task eventually[0..5] Missing;
+}
+";
+
+#[test]
+fn byte_order_marks_and_every_line_end_read_alike() {
+    let want = vec![(5, 27, "HSTL002")];
+    assert_eq!(places(SPEC), want);
+    assert_eq!(places(&SPEC.replace('\n', "\r\n")), want);
+    // Old Mac files end lines with a lone `\r`: the comment ends there too.
+    assert_eq!(places(&SPEC.replace('\n', "\r")), want);
+    let with_bom = format!("\u{feff}{SPEC}");
+    assert_eq!(places(&with_bom), want);
+    assert!(!check(&with_bom.replace("Missing", "A")).has_errors());
+}
+
+#[test]
+fn many_syntax_errors_are_capped_with_one_summary() {
+    let cap = hstl_lang::check::MAX_DIAGNOSTICS;
+    // The bench `hostile` times 40,000 and 400,000; the count does not matter here.
+    let errors = 3_000;
+    let mut src = String::from("spec S { state { x: int in 0..=9 }\n");
+    for _ in 0..errors {
+        src.push_str("let A = x > ;\n");
+    }
+    src.push_str("task x > 1; }\n");
+    let diagnostics = check(&src).diagnostics;
+    assert_eq!(diagnostics.len(), cap + 1);
+    assert!(diagnostics[..cap].iter().all(|d| d.code == "HSTL001"));
+    let last = &diagnostics[cap];
+    assert_eq!((last.code, last.severity), ("HSTL024", Severity::Error));
+    assert!(last.message.starts_with(&format!("{} more diagnostics", errors - cap)));
+    // The first error still says what was expected.
+    assert_eq!(diagnostics[0].message, "expected an expression, found `;`");
+}
+
+#[test]
+fn a_huge_misspelt_name_gets_no_suggestion_but_an_answer() {
+    let name = "a".repeat(100_000);
+    let typo = format!("b{}", &name[1..]);
+    let src = format!("spec S {{ state {{ x: int in 0..=9 }} let {name} = x > 1; task {typo}; }}");
+    let diagnostics = check(&src).diagnostics;
+    let unknown = diagnostics.iter().find(|d| d.code == "HSTL002").expect("an unknown name");
+    assert_eq!(unknown.help.as_deref(), Some(format!("declare it: `let {typo} = ...;`").as_str()));
+    // Both names are also too long to be names.
+    assert_eq!(diagnostics.iter().filter(|d| d.code == "HSTL051").count(), 1);
+}
+
+#[test]
+fn many_unknown_names_among_many_lets_still_suggest_first() {
+    let mut src = String::from("spec S { state { x: int in 0..=9 }\n");
+    for i in 0..3_000 {
+        src.push_str(&format!("let L{i} = x > 1;\nlet M{i} = Z{i} && x < 3;\n"));
+    }
+    src.push_str("task L0; }\n");
+    let diagnostics = check(&src).diagnostics;
+    assert_eq!(diagnostics.len(), hstl_lang::check::MAX_DIAGNOSTICS + 1);
+    // The first reported ones get their suggestion: Z0 is one letter off L0 and M0.
+    assert_eq!(diagnostics[0].help.as_deref(), Some("did you mean `L0`?"));
+}

@@ -1,0 +1,470 @@
+//! Hostile input through the command line (issue 11), one test per class, every input
+//! generated here: each ends with the right answer or a clear error and its documented exit
+//! status, never a panic (exit 101).
+
+use std::io::Write;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// What a run of `hstlc` gave.
+struct Run {
+    status: Option<i32>,
+    stdout: String,
+    stderr: String,
+}
+
+/// Runs `hstlc` in `dir` with `stdin`.
+fn hstlc_in(dir: &Path, args: &[&str], stdin: &[u8]) -> Run {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let mut input = child.stdin.take().expect("piped");
+    // hstlc may stop reading early (an error): a broken pipe here is no failure.
+    let _ = input.write_all(stdin);
+    drop(input);
+    let out = child.wait_with_output().expect("hstlc ends");
+    Run {
+        status: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn write(dir: &Path, name: &str, text: impl AsRef<[u8]>) {
+    std::fs::write(dir.join(name), text).expect("test file written");
+}
+
+const SMALL: &str = "spec Small {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let A = x < 3 && y < 3;
+    let B = x > 11 && y > 11;
+    task always[0..] (eventually[0..40] A && eventually[0..40] B);
+    option A;
+    option B;
+    learn { episodes: 5, choices: 5 }
+}
+";
+
+/// Class 3: an error past column 65,535 (one minified line) is rendered, around its
+/// place, by every command that renders diagnostics.
+#[test]
+fn an_error_on_a_long_line_is_shown_in_a_window() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A syntax error, so that `fmt` reports it too.
+    let spec = format!(
+        "spec S {{ state {{ x: int in 0..=9 }} let A = x > 1;{} task A &&; option A; }}",
+        " ".repeat(100_000)
+    );
+    write(dir.path(), "long.hstl", &spec);
+    write(dir.path(), "t.csv", "x\n1\n");
+    let column = spec.find("&&;").expect("&&;") + 3;
+    for args in [
+        &["check", "long.hstl"][..],
+        &["fmt", "long.hstl"],
+        &["monitor", "long.hstl", "--trace", "t.csv"],
+        &["train", "long.hstl", "--out", "out"],
+        &["study", "long.hstl", "--seeds", "1"],
+    ] {
+        let run = hstlc_in(dir.path(), args, b"");
+        let shown = if args[0] == "check" { &run.stdout } else { &run.stderr };
+        assert_eq!(run.status, Some(1), "{args:?}: {}", run.stderr);
+        assert!(shown.contains(&format!("[long.hstl:1:{column}]")), "{args:?}: {shown}");
+        assert!(shown.contains("task A &&; option A; }"), "{args:?}: {shown}");
+        // A window of the line, not the whole line.
+        assert!(shown.len() < 2_000, "{args:?}: {} bytes", shown.len());
+    }
+    // The same in a multi-line file with a long line in the middle, and a label far away.
+    let spec = format!(
+        "spec S {{\n  state {{ x: int in 0..=9 }}\n  let A = x > 1;\n  let B = {}x > 2;\n  let A = x < 3;\n  task A;\n}}\n",
+        "x > 0 && ".repeat(20_000)
+    );
+    write(dir.path(), "mixed.hstl", &spec);
+    let run = hstlc_in(dir.path(), &["check", "mixed.hstl"], b"");
+    assert_eq!(run.status, Some(1));
+    assert!(run.stdout.contains("[mixed.hstl:5:7]"), "{}", run.stdout);
+    assert!(run.stdout.contains("first defined here"), "{}", run.stdout);
+    assert!(run.stdout.len() < 4_000, "{}", run.stdout);
+}
+
+/// Class 10: reads are bounded. An endless input is refused at its limit, quickly, with the
+/// size and the limit.
+#[test]
+fn endless_and_huge_inputs_are_refused_at_a_stated_size() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    write(dir.path(), "small.hstl", SMALL);
+    for device in ["/dev/zero", "/dev/urandom"] {
+        if !Path::new(device).exists() {
+            continue;
+        }
+        let run = hstlc_in(dir.path(), &["check", device], b"");
+        assert_eq!(run.status, Some(2), "{device}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(&format!("`{device}` is larger than 64 MiB, the limit for a spec")),
+            "{device}: {}",
+            run.stderr
+        );
+        let run = hstlc_in(dir.path(), &["monitor", "small.hstl", "--trace", device], b"");
+        assert_eq!(run.status, Some(2), "{device}: {}", run.stderr);
+        assert!(run.stderr.starts_with(&format!("error: {device}:1:")), "{}", run.stderr);
+    }
+    // A spec on standard input past the limit.
+    let big = vec![b' '; (64 << 20) + 1];
+    let run = hstlc_in(dir.path(), &["check", "-"], &big);
+    assert_eq!(run.status, Some(2));
+    assert!(run.stderr.contains("`<stdin>` is larger than 64 MiB"), "{}", run.stderr);
+    // Not UTF-8: where.
+    write(dir.path(), "latin1.hstl", b"spec S {\n  // caf\xe9\n}\n");
+    let run = hstlc_in(dir.path(), &["check", "latin1.hstl"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(run.stderr.contains("latin1.hstl:2:9: the file is not UTF-8 text"), "{}", run.stderr);
+}
+
+/// Class 11: what Excel and old editors write is read; a header naming a column twice, a
+/// constant task and an over-long name are errors before anything runs.
+#[test]
+fn byte_order_marks_line_ends_and_early_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    write(dir.path(), "bom.hstl", format!("\u{feff}{SMALL}"));
+    write(dir.path(), "cr.hstl", SMALL.replace('\n', "\r"));
+    write(dir.path(), "trace.csv", "\u{feff}t,x,y\r\n0,1,1\r\n1,2,2\r\n");
+    for spec in ["bom.hstl", "cr.hstl"] {
+        let run = hstlc_in(dir.path(), &["check", spec], b"");
+        assert_eq!((run.status, run.stdout.as_str()), (Some(0), "checked 1 file: no problems\n"));
+        let run =
+            hstlc_in(dir.path(), &["monitor", spec, "--trace", "trace.csv", "--formula", "A"], b"");
+        assert_eq!((run.status, run.stdout.as_str()), (Some(0), "2\n"), "{}", run.stderr);
+        assert_eq!(run.stderr, "note: column `t` is not a state variable of `Small`: ignored\n");
+    }
+    // With CR-only line ends the diagnostics name the right line.
+    write(dir.path(), "cr_error.hstl", SMALL.replace('\n', "\r").replace("x < 3", "q < 3"));
+    let run = hstlc_in(dir.path(), &["check", "--format", "concise", "cr_error.hstl"], b"");
+    assert!(run.stdout.starts_with("cr_error.hstl:3:13: HSTL002"), "{}", run.stdout);
+    let run = hstlc_in(dir.path(), &["check", "cr_error.hstl"], b"");
+    assert!(run.stdout.contains("[cr_error.hstl:3:13]"), "{}", run.stdout);
+    // CSV errors too, after a lone-CR line end.
+    write(dir.path(), "cr.csv", "x,y\r1,1\r2,oops\r");
+    let run = hstlc_in(dir.path(), &["monitor", "bom.hstl", "--trace", "cr.csv"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(run.stderr.starts_with("error: cr.csv:3:3: `oops` in column `y`"), "{}", run.stderr);
+    // A header naming a column twice.
+    write(dir.path(), "twice.csv", "x,y,x\n1,1,1\n");
+    let run = hstlc_in(dir.path(), &["monitor", "bom.hstl", "--trace", "twice.csv"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(
+        run.stderr.contains("twice.csv:1:5: the header names column `x` twice (first at column 1)"),
+        "{}",
+        run.stderr
+    );
+    // `task true;` and a 300-character option name: `check` says so, `train` does not start.
+    let long = format!("O{}", "o".repeat(299));
+    for (spec, code) in [
+        (
+            SMALL.replace(
+                "task always[0..] (eventually[0..40] A && eventually[0..40] B);",
+                "task true;",
+            ),
+            "HSTL050",
+        ),
+        (SMALL.replace("option B;", &format!("let {long} = x > 5; option {long};")), "HSTL051"),
+    ] {
+        write(dir.path(), "early.hstl", &spec);
+        let run = hstlc_in(dir.path(), &["check", "--format", "concise", "early.hstl"], b"");
+        assert_eq!(run.status, Some(1));
+        assert!(run.stdout.contains(code), "{}", run.stdout);
+        let run = hstlc_in(dir.path(), &["train", "early.hstl", "--out", "early"], b"");
+        assert_eq!(run.status, Some(1), "{}", run.stderr);
+        assert!(!dir.path().join("early").exists());
+    }
+}
+
+/// Class 11: SARIF locations are URIs: percent-encoded, `file:` for absolute paths, relative
+/// references from `%SRCROOT%` otherwise.
+#[test]
+fn sarif_locations_are_uris() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir.path().join("my specs")).expect("folder");
+    write(dir.path(), "my specs/a b#1.hstl", "spec S { state { x: int in 0..=9 } task zz; }");
+    let absolute = dir.path().join("my specs/a b#1.hstl");
+    let run = hstlc_in(
+        dir.path(),
+        &["check", "--format", "sarif", "my specs/a b#1.hstl", absolute.to_str().expect("utf-8")],
+        b"",
+    );
+    let sarif: serde_json::Value = serde_json::from_str(&run.stdout).expect("SARIF is JSON");
+    let uris: Vec<&serde_json::Value> = sarif["runs"][0]["results"]
+        .as_array()
+        .expect("results")
+        .iter()
+        .map(|r| &r["locations"][0]["physicalLocation"]["artifactLocation"])
+        .collect();
+    assert_eq!(
+        uris[0],
+        &serde_json::json!({ "uri": "my%20specs/a%20b%231.hstl", "uriBaseId": "%SRCROOT%" })
+    );
+    let uri = uris[1]["uri"].as_str().expect("a uri");
+    assert!(uri.starts_with("file:///") && uri.ends_with("/my%20specs/a%20b%231.hstl"), "{uri}");
+    assert!(!uri.contains(' '), "{uri}");
+}
+
+/// Class 11: `eval` refuses flags that cannot make a report before printing anything, in
+/// words (no Rust value such as `WindowConfig { .. }`).
+#[test]
+fn eval_checks_its_flags_first() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    write(dir.path(), "small.hstl", SMALL);
+    let run = hstlc_in(dir.path(), &["train", "small.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    for (flags, words) in [
+        (&["--burn-in", "5000"][..], "burn-in"),
+        (&["--starts", "0"], "--starts"),
+        (&["--steps", "0"], "--steps"),
+    ] {
+        let mut args = vec!["eval", "run/policy.json", "--no-optimum"];
+        args.extend(flags);
+        let run = hstlc_in(dir.path(), &args, b"");
+        assert_eq!((run.status, run.stdout.as_str()), (Some(2), ""), "{flags:?}");
+        assert!(run.stderr.contains(words), "{flags:?}: {}", run.stderr);
+        assert!(!run.stderr.contains("Config"), "{}", run.stderr);
+    }
+}
+
+/// Class 11: `scripts/case-study --seeds N --out DIR`, its own documented use, works (the
+/// flags replace the script's defaults instead of repeating them).
+#[test]
+fn the_case_study_script_takes_seeds_and_out() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/case-study");
+    let out = Command::new("bash")
+        .args([script, "--seeds", "1", "--out", "cs", "--episodes", "2", "--no-optimum"])
+        .env("HSTLC", env!("CARGO_BIN_EXE_hstlc"))
+        .current_dir(dir.path())
+        .output()
+        .expect("bash runs");
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("6 specs x 1 seeds"), "{stdout}");
+    for variant in ["surveillance_ot1", "surveillance_memory_tuned"] {
+        let seeds = dir.path().join("cs").join(variant).join("seeds.csv");
+        let text = std::fs::read_to_string(&seeds).expect("seeds.csv written under --out");
+        assert_eq!(text.lines().count(), 2, "one seed: {text}");
+    }
+}
+
+/// The files of a folder, sorted (hidden ones too).
+fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Class 6: an output folder appears whole, replaces an earlier run's whole, and is held by
+/// one run at a time; file names are made unique before anything is written.
+#[test]
+fn output_folders_are_whole_or_nothing() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    // Two inline regions whose names both read `x___3` as file names.
+    let inline = SMALL
+        .replace(
+            "task always[0..] (eventually[0..40] A && eventually[0..40] B);",
+            "task always[0..] (eventually[0..20] (x > 3) && eventually[0..20] (x < 3));",
+        )
+        .replace(
+            "learn { episodes: 5, choices: 5 }",
+            "learn { episodes: 3, choices: 5, memory: 2 }",
+        );
+    write(d, "inline.hstl", &inline);
+    let run = hstlc_in(d, &["train", "inline.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let files = listing(&d.join("run"));
+    assert!(files.contains(&"options_after_x___3.svg".to_string()), "{files:?}");
+    assert!(files.contains(&"options_after_x___3_2.svg".to_string()), "{files:?}");
+
+    // A later run replaces the folder as a whole, and removes what killed runs left.
+    write(d, "small.hstl", SMALL);
+    std::fs::create_dir(d.join(".run.tmp-99999-0")).expect("a killed run's folder");
+    write(d, ".run.tmp-99999-0/policy.json", "half");
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "run", "--seed", "2"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let files = listing(&d.join("run"));
+    assert!(!files.iter().any(|f| f.starts_with("options_after")), "old files stayed: {files:?}");
+    assert!(files.contains(&"options.svg".to_string()), "{files:?}");
+    let siblings: Vec<String> = listing(d).into_iter().filter(|f| f.starts_with(".run")).collect();
+    assert_eq!(siblings, [".run.lock"], "only the lock file stays beside the folder");
+
+    // A folder holding other files is not replaced.
+    std::fs::create_dir(d.join("mine")).expect("folder");
+    write(d, "mine/notes.txt", "keep me");
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "mine"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(run.stderr.contains("holds `notes.txt`, which no hstlc run writes"), "{}", run.stderr);
+    assert_eq!(listing(&d.join("mine")), ["notes.txt"]);
+
+    // Two runs into one folder: the second is refused while the first holds it; a killed
+    // run leaves no lock behind.
+    let long = SMALL
+        .replace("learn { episodes: 5, choices: 5 }", "learn { episodes: 100000, choices: 20 }");
+    write(d, "long.hstl", &long);
+    let mut first = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["train", "long.hstl", "--out", "busy"])
+        .current_dir(d)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("hstlc starts");
+    let mut refused = None;
+    for _ in 0..200 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        let second = hstlc_in(d, &["train", "small.hstl", "--out", "busy"], b"");
+        if second.status == Some(2) {
+            refused = Some(second.stderr);
+            break;
+        }
+    }
+    first.kill().expect("the first run stops");
+    let _ = first.wait();
+    let refused = refused.expect("the second run was refused while the first ran");
+    assert!(refused.contains("is being written by another hstlc run"), "{refused}");
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "busy"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+
+    // Two specs of one name in a study get folders of their own.
+    for sub in ["a", "b"] {
+        std::fs::create_dir(d.join(sub)).expect("folder");
+        write(d, &format!("{sub}/spec.hstl"), SMALL);
+    }
+    let run = hstlc_in(
+        d,
+        &["study", "a/spec.hstl", "b/spec.hstl", "--seeds", "1", "--no-optimum", "--out", "st"],
+        b"",
+    );
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(
+        listing(&d.join("st")),
+        [".spec-2.lock", ".spec.lock", "curves.csv", "curves.svg", "spec", "spec-2"]
+    );
+    let curves = std::fs::read_to_string(d.join("st/curves.csv")).expect("curves.csv");
+    assert!(curves.contains("a/spec.hstl") && curves.contains("b/spec.hstl"), "{curves}");
+}
+
+/// Class 7: `fmt --write` rewrites a file as the same file: its permissions, the symbolic
+/// link to it, its hard links and its byte order mark stay.
+#[cfg(unix)]
+#[test]
+fn fmt_write_keeps_the_file() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let messy = "spec  S {state{x:int in 0..=9}let A=x>1; task A;}\n";
+    let run = hstlc_in(d, &["fmt", "-"], messy.as_bytes());
+    let tidy = run.stdout;
+    assert_ne!(tidy, messy);
+    let fmt_write = |name: &str| {
+        let run = hstlc_in(d, &["fmt", "--write", name], b"");
+        assert_eq!(run.status, Some(0), "{name}: {}", run.stderr);
+    };
+    let read = |name: &str| std::fs::read_to_string(d.join(name)).expect("readable");
+
+    // Permissions.
+    write(d, "private.hstl", messy);
+    std::fs::set_permissions(d.join("private.hstl"), std::fs::Permissions::from_mode(0o600))
+        .expect("chmod");
+    fmt_write("private.hstl");
+    assert_eq!(read("private.hstl"), tidy);
+    let mode = std::fs::metadata(d.join("private.hstl")).expect("meta").permissions().mode();
+    assert_eq!(mode & 0o777, 0o600);
+
+    // A symbolic link: the target is formatted, the link stays a link.
+    std::fs::create_dir(d.join("real")).expect("folder");
+    write(d, "real/target.hstl", messy);
+    std::os::unix::fs::symlink("real/target.hstl", d.join("link.hstl")).expect("symlink");
+    fmt_write("link.hstl");
+    assert!(std::fs::symlink_metadata(d.join("link.hstl")).expect("meta").file_type().is_symlink());
+    assert_eq!(read("real/target.hstl"), tidy);
+
+    // Hard links: both names see the new text, still one file.
+    write(d, "one.hstl", messy);
+    std::fs::hard_link(d.join("one.hstl"), d.join("two.hstl")).expect("hard link");
+    fmt_write("one.hstl");
+    assert_eq!((read("one.hstl"), read("two.hstl")), (tidy.clone(), tidy.clone()));
+    assert_eq!(std::fs::metadata(d.join("two.hstl")).expect("meta").nlink(), 2);
+
+    // A byte order mark stays; the fixed temporary name of old is left alone.
+    write(d, "bom.hstl", format!("\u{feff}{messy}"));
+    write(d, ".bom.hstl.hstlc-fmt.tmp", "not mine");
+    fmt_write("bom.hstl");
+    assert_eq!(read("bom.hstl"), format!("\u{feff}{tidy}"));
+    assert_eq!(read(".bom.hstl.hstlc-fmt.tmp"), "not mine");
+    let left: Vec<String> = listing(d).into_iter().filter(|f| f.contains("hstlc-fmt-")).collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+}
+
+/// Runs `hstlc` in `dir` with standard output going to `stdout`; status and standard error.
+fn hstlc_to(dir: &Path, args: &[&str], stdout: Stdio) -> (Option<i32>, String) {
+    let child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let out = child.wait_with_output().expect("hstlc ends");
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Class 8: output errors are errors. A full disk (`/dev/full`) stops every command with
+/// status 2 and one line; a reader that went away (`| head`) ends it quietly with 141.
+#[test]
+fn write_errors_are_errors_and_a_closed_pipe_ends_quietly() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    write(d, "t.csv", "x,y\n1,1\n2,2\n");
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let commands: [&[&str]; 11] = [
+        &["check", "small.hstl"],
+        &["check", "--format", "json", "small.hstl"],
+        &["explain", "HSTL003"],
+        &["fmt", "small.hstl"],
+        &["monitor", "small.hstl", "--trace", "t.csv", "--signal"],
+        &["train", "small.hstl", "--out", "again"],
+        &["eval", "run/policy.json", "--no-optimum", "--starts", "2", "--steps", "200"],
+        &["study", "small.hstl", "--seeds", "1", "--no-optimum", "--out", "st"],
+        &["--help"],
+        &["--version"],
+        &["check", "--help"],
+    ];
+    if Path::new("/dev/full").exists() {
+        for args in commands {
+            let full =
+                std::fs::OpenOptions::new().write(true).open("/dev/full").expect("/dev/full");
+            let (status, stderr) = hstlc_to(d, args, Stdio::from(full));
+            assert_eq!(status, Some(2), "{args:?}: {stderr}");
+            assert_eq!(
+                stderr, "error: cannot write `<stdout>`: no space left on device\n",
+                "{args:?}"
+            );
+        }
+    }
+    // The reader closes its end before hstlc starts.
+    write(d, "b.hstl", SMALL);
+    write(d, "c.hstl", SMALL);
+    for args in
+        [&["fmt", "small.hstl", "b.hstl", "c.hstl"][..], &["check", "small.hstl"], &["--help"]]
+    {
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let (status, stderr) = hstlc_to(d, args, Stdio::from(writer));
+        assert_eq!((status, stderr.as_str()), (Some(141), ""), "{args:?}");
+    }
+}

@@ -1,0 +1,234 @@
+//! The exact optimal probability of a reach-avoid task on any grid world.
+//!
+//! The task is `eventually[0..=T] Goal && always[0..=T_avoid] !Avoid` on a run from a
+//! uniformly drawn start of the world's [`Moves`]: the goal holds at some step `0..=T` and
+//! the avoided set at no step `0..=T_avoid`. (An unbounded `always[0..] !Avoid` over runs of
+//! `L` states is the same task with `T_avoid = L - 1`, and the goal's window clipped to the
+//! run: [`ReachAvoid::over_run`].) Goal and avoided set are given per state.
+//!
+//! The most probable way to satisfy it may depend on the whole history of the run, but the
+//! step, the state and whether the goal has held yet say all that matters for the rest, so
+//! dynamic programming on `(step, state, reached)`, backwards from the last step, gives the
+//! maximum over every policy, history-dependent ones included:
+//! `V_t(s, r) = max_a sum_s' P(s' | s, a) V_{t+1}(s', r')` with `r' = r || (t <= T &&
+//! Goal(s))`, 0 once the run fails and 1 once it cannot fail any more.
+
+use crate::Error;
+use std::fmt;
+
+use crate::eval::{Controller, Decision};
+use crate::optimum::Moves;
+
+/// A reach-avoid task over the states of a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReachAvoid {
+    /// `goal[s]`: the goal holds in state `s` (its robustness is above 0).
+    pub goal: Vec<bool>,
+    /// `avoid[s]`: the run fails in state `s`. For `always !Avoid` with robustness above 0,
+    /// that is every state where the robustness of `Avoid` is 0 or more: a state on the
+    /// boundary of `Avoid` fails `!Avoid` too.
+    pub avoid: Vec<bool>,
+    /// `T`: the goal must hold at some step `0..=T`.
+    pub reach_by: usize,
+    /// `T_avoid`: the avoided states must not occur at any step `0..=T_avoid`.
+    pub avoid_through: usize,
+}
+
+/// The optimal probability of a [`ReachAvoid`] task, and the values behind it.
+#[derive(Clone, PartialEq)]
+pub struct ReachAvoidOptimum {
+    /// The most probability any policy gives the task, from a uniform start.
+    pub probability: f64,
+    /// The same from each start, in the order of [`Moves::starts`].
+    pub per_start: Vec<f64>,
+    task: ReachAvoid,
+    dest: Vec<[u32; 4]>,
+    p: f64,
+    /// The last step that matters, `max(T, T_avoid)`.
+    last: usize,
+    /// `values[(2 * t + r) * states + s]`: `V_t(s, r)`, the best probability from state `s`
+    /// at step `t`, `r` saying whether the goal held at a step before `t`.
+    values: Vec<f64>,
+}
+
+/// Follows the optimal policy of a [`ReachAvoidOptimum`], tracking the step and whether the
+/// goal has held.
+#[derive(Clone, Debug)]
+pub struct ReachAvoidController<'a> {
+    optimum: &'a ReachAvoidOptimum,
+    step: usize,
+    reached: bool,
+}
+
+impl ReachAvoid {
+    /// `eventually[0..=reach_by] Goal && always[0..] !Avoid` over runs of `len` states: the
+    /// avoided states must not occur in the whole run, and the goal's window is clipped to
+    /// it (a goal at step `len` or later is past the run's end).
+    pub fn over_run(
+        goal: Vec<bool>,
+        avoid: Vec<bool>,
+        reach_by: usize,
+        len: usize,
+    ) -> Result<ReachAvoid, Error> {
+        let Some(last) = len.checked_sub(1) else {
+            return Err(Error::Config("a run of 0 states cannot reach a goal".into()));
+        };
+        Ok(ReachAvoid { goal, avoid, reach_by: reach_by.min(last), avoid_through: last })
+    }
+
+    /// The outcome of step `t` in state `s` with `reached` from before: `Some(1)` when the
+    /// task can no longer fail, `Some(0)` when it has failed, else `None`; and the new
+    /// `reached`.
+    fn settle(&self, t: usize, s: usize, reached: bool) -> (Option<f64>, bool) {
+        if t <= self.avoid_through && self.avoid[s] {
+            return (Some(0.0), reached);
+        }
+        let reached = reached || (t <= self.reach_by && self.goal[s]);
+        if reached && t >= self.avoid_through {
+            (Some(1.0), true)
+        } else if !reached && t >= self.reach_by {
+            (Some(0.0), false)
+        } else {
+            (None, reached)
+        }
+    }
+}
+
+/// The optimal probability of `task` on `moves`. Fails when the task does not fit the
+/// world, or when its table of `2 * (max(T, T_avoid) + 1) * states` values exceeds
+/// `max_states`, before allocating it.
+pub fn solve_reach_avoid(
+    moves: &Moves,
+    task: &ReachAvoid,
+    max_states: usize,
+) -> Result<ReachAvoidOptimum, Error> {
+    moves.check()?;
+    let n = moves.states();
+    if task.goal.len() != n || task.avoid.len() != n {
+        return Err(Error::Config(format!(
+            "the goal and avoided states were not computed on this world, which has {n} \
+             states (goal: {}, avoid: {})",
+            task.goal.len(),
+            task.avoid.len()
+        )));
+    }
+    let last = task.reach_by.max(task.avoid_through);
+    let size = (last as u128 + 1) * 2 * n as u128;
+    if size > max_states as u128 {
+        return Err(Error::Config(format!(
+            "the reach-avoid optimum needs {size} states ({n} states x {} steps x reached or \
+             not), more than the limit of {max_states}; use a shorter deadline or a smaller \
+             world",
+            last as u128 + 1
+        )));
+    }
+    let mut values = vec![0.0f64; size as usize];
+    let q = (1.0 - moves.p) / 3.0;
+    for t in (0..=last).rev() {
+        for r in [false, true] {
+            for s in 0..n {
+                let (settled, reached) = task.settle(t, s, r);
+                let v = match settled {
+                    Some(v) => v,
+                    None if t == last => f64::from(u8::from(reached)),
+                    None => {
+                        let next = &values[(2 * (t + 1) + usize::from(reached)) * n..][..n];
+                        best_action(&moves.dest[s], next, moves.p, q).1
+                    }
+                };
+                values[(2 * t + usize::from(r)) * n + s] = v;
+            }
+        }
+    }
+    let per_start: Vec<f64> = moves.starts.iter().map(|&s| values[s as usize]).collect();
+    let probability = per_start.iter().sum::<f64>() / per_start.len() as f64;
+    Ok(ReachAvoidOptimum {
+        probability,
+        per_start,
+        task: task.clone(),
+        dest: moves.dest.clone(),
+        p: moves.p,
+        last,
+        values,
+    })
+}
+
+/// The action with the most probability of success from a state whose moves lead to
+/// `dest`, given the next step's values, and that probability; the lowest such action.
+fn best_action(dest: &[u32; 4], next: &[f64], p: f64, q: f64) -> (usize, f64) {
+    let w = dest.map(|t| next[t as usize]);
+    let sum: f64 = w.iter().sum();
+    (0..4)
+        .map(|a| (a, p * w[a] + q * (sum - w[a])))
+        .fold((0, f64::NEG_INFINITY), |best, (a, v)| if v > best.1 { (a, v) } else { best })
+}
+
+impl fmt::Debug for ReachAvoidOptimum {
+    /// The figures, without the value table.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("ReachAvoidOptimum")
+            .field("probability", &self.probability)
+            .field("starts", &self.per_start.len())
+            .field("last_step", &self.last)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ReachAvoidOptimum {
+    /// A controller following the optimal policy.
+    pub fn controller(&self) -> ReachAvoidController<'_> {
+        ReachAvoidController { optimum: self, step: 0, reached: false }
+    }
+
+    /// The last step that matters, `max(T, T_avoid)`: a run of this many states plus one
+    /// decides the task.
+    pub fn last_step(&self) -> usize {
+        self.last
+    }
+
+    /// Whether a run through `states` (from step 0) satisfies the task.
+    pub fn satisfied(&self, states: &[usize]) -> bool {
+        let mut reached = false;
+        for (t, &s) in states.iter().enumerate().take(self.last + 1) {
+            if s >= self.dest.len() {
+                return false;
+            }
+            match self.task.settle(t, s, reached) {
+                (Some(v), _) => return v > 0.0,
+                (None, r) => reached = r,
+            }
+        }
+        // The run ended before the task was decided: the goal held but the avoided states
+        // could still come, which a run this short satisfies; or the goal never held.
+        reached
+    }
+}
+
+impl Controller for ReachAvoidController<'_> {
+    fn reset(&mut self) {
+        self.step = 0;
+        self.reached = false;
+    }
+
+    fn act(&mut self, s: usize) -> Decision {
+        let o = self.optimum;
+        let n = o.dest.len();
+        if s >= n {
+            // Not a state of the solved world: take no valid action.
+            return Decision { action: usize::MAX, option: 0, leg: 0 };
+        }
+        let (settled, reached) = o.task.settle(self.step, s, self.reached);
+        self.reached = reached;
+        if settled.is_some() || self.step >= o.last {
+            // The task is decided: every action is as good.
+            return Decision { action: 0, option: 0, leg: 0 };
+        }
+        let next = &o.values[(2 * (self.step + 1) + usize::from(reached)) * n..][..n];
+        let (action, _) = best_action(&o.dest[s], next, o.p, (1.0 - o.p) / 3.0);
+        Decision { action, option: 0, leg: 0 }
+    }
+
+    fn observe(&mut self, _next: usize) {
+        self.step = self.step.saturating_add(1);
+    }
+}
