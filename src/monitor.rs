@@ -11,7 +11,7 @@
 use std::fmt;
 use std::sync::{Mutex, PoisonError};
 
-use hstl_lang::CheckedSpec;
+use hstl_lang::{CheckedSpec, Domain, VarType};
 use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
 
 use crate::lower::{self, LowerError};
@@ -23,7 +23,45 @@ pub const MAX_BATCH_THREADS: usize = 64;
 #[derive(Clone, Debug)]
 pub struct Monitor {
     vars: Vec<String>,
+    /// What each state variable's values must be.
+    domains: Vec<ValueDomain>,
     formula: rob::Formula,
+}
+
+/// The values a state variable may take: any number, or whole numbers (in a range when
+/// the spec declares one), as `hstlc monitor`'s CSV reader checks them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ValueDomain {
+    /// Any number, `inf` or `-inf` (a `float` variable).
+    Real,
+    /// Whole numbers, inside `lo..=hi` when declared (an `int` variable).
+    Int(Option<(i64, i64)>),
+}
+
+impl ValueDomain {
+    /// The domains of a spec's state variables, in order.
+    pub fn of(spec: &CheckedSpec) -> Vec<ValueDomain> {
+        spec.state_vars
+            .iter()
+            .map(|v| match (v.ty, &v.domain) {
+                (_, Domain::Int { lo, hi }) => ValueDomain::Int(Some((*lo, *hi))),
+                (VarType::Int, _) => ValueDomain::Int(None),
+                _ => ValueDomain::Real,
+            })
+            .collect()
+    }
+
+    /// Whether `v` (not NaN) is a value of this domain.
+    fn holds(self, v: f64) -> bool {
+        match self {
+            ValueDomain::Real => true,
+            ValueDomain::Int(range) => {
+                v.is_finite()
+                    && v.fract() == 0.0
+                    && range.is_none_or(|(lo, hi)| v >= lo as f64 && v <= hi as f64)
+            }
+        }
+    }
 }
 
 /// The samples of one trace, borrowed.
@@ -43,7 +81,7 @@ pub enum Samples<'a> {
 }
 
 /// A trace or a state that cannot be scored.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum TraceError {
     /// The trace lacks a state variable.
     Missing {
@@ -74,6 +112,17 @@ pub enum TraceError {
         /// The step, counted from 0.
         step: usize,
     },
+    /// A sample of an `int` state variable is not a whole number, or outside its range.
+    NotInDomain {
+        /// The state variable.
+        var: String,
+        /// The step, counted from 0.
+        step: usize,
+        /// The sample.
+        value: f64,
+        /// The variable's declared range, if any.
+        range: Option<(i64, i64)>,
+    },
     /// A state (for the online monitor) has the wrong number of values.
     Width {
         /// The spec's state variables, in order.
@@ -91,7 +140,7 @@ pub enum TraceError {
 }
 
 /// A trace of a batch that cannot be scored.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum BatchError {
     /// Trace `trace` (counted from 0) is not a valid trace.
     Trace {
@@ -115,6 +164,7 @@ pub enum BatchError {
 #[derive(Clone, Debug)]
 pub struct Online {
     vars: Vec<String>,
+    domains: Vec<ValueDomain>,
     inner: OnlineMonitor,
 }
 
@@ -125,7 +175,11 @@ impl Monitor {
             None => lower::task(spec)?,
             Some(name) => lower::let_formula(spec, name)?,
         };
-        Ok(Monitor { vars: spec.state_vars.iter().map(|v| v.name.clone()).collect(), formula })
+        Ok(Monitor {
+            vars: spec.state_vars.iter().map(|v| v.name.clone()).collect(),
+            domains: ValueDomain::of(spec),
+            formula,
+        })
     }
 
     /// The spec's state variables, in order: the columns a trace must have.
@@ -280,6 +334,7 @@ impl Monitor {
     pub fn online(&self) -> Online {
         Online {
             vars: self.vars.clone(),
+            domains: self.domains.clone(),
             inner: OnlineMonitor::new(&self.formula, self.vars.len()),
         }
     }
@@ -326,15 +381,23 @@ impl Monitor {
         if len == 0 { Err(TraceError::Empty) } else { Ok(len) }
     }
 
-    /// The first NaN among the first `read` steps, as an error.
+    /// The first NaN, or the first sample of an `int` variable that is not one of its
+    /// values, among the first `read` steps, as an error.
     fn check_nan(&self, samples: &Samples<'_>, read: usize) -> Result<(), TraceError> {
         let nan =
             |var: usize, step: usize| TraceError::NotANumber { var: self.vars[var].clone(), step };
         match samples {
             Samples::Columns(cols) => {
                 for (var, col) in cols.iter().enumerate() {
-                    if let Some(step) = first_nan(&col[..read.min(col.len())]) {
+                    let col = &col[..read.min(col.len())];
+                    if let Some(step) = first_nan(col) {
                         return Err(nan(var, step));
+                    }
+                    let domain = self.domains[var];
+                    if domain != ValueDomain::Real
+                        && let Some(step) = col.iter().position(|&v| !domain.holds(v))
+                    {
+                        return Err(self.not_in_domain(var, step, col[step]));
                     }
                 }
             }
@@ -352,9 +415,30 @@ impl Monitor {
                         return Err(nan(var, step));
                     }
                 }
+                for (var, (&pick, &domain)) in picks.iter().zip(&self.domains).enumerate() {
+                    if domain == ValueDomain::Real {
+                        continue;
+                    }
+                    let bad = rows.chunks(*width).enumerate().find_map(|(step, row)| {
+                        row.get(pick)
+                            .filter(|&&v| !v.is_nan() && !domain.holds(v))
+                            .map(|&v| (step, v))
+                    });
+                    if let Some((step, v)) = bad {
+                        return Err(self.not_in_domain(var, step, v));
+                    }
+                }
             }
         }
         Ok(())
+    }
+
+    fn not_in_domain(&self, var: usize, step: usize, value: f64) -> TraceError {
+        let range = match self.domains[var] {
+            ValueDomain::Int(range) => range,
+            ValueDomain::Real => None,
+        };
+        TraceError::NotInDomain { var: self.vars[var].clone(), step, value, range }
     }
 }
 
@@ -384,6 +468,14 @@ impl Online {
         }
         if let Some(var) = state.iter().position(|v| v.is_nan()) {
             return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps() });
+        }
+        if let Some(var) = state.iter().zip(&self.domains).position(|(&v, d)| !d.holds(v)) {
+            let range = match self.domains[var] {
+                ValueDomain::Int(range) => range,
+                ValueDomain::Real => None,
+            };
+            let (var_name, step) = (self.vars[var].clone(), self.steps());
+            return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
         }
         self.inner
             .push(state)
@@ -425,6 +517,16 @@ impl TraceError {
             TraceError::Width { vars, .. } => {
                 format!("give one value per state variable, in the order {}", quote_list(vars))
             }
+            TraceError::NotInDomain { var, range: Some((lo, hi)), value, .. }
+                if value.is_finite() && value.fract() == 0.0 =>
+            {
+                format!(
+                    "the spec declares `{var}: int in {lo}..={hi}`: widen the range or fix the trace"
+                )
+            }
+            TraceError::NotInDomain { var, .. } => {
+                format!("`{var}` is an `int` state variable: give whole numbers such as `3`")
+            }
             TraceError::Layout { .. } => return None,
         })
     }
@@ -442,6 +544,14 @@ impl fmt::Display for TraceError {
             ),
             TraceError::Empty => f.write_str("the trace has no samples"),
             TraceError::NotANumber { var, step } => write!(f, "`{var}` is NaN at step {step}"),
+            TraceError::NotInDomain { var, step, value, range: Some((lo, hi)) }
+                if value.is_finite() && value.fract() == 0.0 =>
+            {
+                write!(f, "`{var}` is {value} at step {step}, outside its range {lo}..={hi}")
+            }
+            TraceError::NotInDomain { var, step, value, .. } => {
+                write!(f, "`{var}` is {value} at step {step}, not a whole number")
+            }
             TraceError::Width { vars, found } => write!(
                 f,
                 "the state has {found} value{}, the spec has {} state variable{}",

@@ -506,3 +506,46 @@ def test_random_garbage_raises_ordinary_exceptions_only():
         except Exception:
             outcomes["raised"] += 1
     assert outcomes["ok"] > 0 and outcomes["raised"] > 0
+
+
+INT_SPEC = hstl.Spec.parse(
+    "spec Cells { state { x: int in 0..=9, k: int, r: float } let A = x > 3; task A; }"
+)
+
+
+@pytest.mark.parametrize(
+    "trace, message",
+    [
+        (
+            {"x": [1, 1.5], "k": [0, 0], "r": [0.5, 0.5]},
+            "`x` is 1.5 at step 1, not a whole number"
+            "\n  help: `x` is an `int` state variable: give whole numbers such as `3`",
+        ),
+        (
+            {"x": [1, 12], "k": [0, 0], "r": [0.5, 0.5]},
+            "`x` is 12 at step 1, outside its range 0..=9"
+            "\n  help: the spec declares `x: int in 0..=9`: widen the range or fix the trace",
+        ),
+        (
+            {"x": [1, 2], "k": [0, np.inf], "r": [0.5, 0.5]},
+            "`k` is inf at step 1, not a whole number"
+            "\n  help: `k` is an `int` state variable: give whole numbers such as `3`",
+        ),
+    ],
+)
+def test_int_variables_hold_whole_numbers_in_their_range_as_hstlc_monitor_asks(trace, message):
+    # The CLI refuses these rows at line:column; Python refuses them at their step.
+    with pytest.raises(ValueError) as e:
+        INT_SPEC.signal(trace)
+    assert str(e.value) == message
+    rows = np.stack([np.asarray(trace[v], dtype=float) for v in ("x", "k", "r")], axis=1)
+    with pytest.raises(ValueError) as e:
+        INT_SPEC.signal(rows)
+    assert str(e.value) == message
+    online = INT_SPEC.online()
+    online.update({v: trace[v][0] for v in trace})
+    with pytest.raises(ValueError) as e:
+        online.update({v: trace[v][1] for v in trace})
+    assert str(e.value) == message
+    # Fractions in a `float` variable are fine.
+    assert INT_SPEC.signal({"x": [4, 5], "k": [-3, 8], "r": [0.25, np.inf]}).tolist() == [1.0, 2.0]
