@@ -1,22 +1,8 @@
-//! The formatter on any text: never a panic; what it formats parses to the same tree
-//! (only the space between tokens changes), keeps its comments, and formats to itself.
+//! libFuzzer over the property in `fuzz/props/format.rs` (also replayed and mutated by
+//! `hstlc/tests/fuzz_smoke.rs` in every test run).
 #![no_main]
 
-use libfuzzer_sys::fuzz_target;
+#[path = "../props/format.rs"]
+mod prop;
 
-fuzz_target!(|data: &[u8]| {
-    let Ok(src) = std::str::from_utf8(data) else { return };
-    let Ok(formatted) = hstl_lang::format(src) else { return };
-    let before = hstl_lang::check(src);
-    let after = hstl_lang::check(&formatted);
-    assert_eq!(before.has_errors(), after.has_errors(), "{formatted}");
-    let codes = |c: &hstl_lang::Checked| c.diagnostics.iter().map(|d| d.code).collect::<Vec<_>>();
-    assert_eq!(codes(&before), codes(&after), "{formatted}");
-    assert_eq!(
-        before.file.comments.len(),
-        after.file.comments.len(),
-        "comments lost: {formatted}"
-    );
-    let again = hstl_lang::format(&formatted).expect("formatted text formats");
-    assert_eq!(again, formatted, "not idempotent");
-});
+libfuzzer_sys::fuzz_target!(|data: &[u8]| prop::check(data));

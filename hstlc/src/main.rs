@@ -16,7 +16,7 @@ mod output;
 mod render;
 mod spec_file;
 mod study;
-mod trace_csv;
+use hstlc::trace_csv;
 mod train;
 mod world_arg;
 

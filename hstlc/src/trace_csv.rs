@@ -11,8 +11,8 @@
 //! [`MAX_LINE_BYTES`], the trace at most [`MAX_TRACE_VALUES`] values. The reader keeps one
 //! line and the trace's columns in memory, never the file.
 //!
-//! This module depends on nothing else of the CLI, so the fuzz target `trace_csv` builds it
-//! on its own.
+//! This module depends on nothing else of the CLI: it is part of the crate's library, for
+//! the fuzz target `trace_csv`.
 
 use std::fmt;
 use std::io::BufRead;
