@@ -12,7 +12,7 @@ pub fn check(data: &[u8]) {
     match read_trace(data, &vars) {
         Ok(read) => {
             let t = &read.trace;
-            assert!(t.len() > 0);
+            assert!(!t.is_empty());
             assert!(t.column(0).iter().all(|v| !v.is_nan()));
             assert!(t.column(1).iter().all(|v| v.fract() == 0.0 && (-3.0..=14.0).contains(v)));
             assert!(read.ignored.iter().all(|n| n != "x" && n != "k" && !n.is_empty()));
