@@ -731,7 +731,7 @@ fn memory_slices_are_one_map_each_with_shared_colours() {
     // Errors name the slice; no slice is an error.
     let bad = vec![("b = [2]".to_string(), vec![((9, 9), "go A".to_string())])];
     let err = options_policy_slices(&grid, "Options", &bad, &[]).unwrap_err();
-    assert!(err.message().starts_with("memory slice \"b = [2]\": "), "{}", err.message());
+    assert!(err.message().starts_with("memory slice `b = [2]`: "), "{}", err.message());
     assert!(options_policy_slices(&grid, "Options", &[], &[]).is_err());
 }
 
