@@ -12,7 +12,8 @@ use std::fmt;
 use std::sync::{Mutex, PoisonError};
 
 use hstl_lang::{CheckedSpec, Domain, VarType};
-use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
+use hstl_robustness::nan::{self, Atom};
+use hstl_robustness::{self as rob, CmpOp, Evaluator, Expr, OnlineMonitor, Verdict, offline};
 
 use crate::lower::{self, LowerError};
 
@@ -26,6 +27,16 @@ pub struct Monitor {
     /// What each state variable's values must be.
     domains: Vec<ValueDomain>,
     formula: rob::Formula,
+    /// The comparisons that can compute a NaN from numbers (most specs have none).
+    nan_prone: NanProne,
+}
+
+/// The comparisons of a formula that can compute a NaN, each checked on every step read,
+/// so that a NaN is an error instead of a value a min or max skips.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NanProne {
+    atoms: Vec<(Expr, CmpOp, Expr)>,
+    vars: Vec<String>,
 }
 
 /// The values a state variable may take: any number, or whole numbers (in a range when
@@ -123,6 +134,16 @@ pub enum TraceError {
         /// The variable's declared range, if any.
         range: Option<(i64, i64)>,
     },
+    /// An expression of the formula computes NaN on a step (`sqrt` of a negative, `0 / 0`,
+    /// `inf - inf`, ...): robustness has no value there.
+    Undefined {
+        /// The step, counted from 0.
+        step: usize,
+        /// The innermost expression that is NaN, or the comparison, in hstl syntax.
+        expr: String,
+        /// The operation that gave NaN, with its operands (`the square root of -1`).
+        operation: String,
+    },
     /// A state (for the online monitor) has the wrong number of values.
     Width {
         /// The spec's state variables, in order.
@@ -165,6 +186,7 @@ pub enum BatchError {
 pub struct Online {
     vars: Vec<String>,
     domains: Vec<ValueDomain>,
+    nan_prone: NanProne,
     inner: OnlineMonitor,
 }
 
@@ -175,11 +197,9 @@ impl Monitor {
             None => lower::task(spec)?,
             Some(name) => lower::let_formula(spec, name)?,
         };
-        Ok(Monitor {
-            vars: spec.state_vars.iter().map(|v| v.name.clone()).collect(),
-            domains: ValueDomain::of(spec),
-            formula,
-        })
+        let vars: Vec<String> = spec.state_vars.iter().map(|v| v.name.clone()).collect();
+        let nan_prone = NanProne::of(&formula, &vars);
+        Ok(Monitor { vars, domains: ValueDomain::of(spec), formula, nan_prone })
     }
 
     /// The spec's state variables, in order: the columns a trace must have.
@@ -234,14 +254,17 @@ impl Monitor {
             .map_err(|e| self.ragged(&cols, e))
     }
 
-    /// [`Monitor::signal`] of a trace already checked by its reader (the CLI's CSV reader).
-    pub fn signal_of_trace(&self, trace: &rob::Trace) -> Vec<f64> {
-        offline::signal(&self.formula, trace)
+    /// [`Monitor::signal`] of a trace whose samples its reader checked (the CLI's CSV
+    /// reader): only the expressions are checked here.
+    pub fn signal_of_trace(&self, trace: &rob::Trace) -> Result<Vec<f64>, TraceError> {
+        self.nan_prone.check_trace(trace, trace.len())?;
+        Ok(offline::signal(&self.formula, trace))
     }
 
-    /// [`Monitor::robustness`] of a trace already checked by its reader.
-    pub fn robustness_of_trace(&self, trace: &rob::Trace) -> f64 {
-        offline::robustness(&self.formula, trace)
+    /// [`Monitor::robustness`] of a trace whose samples its reader checked.
+    pub fn robustness_of_trace(&self, trace: &rob::Trace) -> Result<f64, TraceError> {
+        self.nan_prone.check_trace(trace, self.samples_read(trace.len()))?;
+        Ok(offline::robustness(&self.formula, trace))
     }
 
     /// The steps of every trace of a batch, when they are valid and have one length.
@@ -335,6 +358,7 @@ impl Monitor {
         Online {
             vars: self.vars.clone(),
             domains: self.domains.clone(),
+            nan_prone: self.nan_prone.clone(),
             inner: OnlineMonitor::new(&self.formula, self.vars.len()),
         }
     }
@@ -430,7 +454,7 @@ impl Monitor {
                 }
             }
         }
-        Ok(())
+        self.nan_prone.check(samples, read)
     }
 
     fn not_in_domain(&self, var: usize, step: usize, value: f64) -> TraceError {
@@ -477,6 +501,7 @@ impl Online {
             let (var_name, step) = (self.vars[var].clone(), self.steps());
             return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
         }
+        self.nan_prone.check_state(state, self.steps())?;
         self.inner
             .push(state)
             .map_err(|_| TraceError::Width { vars: self.vars.clone(), found: state.len() })
@@ -492,6 +517,80 @@ impl Online {
     /// The monitor then starts a new trace at step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
         self.inner.finish()
+    }
+}
+
+impl NanProne {
+    pub(crate) fn of(formula: &rob::Formula, vars: &[String]) -> NanProne {
+        NanProne::of_all(&[formula], vars)
+    }
+
+    /// The comparisons of all `formulas`.
+    pub(crate) fn of_all(formulas: &[&rob::Formula], vars: &[String]) -> NanProne {
+        let mut atoms: Vec<(Expr, CmpOp, Expr)> = Vec::new();
+        for f in formulas {
+            for a in nan::nan_prone_atoms(f) {
+                let atom = (a.lhs.clone(), a.op, a.rhs.clone());
+                if atoms.len() > 64 || !atoms.contains(&atom) {
+                    atoms.push(atom);
+                }
+            }
+        }
+        let vars = if atoms.is_empty() { Vec::new() } else { vars.to_vec() };
+        NanProne { atoms, vars }
+    }
+
+    /// The first comparison that is NaN on the first `read` steps, as an error.
+    fn check(&self, samples: &Samples<'_>, read: usize) -> Result<(), TraceError> {
+        if self.atoms.is_empty() {
+            return Ok(());
+        }
+        let mut state = vec![0.0; self.vars.len()];
+        for step in 0..read {
+            match samples {
+                Samples::Columns(cols) => {
+                    for (v, col) in state.iter_mut().zip(cols) {
+                        *v = col[step];
+                    }
+                }
+                Samples::Rows { data, width, picks } => {
+                    let row = &data[step * width..(step + 1) * width];
+                    for (v, &p) in state.iter_mut().zip(picks) {
+                        *v = row[p];
+                    }
+                }
+            }
+            self.check_state(&state, step)?;
+        }
+        Ok(())
+    }
+
+    fn check_trace(&self, trace: &rob::Trace, read: usize) -> Result<(), TraceError> {
+        if self.atoms.is_empty() {
+            return Ok(());
+        }
+        let cols: Vec<&[f64]> = (0..trace.vars()).map(|i| trace.column(i)).collect();
+        self.check(&Samples::Columns(cols), read.min(trace.len()))
+    }
+
+    /// The first comparison that is NaN on `state` (step `step`), as an error.
+    pub(crate) fn check_state(&self, state: &[f64], step: usize) -> Result<(), TraceError> {
+        for (lhs, op, rhs) in &self.atoms {
+            let atom = Atom { lhs, op: *op, rhs };
+            if let Some(cause) = nan::nan_cause(&atom, state) {
+                let names: Vec<&str> = self.vars.iter().map(String::as_str).collect();
+                let comparison = rob::Formula::Cmp { lhs: lhs.clone(), op: *op, rhs: rhs.clone() };
+                return Err(TraceError::Undefined {
+                    step,
+                    expr: match cause.expr {
+                        Some(e) => e.display_with(&names).to_string(),
+                        None => comparison.display_with(&names).to_string(),
+                    },
+                    operation: cause.operation.to_string(),
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -527,6 +626,10 @@ impl TraceError {
             TraceError::NotInDomain { var, .. } => {
                 format!("`{var}` is an `int` state variable: give whole numbers such as `3`")
             }
+            TraceError::Undefined { .. } => "robustness has no meaning for NaN: write the \
+                expression so that it is defined on every state the trace can hold (for \
+                example `sqrt(abs(x))`), or fix the trace"
+                .to_string(),
             TraceError::Layout { .. } => return None,
         })
     }
@@ -544,6 +647,9 @@ impl fmt::Display for TraceError {
             ),
             TraceError::Empty => f.write_str("the trace has no samples"),
             TraceError::NotANumber { var, step } => write!(f, "`{var}` is NaN at step {step}"),
+            TraceError::Undefined { step, expr, operation } => {
+                write!(f, "`{expr}` is NaN at step {step}: {operation}")
+            }
             TraceError::NotInDomain { var, step, value, range: Some((lo, hi)) }
                 if value.is_finite() && value.fract() == 0.0 =>
             {

@@ -42,7 +42,7 @@ use hstl_lang::CheckedSpec;
 use hstl_robustness::{Bound, Evaluator, Formula, Interval, OnlineMonitor};
 
 use crate::lower::{self, LowerError};
-use crate::monitor::TraceError;
+use crate::monitor::{NanProne, TraceError};
 
 /// Scores the states of one episode as they arrive (see the module docs).
 #[derive(Clone, Debug)]
@@ -56,6 +56,8 @@ pub struct EpisodeMonitor {
     tau: Vec<usize>,
     steps: usize,
     eval: Evaluator,
+    /// The comparisons that can compute a NaN: a state where one does is refused.
+    nan_prone: NanProne,
 }
 
 /// What one state of an episode earned.
@@ -145,8 +147,12 @@ impl EpisodeMonitor {
             .collect();
         let vars: Vec<String> = spec.state_vars.iter().map(|v| v.name.clone()).collect();
         let tau = regions.iter().map(|r| r.1).collect();
+        let mut scored: Vec<&Formula> = vec![&task, &reward];
+        scored.extend(regions.iter().map(|r| &r.0));
+        let nan_prone = NanProne::of_all(&scored, &vars);
         let task = Running::new(&task, vars.len());
-        Ok(EpisodeMonitor { vars, reward, task, regions, tau, steps: 0, eval: Evaluator::new() })
+        let eval = Evaluator::new();
+        Ok(EpisodeMonitor { vars, reward, task, regions, tau, steps: 0, eval, nan_prone })
     }
 
     /// The state variables, in the order [`EpisodeMonitor::push`] takes their values.
@@ -180,6 +186,7 @@ impl EpisodeMonitor {
         if let Some(var) = state.iter().position(|v| v.is_nan()) {
             return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps });
         }
+        self.nan_prone.check_state(state, self.steps)?;
         self.steps += 1;
         let reward = at_state(&self.reward, state);
         let window_kept = if self.regions.is_empty() {

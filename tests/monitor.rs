@@ -88,10 +88,14 @@ fn oracle_cases_through_columns_rows_batches_and_online() {
 
         // What the CLI computes from its CSV reader's trace, bit for bit.
         let trace = Trace::from_columns(vec![c.x.clone(), c.y.clone()]).unwrap();
-        let cli = m.signal_of_trace(&trace);
+        let cli = m.signal_of_trace(&trace).unwrap();
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&m.signal(&columns).unwrap()), bits(&cli), "{label}");
-        assert_eq!(m.robustness_of_trace(&trace).to_bits(), c.robustness.to_bits(), "{label}");
+        assert_eq!(
+            m.robustness_of_trace(&trace).unwrap().to_bits(),
+            c.robustness.to_bits(),
+            "{label}"
+        );
 
         for threads in [1, 2, 3] {
             let batch = [columns.clone(), rows_of(&data), columns.clone()];
@@ -224,6 +228,62 @@ fn bad_traces_are_refused_with_their_message() {
         Some("give one value per state variable, in the order `x`, `y`"),
     );
     assert_eq!(online.steps(), 1, "a refused state changes nothing");
+}
+
+#[test]
+fn a_nan_computed_by_an_expression_is_refused_naming_the_step_and_the_expression() {
+    let undefined_help = "robustness has no meaning for NaN: write the expression so that it \
+                          is defined on every state the trace can hold (for example \
+                          `sqrt(abs(x))`), or fix the trace";
+    // The issue's example: a min over the window would skip the NaN and give 1.
+    let m = monitor("spec S { state { x: float } task always[0..=2] (sqrt(x) > 1); }", None);
+    let x = [4.0, -1.0, 9.0];
+    let columns = Samples::Columns(vec![&x]);
+    for got in [m.signal(&columns).map(|_| ()), m.robustness(&columns).map(|_| ())] {
+        check(got, "`sqrt(x)` is NaN at step 1: the square root of -1", Some(undefined_help));
+    }
+    check(
+        m.signal(&Samples::Rows { data: &x, width: 1, picks: vec![0] }),
+        "`sqrt(x)` is NaN at step 1: the square root of -1",
+        Some(undefined_help),
+    );
+    let fine = [4.0, 4.0, 4.0];
+    let batch = m.signal_batch(&[Samples::Columns(vec![&fine]), columns.clone()], 2);
+    assert_eq!(
+        batch.unwrap_err().to_string(),
+        "trace 1: `sqrt(x)` is NaN at step 1: the square root of -1"
+    );
+    let mut online = m.online();
+    assert!(online.push(&[4.0]).is_ok());
+    check(
+        online.push(&[-1.0]),
+        "`sqrt(x)` is NaN at step 1: the square root of -1",
+        Some(undefined_help),
+    );
+    assert_eq!(online.steps(), 1, "a refused state changes nothing");
+    // Only the steps the value at step 0 reads are checked.
+    let m = monitor("spec S { state { x: float } task sqrt(x) > 1; }", None);
+    assert_eq!(m.robustness(&columns).unwrap(), 1.0);
+
+    // The innermost operation is named: a division of zeros, the comparison of infinities.
+    let m = monitor("spec S { state { x: float, y: float } task x / y + 1 > 0 || y < x; }", None);
+    let (zeros, infs) = ([1.0, 0.0], [1.0, f64::INFINITY]);
+    check(
+        m.signal(&Samples::Columns(vec![&zeros, &zeros])),
+        "`x / y` is NaN at step 1: 0 / 0",
+        Some(undefined_help),
+    );
+    check(
+        m.signal(&Samples::Columns(vec![&infs, &infs])),
+        "`x / y` is NaN at step 1: inf / inf",
+        Some(undefined_help),
+    );
+    let m = monitor("spec S { state { x: float, y: float } task y < x; }", None);
+    check(
+        m.signal(&Samples::Columns(vec![&infs, &infs])),
+        "`y < x` is NaN at step 1: the comparison of inf with inf",
+        Some(undefined_help),
+    );
 }
 
 #[test]

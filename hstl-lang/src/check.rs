@@ -137,6 +137,7 @@ pub(crate) fn check_parsed_in(
         crate::lints::long_names(spec, &mut diags);
         crate::lints::constant_formulas(&checked, &mut diags);
         crate::lints::inclusive_int_bounds(&checked, src, &mut diags);
+        crate::lints::undefined_expressions(&checked, src, &mut diags);
         specs.push(checked);
     }
     let diagnostics = diagnostic::finish(diags, MAX_DIAGNOSTICS, src.len());

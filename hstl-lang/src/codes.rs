@@ -363,6 +363,21 @@ Example:\n    option ReachTheLoadingDockOnTheFarSideOfTheWarehouseWithoutTouchin
 Fix: shorten the name, and say the rest in a doc comment (`/// ...`).",
     },
     CodeInfo {
+        code: "HSTL060",
+        name: "undefined-expression",
+        severity: E,
+        summary: "an expression that is NaN on a state of the declared domain",
+        explanation: "Robustness is a number for every state; NaN has no meaning, and a min or \
+max would skip it and hide the state. `sqrt` of a negative number, `0 / 0`, `inf / inf`, \
+`0 * inf` and `inf - inf` are NaN. When every state variable is a finite `int`, the checker \
+evaluates each comparison on every state of the declared domain and reports the first state \
+where an expression is NaN, at the innermost expression that is. On `float` variables the \
+monitors refuse such a step of a trace instead, naming the step and the expression.\n\n\
+Example:\n    state { x: int in 0..=9 }\n    let Far = sqrt(x - 3) > 1;   // x = 0: the square root of -3\n\n\
+Fix: keep the expression defined on the whole domain (`sqrt(abs(x - 3))`, a divisor that is \
+never 0), or narrow the `int` ranges to the states the system can be in.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,

@@ -1,7 +1,8 @@
 //! Checks that keep a spec from failing later, in `train` or in files it names, or from
 //! meaning something else than it seems: `HSTL050` (a task or reach formula that refers
 //! to no state variable), `HSTL051` (a name longer than [`MAX_NAME_CHARS`]) and `HSTL150`
-//! (`<=` or `>=` against a whole number on an `int` variable).
+//! (`<=` or `>=` against a whole number on an `int` variable), and `HSTL060` (an expression
+//! that is NaN on a state of the declared `int` domain).
 
 use crate::checked::{
     CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Terminate, VarType,
@@ -267,5 +268,144 @@ fn whole(e: &CExpr) -> Option<i64> {
         CExprKind::Const(c) if c.fract() == 0.0 && c.abs() < 1e15 => Some(c as i64),
         CExprKind::Neg(ref a) => whole(a).map(|v| -v),
         _ => None,
+    }
+}
+
+/// `HSTL060` for each comparison whose expressions are NaN on some state of the declared
+/// `int` domain (`sqrt` of a negative, `0 / 0`, ...), at the innermost expression that is,
+/// naming the first such state. Runs when every state variable is a finite `int` and the
+/// domain times the comparisons is within the finite-domain checks' budget.
+pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec<Diagnostic>) {
+    let Some(size) = spec.domain_size() else { return };
+    if spec.state_vars.is_empty() || size > crate::check::MAX_DOMAIN_STATES {
+        return;
+    }
+    let mut atoms: Vec<(&CExpr, &CExpr, &std::ops::Range<usize>)> = Vec::new();
+    let mut stack: Vec<&CFormula> = spec.lets.iter().map(|l| &l.formula).collect();
+    if let Some(task) = &spec.task {
+        stack.push(&task.formula);
+    }
+    for p in &spec.primitives {
+        stack.push(&p.reach);
+        stack.push(&p.init);
+        if let Terminate::Formula(f) = &p.terminate {
+            stack.push(f);
+        }
+    }
+    while let Some(f) = stack.pop() {
+        match &f.kind {
+            CFormulaKind::Cmp(_, a, b) => {
+                if nan_prone(a, b) && !atoms.iter().any(|(_, _, r)| **r == f.range) {
+                    atoms.push((a, b, &f.range));
+                }
+            }
+            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
+                stack.push(g)
+            }
+            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs.iter()),
+            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+                stack.push(a);
+                stack.push(b);
+            }
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Let(_)
+            | CFormulaKind::Invalid => {}
+        }
+    }
+    if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::check::MAX_DOMAIN_WORK {
+        return;
+    }
+    atoms.sort_by_key(|(_, _, r)| r.start);
+    let widths: Vec<(i64, u64)> = spec
+        .state_vars
+        .iter()
+        .map(|v| match v.domain {
+            crate::checked::Domain::Int { lo, hi } => (lo, (hi as i128 - lo as i128 + 1) as u64),
+            _ => (0, 1),
+        })
+        .collect();
+    let mut state = vec![0.0; widths.len()];
+    let mut open: Vec<bool> = vec![true; atoms.len()];
+    for k in 0..size {
+        let mut rest = k;
+        for (v, &(lo, w)) in state.iter_mut().zip(&widths).rev() {
+            *v = (lo as i128 + (rest % w) as i128) as f64;
+            rest /= w;
+        }
+        for (a, &(lhs, rhs, range)) in atoms.iter().enumerate() {
+            if !open[a] {
+                continue;
+            }
+            let cause = match (value(lhs, &state), value(rhs, &state)) {
+                (Err(c), _) | (_, Err(c)) => Some(c),
+                (Ok(l), Ok(r)) if (l - r).is_nan() => {
+                    Some((range.clone(), format!("the comparison of {l} with {r}")))
+                }
+                _ => None,
+            };
+            let Some((at, operation)) = cause else { continue };
+            open[a] = false;
+            let valuation: Vec<String> = spec
+                .state_vars
+                .iter()
+                .zip(&state)
+                .map(|(v, x)| format!("{} = {x}", v.name))
+                .collect();
+            let text = src.get(at.clone()).unwrap_or("the expression");
+            out.push(
+                Diagnostic::new(
+                    "HSTL060",
+                    at,
+                    format!("`{text}` is NaN at {}: {operation}", valuation.join(", ")),
+                )
+                .with_help(
+                    "robustness has no meaning for NaN: keep the expression defined on the whole \
+                     declared domain (for example `sqrt(abs(...))`), or narrow the `int` ranges",
+                ),
+            );
+        }
+        if !open.iter().any(|&o| o) {
+            break;
+        }
+    }
+}
+
+/// Whether `a op b` can be NaN on a state: not when one side is a finite constant and the
+/// other a variable or a finite constant.
+fn nan_prone(a: &CExpr, b: &CExpr) -> bool {
+    let finite = |e: &CExpr| matches!(e.kind, CExprKind::Const(c) if c.is_finite());
+    let plain = |e: &CExpr| matches!(e.kind, CExprKind::Var(_) | CExprKind::Const(_));
+    !((finite(a) && plain(b)) || (finite(b) && plain(a)))
+}
+
+/// The value of `e` on `s`, or the innermost expression that is NaN and what it computed.
+/// Expressions are as deep as the parser's nesting limits allow, so this recursion is
+/// bounded.
+fn value(e: &CExpr, s: &[f64]) -> Result<f64, (std::ops::Range<usize>, String)> {
+    let binary = |a: &CExpr, b: &CExpr, op: fn(f64, f64) -> f64, sym: &str| {
+        let (a, b) = (value(a, s)?, value(b, s)?);
+        let v = op(a, b);
+        if v.is_nan() { Err((e.range.clone(), format!("{a} {sym} {b}"))) } else { Ok(v) }
+    };
+    match &e.kind {
+        CExprKind::Const(c) => Ok(*c),
+        CExprKind::Var(i) => Ok(s.get(*i).copied().unwrap_or(0.0)),
+        CExprKind::Neg(a) => Ok(-value(a, s)?),
+        CExprKind::Abs(a) => Ok(value(a, s)?.abs()),
+        CExprKind::Sqrt(a) => {
+            let v = value(a, s)?;
+            if v < 0.0 {
+                Err((e.range.clone(), format!("the square root of {v}")))
+            } else {
+                Ok(v.sqrt())
+            }
+        }
+        CExprKind::Add(a, b) => binary(a, b, |a, b| a + b, "+"),
+        CExprKind::Sub(a, b) => binary(a, b, |a, b| a - b, "-"),
+        CExprKind::Mul(a, b) => binary(a, b, |a, b| a * b, "*"),
+        CExprKind::Div(a, b) => binary(a, b, |a, b| a / b, "/"),
+        // An invalid part was reported already.
+        CExprKind::Invalid => Ok(0.0),
     }
 }

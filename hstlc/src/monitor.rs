@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use clap::Args;
 use hstl::lang::{CheckedSpec, Domain, VarType};
-use hstl::monitor::Monitor;
+use hstl::monitor::{Monitor, TraceError};
 
 use crate::cli_error::CliError;
 use crate::output::{errln, outln};
@@ -109,16 +109,16 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     }
     let read = read_trace(&traces[0], &columns)?;
     note_ignored(&read.ignored, spec);
-    let trace = read.trace;
+    let name = trace_name(&traces[0]);
+    let values = score(&monitor, &read, args.signal).map_err(|e| trace_error(&name, &read, e))?;
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
-        let signal = monitor.signal_of_trace(&trace);
         writeln!(out, "t,robustness").and_then(|()| {
-            signal.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))
+            values.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))
         })
     } else {
-        writeln!(out, "{}", monitor.robustness_of_trace(&trace))
+        writeln!(out, "{}", values[0])
     }
     .and_then(|()| out.flush());
     // A signal can be long: it goes through its own buffer, its errors as all output's.
@@ -200,6 +200,25 @@ fn trace_name(path: &Path) -> String {
     if path == Path::new("-") { "<stdin>".to_string() } else { path.display().to_string() }
 }
 
+/// The signal of a trace read whole, or its value at step 0.
+fn score(monitor: &Monitor, read: &TraceRead, signal: bool) -> Result<Vec<f64>, TraceError> {
+    if signal {
+        monitor.signal_of_trace(&read.trace)
+    } else {
+        monitor.robustness_of_trace(&read.trace).map(|v| vec![v])
+    }
+}
+
+/// A trace the reader accepted but the monitor cannot score (an expression NaN on a
+/// step), at the line of that step.
+fn trace_error(name: &str, read: &TraceRead, e: TraceError) -> CliError {
+    let line = match &e {
+        TraceError::Undefined { step, .. } => read.line_of(*step),
+        _ => 1,
+    };
+    CliError::new(format!("{name}:{line}:1: {e}"), e.help())
+}
+
 /// A reader's error, at the trace's `name:line:column`.
 fn read_error(name: &str, e: ReadError) -> CliError {
     match e {
@@ -244,13 +263,10 @@ fn score_batch(
             if i >= traces.len() || failed.load(Ordering::Relaxed) {
                 break;
             }
-            let scored = read_trace(&traces[i], columns).map(|read| {
-                let values = if signal {
-                    monitor.signal_of_trace(&read.trace)
-                } else {
-                    vec![monitor.robustness_of_trace(&read.trace)]
-                };
-                (values, read.ignored)
+            let scored = read_trace(&traces[i], columns).and_then(|read| {
+                let values = score(monitor, &read, signal)
+                    .map_err(|e| trace_error(&trace_name(&traces[i]), &read, e))?;
+                Ok((values, read.ignored))
             });
             failed.fetch_or(scored.is_err(), Ordering::Relaxed);
             *results[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(scored);

@@ -52,6 +52,20 @@ pub struct TraceRead {
     pub trace: Trace,
     /// The header's names that are no state variable, in header order.
     pub ignored: Vec<String>,
+    /// `(step, line)` for the first step and each step after skipped blank lines: enough to
+    /// give any step's line without a number per row.
+    lines: Vec<(usize, usize)>,
+}
+
+impl TraceRead {
+    /// The line of the file that holds step `step`.
+    pub fn line_of(&self, step: usize) -> usize {
+        let k = self.lines.partition_point(|&(s, _)| s <= step);
+        match k.checked_sub(1).and_then(|k| self.lines.get(k)) {
+            Some(&(s, line)) => line + (step - s),
+            None => 1,
+        }
+    }
 }
 
 /// Why a trace could not be read.
@@ -94,7 +108,11 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
     let mut columns = vec![Vec::new(); vars.len()];
     let mut state = vec![0.0; vars.len()];
     let mut count = 0usize;
+    let mut lines: Vec<(usize, usize)> = Vec::new();
     while let Some(line) = rows.next_row(&mut state)? {
+        if lines.last().is_none_or(|&(s, l)| l + (count - s) != line) {
+            lines.push((count, line));
+        }
         count += 1;
         if count.saturating_mul(vars.len()) > MAX_TRACE_VALUES {
             return Err(csv(
@@ -118,7 +136,7 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
     let ignored = rows.ignored;
     let trace =
         Trace::from_columns(columns).map_err(|e| csv(1, 1, e.to_string(), String::new()))?;
-    Ok(TraceRead { trace, ignored })
+    Ok(TraceRead { trace, ignored, lines })
 }
 
 /// How much of a stream the reader takes.

@@ -54,6 +54,12 @@ const CASES: &[Case] = &[
         &["monitor", "surveillance.hstl", "--trace", "missing_column.csv"],
     ),
     case("monitor_not_a_number", &["monitor", "surveillance.hstl", "--trace", "not_a_number.csv"]),
+    case("monitor_nan_expression", &["monitor", "sqrt.hstl", "--trace", "sqrt.csv", "--signal"]),
+    Case {
+        name: "monitor_nan_expression_online",
+        args: &["monitor", "sqrt.hstl", "--online", "--trace", "-"],
+        stdin: "x\n4\n-1\n9\n",
+    },
     case("monitor_ragged_row", &["monitor", "surveillance.hstl", "--trace", "ragged.csv"]),
     case("monitor_empty_file", &["monitor", "surveillance.hstl", "--trace", "empty.csv"]),
     case("monitor_header_only", &["monitor", "surveillance.hstl", "--trace", "header_only.csv"]),

@@ -317,6 +317,34 @@ def test_nan_past_the_horizon_does_not_stop_robustness():
         SPEC.signal(trace)
 
 
+def test_a_nan_computed_by_an_expression_raises_naming_the_step_and_the_expression(hstlc, tmp_path):
+    # The example: a min over the window would skip the NaN and give 1.
+    text = "spec S { state { x: float } task always[0..=2] (sqrt(x) > 1); }"
+    spec = hstl.Spec.parse(text)
+    message = (
+        "`sqrt(x)` is NaN at step 1: the square root of -1\n  help: robustness has no meaning "
+        "for NaN: write the expression so that it is defined on every state the trace can hold "
+        "(for example `sqrt(abs(x))`), or fix the trace"
+    )
+    for call in (spec.signal, spec.robustness):
+        with pytest.raises(ValueError) as e:
+            call({"x": [4.0, -1.0, 9.0]})
+        assert str(e.value) == message
+    online = spec.online()
+    online.update({"x": 4.0})
+    with pytest.raises(ValueError) as e:
+        online.update({"x": -1.0})
+    assert str(e.value) == message
+    # The command line refuses the same trace in the same words, at the line of the step.
+    (tmp_path / "s.hstl").write_text(text)
+    (tmp_path / "t.csv").write_text("x\n4\n-1\n9\n")
+    cli = subprocess.run(
+        [hstlc, "monitor", "s.hstl", "--trace", "t.csv"], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert cli.returncode == 2
+    assert cli.stderr == "error: t.csv:3:1: " + message + "\n"
+
+
 def test_bad_states_for_the_online_monitor():
     online = SPEC.online()
     assert online.update({"x": 1, "y": 0}) is None

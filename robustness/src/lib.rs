@@ -14,10 +14,13 @@
 //!   slices, for monitors that compute their operand signals themselves.
 //! - [`segment`] scores option executions and all their suffixes for the learner.
 //!
+//! - [`nan`] finds the comparisons that compute a NaN, so callers can refuse it.
+//!
 //! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
 pub mod formula;
 pub mod kernels;
+pub mod nan;
 pub mod offline;
 pub mod online;
 pub mod reference;
