@@ -86,8 +86,10 @@ pub enum Evaluation {
     },
     /// Another task: its robustness over each run.
     Robustness {
-        /// `rho(task, 0)` over each run, in order.
+        /// `rho(task, 0)` over each run, in order, windows clipped at the run's end.
         values: Vec<f64>,
+        /// The same over complete windows: `None` for a run too short for any.
+        complete: Vec<Option<f64>>,
     },
 }
 
@@ -234,15 +236,18 @@ pub fn evaluate<E: Env>(replay: &Replay<E>, runs: Runs) -> Result<Evaluation, Pr
         // Not a persistent task: the task's robustness over each run is the measure.
         let all_states = state_trace(spec, env)?;
         let mut values = Vec::with_capacity(runs.starts);
+        let mut complete = Vec::with_capacity(runs.starts);
         for _ in 0..runs.starts {
             let start = env.index(&env.reset(&mut rng));
             let states: Vec<usize> = rollout(env, &mut controller, start, runs.steps, &mut rng)
                 .iter()
                 .map(|s| s.state)
                 .collect();
-            values.push(robustness_of_run(spec, &all_states, &states)?);
+            let trace = trace_of_run(&all_states, &states)?;
+            values.push(offline::robustness(&spec.task, &trace));
+            complete.push(hstl_robustness::complete::robustness(&spec.task, &trace));
         }
-        return Ok(Evaluation::Robustness { values });
+        return Ok(Evaluation::Robustness { values, complete });
     }
     let regions = RegionTable::new(spec, env).map_err(|e| Problem::new(e.to_string(), None))?;
     let report =
@@ -318,14 +323,22 @@ pub fn state_trace<E: Env>(spec: &TaskSpec, env: &E) -> Result<Trace, Problem> {
     Trace::from_columns(columns).map_err(|e| Problem::new(e.to_string(), None))
 }
 
-/// The task's robustness over the states of one run (indices into `states`, the trace of
-/// every state of the environment).
-fn robustness_of_run(spec: &TaskSpec, states: &Trace, run: &[usize]) -> Result<f64, Problem> {
+/// The trace of one run (indices into `states`, the trace of every state of the
+/// environment).
+fn trace_of_run(states: &Trace, run: &[usize]) -> Result<Trace, Problem> {
     let mut trace = Trace::new(states.vars());
     let mut row = Vec::with_capacity(states.vars());
     for &s in run {
         states.row_into(s, &mut row);
         trace.push(&row).map_err(|e| Problem::new(e.to_string(), None))?;
     }
-    Ok(offline::robustness(&spec.task, &trace))
+    Ok(trace)
+}
+
+/// The runs that satisfy the task, over complete windows: a run's robustness over complete
+/// windows is above 0, or, for a run too short for a complete window (an episode that
+/// ended early), its robustness with windows clipped at its end is. `clipped` and
+/// `complete` are per run, as [`Evaluation`] holds them.
+pub fn satisfied(clipped: &[f64], complete: &[Option<f64>]) -> usize {
+    clipped.iter().zip(complete).filter(|(c, v)| v.unwrap_or(**c) > 0.0).count()
 }

@@ -254,6 +254,25 @@ impl Monitor {
             .map_err(|e| self.ragged(&cols, e))
     }
 
+    /// The signal over complete windows ([`hstl_robustness::complete`]): `rho(f, t)` for
+    /// the steps whose every window lies inside the trace, as long as there are such
+    /// steps (later steps are undetermined).
+    pub fn complete_signal(&self, samples: &Samples<'_>) -> Result<Vec<f64>, TraceError> {
+        let len = self.lengths(samples)?;
+        self.check_nan(samples, len)?;
+        let mut scratch = Vec::new();
+        let cols = columns(samples, len, &mut scratch);
+        let trace = rob::Trace::from_columns(cols.iter().map(|c| c.to_vec()).collect())
+            .map_err(|e| self.ragged(&cols, e))?;
+        Ok(rob::complete::signal(&self.formula, &trace))
+    }
+
+    /// [`Monitor::complete_signal`] of a trace whose samples its reader checked.
+    pub fn complete_signal_of_trace(&self, trace: &rob::Trace) -> Result<Vec<f64>, TraceError> {
+        self.nan_prone.check_trace(trace, trace.len())?;
+        Ok(rob::complete::signal(&self.formula, trace))
+    }
+
     /// [`Monitor::signal`] of a trace whose samples its reader checked (the CLI's CSV
     /// reader): only the expressions are checked here.
     pub fn signal_of_trace(&self, trace: &rob::Trace) -> Result<Vec<f64>, TraceError> {
@@ -517,6 +536,13 @@ impl Online {
     /// The monitor then starts a new trace at step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
         self.inner.finish()
+    }
+
+    /// Ends the trace over complete windows: the verdicts of the open steps whose windows
+    /// all lie inside the trace (none for a bounded formula); later steps are undetermined.
+    /// The monitor then starts a new trace at step 0.
+    pub fn finish_complete(&mut self) -> Vec<Verdict> {
+        self.inner.finish_complete()
     }
 }
 

@@ -33,8 +33,11 @@ pub struct Trained {
 pub struct WindowSummary {
     /// The share of counted steps whose windows all visit their region.
     pub rate: f64,
-    /// The task's robustness over each run, averaged.
+    /// The task's robustness over each run, windows clipped at its end, averaged.
     pub robustness: f64,
+    /// The share of each run's complete steps where the task's body holds (every window
+    /// kept), averaged over the runs long enough for a complete window.
+    pub kept: Option<f64>,
 }
 
 /// The spec as the runtime's data, when it can be trained: it has options, and every
@@ -127,5 +130,7 @@ pub fn window_summary<E: Env>(
     let mut controller = AgentController::new(agent);
     let report = window_rate(env, &mut controller, &regions, WindowConfig::default(), &mut rng)?;
     let robustness = report.robustness.iter().sum::<f64>() / report.robustness.len() as f64;
-    Ok(Some(WindowSummary { rate: report.rate, robustness }))
+    let shares: Vec<f64> = report.kept.iter().flatten().copied().collect();
+    let kept = (!shares.is_empty()).then(|| shares.iter().sum::<f64>() / shares.len() as f64);
+    Ok(Some(WindowSummary { rate: report.rate, robustness, kept }))
 }

@@ -370,3 +370,30 @@ fn io_errors_read_as_the_cli_prints_them() {
     let trace = Trace::from_columns(vec![x.to_vec()]).unwrap();
     assert_eq!(offline::signal_of_slices(&f, &[&x]).unwrap(), offline::signal(&f, &trace));
 }
+
+#[test]
+fn complete_windows_agree_offline_and_online_and_leave_the_end_undetermined() {
+    let m = monitor(
+        "spec S { state { x: float, y: float } \
+         task always[0..] (eventually[0..=4] x > 0 && eventually[0..=4] y > 0); }",
+        None,
+    );
+    let x: Vec<f64> = (0..12).map(|t| if t % 3 == 0 { 1.0 } else { -1.0 }).collect();
+    let y: Vec<f64> = (0..12).map(|t| if t % 3 == 1 { 1.0 } else { -1.0 }).collect();
+    let samples = Samples::Columns(vec![&x, &y]);
+    // Clipped, the last windows fail; complete, steps 8 to 11 are undetermined.
+    assert_eq!(m.robustness(&samples).unwrap(), -1.0);
+    let complete = m.complete_signal(&samples).unwrap();
+    assert_eq!(complete, vec![1.0; 8]);
+    let mut online = m.online();
+    for t in 0..12 {
+        assert_eq!(online.push(&[x[t], y[t]]).unwrap(), None, "unbounded: no verdict yet");
+    }
+    let verdicts: Vec<f64> = online.finish_complete().iter().map(|v| v.value).collect();
+    assert_eq!(verdicts, complete);
+    assert_eq!(online.steps(), 0, "finishing starts a new trace");
+    // A NaN is refused over complete windows too.
+    let m = monitor("spec S { state { x: float } task always[0..=1] (sqrt(x) > 1); }", None);
+    let bad = [4.0, -1.0, 9.0];
+    assert!(m.complete_signal(&Samples::Columns(vec![&bad])).is_err());
+}

@@ -13,7 +13,9 @@ pub fn check(data: &[u8]) {
                 Ok(Evaluation::Window { report }) => {
                     assert!((0.0..=1.0).contains(&report.rate), "{}", report.rate);
                 }
-                Ok(Evaluation::Robustness { values }) => assert_eq!(values.len(), 2),
+                Ok(Evaluation::Robustness { values, complete }) => {
+                    assert_eq!((values.len(), complete.len()), (2, 2));
+                }
                 Err(p) => assert!(!p.message.is_empty() && !p.message.ends_with('.')),
             }
         }

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use hstl::lang::{CheckedSpec, Domain, VarType};
 use hstl::monitor::{Monitor, TraceError};
 
@@ -52,9 +52,30 @@ pub struct MonitorArgs {
     /// The spec to use when the file holds more than one.
     #[arg(long = "spec", value_name = "NAME")]
     pub spec_name: Option<String>,
+    /// Windows at the trace's end: `clipped` (rtamt's semantics) cuts them short;
+    /// `complete` counts a step only if every window it needs lies inside the trace, and
+    /// leaves later steps undetermined (empty in `--signal` rows). See docs/LANGUAGE.md.
+    #[arg(long, value_enum, default_value_t = Windows::Clipped)]
+    pub windows: Windows,
     /// Threads that score a batch of traces (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
     pub threads: Option<u16>,
+}
+
+/// How windows that run past the end of a trace count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Windows {
+    /// Cut at the end of the trace (empty windows give `inf` or `-inf`), as rtamt does.
+    Clipped,
+    /// A step counts only if its windows lie inside the trace; later steps are
+    /// undetermined.
+    Complete,
+}
+
+/// A trace's values: `values[t]` for the determined steps, of `steps` in the trace.
+struct Scored {
+    values: Vec<f64>,
+    steps: usize,
 }
 
 /// The most trace files one batch scores.
@@ -98,27 +119,29 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     })?;
     let columns = columns(spec);
     if args.online {
-        return online(&monitor, &columns, &traces[0], spec, args.formula.as_deref());
+        return online(&monitor, &columns, &traces[0], spec, args.formula.as_deref(), args.windows);
     }
     if batch {
         let threads = args.threads.map_or_else(
             || std::thread::available_parallelism().map_or(1, usize::from),
             usize::from,
         );
-        return score_batch(&monitor, &columns, &traces, args.signal, threads, spec);
+        return score_batch(&monitor, &columns, &traces, args.signal, args.windows, threads, spec);
     }
     let read = read_trace(&traces[0], &columns)?;
     note_ignored(&read.ignored, spec);
     let name = trace_name(&traces[0]);
-    let values = score(&monitor, &read, args.signal).map_err(|e| trace_error(&name, &read, e))?;
+    let scored = score(&monitor, &read, args.signal, args.windows)
+        .map_err(|e| trace_error(&name, &read, e))?;
+    note_undetermined(&scored, args.signal);
 
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if args.signal {
         writeln!(out, "t,robustness").and_then(|()| {
-            values.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))
+            (0..scored.steps).try_for_each(|t| writeln!(out, "{t},{}", scored.cell(t)))
         })
     } else {
-        writeln!(out, "{}", values[0])
+        writeln!(out, "{}", scored.first())
     }
     .and_then(|()| out.flush());
     // A signal can be long: it goes through its own buffer, its errors as all output's.
@@ -201,11 +224,78 @@ fn trace_name(path: &Path) -> String {
 }
 
 /// The signal of a trace read whole, or its value at step 0.
-fn score(monitor: &Monitor, read: &TraceRead, signal: bool) -> Result<Vec<f64>, TraceError> {
+fn score(
+    monitor: &Monitor,
+    read: &TraceRead,
+    signal: bool,
+    windows: Windows,
+) -> Result<Scored, TraceError> {
+    let steps = if signal { read.trace.len() } else { 1 };
+    let values = match (windows, signal) {
+        (Windows::Clipped, true) => monitor.signal_of_trace(&read.trace)?,
+        (Windows::Clipped, false) => vec![monitor.robustness_of_trace(&read.trace)?],
+        (Windows::Complete, _) => {
+            let mut v = monitor.complete_signal_of_trace(&read.trace)?;
+            v.truncate(steps);
+            v
+        }
+    };
+    Ok(Scored { values, steps })
+}
+
+impl Scored {
+    /// Step `t`'s value as a CSV field: empty when undetermined.
+    fn cell(&self, t: usize) -> String {
+        self.values.get(t).map_or_else(String::new, f64::to_string)
+    }
+
+    /// The value at step 0, or `undetermined`.
+    fn first(&self) -> String {
+        self.values.first().map_or_else(|| "undetermined".to_string(), f64::to_string)
+    }
+
+    fn undetermined(&self) -> usize {
+        self.steps - self.values.len()
+    }
+}
+
+/// Says on standard error which steps of one trace complete windows left undetermined.
+fn note_undetermined(one: &Scored, signal: bool) {
+    if one.undetermined() == 0 {
+        return;
+    }
     if signal {
-        monitor.signal_of_trace(&read.trace)
+        errln!(
+            "note: over complete windows, steps {} to {} are undetermined: their windows run \
+             past the end of the trace (their values are left empty)",
+            one.values.len(),
+            one.steps - 1
+        );
     } else {
-        monitor.robustness_of_trace(&read.trace).map(|v| vec![v])
+        errln!(
+            "note: over complete windows, step 0 is undetermined: its windows run past the end \
+             of the trace"
+        );
+    }
+}
+
+/// Says once, on standard error, how many steps of a batch complete windows left
+/// undetermined.
+fn note_undetermined_rows(rows: &[(&PathBuf, Scored)], signal: bool) {
+    let open: usize = rows.iter().map(|(_, s)| s.undetermined()).sum();
+    match (open, signal) {
+        (0, _) => {}
+        (_, true) => errln!(
+            "note: over complete windows, {open} step{} of the traces {} undetermined: their \
+             windows run past the end of their trace (their values are left empty)",
+            if open == 1 { "" } else { "s" },
+            if open == 1 { "is" } else { "are" }
+        ),
+        (_, false) => errln!(
+            "note: over complete windows, step 0 of {open} trace{} is undetermined: its \
+             windows run past the end of the trace (printed as `undetermined`)",
+            if open == 1 { "" } else { "s" }
+        ),
     }
 }
 
@@ -250,13 +340,14 @@ fn score_batch(
     columns: &[Column<'_>],
     traces: &[PathBuf],
     signal: bool,
+    windows: Windows,
     threads: usize,
     spec: &CheckedSpec,
 ) -> CmdResult {
     let next = AtomicUsize::new(0);
     let failed = AtomicBool::new(false);
-    type Scored = Result<(Vec<f64>, Vec<String>), CliError>;
-    let results: Vec<Mutex<Option<Scored>>> = traces.iter().map(|_| Mutex::new(None)).collect();
+    type Result = std::result::Result<(Scored, Vec<String>), CliError>;
+    let results: Vec<Mutex<Option<Result>>> = traces.iter().map(|_| Mutex::new(None)).collect();
     let work = || {
         loop {
             let i = next.fetch_add(1, Ordering::Relaxed);
@@ -264,9 +355,9 @@ fn score_batch(
                 break;
             }
             let scored = read_trace(&traces[i], columns).and_then(|read| {
-                let values = score(monitor, &read, signal)
+                let scored = score(monitor, &read, signal, windows)
                     .map_err(|e| trace_error(&trace_name(&traces[i]), &read, e))?;
-                Ok((values, read.ignored))
+                Ok((scored, read.ignored))
             });
             failed.fetch_or(scored.is_err(), Ordering::Relaxed);
             *results[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(scored);
@@ -283,13 +374,13 @@ fn score_batch(
     let mut ignored: Vec<String> = Vec::new();
     for (path, slot) in traces.iter().zip(results) {
         match slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
-            Some(Ok((values, names))) => {
+            Some(Ok((scored, names))) => {
                 for n in names {
                     if !ignored.contains(&n) {
                         ignored.push(n);
                     }
                 }
-                rows.push((path, values));
+                rows.push((path, scored));
             }
             Some(Err(e)) => return Err(e),
             // Not scored: an earlier error stopped the batch; it is reported above.
@@ -297,18 +388,19 @@ fn score_batch(
         }
     }
     note_ignored(&ignored, spec);
+    note_undetermined_rows(&rows, signal);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = if signal {
         writeln!(out, "trace,t,robustness").and_then(|()| {
-            rows.iter().try_for_each(|(path, values)| {
+            rows.iter().try_for_each(|(path, scored)| {
                 let name = csv_field(&trace_name(path));
-                values.iter().enumerate().try_for_each(|(t, v)| writeln!(out, "{name},{t},{v}"))
+                (0..scored.steps).try_for_each(|t| writeln!(out, "{name},{t},{}", scored.cell(t)))
             })
         })
     } else {
         writeln!(out, "trace,robustness").and_then(|()| {
-            rows.iter().try_for_each(|(path, values)| {
-                writeln!(out, "{},{}", csv_field(&trace_name(path)), values[0])
+            rows.iter().try_for_each(|(path, scored)| {
+                writeln!(out, "{},{}", csv_field(&trace_name(path)), scored.first())
             })
         })
     }
@@ -326,6 +418,7 @@ fn online(
     path: &Path,
     spec: &CheckedSpec,
     formula: Option<&str>,
+    windows: Windows,
 ) -> CmdResult {
     let name = trace_name(path);
     let stdin;
@@ -378,8 +471,31 @@ fn online(
     if live.steps() == 0 {
         return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
     }
-    for v in live.finish() {
+    let steps = live.steps();
+    let last = match windows {
+        Windows::Clipped => live.finish(),
+        Windows::Complete => live.finish_complete(),
+    };
+    let mut determined = steps;
+    if windows == Windows::Complete {
+        // Verdicts come in step order: the steps after the last are undetermined.
+        determined = last
+            .last()
+            .map_or(0, |v| v.step + 1)
+            .max(steps.saturating_sub(live.horizon().map_or(steps, |h| h.min(steps))));
+    }
+    for v in last {
         outln!("{},{}", v.step, v.value)?;
+    }
+    for t in determined..steps {
+        outln!("{t},")?;
+    }
+    if determined < steps {
+        errln!(
+            "note: over complete windows, steps {determined} to {} are undetermined: their \
+             windows run past the end of the trace (their values are left empty)",
+            steps - 1
+        );
     }
     Ok(Status::Clean)
 }

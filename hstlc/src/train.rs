@@ -115,9 +115,15 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         "  reward per episode: {tail:.2} (mean of the last {} episodes)",
         outcome.curve.len().min(100)
     )?;
-    if let Some((rate, robustness)) = window {
+    if let Some((rate, kept)) = window {
+        let kept = kept.map_or_else(String::new, |k| {
+            format!(
+                "; over complete windows the task's body holds on {:.1}% of the steps",
+                100.0 * k
+            )
+        });
         outln!(
-            "  window rate {rate:.3} over {} greedy runs of {} steps; task robustness {robustness:.2} (mean over runs)",
+            "  window rate {rate:.3} over {} greedy runs of {} steps{kept}",
             WindowConfig::default().starts,
             WindowConfig::default().steps
         )?;
@@ -159,16 +165,17 @@ pub fn policy_json(policy: &Policy, source: &str, seed: u64) -> Result<String, C
     hstl::train::policy_json(policy, source, seed).map_err(|e| CliError::new(e.to_string(), None))
 }
 
-/// The window rate and mean task robustness of the greedy agent, for persistent tasks.
+/// The window rate of the greedy agent, and the share of steps keeping every complete
+/// window, for persistent tasks.
 pub fn window_report(
     spec: &TaskSpec,
     env: &GridWorld,
     agent: &hstl::runtime::Agent,
     seed: u64,
-) -> Result<Option<(f64, f64)>, CliError> {
+) -> Result<Option<(f64, Option<f64>)>, CliError> {
     let summary = hstl::train::window_summary(spec, env, agent, seed)
         .map_err(|e| CliError::new(e.to_string(), None))?;
-    Ok(summary.map(|s| (s.rate, s.robustness)))
+    Ok(summary.map(|s| (s.rate, s.kept)))
 }
 
 /// The mean of the last `n` values.

@@ -457,8 +457,13 @@ impl Policy {
     /// nearest-cell cycle on the same starts and slips) and, with `optimum=True`,
     /// `optimum` (`W*`, by value iteration: a few seconds for the case study),
     /// `optimum_bounds` and `optimum_converged`; for any task `robustness` (the task's
-    /// robustness over each run), `robustness_mean` and `satisfied` (runs with positive
-    /// robustness). Keys that do not apply hold None.
+    /// robustness over each run, windows clipped at the run's end), `robustness_mean`,
+    /// `robustness_complete` (over complete windows; None for a run too short for one),
+    /// `satisfied` (runs with positive robustness over complete windows; a run too short
+    /// for one is judged with its windows clipped) and
+    /// `satisfied_clipped` (the same, windows clipped); for a persistent task
+    /// `windows_kept` (per run, the share of its complete steps where the task's body
+    /// holds). Keys that do not apply hold None.
     ///
     /// A policy trained on a gymnasium environment is replayed in `env` (the same
     /// environment, with the same `valuation`), more slowly; its `baseline` and `optimum`
@@ -545,22 +550,29 @@ impl Policy {
             }
         };
         let out = PyDict::new(py);
-        let robustness = match evaluation {
+        let (robustness, complete) = match evaluation {
             Evaluation::Window { report } => {
                 out.set_item("window_rate", report.rate)?;
                 out.set_item("window_rates", report.per_rollout)?;
-                report.robustness
+                out.set_item("windows_kept", report.kept)?;
+                (report.robustness, report.complete)
             }
-            Evaluation::Robustness { values } => {
+            Evaluation::Robustness { values, complete } => {
                 out.set_item("window_rate", py.None())?;
                 out.set_item("window_rates", py.None())?;
-                values
+                out.set_item("windows_kept", py.None())?;
+                (values, complete)
             }
         };
         let mean = robustness.iter().sum::<f64>() / robustness.len().max(1) as f64;
         out.set_item("robustness_mean", mean)?;
-        out.set_item("satisfied", robustness.iter().filter(|&&v| v > 0.0).count())?;
+        // Satisfaction is counted over complete windows: clipped windows at a run's end make
+        // a persistent task fail on nearly every finite run.
+        let satisfied = evaluate::satisfied(&robustness, &complete);
+        out.set_item("satisfied", satisfied)?;
+        out.set_item("satisfied_clipped", robustness.iter().filter(|&&v| v > 0.0).count())?;
         out.set_item("robustness", robustness)?;
+        out.set_item("robustness_complete", complete)?;
         out.set_item("baseline", baseline)?;
         out.set_item("optimum", best.as_ref().map(|o| o.gain))?;
         out.set_item("optimum_bounds", best.as_ref().map(|o| (o.lower, o.upper)))?;

@@ -79,7 +79,7 @@ def eval_figures(stdout: str) -> dict:
     figures = {"window_rate": re.search(r"window rate (\d\.\d+) \(runs", stdout)}
     figures["baseline"] = re.search(r"baseline .*window rate (\d\.\d+)", stdout)
     figures["optimum"] = re.search(r"optimum W\* = (\d\.\d+)", stdout)
-    figures["mean"] = re.search(r"task robustness over each run: mean (-?[\d.]+|-?inf)", stdout)
+    figures["mean"] = re.search(r"task robustness over each run \(windows clipped at the run's end\): mean (-?[\d.]+|-?inf)", stdout)
     figures["satisfied"] = re.search(r"satisfied in (\d+) of", stdout)
     return {k: m.group(1) for k, m in figures.items() if m}
 

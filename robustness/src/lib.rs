@@ -18,6 +18,7 @@
 //!
 //! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
+pub mod complete;
 pub mod formula;
 pub mod kernels;
 pub mod nan;

@@ -128,12 +128,39 @@ impl OnlineMonitor {
             .enumerate()
             .map(|(i, &value)| Verdict { step: first + i, value })
             .collect();
+        self.reset();
+        out
+    }
+
+    /// Ends the trace over complete windows ([`crate::complete`]): the verdicts of the
+    /// open steps that are complete. A bounded formula has none (its complete steps are
+    /// exactly those [`OnlineMonitor::push`] gave); an unbounded one gets its whole
+    /// complete prefix. Later steps are undetermined. The monitor is then ready for a new
+    /// trace, counting from step 0.
+    pub fn finish_complete(&mut self) -> Vec<Verdict> {
+        let mut out = Vec::new();
+        if self.horizon.is_none() && self.buffered() > 0 {
+            let cols: Vec<Vec<f64>> =
+                self.columns.iter().map(|c| c[self.start..].to_vec()).collect();
+            if let Ok(trace) = crate::Trace::from_columns(cols) {
+                let first = self.first_step;
+                out = crate::complete::signal(&self.formula, &trace)
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, value)| Verdict { step: first + i, value })
+                    .collect();
+            }
+        }
+        self.reset();
+        out
+    }
+
+    fn reset(&mut self) {
         self.columns.iter_mut().for_each(Vec::clear);
         self.len = 0;
         self.start = 0;
         self.first_step = 0;
         self.nodes = Node::build(&self.formula);
-        out
     }
 
     fn buffered(&self) -> usize {

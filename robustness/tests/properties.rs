@@ -4,7 +4,7 @@
 mod common;
 
 use common::{check_all, parse};
-use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace, reference};
+use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace, complete, reference};
 use proptest::prelude::*;
 
 fn value() -> impl Strategy<Value = f64> {
@@ -148,4 +148,96 @@ fn missing_variable_is_nan() {
     let t = common::trace_xy(&[1.0, 2.0], &[3.0, 4.0]);
     check_all(&f, &t, &reference::signal(&f, &t));
     assert!(reference::signal(&f, &t).iter().all(|v| v.is_nan()));
+}
+
+/// Complete windows read literally: `(complete steps, rho(f, t))` where every operator's
+/// window is cut at its operands' complete prefix (the table in `complete`'s docs).
+fn complete_reference(f: &Formula, trace: &Trace) -> (usize, Vec<f64>) {
+    let n = trace.len();
+    let cut = |(c, v): (usize, Vec<f64>)| v[..c].to_vec();
+    let fold = |vals: &mut dyn Iterator<Item = f64>, min: bool| {
+        vals.fold(if min { f64::INFINITY } else { f64::NEG_INFINITY }, |a, b| {
+            if min { a.min(b) } else { a.max(b) }
+        })
+    };
+    // The steps `t' ` of interval `i` at `t` within `m` steps, and the node's own prefix.
+    let window = |i: &Interval, t: usize, m: usize| i.window(t, m);
+    let own = |i: &Interval, m: usize| match i.end {
+        Bound::Unbounded => m.saturating_sub(i.start),
+        _ => m.saturating_sub(i.last_offset().unwrap_or(0)),
+    };
+    match f {
+        Formula::True | Formula::False | Formula::Cmp { .. } => (n, reference::signal(f, trace)),
+        Formula::Not(g) => {
+            let g = cut(complete_reference(g, trace));
+            (g.len(), g.iter().map(|v| -v).collect())
+        }
+        Formula::And(gs) | Formula::Or(gs) => {
+            let kids: Vec<Vec<f64>> =
+                gs.iter().map(|g| cut(complete_reference(g, trace))).collect();
+            let m = kids.iter().map(Vec::len).min().unwrap_or(n);
+            let min = matches!(f, Formula::And(_));
+            (m, (0..m).map(|t| fold(&mut kids.iter().map(|k| k[t]), min)).collect())
+        }
+        Formula::Implies(g, h) => {
+            let (g, h) = (cut(complete_reference(g, trace)), cut(complete_reference(h, trace)));
+            let m = g.len().min(h.len());
+            (m, (0..m).map(|t| (-g[t]).max(h[t])).collect())
+        }
+        Formula::Always(i, g) | Formula::Eventually(i, g) => {
+            let g = cut(complete_reference(g, trace));
+            let m = g.len();
+            let min = matches!(f, Formula::Always(..));
+            let v = (0..m).map(|t| fold(&mut window(i, t, m).map(|u| g[u]), min)).collect();
+            (own(i, m), v)
+        }
+        Formula::Until(i, g, h) => {
+            let (g, h) = (cut(complete_reference(g, trace)), cut(complete_reference(h, trace)));
+            let m = g.len().min(h.len());
+            let v = (0..m)
+                .map(|t| {
+                    fold(
+                        &mut window(i, t, m)
+                            .map(|u| h[u].min(fold(&mut (t..u).map(|w| g[w]), true))),
+                        false,
+                    )
+                })
+                .collect();
+            (own(i, m), v)
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
+
+    /// The complete-window evaluator against its literal reading, and against the clipped
+    /// signal wherever no unbounded operator cuts a prefix.
+    #[test]
+    fn complete_windows_agree_with_their_reference(f in formula(0), t in trace(2, false)) {
+        let (c, want) = complete_reference(&f, &t);
+        prop_assert_eq!(complete::complete_len(&f, t.len()), c);
+        let got = complete::signal(&f, &t);
+        common::assert_same("complete", &got, &want[..c]);
+        if let Some(h) = f.horizon() {
+            prop_assert_eq!(c, t.len().saturating_sub(h));
+            common::assert_same("bounded", &got, &reference::signal(&f, &t)[..c]);
+        }
+    }
+}
+
+/// The example: a perfect A -> B -> C cycle keeps the persistent task over every
+/// complete window, though clipped windows make it negative at the trace's end.
+#[test]
+fn a_perfect_cycle_keeps_the_persistent_task_over_complete_windows() {
+    let f = parse("always[0..] (eventually[0..=4] x > 0 && eventually[0..=4] y > 0)");
+    // x holds every 3 steps, y every 3 steps shifted by one; the trace ends on neither.
+    let x: Vec<f64> = (0..31).map(|t| if t % 3 == 0 && t < 30 { 1.0 } else { -1.0 }).collect();
+    let y: Vec<f64> = (0..31).map(|t| if t % 3 == 1 && t < 29 { 1.0 } else { -1.0 }).collect();
+    let t = common::trace_xy(&x, &y);
+    assert!(reference::robustness(&f, &t, 0) < 0.0, "clipped windows fail at the end");
+    assert_eq!(complete::complete_len(&f, 31), 27);
+    assert_eq!(complete::robustness(&f, &t), Some(1.0));
+    // Too short a trace leaves step 0 undetermined.
+    assert_eq!(complete::robustness(&f, &common::trace_xy(&x[..4], &y[..4])), None);
 }

@@ -8,7 +8,7 @@
 //! when the start state satisfies `R_j`. The rate is the share of the steps
 //! `burn_in..steps` with `psi(t) = 1`, pooled over all rollouts.
 
-use hstl_robustness::{Trace, offline, reference};
+use hstl_robustness::{Trace, complete, offline, reference};
 
 use crate::{Agent, Env, Error, Rng, TaskSpec};
 
@@ -63,8 +63,16 @@ pub struct WindowReport {
     pub rate: f64,
     /// The window rate of each rollout.
     pub per_rollout: Vec<f64>,
-    /// The task's robustness `rho(task, 0)` over each whole rollout.
+    /// The task's robustness `rho(task, 0)` over each whole rollout, windows clipped at
+    /// its end.
     pub robustness: Vec<f64>,
+    /// The same over complete windows ([`hstl_robustness::complete`]): `None` for a
+    /// rollout too short for any.
+    pub complete: Vec<Option<f64>>,
+    /// For a task `always[0..] f`: the share of each rollout's complete steps where `f`
+    /// holds (robustness above 0), the task kept window by window; `None` for a rollout
+    /// too short for a complete window.
+    pub kept: Vec<Option<f64>>,
 }
 
 /// Region membership per state index, for the window rate.
@@ -156,15 +164,32 @@ impl RegionTable {
     /// The task's robustness over the states of a rollout (by the offline evaluator, which
     /// gives the reference evaluator's values in linear time).
     pub fn robustness(&self, states: &[usize]) -> f64 {
+        self.rollout_trace(states).map_or(f64::NAN, |t| offline::robustness(&self.task, &t))
+    }
+
+    /// The task's robustness over a rollout, over complete windows: `None` when the
+    /// rollout is too short for step 0's windows.
+    pub fn complete_robustness(&self, states: &[usize]) -> Option<f64> {
+        complete::robustness(&self.task, &self.rollout_trace(states)?)
+    }
+
+    /// For a task `always[0..] f`, the share of the rollout's complete steps where `f`
+    /// holds; `None` for another task or a rollout too short for a complete window.
+    pub fn kept_share(&self, states: &[usize]) -> Option<f64> {
+        let (body, _) = reference::persistent_body(&self.task)?;
+        let signal = complete::signal(body, &self.rollout_trace(states)?);
+        let kept = signal.iter().filter(|&&v| v > 0.0).count();
+        (!signal.is_empty()).then(|| kept as f64 / signal.len() as f64)
+    }
+
+    fn rollout_trace(&self, states: &[usize]) -> Option<Trace> {
         let mut t = Trace::new(self.trace.vars());
         let mut row = Vec::new();
         for &s in states {
             self.trace.row_into(s, &mut row);
-            if t.push(&row).is_err() {
-                return f64::NAN;
-            }
+            t.push(&row).ok()?;
         }
-        offline::robustness(&self.task, &t)
+        Some(t)
     }
 
     /// `psi(t)` for every step of a rollout through `states` (an index past the table
@@ -443,6 +468,8 @@ pub fn window_rate<E: Env, C: Controller>(
     }
     let mut per_rollout = Vec::with_capacity(config.starts);
     let mut robustness = Vec::with_capacity(config.starts);
+    let mut complete = Vec::with_capacity(config.starts);
+    let mut kept_share = Vec::with_capacity(config.starts);
     let mut kept = 0usize;
     for _ in 0..config.starts {
         let start = env.index(&env.reset(rng));
@@ -452,7 +479,9 @@ pub fn window_rate<E: Env, C: Controller>(
         kept += here;
         per_rollout.push(here as f64 / (config.steps - config.burn_in) as f64);
         robustness.push(regions.robustness(&states));
+        complete.push(regions.complete_robustness(&states));
+        kept_share.push(regions.kept_share(&states));
     }
     let rate = kept as f64 / (config.starts * (config.steps - config.burn_in)) as f64;
-    Ok(WindowReport { rate, per_rollout, robustness })
+    Ok(WindowReport { rate, per_rollout, robustness, complete, kept: kept_share })
 }
