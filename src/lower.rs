@@ -2,7 +2,11 @@
 //!
 //! This is the interpreter's path (the CLI, tools, tests); the `hstl!` macro emits the same
 //! data as Rust code. `tests/lower_vs_macro.rs` holds the two paths against each other.
-//! `let`s are inlined: the runtime's formulas are trees without names.
+//! The runtime's formulas are DAGs without names: each `let` is lowered once into one node
+//! that every use shares, so a formula's size is that of the spec, however the lets nest.
+//! The lets a formula needs are found with an explicit stack and lowered in dependency
+//! order; only one let's own body is walked recursively, and the parser bounds its height
+//! ([`hstl_lang::parser::MAX_HEIGHT`]), so no chain of lets can exhaust the stack.
 
 use std::fmt;
 
@@ -57,7 +61,7 @@ impl std::error::Error for LowerError {}
 pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerError> {
     let invalid = || LowerError::Invalid { spec: spec.name.clone() };
     let task = spec.task.as_ref().ok_or_else(invalid)?;
-    let lower = Lowerer { spec };
+    let mut lower = Lowerer::new(spec);
     let task = lower.formula(&task.formula).ok_or_else(invalid)?;
     let state_vars = spec
         .state_vars
@@ -144,7 +148,7 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
 pub fn task(spec: &CheckedSpec) -> Result<rob::Formula, LowerError> {
     spec.task
         .as_ref()
-        .and_then(|t| Lowerer { spec }.formula(&t.formula))
+        .and_then(|t| Lowerer::new(spec).formula(&t.formula))
         .ok_or_else(|| LowerError::Invalid { spec: spec.name.clone() })
 }
 
@@ -157,29 +161,52 @@ pub fn let_formula(spec: &CheckedSpec, name: &str) -> Result<rob::Formula, Lower
             known: spec.lets.iter().map(|l| l.name.clone()).collect(),
         });
     };
-    Lowerer { spec }
+    Lowerer::new(spec)
         .formula(&l.formula)
         .ok_or_else(|| LowerError::Invalid { spec: spec.name.clone() })
 }
 
 /// Any checked formula of `spec`; `None` when part of it did not check.
 pub fn formula(spec: &CheckedSpec, f: &CFormula) -> Option<rob::Formula> {
-    Lowerer { spec }.formula(f)
+    Lowerer::new(spec).formula(f)
 }
 
 /// Any checked expression; `None` when part of it did not check.
 pub fn expr(e: &CExpr) -> Option<rob::Expr> {
-    let boxed = |a: &CExpr| expr(a).map(Box::new);
+    let mut b = rob::FormulaBuilder::new();
+    let id = lower_expr(&mut b, e)?;
+    Some(b.build_expr(id))
+}
+
+/// `e` into `b`; recursive, but an expression is never taller than the parser's limit.
+fn lower_expr(b: &mut rob::FormulaBuilder, e: &CExpr) -> Option<rob::ExprId> {
     Some(match &e.kind {
-        CExprKind::Const(c) => rob::Expr::Const(*c),
-        CExprKind::Var(i) => rob::Expr::Var(*i),
-        CExprKind::Neg(a) => rob::Expr::Neg(boxed(a)?),
-        CExprKind::Abs(a) => rob::Expr::Abs(boxed(a)?),
-        CExprKind::Sqrt(a) => rob::Expr::Sqrt(boxed(a)?),
-        CExprKind::Add(a, b) => rob::Expr::Add(boxed(a)?, boxed(b)?),
-        CExprKind::Sub(a, b) => rob::Expr::Sub(boxed(a)?, boxed(b)?),
-        CExprKind::Mul(a, b) => rob::Expr::Mul(boxed(a)?, boxed(b)?),
-        CExprKind::Div(a, b) => rob::Expr::Div(boxed(a)?, boxed(b)?),
+        CExprKind::Const(c) => b.constant(*c),
+        CExprKind::Var(i) => b.var(*i),
+        CExprKind::Neg(a) => {
+            let a = lower_expr(b, a)?;
+            b.neg(a)
+        }
+        CExprKind::Abs(a) => {
+            let a = lower_expr(b, a)?;
+            b.abs(a)
+        }
+        CExprKind::Sqrt(a) => {
+            let a = lower_expr(b, a)?;
+            b.sqrt(a)
+        }
+        CExprKind::Add(x, y)
+        | CExprKind::Sub(x, y)
+        | CExprKind::Mul(x, y)
+        | CExprKind::Div(x, y) => {
+            let (x, y) = (lower_expr(b, x)?, lower_expr(b, y)?);
+            match e.kind {
+                CExprKind::Add(..) => b.add_expr(x, y),
+                CExprKind::Sub(..) => b.sub_expr(x, y),
+                CExprKind::Mul(..) => b.mul_expr(x, y),
+                _ => b.div_expr(x, y),
+            }
+        }
         CExprKind::Invalid => return None,
     })
 }
@@ -198,51 +225,98 @@ pub fn interval(iv: &hstl_lang::Interval) -> rob::Interval {
     }
 }
 
-/// The longest chain of lets inlined into one formula.
-pub const MAX_LET_DEPTH: usize = 256;
-
+/// Lowers formulas of one spec into one builder, each `let` once.
 struct Lowerer<'a> {
     spec: &'a CheckedSpec,
+    b: rob::FormulaBuilder,
+    /// The node of each lowered let; `None` when not lowered yet, on a cycle, or invalid.
+    lets: Vec<Option<rob::NodeId>>,
+    /// Whether each let was tried.
+    tried: Vec<bool>,
 }
 
-impl Lowerer<'_> {
-    fn formula(&self, f: &CFormula) -> Option<rob::Formula> {
-        self.formula_at(f, 0)
+impl<'a> Lowerer<'a> {
+    fn new(spec: &'a CheckedSpec) -> Lowerer<'a> {
+        let n = spec.lets.len();
+        Lowerer { spec, b: rob::FormulaBuilder::new(), lets: vec![None; n], tried: vec![false; n] }
     }
 
-    /// `depth` counts inlined lets: a chain longer than [`MAX_LET_DEPTH`] is refused rather
-    /// than risking the stack here or in the evaluators' recursion.
-    fn formula_at(&self, f: &CFormula, depth: usize) -> Option<rob::Formula> {
-        let boxed = |g: &CFormula| self.formula_at(g, depth).map(Box::new);
-        let all = |v: &[CFormula]| {
-            v.iter().map(|g| self.formula_at(g, depth)).collect::<Option<Vec<_>>>()
-        };
-        Some(match &f.kind {
-            CFormulaKind::True => rob::Formula::True,
-            CFormulaKind::False => rob::Formula::False,
-            // `let_order` leaves out the lets on a cycle, so this recursion ends.
-            CFormulaKind::Let(i) if depth < MAX_LET_DEPTH && self.spec.let_order.contains(i) => {
-                self.formula_at(&self.spec.lets.get(*i)?.formula, depth + 1)?
+    /// `f` as the runtime's formula; `None` when part of it (or of a let it uses) did not
+    /// check.
+    fn formula(&mut self, f: &CFormula) -> Option<rob::Formula> {
+        self.prepare(f);
+        let root = self.lower(f)?;
+        Some(self.b.build(root))
+    }
+
+    /// Lowers every let `f` needs, directly or not, in dependency order: an explicit stack
+    /// finds them, so a chain of lets as long as the spec costs no stack.
+    fn prepare(&mut self, f: &CFormula) {
+        let spec = self.spec;
+        let mut need = vec![false; spec.lets.len()];
+        let mut stack = vec![f];
+        while let Some(g) = stack.pop() {
+            hstl_lang::visit_lets(g, &mut |i| {
+                if i < need.len() && !need[i] && !self.tried[i] {
+                    need[i] = true;
+                    stack.push(&spec.lets[i].formula);
+                }
+            });
+        }
+        // `let_order` leaves out the lets on a cycle: they stay `None`.
+        for &i in &spec.let_order {
+            if need.get(i).copied().unwrap_or(false) {
+                self.tried[i] = true;
+                self.lets[i] = self.lower(&spec.lets[i].formula);
             }
-            CFormulaKind::Let(_) => return None,
-            CFormulaKind::Cmp(op, a, b) => rob::Formula::Cmp {
-                lhs: expr(a)?,
-                op: match op {
+        }
+    }
+
+    /// `f` into the builder, its lets already lowered. Recursive over one formula only,
+    /// whose height the parser bounds.
+    fn lower(&mut self, f: &CFormula) -> Option<rob::NodeId> {
+        let b = |s: &mut Self, g: &CFormula| s.lower(g);
+        Some(match &f.kind {
+            CFormulaKind::True => self.b.bool(true),
+            CFormulaKind::False => self.b.bool(false),
+            CFormulaKind::Let(i) => self.lets.get(*i).copied().flatten()?,
+            CFormulaKind::Cmp(op, x, y) => {
+                let (x, y) = (lower_expr(&mut self.b, x)?, lower_expr(&mut self.b, y)?);
+                let op = match op {
                     CmpOp::Lt => rob::CmpOp::Lt,
                     CmpOp::Le => rob::CmpOp::Le,
                     CmpOp::Gt => rob::CmpOp::Gt,
                     CmpOp::Ge => rob::CmpOp::Ge,
-                },
-                rhs: expr(b)?,
-            },
-            CFormulaKind::Not(a) => rob::Formula::Not(boxed(a)?),
-            CFormulaKind::And(v) => rob::Formula::And(all(v)?),
-            CFormulaKind::Or(v) => rob::Formula::Or(all(v)?),
-            CFormulaKind::Implies(a, b) => rob::Formula::Implies(boxed(a)?, boxed(b)?),
-            CFormulaKind::Always(iv, a) => rob::Formula::Always(interval(iv), boxed(a)?),
-            CFormulaKind::Eventually(iv, a) => rob::Formula::Eventually(interval(iv), boxed(a)?),
-            CFormulaKind::Until(iv, a, b) => {
-                rob::Formula::Until(interval(iv), boxed(a)?, boxed(b)?)
+                };
+                self.b.cmp(x, op, y)
+            }
+            CFormulaKind::Not(a) => {
+                let a = b(self, a)?;
+                self.b.not(a)
+            }
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
+                let ids = v.iter().map(|g| self.lower(g)).collect::<Option<Vec<_>>>()?;
+                if matches!(f.kind, CFormulaKind::And(_)) {
+                    self.b.and(ids)
+                } else {
+                    self.b.or(ids)
+                }
+            }
+            CFormulaKind::Implies(x, y) => {
+                let (x, y) = (b(self, x)?, b(self, y)?);
+                self.b.implies(x, y)
+            }
+            CFormulaKind::Always(iv, a) => {
+                let a = b(self, a)?;
+                self.b.always(interval(iv), a)
+            }
+            CFormulaKind::Eventually(iv, a) => {
+                let a = b(self, a)?;
+                self.b.eventually(interval(iv), a)
+            }
+            CFormulaKind::Until(iv, x, y) => {
+                let (x, y) = (b(self, x)?, b(self, y)?);
+                self.b.until(interval(iv), x, y)
             }
             CFormulaKind::Invalid => return None,
         })

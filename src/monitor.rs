@@ -12,8 +12,8 @@ use std::fmt;
 use std::sync::{Mutex, PoisonError};
 
 use hstl_lang::{CheckedSpec, Domain, VarType};
-use hstl_robustness::nan::{self, Atom};
-use hstl_robustness::{self as rob, CmpOp, Evaluator, Expr, OnlineMonitor, Verdict, offline};
+use hstl_robustness::nan::NanCheck;
+use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
 
 use crate::lower::{self, LowerError};
 
@@ -35,7 +35,9 @@ pub struct Monitor {
 /// so that a NaN is an error instead of a value a min or max skips.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NanProne {
-    atoms: Vec<(Expr, CmpOp, Expr)>,
+    /// Each formula with its comparisons that can be NaN; formulas without any are left
+    /// out.
+    checks: Vec<(rob::Formula, NanCheck)>,
     vars: Vec<String>,
 }
 
@@ -553,25 +555,22 @@ impl NanProne {
 
     /// The comparisons of all `formulas`.
     pub(crate) fn of_all(formulas: &[&rob::Formula], vars: &[String]) -> NanProne {
-        let mut atoms: Vec<(Expr, CmpOp, Expr)> = Vec::new();
-        for f in formulas {
-            for a in nan::nan_prone_atoms(f) {
-                let atom = (a.lhs.clone(), a.op, a.rhs.clone());
-                if atoms.len() > 64 || !atoms.contains(&atom) {
-                    atoms.push(atom);
-                }
-            }
-        }
-        let vars = if atoms.is_empty() { Vec::new() } else { vars.to_vec() };
-        NanProne { atoms, vars }
+        let checks: Vec<(rob::Formula, NanCheck)> = formulas
+            .iter()
+            .map(|f| ((*f).clone(), NanCheck::new(f)))
+            .filter(|(_, c)| !c.is_empty())
+            .collect();
+        let vars = if checks.is_empty() { Vec::new() } else { vars.to_vec() };
+        NanProne { checks, vars }
     }
 
     /// The first comparison that is NaN on the first `read` steps, as an error.
     fn check(&self, samples: &Samples<'_>, read: usize) -> Result<(), TraceError> {
-        if self.atoms.is_empty() {
+        if self.checks.is_empty() {
             return Ok(());
         }
         let mut state = vec![0.0; self.vars.len()];
+        let mut values = Vec::new();
         for step in 0..read {
             match samples {
                 Samples::Columns(cols) => {
@@ -586,13 +585,13 @@ impl NanProne {
                     }
                 }
             }
-            self.check_state(&state, step)?;
+            self.check_state_with(&state, step, &mut values)?;
         }
         Ok(())
     }
 
     fn check_trace(&self, trace: &rob::Trace, read: usize) -> Result<(), TraceError> {
-        if self.atoms.is_empty() {
+        if self.checks.is_empty() {
             return Ok(());
         }
         let cols: Vec<&[f64]> = (0..trace.vars()).map(|i| trace.column(i)).collect();
@@ -601,17 +600,26 @@ impl NanProne {
 
     /// The first comparison that is NaN on `state` (step `step`), as an error.
     pub(crate) fn check_state(&self, state: &[f64], step: usize) -> Result<(), TraceError> {
-        for (lhs, op, rhs) in &self.atoms {
-            let atom = Atom { lhs, op: *op, rhs };
-            if let Some(cause) = nan::nan_cause(&atom, state) {
+        self.check_state_with(state, step, &mut Vec::new())
+    }
+
+    /// [`NanProne::check_state`] with scratch space for the expressions' values.
+    fn check_state_with(
+        &self,
+        state: &[f64],
+        step: usize,
+        values: &mut Vec<f64>,
+    ) -> Result<(), TraceError> {
+        for (formula, check) in &self.checks {
+            if let Some(cause) = check.check(formula, state, values) {
                 let names: Vec<&str> = self.vars.iter().map(String::as_str).collect();
-                let comparison = rob::Formula::Cmp { lhs: lhs.clone(), op: *op, rhs: rhs.clone() };
+                let expr = match cause.expr {
+                    Some(e) => formula.expr_at(e).display_with(&names).to_string(),
+                    None => formula.sub(cause.atom).display_with(&names).to_string(),
+                };
                 return Err(TraceError::Undefined {
                     step,
-                    expr: match cause.expr {
-                        Some(e) => e.display_with(&names).to_string(),
-                        None => comparison.display_with(&names).to_string(),
-                    },
+                    expr,
                     operation: cause.operation.to_string(),
                 });
             }

@@ -14,7 +14,8 @@
 //!   window ending at `t` is **kept** (`psi(t)` of LANGUAGE.md: every region held within
 //!   its last `N_j` steps), the measure the window rate counts.
 //!
-//! Cost per state: the reward is `O(|formula|)` (the formula on one state). The task's
+//! Cost per state: the reward is `O(|formula|)` (the formula on one state, each shared
+//! node once). The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
 //! distributes over `&&` (`eventually` over `||`); `always[c..] eventually[J] f` and
@@ -39,7 +40,9 @@
 //! ```
 
 use hstl_lang::CheckedSpec;
-use hstl_robustness::{Bound, Evaluator, Formula, Interval, OnlineMonitor};
+use hstl_robustness::{
+    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor,
+};
 
 use crate::lower::{self, LowerError};
 use crate::monitor::{NanProne, TraceError};
@@ -50,6 +53,8 @@ pub struct EpisodeMonitor {
     vars: Vec<String>,
     reward: Formula,
     task: Running,
+    /// Scratch values of [`at_state`].
+    scratch: Vec<f64>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
     /// `tau_j`: steps since region `j` last held, capped at `N_j`.
@@ -71,9 +76,19 @@ pub struct StepScore {
     pub window_kept: Option<bool>,
 }
 
-/// `rho(f, 0)` over a trace that grows by one state at a time.
+/// `rho(f, 0)` over a trace that grows by one state at a time: the formula's boolean
+/// skeleton as a list of parts, each reading earlier ones (a shared subformula is one
+/// part), so a push is one forward pass.
 #[derive(Clone, Debug)]
-enum Running {
+struct Running {
+    parts: Vec<Part>,
+    /// Each part's value after the last push.
+    values: Vec<f64>,
+}
+
+/// One part of a [`Running`]; the combinators name earlier parts by index.
+#[derive(Clone, Debug)]
+enum Part {
     /// A part evaluated over the states so far, fixed once its horizon has passed.
     Whole {
         formula: Formula,
@@ -112,10 +127,10 @@ enum Running {
         /// The fold of the final values of `g` at positions from `c` on.
         settled: f64,
     },
-    Not(Box<Running>),
-    And(Vec<Running>),
-    Or(Vec<Running>),
-    Implies(Box<Running>, Box<Running>),
+    Not(usize),
+    And(Vec<usize>),
+    Or(Vec<usize>),
+    Implies(usize, usize),
 }
 
 /// States kept as columns, the oldest dropped from the front in amortised `O(1)`.
@@ -151,8 +166,18 @@ impl EpisodeMonitor {
         scored.extend(regions.iter().map(|r| &r.0));
         let nan_prone = NanProne::of_all(&scored, &vars);
         let task = Running::new(&task, vars.len());
-        let eval = Evaluator::new();
-        Ok(EpisodeMonitor { vars, reward, task, regions, tau, steps: 0, eval, nan_prone })
+        let scratch = Vec::new();
+        Ok(EpisodeMonitor {
+            vars,
+            reward,
+            task,
+            scratch,
+            regions,
+            tau,
+            steps: 0,
+            eval: Evaluator::new(),
+            nan_prone,
+        })
     }
 
     /// The state variables, in the order [`EpisodeMonitor::push`] takes their values.
@@ -188,71 +213,142 @@ impl EpisodeMonitor {
         }
         self.nan_prone.check_state(state, self.steps)?;
         self.steps += 1;
-        let reward = at_state(&self.reward, state);
+        let reward = at_state(&self.reward, state, &mut self.scratch);
         let window_kept = if self.regions.is_empty() {
             None
         } else {
             let mut kept = true;
             for ((formula, n), tau) in self.regions.iter().zip(&mut self.tau) {
-                let inside = at_state(formula, state) > 0.0;
+                let inside = at_state(formula, state, &mut self.scratch) > 0.0;
                 *tau = if inside { 0 } else { (*tau + 1).min(*n) };
                 kept &= *tau < *n;
             }
             Some(kept)
         };
-        let task_robustness = self.task.push(state, self.steps, &mut self.eval);
+        let task_robustness = self.task.push(state, self.steps, &mut self.eval, &mut self.scratch);
         Ok(StepScore { reward, task_robustness, window_kept })
     }
 }
 
 impl Running {
+    /// The parts of `f`: its `!`, `&&`, `||` and `->` (and `always` over `&&`, `eventually`
+    /// over `||`, which distribute) split down to the parts [`Part::leaf`] shapes, with an
+    /// explicit stack, each distinct subformula once.
     fn new(f: &Formula, vars: usize) -> Running {
-        let whole = || Running::Whole {
+        let mut b = FormulaBuilder::new();
+        let root = b.formula(f);
+        let mut index: std::collections::HashMap<NodeId, usize> = Default::default();
+        let mut parts: Vec<Part> = Vec::new();
+        // (node, whether its operands are done)
+        let mut stack = vec![(root, false)];
+        while let Some((v, ready)) = stack.pop() {
+            if index.contains_key(&v) {
+                continue;
+            }
+            let ops = operands(&mut b, v);
+            if !ready {
+                stack.push((v, true));
+                for &g in ops.iter().flatten().rev() {
+                    if !index.contains_key(&g) {
+                        stack.push((g, false));
+                    }
+                }
+                continue;
+            }
+            let at = |g: &NodeId| index[g];
+            let part = match (b.node(v), ops) {
+                (Node::Not(_), Some(gs)) => Part::Not(at(&gs[0])),
+                (Node::Implies(..), Some(gs)) => Part::Implies(at(&gs[0]), at(&gs[1])),
+                (Node::And(_) | Node::Always(..), Some(gs)) => {
+                    Part::And(gs.iter().map(at).collect())
+                }
+                (Node::Or(_) | Node::Eventually(..), Some(gs)) => {
+                    Part::Or(gs.iter().map(at).collect())
+                }
+                _ => Part::leaf(&b.build(v), vars),
+            };
+            index.insert(v, parts.len());
+            parts.push(part);
+        }
+        let values = vec![f64::NAN; parts.len()];
+        Running { parts, values }
+    }
+
+    fn reset(&mut self) {
+        self.parts.iter_mut().for_each(Part::reset);
+    }
+
+    /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them.
+    fn push(
+        &mut self,
+        state: &[f64],
+        n: usize,
+        eval: &mut Evaluator,
+        scratch: &mut Vec<f64>,
+    ) -> f64 {
+        for k in 0..self.parts.len() {
+            let v = self.parts[k].push(state, n, eval, scratch, &self.values);
+            self.values[k] = v;
+        }
+        self.values.last().copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// The nodes `v` splits into for [`Running`] (`None`: `v` is a leaf part). `always[I]` over
+/// `&&` becomes the `&&` of `always[I]` over each conjunct (and `eventually[I]` over `||`
+/// the `||`), new nodes added to `b`.
+fn operands(b: &mut FormulaBuilder, v: NodeId) -> Option<Vec<NodeId>> {
+    match b.node(v).clone() {
+        Node::Not(g) => Some(vec![g]),
+        Node::And(gs) | Node::Or(gs) => Some(gs),
+        Node::Implies(g, h) => Some(vec![g, h]),
+        Node::Always(i, body) | Node::Eventually(i, body) => {
+            let always = matches!(b.node(v), Node::Always(..));
+            let gs = match (b.node(body), always) {
+                (Node::And(gs), true) | (Node::Or(gs), false) => gs.clone(),
+                _ => return None,
+            };
+            let ids = gs
+                .into_iter()
+                .map(|g| if always { b.always(i, g) } else { b.eventually(i, g) })
+                .collect();
+            Some(ids)
+        }
+        _ => None,
+    }
+}
+
+impl Part {
+    /// The leaf part of `f`, the cheapest shape its form allows.
+    fn leaf(f: &Formula, vars: usize) -> Part {
+        let whole = || Part::Whole {
             formula: f.clone(),
             horizon: f.horizon(),
             states: Columns::new(vars),
             fixed: None,
         };
-        match f {
-            Formula::Not(g) => Running::Not(Box::new(Running::new(g, vars))),
-            Formula::And(gs) => Running::And(gs.iter().map(|g| Running::new(g, vars)).collect()),
-            Formula::Or(gs) => Running::Or(gs.iter().map(|g| Running::new(g, vars)).collect()),
-            Formula::Implies(g, h) => {
-                Running::Implies(Box::new(Running::new(g, vars)), Box::new(Running::new(h, vars)))
-            }
-            // `always` distributes over `&&` and `eventually` over `||` (the same min or
-            // max, clipped windows and empty ones alike), so each part can take a
-            // cheaper shape below.
-            Formula::Always(interval, body) if matches!(**body, Formula::And(_)) => {
-                let Formula::And(gs) = &**body else { unreachable!("matched above") };
-                let part = |g: &Formula| Formula::Always(*interval, Box::new(g.clone()));
-                Running::And(gs.iter().map(|g| Running::new(&part(g), vars)).collect())
-            }
-            Formula::Eventually(interval, body) if matches!(**body, Formula::Or(_)) => {
-                let Formula::Or(gs) = &**body else { unreachable!("matched above") };
-                let part = |g: &Formula| Formula::Eventually(*interval, Box::new(g.clone()));
-                Running::Or(gs.iter().map(|g| Running::new(&part(g), vars)).collect())
-            }
-            Formula::Always(interval, body) | Formula::Eventually(interval, body)
+        match f.root_node() {
+            Node::Always(interval, body) | Node::Eventually(interval, body)
                 if interval.end == Bound::Unbounded && is_dual_over_state(f) =>
             {
-                let always = matches!(f, Formula::Always(..));
-                Running::Stream {
+                let always = matches!(f.root_node(), Node::Always(..));
+                let body = f.sub(*body);
+                Part::Stream {
                     always,
                     from: interval.start,
-                    body: (**body).clone(),
-                    online: Box::new(OnlineMonitor::new(body, vars)),
+                    online: Box::new(OnlineMonitor::new(&body, vars)),
+                    body,
                     settled: identity(always),
                 }
             }
-            Formula::Always(interval, body) | Formula::Eventually(interval, body) => {
-                match body.horizon() {
-                    Some(horizon) => Running::Window {
-                        always: matches!(f, Formula::Always(..)),
+            Node::Always(interval, body) | Node::Eventually(interval, body) => {
+                match f.horizon_of(*body) {
+                    Some(horizon) => Part::Window {
+                        always: matches!(f.root_node(), Node::Always(..)),
                         interval: *interval,
-                        body: (**body).clone(),
+                        body: f.sub(*body),
                         horizon,
-                        settled: identity(matches!(f, Formula::Always(..))),
+                        settled: identity(matches!(f.root_node(), Node::Always(..))),
                         states: Columns::new(vars),
                         first: 0,
                     },
@@ -265,34 +361,36 @@ impl Running {
 
     fn reset(&mut self) {
         match self {
-            Running::Whole { states, fixed, .. } => {
+            Part::Whole { states, fixed, .. } => {
                 states.clear();
                 *fixed = None;
             }
-            Running::Window { always, settled, states, first, .. } => {
+            Part::Window { always, settled, states, first, .. } => {
                 *settled = identity(*always);
                 states.clear();
                 *first = 0;
             }
-            Running::Stream { always, online, settled, .. } => {
+            Part::Stream { always, online, settled, .. } => {
                 // Ending the trace readies the monitor for a new one.
                 online.finish();
                 *settled = identity(*always);
             }
-            Running::Not(g) => g.reset(),
-            Running::And(gs) | Running::Or(gs) => gs.iter_mut().for_each(Running::reset),
-            Running::Implies(g, h) => {
-                g.reset();
-                h.reset();
-            }
+            Part::Not(_) | Part::And(_) | Part::Or(_) | Part::Implies(..) => {}
         }
     }
 
     /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them,
-    /// as the reference evaluator combines it.
-    fn push(&mut self, state: &[f64], n: usize, eval: &mut Evaluator) -> f64 {
+    /// as the reference evaluator combines it; `values` holds the earlier parts' values.
+    fn push(
+        &mut self,
+        state: &[f64],
+        n: usize,
+        eval: &mut Evaluator,
+        scratch: &mut Vec<f64>,
+        values: &[f64],
+    ) -> f64 {
         match self {
-            Running::Whole { formula, horizon, states, fixed } => {
+            Part::Whole { formula, horizon, states, fixed } => {
                 if let Some(v) = fixed {
                     return *v;
                 }
@@ -306,7 +404,7 @@ impl Running {
                 }
                 value
             }
-            Running::Window { always, interval, body, horizon, settled, states, first } => {
+            Part::Window { always, interval, body, horizon, settled, states, first } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
                 states.push(state);
                 let signal = eval.signal_of_slices(body, &states.slices()).unwrap_or(&[]);
@@ -333,7 +431,7 @@ impl Running {
                 }
                 value
             }
-            Running::Stream { always, from, body, online, settled } => {
+            Part::Stream { always, from, body, online, settled } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
                 // The state has the monitor's width and no NaN (checked by the caller).
                 if let Ok(Some(verdict)) = online.push(state)
@@ -345,63 +443,70 @@ impl Running {
                     // No position of the outer window has arrived.
                     return *settled;
                 }
-                fold(*settled, at_state(body, state))
+                fold(*settled, at_state(body, state, scratch))
             }
-            Running::Not(g) => -g.push(state, n, eval),
-            Running::And(gs) => {
-                gs.iter_mut().map(|g| g.push(state, n, eval)).fold(f64::INFINITY, f64::min)
-            }
-            Running::Or(gs) => {
-                gs.iter_mut().map(|g| g.push(state, n, eval)).fold(f64::NEG_INFINITY, f64::max)
-            }
-            Running::Implies(g, h) => {
-                let a = g.push(state, n, eval);
-                (-a).max(h.push(state, n, eval))
-            }
+            Part::Not(g) => -values[*g],
+            Part::And(gs) => gs.iter().map(|g| values[*g]).fold(f64::INFINITY, f64::min),
+            Part::Or(gs) => gs.iter().map(|g| values[*g]).fold(f64::NEG_INFINITY, f64::max),
+            Part::Implies(g, h) => (-values[*g]).max(values[*h]),
         }
     }
 }
 
 /// `rho(f, 0)` over the one-state trace `state`: the reference semantics with `n = 1`
-/// (a window holds step 0 or nothing), without building a trace. The parser bounds a
-/// formula's height, so the recursion is bounded too.
-fn at_state(f: &Formula, state: &[f64]) -> f64 {
+/// (a window holds step 0 or nothing), without building a trace: one pass over the nodes,
+/// `vals` holding their values.
+fn at_state(f: &Formula, state: &[f64], vals: &mut Vec<f64>) -> f64 {
     let holds_now = |i: &Interval| !i.window(0, 1).is_empty();
-    match f {
-        Formula::True => f64::INFINITY,
-        Formula::False => f64::NEG_INFINITY,
-        Formula::Cmp { lhs, op, rhs } => op.robustness(lhs.eval(state), rhs.eval(state)),
-        Formula::Not(g) => -at_state(g, state),
-        Formula::And(gs) => gs.iter().map(|g| at_state(g, state)).fold(f64::INFINITY, f64::min),
-        Formula::Or(gs) => gs.iter().map(|g| at_state(g, state)).fold(f64::NEG_INFINITY, f64::max),
-        Formula::Implies(g, h) => (-at_state(g, state)).max(at_state(h, state)),
-        Formula::Always(i, g) if holds_now(i) => f64::INFINITY.min(at_state(g, state)),
-        Formula::Always(..) => f64::INFINITY,
-        Formula::Eventually(i, g) if holds_now(i) => f64::NEG_INFINITY.max(at_state(g, state)),
-        Formula::Eventually(..) => f64::NEG_INFINITY,
-        // Nothing comes before step 0, so the left side's minimum is over no step.
-        Formula::Until(i, _, h) if holds_now(i) => {
-            f64::NEG_INFINITY.max(at_state(h, state).min(f64::INFINITY))
-        }
-        Formula::Until(..) => f64::NEG_INFINITY,
+    vals.clear();
+    for node in f.nodes() {
+        let v = |g: &NodeId| vals[g.index()];
+        let e = |g: &hstl_robustness::ExprId| vals[g.index()];
+        let x = match node {
+            Node::Const(c) => *c,
+            Node::Var(i) => state.get(*i).copied().unwrap_or(f64::NAN),
+            Node::Neg(a) => -e(a),
+            Node::Abs(a) => e(a).abs(),
+            Node::Sqrt(a) => e(a).sqrt(),
+            Node::Add(a, b) => e(a) + e(b),
+            Node::Sub(a, b) => e(a) - e(b),
+            Node::Mul(a, b) => e(a) * e(b),
+            Node::Div(a, b) => e(a) / e(b),
+            Node::True => f64::INFINITY,
+            Node::False => f64::NEG_INFINITY,
+            Node::Cmp { lhs, op, rhs } => op.robustness(e(lhs), e(rhs)),
+            Node::Not(g) => -v(g),
+            Node::And(gs) => gs.iter().map(v).fold(f64::INFINITY, f64::min),
+            Node::Or(gs) => gs.iter().map(v).fold(f64::NEG_INFINITY, f64::max),
+            Node::Implies(g, h) => (-v(g)).max(v(h)),
+            Node::Always(i, g) if holds_now(i) => f64::INFINITY.min(v(g)),
+            Node::Always(..) => f64::INFINITY,
+            Node::Eventually(i, g) if holds_now(i) => f64::NEG_INFINITY.max(v(g)),
+            Node::Eventually(..) => f64::NEG_INFINITY,
+            // Nothing comes before step 0, so the left side's minimum is over no step.
+            Node::Until(i, _, h) if holds_now(i) => f64::NEG_INFINITY.max(v(h).min(f64::INFINITY)),
+            Node::Until(..) => f64::NEG_INFINITY,
+        };
+        vals.push(x);
     }
+    vals[f.root().index()]
 }
 
 /// Whether `f` is `always[I] eventually[J] g` or `eventually[I] always[J] g` with `g` a
-/// state formula (horizon 0) and `J` bounded: what [`Running::Stream`] takes.
+/// state formula (horizon 0) and `J` bounded: what [`Part::Stream`] takes.
 fn is_dual_over_state(f: &Formula) -> bool {
-    let inner = match f {
-        Formula::Always(_, body) => match &**body {
-            Formula::Eventually(j, g) => Some((j, g)),
+    let inner = match f.root_node() {
+        Node::Always(_, body) => match &f[*body] {
+            Node::Eventually(j, g) => Some((j, g)),
             _ => None,
         },
-        Formula::Eventually(_, body) => match &**body {
-            Formula::Always(j, g) => Some((j, g)),
+        Node::Eventually(_, body) => match &f[*body] {
+            Node::Always(j, g) => Some((j, g)),
             _ => None,
         },
         _ => None,
     };
-    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && g.horizon() == Some(0))
+    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.horizon_of(*g) == Some(0))
 }
 
 /// The value of an empty window: `+inf` for `always`, `-inf` for `eventually`.

@@ -67,23 +67,23 @@ fn same_signal(a: &[f64], b: &[f64]) -> bool {
 }
 
 fn lower_expr(e: &CExpr) -> Expr {
-    let b = |a: &CExpr| Box::new(lower_expr(a));
+    let b = |a: &CExpr| lower_expr(a);
     match &e.kind {
-        CExprKind::Const(c) => Expr::Const(*c),
-        CExprKind::Var(i) => Expr::Var(*i),
-        CExprKind::Neg(a) => Expr::Neg(b(a)),
-        CExprKind::Add(x, y) => Expr::Add(b(x), b(y)),
-        CExprKind::Sub(x, y) => Expr::Sub(b(x), b(y)),
-        CExprKind::Mul(x, y) => Expr::Mul(b(x), b(y)),
-        CExprKind::Div(x, y) => Expr::Div(b(x), b(y)),
-        CExprKind::Abs(a) => Expr::Abs(b(a)),
-        CExprKind::Sqrt(a) => Expr::Sqrt(b(a)),
+        CExprKind::Const(c) => Expr::constant(*c),
+        CExprKind::Var(i) => Expr::var(*i),
+        CExprKind::Neg(a) => Expr::neg(b(a)),
+        CExprKind::Add(x, y) => Expr::add(b(x), b(y)),
+        CExprKind::Sub(x, y) => Expr::sub(b(x), b(y)),
+        CExprKind::Mul(x, y) => Expr::mul(b(x), b(y)),
+        CExprKind::Div(x, y) => Expr::div(b(x), b(y)),
+        CExprKind::Abs(a) => Expr::abs(b(a)),
+        CExprKind::Sqrt(a) => Expr::sqrt(b(a)),
         CExprKind::Invalid => panic!("the differential spec checks"),
     }
 }
 
 fn lower(spec: &CheckedSpec, f: &CFormula) -> Formula {
-    let b = |g: &CFormula| Box::new(lower(spec, g));
+    let b = |g: &CFormula| lower(spec, g);
     let iv = |i: &hstl::lang::Interval| Interval {
         start: i.start as usize,
         end: match i.end {
@@ -93,26 +93,26 @@ fn lower(spec: &CheckedSpec, f: &CFormula) -> Formula {
         },
     };
     match &f.kind {
-        CFormulaKind::True => Formula::True,
-        CFormulaKind::False => Formula::False,
+        CFormulaKind::True => Formula::bool(true),
+        CFormulaKind::False => Formula::bool(false),
         CFormulaKind::Let(i) => lower(spec, &spec.lets[*i].formula),
-        CFormulaKind::Cmp(op, l, r) => Formula::Cmp {
-            lhs: lower_expr(l),
-            op: match op {
+        CFormulaKind::Cmp(op, l, r) => Formula::cmp(
+            lower_expr(l),
+            match op {
                 LCmp::Lt => CmpOp::Lt,
                 LCmp::Le => CmpOp::Le,
                 LCmp::Gt => CmpOp::Gt,
                 LCmp::Ge => CmpOp::Ge,
             },
-            rhs: lower_expr(r),
-        },
-        CFormulaKind::Not(a) => Formula::Not(b(a)),
-        CFormulaKind::And(v) => Formula::And(v.iter().map(|g| lower(spec, g)).collect()),
-        CFormulaKind::Or(v) => Formula::Or(v.iter().map(|g| lower(spec, g)).collect()),
-        CFormulaKind::Implies(x, y) => Formula::Implies(b(x), b(y)),
-        CFormulaKind::Always(i, a) => Formula::Always(iv(i), b(a)),
-        CFormulaKind::Eventually(i, a) => Formula::Eventually(iv(i), b(a)),
-        CFormulaKind::Until(i, x, y) => Formula::Until(iv(i), b(x), b(y)),
+            lower_expr(r),
+        ),
+        CFormulaKind::Not(a) => Formula::not(b(a)),
+        CFormulaKind::And(v) => Formula::and(v.iter().map(|g| lower(spec, g)).collect()),
+        CFormulaKind::Or(v) => Formula::or(v.iter().map(|g| lower(spec, g)).collect()),
+        CFormulaKind::Implies(x, y) => Formula::implies(b(x), b(y)),
+        CFormulaKind::Always(i, a) => Formula::always(iv(i), b(a)),
+        CFormulaKind::Eventually(i, a) => Formula::eventually(iv(i), b(a)),
+        CFormulaKind::Until(i, x, y) => Formula::until(iv(i), b(x), b(y)),
         CFormulaKind::Invalid => panic!("the differential spec checks"),
     }
 }

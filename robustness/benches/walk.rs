@@ -46,13 +46,13 @@ pub fn walk(steps: usize, rng: &mut SplitMix64) -> Trace {
 }
 
 fn cmp(lhs: Expr, op: CmpOp, rhs: Expr) -> Formula {
-    Formula::Cmp { lhs, op, rhs }
+    Formula::cmp(lhs, op, rhs)
 }
 
 /// `lo_x < x < hi_x && lo_y < y < hi_y` over `x` (variable 0) and `y` (variable 1).
 pub fn region(lo_x: f64, hi_x: f64, lo_y: f64, hi_y: f64) -> Formula {
-    let (x, y, c) = (|| Expr::Var(0), || Expr::Var(1), Expr::Const);
-    Formula::And(vec![
+    let (x, y, c) = (|| Expr::var(0), || Expr::var(1), Expr::constant);
+    Formula::and(vec![
         cmp(x(), CmpOp::Gt, c(lo_x)),
         cmp(x(), CmpOp::Lt, c(hi_x)),
         cmp(y(), CmpOp::Gt, c(lo_y)),
@@ -63,25 +63,25 @@ pub fn region(lo_x: f64, hi_x: f64, lo_y: f64, hi_y: f64) -> Formula {
 /// F1: `always[0..=w] (x > 3 && x < 9 && y > 10 && y < 14)`.
 pub fn f1(w: usize) -> Formula {
     let i = Interval { start: 0, end: Bound::Inclusive(w) };
-    Formula::Always(i, Box::new(region(3.0, 9.0, 10.0, 14.0)))
+    Formula::always(i, region(3.0, 9.0, 10.0, 14.0))
 }
 
 /// F2: `always[0..] (eventually[0..40] A && eventually[0..40] B && eventually[0..40] C)`.
 pub fn f2() -> Formula {
-    let ev = |f| Formula::Eventually(Interval { start: 0, end: Bound::Exclusive(40) }, Box::new(f));
-    let body = Formula::And(vec![
+    let ev = |f| Formula::eventually(Interval { start: 0, end: Bound::Exclusive(40) }, f);
+    let body = Formula::and(vec![
         ev(region(3.0, 9.0, 10.0, 14.0)),
         ev(region(1.0, 5.0, 1.0, 5.0)),
         ev(region(9.0, 13.0, 1.0, 7.0)),
     ]);
-    Formula::Always(Interval::ALL, Box::new(body))
+    Formula::always(Interval::ALL, body)
 }
 
 /// F3: `(x > 5) until[0..=20] (y > 10)`.
 pub fn f3() -> Formula {
-    Formula::Until(
+    Formula::until(
         Interval { start: 0, end: Bound::Inclusive(20) },
-        Box::new(cmp(Expr::Var(0), CmpOp::Gt, Expr::Const(5.0))),
-        Box::new(cmp(Expr::Var(1), CmpOp::Gt, Expr::Const(10.0))),
+        cmp(Expr::var(0), CmpOp::Gt, Expr::constant(5.0)),
+        cmp(Expr::var(1), CmpOp::Gt, Expr::constant(10.0)),
     )
 }

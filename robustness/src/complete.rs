@@ -20,81 +20,112 @@
 //! persistent task `always[0..] (eventually[0..40] A && ...)` is then the minimum over the
 //! steps whose 40-step windows are whole. Steps past the complete prefix are undetermined.
 
+use crate::formula::Node;
 use crate::kernels::{Kernels, and_into, or_into};
 use crate::{Bound, Formula, Trace};
 
 /// The steps of `f` on a trace of `n` states whose value is determined.
 pub fn complete_len(f: &Formula, n: usize) -> usize {
-    let mut lens: Vec<usize> = Vec::new();
-    for node in post_order(f) {
-        let kids = lens.split_off(lens.len() - arity(node));
-        lens.push(node_len(node, kids.into_iter().min().unwrap_or(n)));
+    let nodes = f.nodes();
+    let mut lens: Vec<usize> = Vec::with_capacity(nodes.len());
+    for node in nodes {
+        let fewest = node.children().map(|k| lens[k]).min().unwrap_or(n);
+        lens.push(if node.is_expr() { n } else { node_len(node, fewest) });
     }
-    lens.pop().unwrap_or(n)
+    lens.last().copied().unwrap_or(n)
 }
 
 /// `rho(f, t)` over complete windows for every complete step `t` (see the module docs):
-/// as long as [`complete_len`], empty when no step is determined.
+/// as long as [`complete_len`], empty when no step is determined. Each node's signal is
+/// dropped after its last parent used it, so memory follows the widest level of the
+/// formula, not its size.
 pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
+    let nodes = f.nodes();
     let n = trace.len();
-    let mut kernels = Kernels::new();
-    let mut row = Vec::new();
-    let mut values: Vec<Vec<f64>> = Vec::new();
-    for node in post_order(f) {
-        let v = match node {
-            Formula::True => vec![f64::INFINITY; n],
-            Formula::False => vec![f64::NEG_INFINITY; n],
-            Formula::Cmp { lhs, op, rhs } => (0..n)
-                .map(|t| {
-                    trace.row_into(t, &mut row);
-                    op.robustness(lhs.eval(&row), rhs.eval(&row))
-                })
-                .collect(),
-            Formula::Not(_) => {
-                let mut v = values.pop().unwrap_or_default();
-                v.iter_mut().for_each(|x| *x = -*x);
-                v
+    // The last node that reads each node's signal.
+    let mut last_use = vec![0usize; nodes.len()];
+    for (i, node) in nodes.iter().enumerate() {
+        if !node.is_expr() {
+            node.children().for_each(|k| last_use[k] = i);
+        }
+    }
+    // Comparisons read expression values step by step: one forward pass per step.
+    let mut signals: Vec<Option<Vec<f64>>> = vec![None; nodes.len()];
+    let cmps: Vec<usize> =
+        (0..nodes.len()).filter(|&i| matches!(nodes[i], Node::Cmp { .. })).collect();
+    if !cmps.is_empty() {
+        let last = cmps[cmps.len() - 1];
+        let mut bufs: Vec<Vec<f64>> = cmps.iter().map(|_| Vec::with_capacity(n)).collect();
+        let (mut row, mut vals) = (Vec::new(), Vec::with_capacity(last + 1));
+        for t in 0..n {
+            trace.row_into(t, &mut row);
+            vals.clear();
+            for node in &nodes[..=last] {
+                let v = crate::formula::expr_value(node, &vals, &row);
+                vals.push(v);
             }
-            Formula::And(gs) | Formula::Or(gs) => {
-                let kids = values.split_off(values.len() - gs.len());
-                let m = kids.iter().map(Vec::len).min().unwrap_or(n);
-                let and = matches!(node, Formula::And(_));
+            for (buf, &i) in bufs.iter_mut().zip(&cmps) {
+                if let Node::Cmp { lhs, op, rhs } = &nodes[i] {
+                    buf.push(op.robustness(vals[lhs.index()], vals[rhs.index()]));
+                }
+            }
+        }
+        for (buf, &i) in bufs.into_iter().zip(&cmps) {
+            signals[i] = Some(buf);
+        }
+    }
+    let mut kernels = Kernels::new();
+    for (i, node) in nodes.iter().enumerate() {
+        if node.is_expr() || matches!(node, Node::Cmp { .. }) {
+            continue;
+        }
+        let kid = |k: usize| signals[k].as_deref().unwrap_or(&[]);
+        let v = match node {
+            Node::True => vec![f64::INFINITY; n],
+            Node::False => vec![f64::NEG_INFINITY; n],
+            Node::Not(a) => kid(a.index()).iter().map(|x| -x).collect(),
+            Node::And(gs) | Node::Or(gs) => {
+                let m = gs.iter().map(|g| kid(g.index()).len()).min().unwrap_or(n);
+                let and = matches!(node, Node::And(_));
                 let mut acc = vec![if and { f64::INFINITY } else { f64::NEG_INFINITY }; m];
-                for k in &kids {
-                    if and { and_into(&mut acc, &k[..m]) } else { or_into(&mut acc, &k[..m]) }
+                for g in gs {
+                    let k = &kid(g.index())[..m];
+                    if and { and_into(&mut acc, k) } else { or_into(&mut acc, k) }
                 }
                 acc
             }
-            Formula::Implies(..) => {
-                let g = values.pop().unwrap_or_default();
-                let f = values.pop().unwrap_or_default();
-                let m = f.len().min(g.len());
-                (0..m).map(|t| (-f[t]).max(g[t])).collect()
+            Node::Implies(a, b) => {
+                let (a, b) = (kid(a.index()), kid(b.index()));
+                a.iter().zip(b).map(|(a, b)| (-a).max(*b)).collect()
             }
-            Formula::Always(i, _) | Formula::Eventually(i, _) => {
-                let mut v = values.pop().unwrap_or_default();
-                if matches!(node, Formula::Always(..)) {
-                    kernels.always(i, &mut v);
+            Node::Always(iv, a) | Node::Eventually(iv, a) => {
+                let mut v = kid(a.index()).to_vec();
+                if matches!(node, Node::Always(..)) {
+                    kernels.always(iv, &mut v);
                 } else {
-                    kernels.eventually(i, &mut v);
+                    kernels.eventually(iv, &mut v);
                 }
-                let c = node_len(node, v.len());
-                v.truncate(c);
+                v.truncate(node_len(node, v.len()));
                 v
             }
-            Formula::Until(i, ..) => {
-                let mut g = values.pop().unwrap_or_default();
-                let mut f = values.pop().unwrap_or_default();
-                let m = f.len().min(g.len());
-                g.truncate(m);
-                kernels.until(i, &mut f, &mut g);
-                g.truncate(node_len(node, m));
-                g
+            Node::Until(iv, a, b) => {
+                let (a, b) = (kid(a.index()), kid(b.index()));
+                let m = a.len().min(b.len());
+                let (mut lhs, mut out) = (a[..m].to_vec(), b[..m].to_vec());
+                kernels.until(iv, &mut lhs, &mut out);
+                out.truncate(node_len(node, m));
+                out
             }
+            _ => Vec::new(),
         };
-        values.push(v);
+        signals[i] = Some(v);
+        for k in node.children() {
+            if last_use[k] == i && k + 1 != nodes.len() {
+                signals[k] = None;
+            }
+        }
     }
-    values.pop().unwrap_or_default()
+    signals.pop().flatten().unwrap_or_default()
 }
 
 /// `rho(f, 0)` over complete windows, or `None` when step 0 is undetermined.
@@ -103,43 +134,12 @@ pub fn robustness(f: &Formula, trace: &Trace) -> Option<f64> {
 }
 
 /// A node's complete steps, given the fewest complete steps `m` among its operands.
-fn node_len(node: &Formula, m: usize) -> usize {
+fn node_len(node: &Node, m: usize) -> usize {
     match node {
-        Formula::Always(i, _) | Formula::Eventually(i, _) | Formula::Until(i, ..) => match i.end {
+        Node::Always(i, _) | Node::Eventually(i, _) | Node::Until(i, ..) => match i.end {
             Bound::Unbounded => m.saturating_sub(i.start),
             _ => m.saturating_sub(i.last_offset().unwrap_or(0)),
         },
         _ => m,
     }
-}
-
-/// How many operands `node` has.
-fn arity(node: &Formula) -> usize {
-    match node {
-        Formula::True | Formula::False | Formula::Cmp { .. } => 0,
-        Formula::Not(_) | Formula::Always(..) | Formula::Eventually(..) => 1,
-        Formula::Implies(..) | Formula::Until(..) => 2,
-        Formula::And(gs) | Formula::Or(gs) => gs.len(),
-    }
-}
-
-/// The nodes of `f`, each after its operands (in order), found without recursion.
-fn post_order(f: &Formula) -> Vec<&Formula> {
-    let mut order = Vec::new();
-    let mut stack = vec![f];
-    // Parents before children, children right to left: reversed, a post-order.
-    while let Some(node) = stack.pop() {
-        order.push(node);
-        match node {
-            Formula::True | Formula::False | Formula::Cmp { .. } => {}
-            Formula::Not(g) | Formula::Always(_, g) | Formula::Eventually(_, g) => stack.push(g),
-            Formula::And(gs) | Formula::Or(gs) => stack.extend(gs.iter()),
-            Formula::Implies(g, h) | Formula::Until(_, g, h) => {
-                stack.push(g);
-                stack.push(h);
-            }
-        }
-    }
-    order.reverse();
-    order
 }

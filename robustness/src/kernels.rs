@@ -207,7 +207,7 @@ mod tests {
     }
 
     fn atom(c: f64) -> Formula {
-        Formula::Cmp { lhs: Expr::Var(0), op: CmpOp::Gt, rhs: Expr::Const(c) }
+        Formula::cmp(Expr::var(0), CmpOp::Gt, Expr::constant(c))
     }
 
     fn same(a: &[f64], b: &[f64]) -> bool {
@@ -228,21 +228,21 @@ mod tests {
         ];
         for i in intervals {
             let h = i.last_offset().unwrap_or(0);
-            let f = Formula::Always(i, Box::new(atom(0.1)));
+            let f = Formula::always(i, atom(0.1));
             let got = pieces(xs.len(), h, |r| {
                 let mut v: Vec<f64> = xs[r].iter().map(|x| x - 0.1).collect();
                 k.always(&i, &mut v);
                 v
             });
             assert!(same(&got, &offline::signal(&f, &trace)), "always{i}");
-            let f = Formula::Eventually(i, Box::new(atom(0.1)));
+            let f = Formula::eventually(i, atom(0.1));
             let got = pieces(xs.len(), h, |r| {
                 let mut v: Vec<f64> = xs[r].iter().map(|x| x - 0.1).collect();
                 k.eventually(&i, &mut v);
                 v
             });
             assert!(same(&got, &offline::signal(&f, &trace)), "eventually{i}");
-            let f = Formula::Until(i, Box::new(atom(-0.4)), Box::new(atom(0.3)));
+            let f = Formula::until(i, atom(-0.4), atom(0.3));
             let got = pieces(xs.len(), h, |r| {
                 let mut lhs: Vec<f64> = xs[r.clone()].iter().map(|x| x + 0.4).collect();
                 let mut out: Vec<f64> = xs[r].iter().map(|x| x - 0.3).collect();
@@ -254,7 +254,7 @@ mod tests {
         // Unbounded windows: whole signals.
         let mut v: Vec<f64> = xs.iter().map(|x| x - 0.1).collect();
         k.always(&Interval { start: 4, end: Bound::Unbounded }, &mut v);
-        let f = Formula::Always(Interval { start: 4, end: Bound::Unbounded }, Box::new(atom(0.1)));
+        let f = Formula::always(Interval { start: 4, end: Bound::Unbounded }, atom(0.1));
         assert!(same(&v, &offline::signal(&f, &trace)));
     }
 

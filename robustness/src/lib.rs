@@ -29,7 +29,7 @@ pub mod segment;
 mod stream;
 pub mod trace;
 
-pub use formula::{Bound, CmpOp, Expr, Formula, Interval};
+pub use formula::{Bound, CmpOp, Expr, ExprId, Formula, FormulaBuilder, Interval, Node, NodeId};
 pub use offline::Evaluator;
 pub use online::{OnlineMonitor, Verdict};
 pub use trace::{Trace, TraceError};

@@ -3,23 +3,13 @@
 //!
 //! A trace without NaN gives a NaN robustness only at a comparison whose expressions
 //! compute one: `sqrt` of a negative number, `0 / 0`, `inf / inf`, `0 * inf`,
-//! `inf - inf`, or a comparison of two infinities of one sign. [`nan_prone_atoms`] finds
-//! the comparisons that can do so (most cannot: `x > 3` never does), and [`nan_cause`]
-//! names the operation that did on one state.
+//! `inf - inf`, or a comparison of two infinities of one sign. A [`NanCheck`] finds the
+//! comparisons of a formula that can do so (most cannot: `x > 3` never does) and, state by
+//! state, names the operation that did.
 
-use crate::{CmpOp, Expr, Formula};
+use crate::Formula;
+use crate::formula::{ExprId, Node, NodeId};
 use std::fmt;
-
-/// A comparison `lhs op rhs` of a formula.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Atom<'f> {
-    /// The left operand.
-    pub lhs: &'f Expr,
-    /// The comparison.
-    pub op: CmpOp,
-    /// The right operand.
-    pub rhs: &'f Expr,
-}
 
 /// The operation that made a NaN out of numbers, with its operands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,57 +30,110 @@ pub enum Operation {
 
 /// Where a NaN arose on one state.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NanCause<'f> {
+pub struct NanCause {
+    /// The comparison whose robustness is NaN.
+    pub atom: NodeId,
     /// The innermost expression that is NaN; `None` when the operands are numbers and the
     /// comparison itself is not.
-    pub expr: Option<&'f Expr>,
+    pub expr: Option<ExprId>,
     /// What it computed.
     pub operation: Operation,
 }
 
-/// The comparisons of `formula` that can be NaN on a state without NaN, in the order they
-/// first appear (each once while there are few).
-pub fn nan_prone_atoms(formula: &Formula) -> Vec<Atom<'_>> {
-    let mut atoms: Vec<Atom<'_>> = Vec::new();
-    let mut stack = vec![formula];
-    while let Some(f) = stack.pop() {
-        match f {
-            Formula::True | Formula::False => {}
-            Formula::Cmp { lhs, op, rhs } => {
-                let atom = Atom { lhs, op: *op, rhs };
-                // Lowering inlines lets, so one atom can appear many times; checking it
-                // twice is only slower, so long lists skip the quadratic search.
-                if nan_prone(&atom) && (atoms.len() > 64 || !atoms.contains(&atom)) {
-                    atoms.push(atom);
-                }
-            }
-            Formula::Not(g) | Formula::Always(_, g) | Formula::Eventually(_, g) => stack.push(g),
-            Formula::And(gs) | Formula::Or(gs) => stack.extend(gs.iter().rev()),
-            Formula::Implies(a, b) | Formula::Until(_, a, b) => {
-                stack.push(b);
-                stack.push(a);
-            }
-        }
-    }
-    atoms
+/// The comparisons of one formula that can be NaN on a state without NaN, checked one
+/// state at a time.
+#[derive(Clone, Debug)]
+pub struct NanCheck {
+    atoms: Vec<NodeId>,
 }
 
-/// Why `atom` is NaN on `state` (`state[i]` is variable `i`, none of them NaN), or `None`
-/// when it is a number.
-pub fn nan_cause<'f>(atom: &Atom<'f>, state: &[f64]) -> Option<NanCause<'f>> {
-    let l = value(atom.lhs, state);
-    let r = value(atom.rhs, state);
-    if let Err(cause) = l {
-        return Some(cause);
+impl NanCheck {
+    /// The check of `formula`'s comparisons.
+    pub fn new(formula: &Formula) -> NanCheck {
+        let nodes = formula.nodes();
+        let finite = |e: &ExprId| matches!(nodes[e.index()], Node::Const(c) if c.is_finite());
+        let plain = |e: &ExprId| matches!(nodes[e.index()], Node::Var(_) | Node::Const(_));
+        let atoms = nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| match n {
+                // Not when one side is a finite constant and the other a variable or one.
+                Node::Cmp { lhs, rhs, .. } => {
+                    !((finite(lhs) && plain(rhs)) || (finite(rhs) && plain(lhs)))
+                }
+                _ => false,
+            })
+            .map(|(i, _)| NodeId::from_index(i))
+            .collect();
+        NanCheck { atoms }
     }
-    if let Err(cause) = r {
-        return Some(cause);
+
+    /// Whether no comparison can be NaN (then [`NanCheck::check`] always passes).
+    pub fn is_empty(&self) -> bool {
+        self.atoms.is_empty()
     }
-    let (l, r) = (l.ok()?, r.ok()?);
-    atom.op
-        .robustness(l, r)
-        .is_nan()
-        .then_some(NanCause { expr: None, operation: Operation::Compare(l, r) })
+
+    /// The first comparison (in node order) of `formula` (the one this check was made
+    /// for) that is NaN on `state` (`state[i]` is variable `i`, none of them NaN), and why;
+    /// `None` when every one is a number. `values` is scratch space, reused across calls.
+    pub fn check(
+        &self,
+        formula: &Formula,
+        state: &[f64],
+        values: &mut Vec<f64>,
+    ) -> Option<NanCause> {
+        let last = self.atoms.last()?.index();
+        let nodes = formula.nodes();
+        values.clear();
+        for node in &nodes[..=last] {
+            let v = crate::formula::expr_value(node, values, state);
+            values.push(v);
+        }
+        for &atom in &self.atoms {
+            let Node::Cmp { lhs, op, rhs } = &nodes[atom.index()] else { continue };
+            let (l, r) = (values[lhs.index()], values[rhs.index()]);
+            if let Some(e) = [lhs, rhs].into_iter().find(|e| values[e.index()].is_nan()) {
+                let (expr, operation) = origin(nodes, values, *e);
+                return Some(NanCause { atom, expr: Some(expr), operation });
+            }
+            if op.robustness(l, r).is_nan() {
+                return Some(NanCause { atom, expr: None, operation: Operation::Compare(l, r) });
+            }
+        }
+        None
+    }
+}
+
+/// The innermost NaN below expression node `e` (itself NaN): follow NaN operands down.
+fn origin(nodes: &[Node], values: &[f64], mut e: ExprId) -> (ExprId, Operation) {
+    loop {
+        let node = &nodes[e.index()];
+        let v = |k: &ExprId| values[k.index()];
+        let nan_kid = match node {
+            Node::Neg(a) | Node::Abs(a) | Node::Sqrt(a) => [Some(a), None],
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                [Some(a), Some(b)]
+            }
+            _ => [None, None],
+        }
+        .into_iter()
+        .flatten()
+        .find(|k| v(k).is_nan());
+        if let Some(k) = nan_kid {
+            e = *k;
+            continue;
+        }
+        let operation = match node {
+            Node::Sqrt(a) => Operation::Sqrt(v(a)),
+            Node::Add(a, b) => Operation::Add(v(a), v(b)),
+            Node::Sub(a, b) => Operation::Sub(v(a), v(b)),
+            Node::Mul(a, b) => Operation::Mul(v(a), v(b)),
+            Node::Div(a, b) => Operation::Div(v(a), v(b)),
+            // A NaN constant or variable: reported as the comparison of its value.
+            _ => Operation::Compare(f64::NAN, f64::NAN),
+        };
+        return (e, operation);
+    }
 }
 
 impl fmt::Display for Operation {
@@ -106,107 +149,58 @@ impl fmt::Display for Operation {
     }
 }
 
-/// Whether the atom can be NaN on a state without NaN: not when one side is a finite
-/// constant and the other a variable or a finite constant.
-fn nan_prone(atom: &Atom<'_>) -> bool {
-    let finite = |e: &Expr| matches!(e, Expr::Const(c) if c.is_finite());
-    let plain = |e: &Expr| matches!(e, Expr::Var(_) | Expr::Const(_));
-    !((finite(atom.lhs) && plain(atom.rhs)) || (finite(atom.rhs) && plain(atom.lhs)))
-}
-
-/// The value of `e`, or the innermost operation that made a NaN of numbers. Expressions
-/// are as deep as the checker's nesting limits allow, so this recursion is bounded.
-fn value<'f>(e: &'f Expr, s: &[f64]) -> Result<f64, NanCause<'f>> {
-    let binary =
-        |a: &'f Expr, b: &'f Expr, op: fn(f64, f64) -> f64, what: fn(f64, f64) -> Operation| {
-            let (a, b) = (value(a, s)?, value(b, s)?);
-            let v = op(a, b);
-            if v.is_nan() { Err(NanCause { expr: Some(e), operation: what(a, b) }) } else { Ok(v) }
-        };
-    match e {
-        Expr::Const(c) => Ok(*c),
-        Expr::Var(_) => Ok(e.eval(s)),
-        Expr::Neg(a) => Ok(-value(a, s)?),
-        Expr::Abs(a) => Ok(value(a, s)?.abs()),
-        Expr::Sqrt(a) => {
-            let v = value(a, s)?;
-            if v < 0.0 {
-                Err(NanCause { expr: Some(e), operation: Operation::Sqrt(v) })
-            } else {
-                Ok(v.sqrt())
-            }
-        }
-        Expr::Add(a, b) => binary(a, b, |a, b| a + b, Operation::Add),
-        Expr::Sub(a, b) => binary(a, b, |a, b| a - b, Operation::Sub),
-        Expr::Mul(a, b) => binary(a, b, |a, b| a * b, Operation::Mul),
-        Expr::Div(a, b) => binary(a, b, |a, b| a / b, Operation::Div),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Interval;
+    use crate::{CmpOp, Expr, Interval};
 
     fn x() -> Expr {
-        Expr::Var(0)
-    }
-
-    fn cmp(lhs: Expr, op: CmpOp, rhs: Expr) -> Formula {
-        Formula::Cmp { lhs, op, rhs }
+        Expr::var(0)
     }
 
     #[test]
     fn plain_comparisons_are_never_nan_prone() {
-        let f = Formula::Always(
+        let f = Formula::always(
             Interval::ALL,
-            Box::new(Formula::And(vec![
-                cmp(x(), CmpOp::Gt, Expr::Const(3.0)),
-                cmp(Expr::Const(1.0), CmpOp::Lt, x()),
-            ])),
+            Formula::and(vec![
+                Formula::cmp(x(), CmpOp::Gt, Expr::constant(3.0)),
+                Formula::cmp(Expr::constant(1.0), CmpOp::Lt, x()),
+            ]),
         );
-        assert!(nan_prone_atoms(&f).is_empty());
+        assert!(NanCheck::new(&f).is_empty());
     }
 
     #[test]
     fn the_square_root_of_a_negative_is_named() {
-        let sqrt = Expr::Sqrt(Box::new(x()));
-        let f = Formula::Not(Box::new(cmp(sqrt.clone(), CmpOp::Gt, Expr::Const(1.0))));
-        let atoms = nan_prone_atoms(&f);
-        assert_eq!(atoms.len(), 1);
-        assert_eq!(nan_cause(&atoms[0], &[4.0]), None);
-        let cause = nan_cause(&atoms[0], &[-1.0]).unwrap();
-        assert_eq!(cause.expr, Some(&sqrt));
+        let f = Formula::not(Formula::cmp(Expr::sqrt(x()), CmpOp::Gt, Expr::constant(1.0)));
+        let check = NanCheck::new(&f);
+        assert!(!check.is_empty());
+        assert_eq!(check.check(&f, &[4.0], &mut Vec::new()), None);
+        let cause = check.check(&f, &[-1.0], &mut Vec::new()).unwrap();
+        let names = ["x"];
+        let expr = f.expr_at(cause.expr.unwrap());
+        assert_eq!(expr.display_with(&names).to_string(), "sqrt(x)");
         assert_eq!(cause.operation.to_string(), "the square root of -1");
     }
 
     #[test]
     fn the_innermost_operation_is_named() {
         // (x / x) + 1 at x = 0: the division, not the sum.
-        let div = Expr::Div(Box::new(x()), Box::new(x()));
-        let sum = Expr::Add(Box::new(div.clone()), Box::new(Expr::Const(1.0)));
-        let f = cmp(sum, CmpOp::Ge, Expr::Const(0.0));
-        let atoms = nan_prone_atoms(&f);
-        let cause = nan_cause(&atoms[0], &[0.0]).unwrap();
-        assert_eq!(cause.expr, Some(&div));
+        let sum = Expr::add(Expr::div(x(), x()), Expr::constant(1.0));
+        let f = Formula::cmp(sum, CmpOp::Ge, Expr::constant(0.0));
+        let check = NanCheck::new(&f);
+        let cause = check.check(&f, &[0.0], &mut Vec::new()).unwrap();
+        assert_eq!(f.expr_at(cause.expr.unwrap()).display_with(&["x"]).to_string(), "x / x");
         assert_eq!(cause.operation, Operation::Div(0.0, 0.0));
     }
 
     #[test]
     fn two_equal_infinities_compared_are_nan() {
-        let f = cmp(x(), CmpOp::Gt, Expr::Var(1));
-        let atoms = nan_prone_atoms(&f);
-        assert_eq!(atoms.len(), 1);
-        assert_eq!(nan_cause(&atoms[0], &[f64::INFINITY, 1.0]), None);
-        let cause = nan_cause(&atoms[0], &[f64::INFINITY, f64::INFINITY]).unwrap();
+        let f = Formula::cmp(x(), CmpOp::Gt, Expr::var(1));
+        let check = NanCheck::new(&f);
+        assert_eq!(check.check(&f, &[f64::INFINITY, 1.0], &mut Vec::new()), None);
+        let cause = check.check(&f, &[f64::INFINITY, f64::INFINITY], &mut Vec::new()).unwrap();
         assert_eq!(cause.expr, None);
         assert_eq!(cause.operation.to_string(), "the comparison of inf with inf");
-    }
-
-    #[test]
-    fn a_repeated_atom_is_listed_once() {
-        let a = cmp(Expr::Sqrt(Box::new(x())), CmpOp::Gt, Expr::Const(1.0));
-        let f = Formula::Or(vec![a.clone(), Formula::Not(Box::new(a))]);
-        assert_eq!(nan_prone_atoms(&f).len(), 1);
     }
 }

@@ -26,8 +26,9 @@
 //! `x > 3` with `x = inf` is `inf`. The one thing not pinned is the sign of a zero
 //! (`min(0, -0)`): the tests compare with `==`, under which `0 == -0`.
 
+use crate::formula::Node;
 use crate::kernels::Kernels;
-use crate::{CmpOp, Expr, Formula, Interval, Trace, TraceError};
+use crate::{CmpOp, Formula, Interval, Trace, TraceError};
 
 const INF: f64 = f64::INFINITY;
 const NEG_INF: f64 = f64::NEG_INFINITY;
@@ -36,15 +37,24 @@ const CHUNK: usize = 512;
 /// The least number of steps per piece of a bounded temporal formula: its buffers stay
 /// in L2.
 const PIECE: usize = 8192;
+/// No group: a leaf, or not yet decided.
+const NONE: u32 = u32::MAX;
+/// Reached from more than one group: the node gets a group of its own.
+const MANY: u32 = u32::MAX - 1;
 
 /// A reusable evaluator: keeps its buffers between calls, so repeated evaluation (the RL
 /// reward pattern) allocates nothing once warmed up.
+///
+/// It walks the formula's nodes bottom-up, one signal per node, so a node shared by
+/// several parents (a `let` used twice) is computed once per step. Nodes are evaluated in
+/// groups (see [`Plan`]): a bounded temporal group in cache-sized pieces, its state
+/// nodes in chunks of 512 steps. A node's buffer goes back to the pool after its last
+/// reader has used it, so memory holds the signals still to be read, never one per node
+/// of the formula (a chain of 20,000 `!` holds two).
 #[derive(Clone, Debug, Default)]
 pub struct Evaluator {
-    pool: Vec<Vec<f64>>,
-    chunks: Vec<Vec<f64>>,
+    runner: Runner,
     result: Vec<f64>,
-    kernels: Kernels,
 }
 
 /// A min or a max, with its identity.
@@ -156,9 +166,9 @@ impl Evaluator {
 
     /// [`Evaluator::signal`] over columns given as slices, each at least `n` long.
     pub(crate) fn signal_of_columns(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> &[f64] {
-        let out = self.eval(f, cols, n);
+        let out = self.runner.run(f, Source::Columns(cols), n);
         let old = std::mem::replace(&mut self.result, out);
-        self.pool.push(old);
+        self.runner.put(old);
         &self.result
     }
 
@@ -171,13 +181,226 @@ impl Evaluator {
         if n == 0 {
             return empty_trace_value(f);
         }
-        let out = self.eval(f, cols, n);
+        let out = self.runner.run(f, Source::Columns(cols), n);
         let v = out[0];
-        self.pool.push(out);
+        self.runner.put(out);
         v
     }
+}
 
-    fn take(&mut self, n: usize) -> Vec<f64> {
+/// How a node's values are held while its group is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Role {
+    /// A variable or a constant: read in place, never stored.
+    Leaf,
+    /// An atom over leaves that all its readers fold in directly (`x > 3` in
+    /// `x > 3 && y < 2`): never stored.
+    Fused,
+    /// A state node that only state nodes of its group read: a chunk buffer at a time.
+    Chunk,
+    /// A temporal node, a state node a temporal node reads, or a group's root: a buffer
+    /// over the whole piece.
+    Piece,
+}
+
+/// Nodes evaluated together over the same pieces of the trace.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Group {
+    /// The node whose signal the group produces (the largest index in it).
+    root: usize,
+    /// The state members that are stored (role `Chunk` or `Piece`), in index order.
+    state: Vec<usize>,
+    /// The temporal members, in index order.
+    temporal: Vec<usize>,
+}
+
+/// How a formula is evaluated: its nodes cut into groups, computed in order.
+///
+/// Every node belongs to one group. A group's root is the formula's root, an unbounded
+/// temporal node (computed over the whole trace at once), a node one of those reads, or a
+/// node read from two groups; the other nodes join the group of their readers. A bounded
+/// group is computed in pieces of `max(8192, 16 H)` steps, each with the `H` steps after
+/// it, so its buffers stay in cache: `rho(t)` reads only `t ..= t + H`, so the overlap
+/// gives the exact values. Other groups read a group's root from its whole signal. No node
+/// is computed twice for one piece, so the cost is linear in the formula's size.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Plan {
+    groups: Vec<Group>,
+    role: Vec<Role>,
+    /// The root of each node's group; `NONE` for leaves.
+    owner: Vec<u32>,
+    /// Reads of each node by state nodes of its own group.
+    state_reads: Vec<u32>,
+    /// Reads of each node by temporal nodes of its own group.
+    temporal_reads: Vec<u32>,
+    /// Reads of a group's root by other groups, and one for the caller at the root.
+    ext_reads: Vec<u32>,
+}
+
+fn is_leaf(node: &Node) -> bool {
+    matches!(node, Node::Var(_) | Node::Const(_))
+}
+
+impl Plan {
+    /// The plan of canonical nodes with their horizons and state flags.
+    pub(crate) fn new(
+        nodes: &[Node],
+        root: usize,
+        horizon: &[Option<usize>],
+        state: &[bool],
+    ) -> Plan {
+        let n = nodes.len();
+        // Groups, from the root down: a node joins its readers' group when they agree.
+        let mut cand = vec![NONE; n];
+        let mut owner = vec![NONE; n];
+        for v in (0..n).rev() {
+            if is_leaf(&nodes[v]) {
+                continue;
+            }
+            let own = v == root || horizon[v].is_none() || cand[v] == MANY || cand[v] == NONE;
+            owner[v] = if own { v as u32 } else { cand[v] };
+            // An unbounded node reads whole signals: each operand heads a group.
+            let give = if horizon[v].is_none() { MANY } else { owner[v] };
+            for c in nodes[v].children() {
+                if !is_leaf(&nodes[c]) {
+                    cand[c] = match cand[c] {
+                        NONE => give,
+                        x if x == give => x,
+                        _ => MANY,
+                    };
+                }
+            }
+        }
+        let mut state_reads = vec![0u32; n];
+        let mut temporal_reads = vec![0u32; n];
+        let mut ext_reads = vec![0u32; n];
+        // Read whole by a state node (not folded in as an atom).
+        let mut slice_read = vec![false; n];
+        for v in 0..n {
+            if is_leaf(&nodes[v]) {
+                continue;
+            }
+            let folds = matches!(nodes[v], Node::And(_) | Node::Or(_));
+            for c in nodes[v].children() {
+                if is_leaf(&nodes[c]) {
+                    continue;
+                }
+                if owner[c] != owner[v] {
+                    ext_reads[c] += 1;
+                } else if state[v] {
+                    state_reads[c] += 1;
+                    slice_read[c] |= !folds;
+                } else {
+                    temporal_reads[c] += 1;
+                }
+            }
+        }
+        ext_reads[root] += 1;
+        let role: Vec<Role> = (0..n)
+            .map(|v| {
+                let node = &nodes[v];
+                if is_leaf(node) {
+                    Role::Leaf
+                } else if owner[v] as usize == v || temporal_reads[v] > 0 || !state[v] {
+                    Role::Piece
+                } else if !slice_read[v] && fused_atom(nodes, v) {
+                    Role::Fused
+                } else {
+                    Role::Chunk
+                }
+            })
+            .collect();
+        let mut group_of = vec![NONE; n];
+        let mut groups = Vec::new();
+        for v in 0..n {
+            if owner[v] as usize == v {
+                group_of[v] = groups.len() as u32;
+                groups.push(Group { root: v, state: Vec::new(), temporal: Vec::new() });
+            }
+        }
+        for v in 0..n {
+            if matches!(role[v], Role::Leaf | Role::Fused) {
+                continue;
+            }
+            let g = &mut groups[group_of[owner[v] as usize] as usize];
+            if state[v] { g.state.push(v) } else { g.temporal.push(v) }
+        }
+        Plan { groups, role, owner, state_reads, temporal_reads, ext_reads }
+    }
+
+    /// How node `v` is held during evaluation.
+    pub(crate) fn role(&self, v: usize) -> Role {
+        self.role[v]
+    }
+}
+
+/// Whether node `v` is a comparison of two leaves (`x > 3`).
+fn fused_atom(nodes: &[Node], v: usize) -> bool {
+    match &nodes[v] {
+        Node::Cmp { lhs, rhs, .. } => is_leaf(&nodes[lhs.index()]) && is_leaf(&nodes[rhs.index()]),
+        _ => false,
+    }
+}
+
+/// Where the state nodes' values come from.
+#[derive(Clone, Copy)]
+pub(crate) enum Source<'a> {
+    /// Computed from the trace's columns.
+    Columns(&'a [&'a [f64]]),
+    /// Looked up: `tables[v][seg[t]]` for each stored state node `v`, its last entry
+    /// standing for an index past the table.
+    Tables { tables: &'a [Vec<f64>], seg: &'a [usize] },
+}
+
+/// An operand of a state node over one chunk: a slice of values or one value for all.
+#[derive(Clone, Copy)]
+enum Src<'a> {
+    Slice(&'a [f64]),
+    Scalar(f64),
+}
+
+/// `op(out[i], a[i], b[i])` for every `i`, whatever mix of slices and scalars `a`, `b` are.
+#[inline(always)]
+fn zip2(out: &mut [f64], a: Src<'_>, b: Src<'_>, op: impl Fn(&mut f64, f64, f64)) {
+    match (a, b) {
+        (Src::Slice(a), Src::Slice(b)) => {
+            out.iter_mut().zip(a).zip(b).for_each(|((o, x), y)| op(o, *x, *y))
+        }
+        (Src::Slice(a), Src::Scalar(y)) => out.iter_mut().zip(a).for_each(|(o, x)| op(o, *x, y)),
+        (Src::Scalar(x), Src::Slice(b)) => out.iter_mut().zip(b).for_each(|(o, y)| op(o, x, *y)),
+        (Src::Scalar(x), Src::Scalar(y)) => out.iter_mut().for_each(|o| op(o, x, y)),
+    }
+}
+
+/// The buffers of an evaluation, kept between calls.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Runner {
+    pool: Vec<Vec<f64>>,
+    chunks: Vec<Vec<f64>>,
+    kernels: Kernels,
+    /// Whole signals of group roots still to be read, by node.
+    full: Vec<Vec<f64>>,
+    /// Piece buffers of the current group's members, by node.
+    piece: Vec<Vec<f64>>,
+    /// Chunk buffers of the current group's state members, by node.
+    chunk: Vec<Vec<f64>>,
+    state_left: Vec<u32>,
+    temporal_left: Vec<u32>,
+    ext_left: Vec<u32>,
+    /// Windows as the tabular scorer computes them (short segments).
+    tabular: bool,
+    pre: Vec<f64>,
+    suf: Vec<f64>,
+}
+
+impl Runner {
+    /// A runner whose windows use the tabular scorer's straight-loop van Herk.
+    pub(crate) fn tabular() -> Runner {
+        Runner { tabular: true, ..Runner::default() }
+    }
+
+    /// A buffer of `n` values, stale: every operator overwrites its whole output.
+    pub(crate) fn take(&mut self, n: usize) -> Vec<f64> {
         // The shortest buffer that is long enough, else the longest: growing a buffer's
         // length writes zeros, so big buffers are kept for big requests.
         let fit =
@@ -187,7 +410,6 @@ impl Evaluator {
             Some(i) => self.pool.swap_remove(i),
             None => Vec::new(),
         };
-        // Every operator overwrites its whole output, so stale values may stay.
         if v.len() < n {
             v.resize(n, 0.0);
         } else {
@@ -196,267 +418,418 @@ impl Evaluator {
         v
     }
 
-    fn take_chunk(&mut self) -> Vec<f64> {
-        self.chunks.pop().unwrap_or_else(|| vec![0.0; CHUNK])
+    /// Gives a buffer back to the pool.
+    pub(crate) fn put(&mut self, v: Vec<f64>) {
+        if v.capacity() > 0 {
+            self.pool.push(v);
+        }
     }
 
-    /// The signal of `f` over the first `n` steps, in a buffer from the pool.
-    ///
-    /// A temporal formula with a finite horizon `H` is evaluated in pieces of `C` steps:
-    /// `rho(t)` reads only `t ..= t + H`, so each piece needs the `H` steps after it and
-    /// nothing else, and its windows are clipped only where the trace really ends. Every
-    /// buffer then stays in cache; the overlap costs `H / C` extra work.
-    fn eval(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
-        let piece = match f.horizon() {
-            Some(h) if !f.is_state_formula() => piece_len(h),
-            _ => usize::MAX,
-        };
-        if n / 2 <= piece {
-            return self.eval_whole(f, cols, n);
+    /// The signal of `f`'s root over the first `n` steps.
+    pub(crate) fn run(&mut self, f: &Formula, src: Source<'_>, n: usize) -> Vec<f64> {
+        let plan = &f.plan;
+        let len = f.len();
+        for v in [&mut self.full, &mut self.piece, &mut self.chunk] {
+            v.resize_with(len, Vec::new);
         }
-        let h = f.horizon().unwrap_or(0);
-        let mut out = self.take(n);
-        let mut sub: Vec<&[f64]> = Vec::with_capacity(cols.len());
-        let mut lo = 0;
-        while lo < n {
-            let hi = (lo + piece).min(n);
-            let end = hi.saturating_add(h).min(n);
-            sub.clear();
-            sub.extend(cols.iter().map(|c| &c[lo..end]));
-            let v = self.eval_whole(f, &sub, end - lo);
-            out[lo..hi].copy_from_slice(&v[..hi - lo]);
-            self.pool.push(v);
-            lo = hi;
+        self.state_left.resize(len, 0);
+        self.temporal_left.resize(len, 0);
+        self.ext_left.clear();
+        self.ext_left.extend_from_slice(&plan.ext_reads);
+        for g in &plan.groups {
+            let root = g.root;
+            let piece = match f.horizons()[root] {
+                Some(h) if !f.states()[root] => piece_len(h),
+                _ => usize::MAX,
+            };
+            let out = if n / 2 <= piece {
+                self.group(f, g, src, 0, n, true)
+            } else {
+                let h = f.horizons()[root].unwrap_or(0);
+                let mut out = self.take(n);
+                let mut lo = 0;
+                while lo < n {
+                    let hi = (lo + piece).min(n);
+                    let end = hi.saturating_add(h).min(n);
+                    let v = self.group(f, g, src, lo, end - lo, hi == n);
+                    out[lo..hi].copy_from_slice(&v[..hi - lo]);
+                    self.put(v);
+                    lo = hi;
+                }
+                out
+            };
+            self.full[root] = out;
+            // Group roots no later group reads go back to the pool.
+            for &v in g.state.iter().chain(&g.temporal) {
+                for c in f.nodes()[v].children() {
+                    if plan.owner[c] != NONE
+                        && plan.owner[c] != plan.owner[v]
+                        && self.ext_left[c] == 0
+                    {
+                        let buf = std::mem::take(&mut self.full[c]);
+                        self.put(buf);
+                    }
+                }
+            }
+        }
+        std::mem::take(&mut self.full[f.root().index()])
+    }
+
+    /// The group's root over steps `lo .. lo + m`. `last` says this is the group's last
+    /// piece (the reads of other groups' roots are then counted off).
+    fn group(
+        &mut self,
+        f: &Formula,
+        g: &Group,
+        src: Source<'_>,
+        lo: usize,
+        m: usize,
+        last: bool,
+    ) -> Vec<f64> {
+        let plan = &f.plan;
+        for &s in &g.state {
+            if plan.role[s] == Role::Piece {
+                self.piece[s] = self.take(m);
+            }
+        }
+        self.state_phase(f, g, src, lo, m);
+        if last {
+            for &s in &g.state {
+                for c in f.nodes()[s].children() {
+                    if plan.owner[c] != NONE && plan.owner[c] != plan.owner[s] {
+                        self.ext_left[c] -= 1;
+                    }
+                }
+            }
+        }
+        for &v in g.state.iter().chain(&g.temporal) {
+            self.temporal_left[v] = plan.temporal_reads[v];
+        }
+        // A whole-trace group (one piece) may take a group root's buffer for its own.
+        let whole = last && lo == 0;
+        for &v in &g.temporal {
+            let out = self.temporal(f, v, lo, m, last, whole);
+            self.piece[v] = out;
+        }
+        let out = std::mem::take(&mut self.piece[g.root]);
+        for &v in g.state.iter().chain(&g.temporal) {
+            let buf = std::mem::take(&mut self.piece[v]);
+            self.put(buf);
         }
         out
     }
 
-    /// [`Evaluator::eval`] in one piece.
-    fn eval_whole(&mut self, f: &Formula, cols: &[&[f64]], n: usize) -> Vec<f64> {
-        if f.is_state_formula() {
-            let mut out = self.take(n);
-            let mut lo = 0;
-            while lo < n {
-                let hi = (lo + CHUNK).min(n);
-                self.state_chunk(f, cols, lo, &mut out[lo..hi]);
-                lo = hi;
+    /// The stored state members of `g` over steps `lo .. lo + m`.
+    fn state_phase(&mut self, f: &Formula, g: &Group, src: Source<'_>, lo: usize, m: usize) {
+        let plan = &f.plan;
+        let cols = match src {
+            Source::Tables { tables, seg } => {
+                for &s in &g.state {
+                    if plan.role[s] != Role::Piece {
+                        continue;
+                    }
+                    let table = &tables[s];
+                    let nan_row = table.len() - 1;
+                    for (o, &k) in self.piece[s].iter_mut().zip(&seg[lo..lo + m]) {
+                        *o = table[k.min(nan_row)];
+                    }
+                }
+                return;
             }
+            Source::Columns(cols) => cols,
+        };
+        let mut c0 = 0;
+        while c0 < m {
+            let c1 = (c0 + CHUNK).min(m);
+            for &s in &g.state {
+                self.state_left[s] = plan.state_reads[s];
+            }
+            for &s in &g.state {
+                let piece = plan.role[s] == Role::Piece;
+                let mut target = if piece {
+                    std::mem::take(&mut self.piece[s])
+                } else {
+                    self.chunks.pop().unwrap_or_else(|| vec![0.0; CHUNK])
+                };
+                let out = if piece { &mut target[c0..c1] } else { &mut target[..c1 - c0] };
+                self.state_node(f, s, cols, lo, c0, out);
+                if piece {
+                    self.piece[s] = target;
+                } else {
+                    self.chunk[s] = target;
+                }
+                // A chunk buffer read for the last time goes back.
+                for c in f.nodes()[s].children() {
+                    if plan.role[c] == Role::Chunk && plan.owner[c] == plan.owner[s] {
+                        self.state_left[c] -= 1;
+                        if self.state_left[c] == 0 {
+                            let buf = std::mem::take(&mut self.chunk[c]);
+                            self.chunks.push(buf);
+                        }
+                    }
+                }
+            }
+            c0 = c1;
+        }
+    }
+
+    /// Operand `c` of state node `s` over chunk `c0 ..` of the piece at `lo`.
+    fn src<'a>(
+        &'a self,
+        f: &'a Formula,
+        s: usize,
+        c: usize,
+        cols: &[&'a [f64]],
+        lo: usize,
+        c0: usize,
+        len: usize,
+    ) -> Src<'a> {
+        let plan = &f.plan;
+        match &f.nodes()[c] {
+            Node::Var(i) => match cols.get(*i) {
+                Some(col) => Src::Slice(&col[lo + c0..lo + c0 + len]),
+                None => Src::Scalar(f64::NAN),
+            },
+            Node::Const(x) => Src::Scalar(*x),
+            _ if plan.owner[c] != plan.owner[s] => {
+                Src::Slice(&self.full[c][lo + c0..lo + c0 + len])
+            }
+            _ if plan.role[c] == Role::Piece => Src::Slice(&self.piece[c][c0..c0 + len]),
+            _ => Src::Slice(&self.chunk[c][..len]),
+        }
+    }
+
+    /// State node `s` on steps `lo + c0 .. lo + c0 + out.len()`, into `out`.
+    fn state_node(
+        &self,
+        f: &Formula,
+        s: usize,
+        cols: &[&[f64]],
+        lo: usize,
+        c0: usize,
+        out: &mut [f64],
+    ) {
+        let len = out.len();
+        let src = |c: usize| self.src(f, s, c, cols, lo, c0, len);
+        let set = |o: &mut f64, x: f64, _: f64| *o = x;
+        match &f.nodes()[s] {
+            Node::True => out.fill(INF),
+            Node::False => out.fill(NEG_INF),
+            Node::Cmp { lhs, op, rhs } => {
+                let (a, b) = (src(lhs.index()), src(rhs.index()));
+                match op {
+                    CmpOp::Lt | CmpOp::Le => zip2(out, a, b, |o, x, y| *o = y - x),
+                    CmpOp::Gt | CmpOp::Ge => zip2(out, a, b, |o, x, y| *o = x - y),
+                }
+            }
+            Node::Const(x) => out.fill(*x),
+            Node::Var(_) => zip2(out, src(s), Src::Scalar(0.0), set),
+            Node::Neg(a) => zip2(out, src(a.index()), Src::Scalar(0.0), |o, x, _| *o = -x),
+            Node::Abs(a) => zip2(out, src(a.index()), Src::Scalar(0.0), |o, x, _| *o = x.abs()),
+            Node::Sqrt(a) => zip2(out, src(a.index()), Src::Scalar(0.0), |o, x, _| *o = x.sqrt()),
+            Node::Add(a, b) => zip2(out, src(a.index()), src(b.index()), |o, x, y| *o = x + y),
+            Node::Sub(a, b) => zip2(out, src(a.index()), src(b.index()), |o, x, y| *o = x - y),
+            Node::Mul(a, b) => zip2(out, src(a.index()), src(b.index()), |o, x, y| *o = x * y),
+            Node::Div(a, b) => zip2(out, src(a.index()), src(b.index()), |o, x, y| *o = x / y),
+            Node::Not(g) => zip2(out, src(g.index()), Src::Scalar(0.0), |o, x, _| *o = -x),
+            Node::Implies(g, h) => {
+                zip2(out, src(g.index()), src(h.index()), |o, x, y| *o = (-x).max(y))
+            }
+            Node::And(gs) => self.fold_chunk::<Min>(f, s, gs, cols, lo, c0, out),
+            Node::Or(gs) => self.fold_chunk::<Max>(f, s, gs, cols, lo, c0, out),
+            // Temporal nodes are never state members.
+            Node::Always(..) | Node::Eventually(..) | Node::Until(..) => out.fill(f64::NAN),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn fold_chunk<L: Lattice>(
+        &self,
+        f: &Formula,
+        s: usize,
+        gs: &[crate::NodeId],
+        cols: &[&[f64]],
+        lo: usize,
+        c0: usize,
+        out: &mut [f64],
+    ) {
+        let len = out.len();
+        let src = |c: usize| self.src(f, s, c, cols, lo, c0, len);
+        out.fill(L::ID);
+        for g in gs {
+            let g = g.index();
+            // `x op c` folds straight in: no pass through a buffer of its own.
+            if f.plan.role[g] == Role::Fused
+                && let Node::Cmp { lhs, op, rhs } = &f.nodes()[g]
+            {
+                let (a, b) = (src(lhs.index()), src(rhs.index()));
+                match op {
+                    CmpOp::Lt | CmpOp::Le => zip2(out, a, b, |o, x, y| *o = L::acc(*o, y - x)),
+                    CmpOp::Gt | CmpOp::Ge => zip2(out, a, b, |o, x, y| *o = L::acc(*o, x - y)),
+                }
+                continue;
+            }
+            zip2(out, src(g), Src::Scalar(0.0), |o, x, _| *o = L::acc(*o, x));
+        }
+    }
+
+    /// Operand `c` of temporal node `v` over the piece, as a buffer of its own: the
+    /// operand's buffer when this is its last read, else a copy.
+    fn own(
+        &mut self,
+        f: &Formula,
+        v: usize,
+        c: usize,
+        lo: usize,
+        m: usize,
+        last: bool,
+        whole: bool,
+    ) -> Vec<f64> {
+        let plan = &f.plan;
+        if plan.owner[c] == plan.owner[v] {
+            self.temporal_left[c] -= 1;
+            if self.temporal_left[c] == 0 {
+                return std::mem::take(&mut self.piece[c]);
+            }
+            let mut out = self.take(m);
+            out.copy_from_slice(&self.piece[c][..m]);
             return out;
         }
-        match f {
-            Formula::Not(g) => {
-                let mut out = self.eval(g, cols, n);
-                out.iter_mut().for_each(|v| *v = -*v);
+        if last {
+            self.ext_left[c] -= 1;
+        }
+        if whole && self.ext_left[c] == 0 {
+            return std::mem::take(&mut self.full[c]);
+        }
+        let mut out = self.take(m);
+        out.copy_from_slice(&self.full[c][lo..lo + m]);
+        out
+    }
+
+    /// Operand `c` of temporal node `v` over the piece, borrowed.
+    fn read(&self, f: &Formula, v: usize, c: usize, lo: usize, m: usize) -> &[f64] {
+        let plan = &f.plan;
+        if plan.owner[c] == plan.owner[v] { &self.piece[c][..m] } else { &self.full[c][lo..lo + m] }
+    }
+
+    /// Counts off a [`Runner::read`] of operand `c` by temporal node `v`.
+    fn done(&mut self, f: &Formula, v: usize, c: usize, last: bool) {
+        let plan = &f.plan;
+        if plan.owner[c] == plan.owner[v] {
+            self.temporal_left[c] -= 1;
+            if self.temporal_left[c] == 0 {
+                let buf = std::mem::take(&mut self.piece[c]);
+                self.put(buf);
+            }
+        } else if last {
+            self.ext_left[c] -= 1;
+        }
+    }
+
+    /// Temporal node `v` over steps `lo .. lo + m`.
+    fn temporal(
+        &mut self,
+        f: &Formula,
+        v: usize,
+        lo: usize,
+        m: usize,
+        last: bool,
+        whole: bool,
+    ) -> Vec<f64> {
+        match &f.nodes()[v] {
+            Node::Not(g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                out.iter_mut().for_each(|x| *x = -*x);
                 out
             }
-            Formula::And(gs) => self.fold::<Min>(gs, cols, n),
-            Formula::Or(gs) => self.fold::<Max>(gs, cols, n),
-            Formula::Implies(g, h) => {
-                let mut out = self.eval(g, cols, n);
-                let rhs = self.eval(h, cols, n);
-                out.iter_mut().zip(&rhs).for_each(|(a, b)| *a = (-*a).max(*b));
-                self.pool.push(rhs);
+            Node::And(gs) => self.fold::<Min>(f, v, gs, lo, m, last, whole),
+            Node::Or(gs) => self.fold::<Max>(f, v, gs, lo, m, last, whole),
+            Node::Implies(g, h) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                let rhs = self.read(f, v, h.index(), lo, m);
+                out.iter_mut().zip(rhs).for_each(|(a, b)| *a = (-*a).max(*b));
+                self.done(f, v, h.index(), last);
                 out
             }
-            Formula::Always(i, g) => {
-                let mut out = self.eval(g, cols, n);
-                self.window::<Min>(&mut out, i);
+            Node::Always(i, g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.window::<Min>(i, &mut out);
                 out
             }
-            Formula::Eventually(i, g) => {
-                let mut out = self.eval(g, cols, n);
-                self.window::<Max>(&mut out, i);
+            Node::Eventually(i, g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.window::<Max>(i, &mut out);
                 out
             }
-            Formula::Until(i, g, h) => {
-                let mut lhs = self.eval(g, cols, n);
-                let mut out = self.eval(h, cols, n);
-                self.until(i, &mut lhs, &mut out);
-                self.pool.push(lhs);
+            Node::Until(i, g, h) => {
+                let mut lhs = self.own(f, v, g.index(), lo, m, last, whole);
+                let mut out = self.own(f, v, h.index(), lo, m, last, whole);
+                self.kernels.until(i, &mut lhs, &mut out);
+                self.put(lhs);
                 out
             }
-            // State formulas were handled above.
-            Formula::True | Formula::False | Formula::Cmp { .. } => {
-                unreachable!("state formulas are evaluated in chunks")
+            // State nodes are state members, computed in chunks.
+            _ => {
+                let mut out = self.take(m);
+                out.fill(f64::NAN);
+                out
             }
         }
     }
 
-    fn fold<L: Lattice>(&mut self, gs: &[Formula], cols: &[&[f64]], n: usize) -> Vec<f64> {
+    #[allow(clippy::too_many_arguments)]
+    fn fold<L: Lattice>(
+        &mut self,
+        f: &Formula,
+        v: usize,
+        gs: &[crate::NodeId],
+        lo: usize,
+        m: usize,
+        last: bool,
+        whole: bool,
+    ) -> Vec<f64> {
         let Some((first, rest)) = gs.split_first() else {
-            let mut out = self.take(n);
+            let mut out = self.take(m);
             out.fill(L::ID);
             return out;
         };
         // The first operand's buffer becomes the output; folding it into `ID` (which
         // drops a NaN) happens in the first combining pass rather than a pass of its own.
-        let mut out = self.eval(first, cols, n);
+        let mut out = self.own(f, v, first.index(), lo, m, last, whole);
         if rest.is_empty() {
             fold_operand::<L>(&mut out, None, true);
         }
         for (k, g) in rest.iter().enumerate() {
-            let v = self.eval(g, cols, n);
-            fold_operand::<L>(&mut out, Some(&v), k == 0);
-            self.pool.push(v);
+            fold_operand::<L>(&mut out, Some(self.read(f, v, g.index(), lo, m)), k == 0);
+            self.done(f, v, g.index(), last);
         }
         out
     }
 
-    /// A state formula on steps `lo .. lo + out.len()`.
-    fn state_chunk(&mut self, f: &Formula, cols: &[&[f64]], lo: usize, out: &mut [f64]) {
-        match f {
-            Formula::True => out.fill(INF),
-            Formula::False => out.fill(NEG_INF),
-            Formula::Cmp { lhs, op, rhs } => self.cmp_chunk(lhs, *op, rhs, cols, lo, out),
-            Formula::Not(g) => {
-                self.state_chunk(g, cols, lo, out);
-                out.iter_mut().for_each(|v| *v = -*v);
-            }
-            Formula::And(gs) => self.fold_chunk::<Min>(gs, cols, lo, out),
-            Formula::Or(gs) => self.fold_chunk::<Max>(gs, cols, lo, out),
-            Formula::Implies(g, h) => {
-                self.state_chunk(g, cols, lo, out);
-                let mut tmp = self.take_chunk();
-                let tmp_s = &mut tmp[..out.len()];
-                self.state_chunk(h, cols, lo, tmp_s);
-                out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = (-*a).max(*b));
-                self.chunks.push(tmp);
-            }
-            // Temporal operators never reach here: `eval` sends only state formulas.
-            Formula::Always(..) | Formula::Eventually(..) | Formula::Until(..) => {
-                unreachable!("temporal operators are not state formulas")
-            }
-        }
-    }
-
-    fn fold_chunk<L: Lattice>(
-        &mut self,
-        gs: &[Formula],
-        cols: &[&[f64]],
-        lo: usize,
-        out: &mut [f64],
-    ) {
-        out.fill(L::ID);
-        let mut tmp = self.take_chunk();
-        let tmp_s = &mut tmp[..out.len()];
-        for g in gs {
-            // `x op c` folds straight in: no pass through `tmp`.
-            if let Some((col, c, x_minus_c)) = simple_atom(g, cols) {
-                let col = &col[lo..lo + out.len()];
-                if x_minus_c {
-                    out.iter_mut().zip(col).for_each(|(a, x)| *a = L::acc(*a, *x - c));
-                } else {
-                    out.iter_mut().zip(col).for_each(|(a, x)| *a = L::acc(*a, c - *x));
-                }
-                continue;
-            }
-            self.state_chunk(g, cols, lo, tmp_s);
-            out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = L::acc(*a, *b));
-        }
-        self.chunks.push(tmp);
-    }
-
-    fn cmp_chunk(
-        &mut self,
-        lhs: &Expr,
-        op: CmpOp,
-        rhs: &Expr,
-        cols: &[&[f64]],
-        lo: usize,
-        out: &mut [f64],
-    ) {
-        let hi = lo + out.len();
-        // `x op c` and `c op x` are the common atoms: one pass, no copy.
-        let (var, c, var_left) = match (lhs, rhs) {
-            (Expr::Var(i), Expr::Const(c)) => (*i, *c, true),
-            (Expr::Const(c), Expr::Var(i)) => (*i, *c, false),
-            _ => {
-                self.expr_chunk(lhs, cols, lo, out);
-                let mut tmp = self.take_chunk();
-                let tmp_s = &mut tmp[..out.len()];
-                self.expr_chunk(rhs, cols, lo, tmp_s);
-                out.iter_mut().zip(tmp_s.iter()).for_each(|(a, b)| *a = op.robustness(*a, *b));
-                self.chunks.push(tmp);
-                return;
-            }
-        };
-        let Some(col) = cols.get(var) else {
-            out.fill(f64::NAN);
-            return;
-        };
-        let col = &col[lo..hi];
-        let x_minus_c = matches!(op, CmpOp::Gt | CmpOp::Ge) == var_left;
-        if x_minus_c {
-            out.iter_mut().zip(col).for_each(|(o, x)| *o = *x - c);
-        } else {
-            out.iter_mut().zip(col).for_each(|(o, x)| *o = c - *x);
-        }
-    }
-
-    fn expr_chunk(&mut self, e: &Expr, cols: &[&[f64]], lo: usize, out: &mut [f64]) {
-        let hi = lo + out.len();
-        match e {
-            Expr::Const(c) => out.fill(*c),
-            Expr::Var(i) => match cols.get(*i) {
-                Some(col) => out.copy_from_slice(&col[lo..hi]),
-                None => out.fill(f64::NAN),
-            },
-            Expr::Neg(a) => {
-                self.expr_chunk(a, cols, lo, out);
-                out.iter_mut().for_each(|v| *v = -*v);
-            }
-            Expr::Abs(a) => {
-                self.expr_chunk(a, cols, lo, out);
-                out.iter_mut().for_each(|v| *v = v.abs());
-            }
-            Expr::Sqrt(a) => {
-                self.expr_chunk(a, cols, lo, out);
-                out.iter_mut().for_each(|v| *v = v.sqrt());
-            }
-            Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b) | Expr::Div(a, b) => {
-                self.expr_chunk(a, cols, lo, out);
-                let mut tmp = self.take_chunk();
-                let tmp_s = &mut tmp[..out.len()];
-                self.expr_chunk(b, cols, lo, tmp_s);
-                let pairs = out.iter_mut().zip(tmp_s.iter());
-                match e {
-                    Expr::Add(..) => pairs.for_each(|(x, y)| *x += *y),
-                    Expr::Sub(..) => pairs.for_each(|(x, y)| *x -= *y),
-                    Expr::Mul(..) => pairs.for_each(|(x, y)| *x *= *y),
-                    _ => pairs.for_each(|(x, y)| *x /= *y),
-                }
-                self.chunks.push(tmp);
-            }
-        }
-    }
-
     /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, in place.
-    fn window<L: Lattice>(&mut self, buf: &mut [f64], i: &Interval) {
-        self.kernels.window::<L>(buf, i);
-    }
-
-    /// `out[t]` becomes `rho(lhs until[i] out, t)` given the two operand signals.
-    fn until(&mut self, i: &Interval, lhs: &mut [f64], out: &mut [f64]) {
-        self.kernels.until(i, lhs, out);
+    fn window<L: Lattice>(&mut self, i: &Interval, buf: &mut [f64]) {
+        if !self.tabular {
+            self.kernels.window::<L>(buf, i);
+            return;
+        }
+        // The tabular scorer's short segments: the common case (a bounded window of two
+        // steps or more that starts inside `buf`) runs its straight-loop van Herk.
+        let n = buf.len();
+        let len = match i.last_offset() {
+            Some(last) if !i.is_empty() && i.start < n => (last - i.start).saturating_add(1),
+            _ => 1,
+        };
+        if len == 1 {
+            self.kernels.window::<L>(buf, i);
+            return;
+        }
+        crate::segment::van_herk::<L>(buf, i.start, len.min(n), &mut self.pre, &mut self.suf);
     }
 }
 
 /// The steps per piece of a temporal formula with horizon `h`: its buffers stay in L2.
 pub(crate) fn piece_len(h: usize) -> usize {
     PIECE.max(h.saturating_mul(16))
-}
-
-/// For an atom `x op c` or `c op x` over a variable the trace has: the column, `c`, and
-/// whether the robustness is `x - c` (else `c - x`).
-fn simple_atom<'a>(f: &Formula, cols: &[&'a [f64]]) -> Option<(&'a [f64], f64, bool)> {
-    let Formula::Cmp { lhs, op, rhs } = f else { return None };
-    let (var, c, var_left) = match (lhs, rhs) {
-        (Expr::Var(i), Expr::Const(c)) => (*i, *c, true),
-        (Expr::Const(c), Expr::Var(i)) => (*i, *c, false),
-        _ => return None,
-    };
-    let x_minus_c = matches!(op, CmpOp::Gt | CmpOp::Ge) == var_left;
-    Some((cols.get(var)?, c, x_minus_c))
 }
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {
@@ -472,6 +845,26 @@ fn same_length(columns: &[&[f64]]) -> Result<usize, TraceError> {
             Err(TraceError::Ragged { column, expected: len, found: columns[column].len() })
         }
     }
+}
+
+/// `rho(f, 0)` on the empty trace, as the reference evaluator gives it.
+pub(crate) fn empty_trace_value(f: &Formula) -> f64 {
+    let mut vals: Vec<f64> = Vec::with_capacity(f.len());
+    for node in f.nodes() {
+        let v = |k: usize| vals[k];
+        let x = match node {
+            Node::True | Node::Always(..) => INF,
+            Node::False | Node::Eventually(..) | Node::Until(..) => NEG_INF,
+            Node::Not(g) => -v(g.index()),
+            Node::And(gs) => gs.iter().map(|g| v(g.index())).fold(INF, f64::min),
+            Node::Or(gs) => gs.iter().map(|g| v(g.index())).fold(NEG_INF, f64::max),
+            Node::Implies(g, h) => (-v(g.index())).max(v(h.index())),
+            // Atoms (and the expressions in them) have no sample to read.
+            _ => f64::NAN,
+        };
+        vals.push(x);
+    }
+    vals[f.root().index()]
 }
 
 /// `buf[t] = buf[t + a]`, and the identity where `t + a` is past the end.
@@ -610,17 +1003,4 @@ pub(crate) fn van_herk<L: Lattice>(
         *o = if s >= last_block { suf[s] } else { L::acc(suf[s], pre[n - 1]) };
     }
     buf[n - a..].fill(L::ID);
-}
-
-/// `rho(f, 0)` on the empty trace, as the reference evaluator gives it.
-fn empty_trace_value(f: &Formula) -> f64 {
-    match f {
-        Formula::True | Formula::Always(..) => INF,
-        Formula::False | Formula::Eventually(..) | Formula::Until(..) => NEG_INF,
-        Formula::Cmp { .. } => f64::NAN,
-        Formula::Not(g) => -empty_trace_value(g),
-        Formula::And(gs) => gs.iter().map(empty_trace_value).fold(INF, f64::min),
-        Formula::Or(gs) => gs.iter().map(empty_trace_value).fold(NEG_INF, f64::max),
-        Formula::Implies(g, h) => (-empty_trace_value(g)).max(empty_trace_value(h)),
-    }
 }

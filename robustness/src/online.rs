@@ -14,7 +14,7 @@
 //! the monitor keeps every state, and [`OnlineMonitor::provisional`] gives the value the
 //! first open step would have if the trace ended now (it is not a verdict).
 
-use crate::stream::Node;
+use crate::stream::Stream;
 use crate::{Formula, TraceError, offline::Evaluator};
 
 /// The final robustness of the trace at one step.
@@ -34,7 +34,7 @@ pub struct OnlineMonitor {
     formula: Formula,
     horizon: Option<usize>,
     /// The streaming operators of a bounded formula.
-    nodes: Option<Node>,
+    nodes: Option<Stream>,
     columns: Vec<Vec<f64>>,
     /// The length of every column (kept apart so a formula over no variable works).
     len: usize,
@@ -51,7 +51,7 @@ impl OnlineMonitor {
         OnlineMonitor {
             formula: formula.clone(),
             horizon: formula.horizon(),
-            nodes: Node::build(formula),
+            nodes: Stream::build(formula),
             columns: vec![Vec::new(); vars],
             len: 0,
             start: 0,
@@ -85,9 +85,8 @@ impl OnlineMonitor {
         }
         self.len += 1;
         let (Some(h), Some(nodes)) = (self.horizon, &mut self.nodes) else { return Ok(None) };
-        nodes.push(state);
         // Every node emits one value per state once warmed up: at most one verdict here.
-        let Some(value) = nodes.pop() else { return Ok(None) };
+        let Some(value) = nodes.push(&self.formula, state) else { return Ok(None) };
         let window = h.saturating_add(1);
         let verdict = Verdict { step: self.first_step, value };
         self.start += 1;
@@ -160,7 +159,7 @@ impl OnlineMonitor {
         self.len = 0;
         self.start = 0;
         self.first_step = 0;
-        self.nodes = Node::build(&self.formula);
+        self.nodes = Stream::build(&self.formula);
     }
 
     fn buffered(&self) -> usize {

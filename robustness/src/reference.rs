@@ -1,7 +1,8 @@
 //! The reference evaluator: the semantics table of the language reference, read literally.
 //!
 //! It is slow on purpose (every operator re-reads its whole window) and exists to be
-//! obviously right. The fast evaluators are tested against it.
+//! obviously right. The fast evaluators are tested against it. It computes every node's
+//! signal in node order (children before parents), so it never recurses.
 //!
 //! NaN policy: min and max are Rust's [`f64::min`] and [`f64::max`] (IEEE `minNum` and
 //! `maxNum`): a NaN operand is skipped. `&&`, `||` and the temporal operators fold from
@@ -9,49 +10,83 @@
 //! both sides are NaN. NaN itself comes only from atoms (`sqrt(-1)`, `inf - inf`, a
 //! variable the trace lacks).
 
-use crate::{Formula, Trace};
+use crate::formula::Node;
+use crate::{Formula, NodeId, Trace};
 
 /// `rho(f, t)` on `trace`. Steps at or past the end of the trace see empty windows.
+///
+/// Only the steps `t ..= t + H` are computed for a formula of horizon `H`: `rho(f, t)`
+/// reads no other.
 pub fn robustness(f: &Formula, trace: &Trace, t: usize) -> f64 {
     let n = trace.len();
-    match f {
-        Formula::True => f64::INFINITY,
-        Formula::False => f64::NEG_INFINITY,
-        Formula::Cmp { lhs, op, rhs } => {
-            if t >= n {
-                return f64::NAN;
-            }
-            let mut row = Vec::with_capacity(trace.vars());
-            trace.row_into(t, &mut row);
-            op.robustness(lhs.eval(&row), rhs.eval(&row))
-        }
-        Formula::Not(g) => -robustness(g, trace, t),
-        Formula::And(gs) => {
-            gs.iter().map(|g| robustness(g, trace, t)).fold(f64::INFINITY, f64::min)
-        }
-        Formula::Or(gs) => {
-            gs.iter().map(|g| robustness(g, trace, t)).fold(f64::NEG_INFINITY, f64::max)
-        }
-        Formula::Implies(g, h) => (-robustness(g, trace, t)).max(robustness(h, trace, t)),
-        Formula::Always(i, g) => {
-            i.window(t, n).map(|u| robustness(g, trace, u)).fold(f64::INFINITY, f64::min)
-        }
-        Formula::Eventually(i, g) => {
-            i.window(t, n).map(|u| robustness(g, trace, u)).fold(f64::NEG_INFINITY, f64::max)
-        }
-        Formula::Until(i, g, h) => i
-            .window(t, n)
-            .map(|u| {
-                let before = (t..u).map(|v| robustness(g, trace, v)).fold(f64::INFINITY, f64::min);
-                robustness(h, trace, u).min(before)
-            })
-            .fold(f64::NEG_INFINITY, f64::max),
-    }
+    let stop = match f.horizon() {
+        Some(h) => t.saturating_add(h).saturating_add(1).min(n.max(t + 1)),
+        None => n.max(t + 1),
+    };
+    signals(f, trace, t, stop)[f.root().index()][0]
 }
 
 /// `rho(f, t)` for every step `t` of `trace`.
 pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
-    (0..trace.len()).map(|t| robustness(f, trace, t)).collect()
+    let mut all = signals(f, trace, 0, trace.len());
+    std::mem::take(&mut all[f.root().index()])
+}
+
+/// The signal of every node of `f` at the steps `from .. to` (steps past the trace see
+/// NaN atoms and empty windows); an operator at `u` reads its operands at `u..to`, so the
+/// values are exact where `u + horizon < to` or `to` is at least the trace's length.
+fn signals(f: &Formula, trace: &Trace, from: usize, to: usize) -> Vec<Vec<f64>> {
+    let n = trace.len();
+    let steps = to.saturating_sub(from);
+    let mut sig: Vec<Vec<f64>> = Vec::with_capacity(f.len());
+    for node in f.nodes() {
+        // `at(k, u)`: node `k` at step `u` (absolute).
+        let at = |k: usize, u: usize| sig[k][u - from];
+        let window = |i: &crate::Interval, u: usize| i.window(u, n.min(to));
+        let values: Vec<f64> = (from..to)
+            .map(|u| match node {
+                Node::True => f64::INFINITY,
+                Node::False => f64::NEG_INFINITY,
+                Node::Const(c) => *c,
+                Node::Var(i) if u < n && *i < trace.vars() => trace.column(*i)[u],
+                Node::Var(_) => f64::NAN,
+                Node::Neg(e) => -at(e.index(), u),
+                Node::Abs(e) => at(e.index(), u).abs(),
+                Node::Sqrt(e) => at(e.index(), u).sqrt(),
+                Node::Add(a, b) => at(a.index(), u) + at(b.index(), u),
+                Node::Sub(a, b) => at(a.index(), u) - at(b.index(), u),
+                Node::Mul(a, b) => at(a.index(), u) * at(b.index(), u),
+                Node::Div(a, b) => at(a.index(), u) / at(b.index(), u),
+                Node::Cmp { lhs, op, rhs } => {
+                    if u >= n {
+                        return f64::NAN;
+                    }
+                    op.robustness(at(lhs.index(), u), at(rhs.index(), u))
+                }
+                Node::Not(g) => -at(g.index(), u),
+                Node::And(gs) => gs.iter().map(|g| at(g.index(), u)).fold(f64::INFINITY, f64::min),
+                Node::Or(gs) => {
+                    gs.iter().map(|g| at(g.index(), u)).fold(f64::NEG_INFINITY, f64::max)
+                }
+                Node::Implies(g, h) => (-at(g.index(), u)).max(at(h.index(), u)),
+                Node::Always(i, g) => {
+                    window(i, u).map(|w| at(g.index(), w)).fold(f64::INFINITY, f64::min)
+                }
+                Node::Eventually(i, g) => {
+                    window(i, u).map(|w| at(g.index(), w)).fold(f64::NEG_INFINITY, f64::max)
+                }
+                Node::Until(i, g, h) => window(i, u)
+                    .map(|w| {
+                        let before = (u..w).map(|v| at(g.index(), v)).fold(f64::INFINITY, f64::min);
+                        at(h.index(), w).min(before)
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max),
+            })
+            .collect();
+        debug_assert_eq!(values.len(), steps);
+        sig.push(values);
+    }
+    sig
 }
 
 /// The reward of an option execution whose states form `segment`, as the language
@@ -65,17 +100,21 @@ pub fn segment_reward(task: &Formula, segment: &Trace) -> f64 {
     }
     match persistent_body(task) {
         Some((body, h)) => {
+            let body = task.sub(body);
             let last = (m - 1).saturating_sub(h);
-            (0..=last).map(|t| robustness(body, segment, t)).fold(f64::INFINITY, f64::min)
+            let sig = signal(&body, segment);
+            sig[..=last].iter().fold(f64::INFINITY, |a, b| a.min(*b))
         }
         None => robustness(task, segment, 0),
     }
 }
 
-/// For a task `always[0..] f` with a finite horizon of `f`, the body `f` and that horizon.
-pub fn persistent_body(task: &Formula) -> Option<(&Formula, usize)> {
-    match task {
-        Formula::Always(i, body) if *i == crate::Interval::ALL => Some((body, body.horizon()?)),
+/// For a task `always[0..] f` with a finite horizon of `f`, the node `f` and that horizon.
+pub fn persistent_body(task: &Formula) -> Option<(NodeId, usize)> {
+    match task.root_node() {
+        Node::Always(i, body) if *i == crate::Interval::ALL => {
+            Some((*body, task.horizon_of(*body)?))
+        }
         _ => None,
     }
 }

@@ -9,9 +9,9 @@
 //! `i` takes the minimum of `rho(f, u)` over `i <= u <= max(i, m - 1 - H)`: one backward
 //! running minimum gives all of them.
 
-use crate::kernels::Kernels;
-use crate::offline::{Evaluator, Lattice, Max, Min, fold_operand, piece_len};
-use crate::{CmpOp, Expr, Formula, Interval, Trace, reference};
+use crate::formula::{Node, expr_value};
+use crate::offline::{Evaluator, Lattice, Max, Min, Role, Runner, Source};
+use crate::{Formula, Trace, reference};
 
 /// Scores segments of a trace against one task, reusing its buffers between calls.
 #[derive(Clone, Debug)]
@@ -25,10 +25,9 @@ pub struct SegmentScorer {
 impl SegmentScorer {
     /// A scorer for `task`.
     pub fn new(task: &Formula) -> SegmentScorer {
-        let body = reference::persistent_body(task).map(|(f, h)| (f.clone(), h));
+        let body = reference::persistent_body(task).map(|(f, h)| (task.sub(f), h));
         SegmentScorer { task: task.clone(), body, eval: Evaluator::new() }
     }
-
     /// The reward of one option execution whose states are `segment`; NaN when empty.
     pub fn reward(&mut self, segment: &Trace) -> f64 {
         let cols = columns(segment);
@@ -79,86 +78,83 @@ impl SegmentScorer {
 }
 
 /// Scores segments given as indices into a fixed table of states, as tabular learners
-/// see them. Every maximal state subformula of the task (one with no temporal operator)
-/// is computed once per state, in [`TabularScorer::new`]; a segment then only gathers
-/// those values and runs the temporal operators. An index outside the table reads as a
-/// state whose atoms are all NaN.
+/// see them. Every state subformula the temporal operators read is computed once per
+/// state, in [`TabularScorer::new`]; a segment then only gathers those values and runs
+/// the temporal operators. An index outside the table reads as a state whose atoms are
+/// all NaN.
 ///
 /// The values are [`SegmentScorer`]'s on the segment's states, bit for bit: the state
-/// values come from the same evaluator code, and the temporal operators run the same
-/// kernels over the same pieces.
+/// values are computed with the same operations in the same order, and the temporal
+/// operators run the same kernels over the same pieces.
 #[derive(Clone, Debug)]
 pub struct TabularScorer {
-    /// `tables[j][s]`: the robustness of state subformula `j` in the state with index `s`;
-    /// the last entry is its value when every atom is NaN.
-    tables: Vec<Vec<f64>>,
     /// The task, or for a task `always[0..] f` with a finite horizon of `f`, `f`.
-    plan: Node,
+    plan: Formula,
+    /// `tables[v][s]`: the robustness of state node `v` of `plan` in the state with index
+    /// `s`, for the nodes the evaluation stores (empty for the others); the last entry is
+    /// its value when every atom is NaN.
+    tables: Vec<Vec<f64>>,
     /// The horizon of `f` when the task is `always[0..] f`.
     persistent: Option<usize>,
-    work: Work,
-}
-
-/// A task with its state subformulas replaced by per-state tables.
-#[derive(Clone, Debug)]
-struct Node {
-    op: Op,
-    /// The subformula's horizon.
-    horizon: Option<usize>,
-}
-
-#[derive(Clone, Debug)]
-enum Op {
-    /// Maximal state subformula `j`: `tables[j]`.
-    State(usize),
-    Not(Box<Node>),
-    And(Vec<Node>),
-    Or(Vec<Node>),
-    Implies(Box<Node>, Box<Node>),
-    Always(Interval, Box<Node>),
-    Eventually(Interval, Box<Node>),
-    Until(Interval, Box<Node>, Box<Node>),
-}
-
-/// The buffers of [`TabularScorer`]'s evaluation.
-#[derive(Clone, Debug, Default)]
-struct Work {
-    pool: Vec<Vec<f64>>,
-    kernels: Kernels,
-    /// Prefix and suffix folds of [`van_herk`].
-    pre: Vec<f64>,
-    suf: Vec<f64>,
+    runner: Runner,
 }
 
 impl TabularScorer {
     /// A scorer for `task` over `states`, whose row `i` is the state with index `i`.
     pub fn new(task: &Formula, states: &Trace) -> TabularScorer {
-        let mut atoms = Vec::new();
-        let task = lift_atoms(task, &mut atoms);
-        // One column per atom over the states and a last row of NaN, and one more column
-        // so that the trace has a column even when the task has no atom.
+        let (plan, persistent) = match reference::persistent_body(task) {
+            Some((body, h)) => (task.sub(body), Some(h)),
+            None => (task.clone(), None),
+        };
+        let nodes = plan.nodes();
+        let stored: Vec<bool> = (0..nodes.len())
+            .map(|v| plan.states()[v] && plan.plan.role(v) == Role::Piece)
+            .collect();
+        let mut tables: Vec<Vec<f64>> = stored
+            .iter()
+            .map(|&s| if s { Vec::with_capacity(states.len() + 1) } else { Vec::new() })
+            .collect();
         let mut row = Vec::with_capacity(states.vars());
-        let mut columns = vec![Vec::with_capacity(states.len() + 1); atoms.len() + 1];
-        for s in 0..states.len() {
-            states.row_into(s, &mut row);
-            for ((lhs, op, rhs), col) in atoms.iter().zip(&mut columns) {
-                col.push(op.robustness(lhs.eval(&row), rhs.eval(&row)));
+        let mut vals = vec![f64::NAN; nodes.len()];
+        // Every state, then the state whose atoms are all NaN.
+        for s in 0..=states.len() {
+            let real = s < states.len();
+            if real {
+                states.row_into(s, &mut row);
+            }
+            for (v, node) in nodes.iter().enumerate() {
+                if !plan.states()[v] {
+                    continue;
+                }
+                let x = |k: &crate::NodeId| vals[k.index()];
+                vals[v] = match node {
+                    Node::True => f64::INFINITY,
+                    Node::False => f64::NEG_INFINITY,
+                    Node::Cmp { .. } if !real => f64::NAN,
+                    Node::Cmp { lhs, op, rhs } => {
+                        op.robustness(vals[lhs.index()], vals[rhs.index()])
+                    }
+                    Node::Not(g) => -x(g),
+                    // As the evaluator folds a state `&&` or `||`: from the identity.
+                    Node::And(gs) => gs.iter().fold(Min::ID, |a, g| Min::acc(a, x(g))),
+                    Node::Or(gs) => gs.iter().fold(Max::ID, |a, g| Max::acc(a, x(g))),
+                    Node::Implies(g, h) => (-x(g)).max(x(h)),
+                    _ if real => expr_value(node, &vals, &row),
+                    _ => f64::NAN,
+                };
+            }
+            for (v, table) in tables.iter_mut().enumerate() {
+                if stored[v] {
+                    table.push(vals[v]);
+                }
             }
         }
-        for col in &mut columns[..atoms.len()] {
-            col.push(f64::NAN);
-        }
-        columns[atoms.len()].resize(states.len() + 1, 0.0);
-        let atom_trace = Trace::from_columns(columns).expect("columns of equal length");
-        let (root, persistent) = match reference::persistent_body(&task) {
-            Some((body, h)) => (body, Some(h)),
-            None => (&task, None),
-        };
-        let mut subformulas = Vec::new();
-        let plan = compile(root, &mut subformulas);
-        let mut eval = Evaluator::new();
-        let tables = subformulas.iter().map(|f| eval.signal(f, &atom_trace).to_vec()).collect();
-        TabularScorer { tables, plan, persistent, work: Work::default() }
+        TabularScorer { plan, tables, persistent, runner: Runner::tabular() }
+    }
+
+    fn signal(&mut self, seg: &[usize]) -> Vec<f64> {
+        let src = Source::Tables { tables: &self.tables, seg };
+        self.runner.run(&self.plan, src, seg.len())
     }
 
     /// The reward of the option execution through the states `segment`.
@@ -170,19 +166,19 @@ impl TabularScorer {
         match self.persistent {
             Some(h) => {
                 let last = (m - 1).saturating_sub(h);
-                let sig = self.work.eval(&self.plan, &self.tables, segment);
+                let sig = self.signal(segment);
                 let r = sig[..=last].iter().fold(f64::INFINITY, |a, b| a.min(*b));
-                self.work.pool.push(sig);
+                self.runner.put(sig);
                 r
             }
             None => {
-                let n = match self.plan.horizon {
+                let n = match self.plan.horizon() {
                     Some(h) => m.min(h.saturating_add(1)),
                     None => m,
                 };
-                let sig = self.work.eval(&self.plan, &self.tables, &segment[..n]);
+                let sig = self.signal(&segment[..n]);
                 let r = sig[0];
-                self.work.pool.push(sig);
+                self.runner.put(sig);
                 r
             }
         }
@@ -192,7 +188,7 @@ impl TabularScorer {
     pub fn suffix_rewards(&mut self, segment: &[usize], out: &mut Vec<f64>) {
         let m = segment.len();
         out.clear();
-        let sig = self.work.eval(&self.plan, &self.tables, segment);
+        let sig = self.signal(segment);
         match self.persistent {
             Some(h) => {
                 out.resize(m, 0.0);
@@ -212,163 +208,7 @@ impl TabularScorer {
             }
             None => out.extend_from_slice(&sig),
         }
-        self.work.pool.push(sig);
-    }
-}
-
-/// `f` as a [`Node`]; its maximal state subformulas are appended to `states` (equal ones
-/// shared).
-fn compile(f: &Formula, states: &mut Vec<Formula>) -> Node {
-    let horizon = f.horizon();
-    let mut sub = |g: &Formula| Box::new(compile(g, states));
-    let op = match f {
-        _ if f.is_state_formula() => {
-            let j = states.iter().position(|g| g == f).unwrap_or_else(|| {
-                states.push(f.clone());
-                states.len() - 1
-            });
-            Op::State(j)
-        }
-        Formula::Not(g) => Op::Not(sub(g)),
-        Formula::Implies(g, h) => {
-            let g = sub(g);
-            Op::Implies(g, sub(h))
-        }
-        Formula::Always(i, g) => Op::Always(*i, sub(g)),
-        Formula::Eventually(i, g) => Op::Eventually(*i, sub(g)),
-        Formula::Until(i, g, h) => {
-            let g = sub(g);
-            Op::Until(*i, g, sub(h))
-        }
-        Formula::And(gs) => Op::And(gs.iter().map(|g| compile(g, states)).collect()),
-        Formula::Or(gs) => Op::Or(gs.iter().map(|g| compile(g, states)).collect()),
-        // State formulas were taken above.
-        Formula::True | Formula::False | Formula::Cmp { .. } => {
-            unreachable!("a formula without temporal operator is a state formula")
-        }
-    };
-    Node { op, horizon }
-}
-
-impl Work {
-    /// A buffer of `n` values, stale: every operator overwrites its whole output.
-    fn take(&mut self, n: usize) -> Vec<f64> {
-        let mut v = self.pool.pop().unwrap_or_default();
-        if v.len() < n {
-            v.resize(n, 0.0);
-        } else {
-            v.truncate(n);
-        }
-        v
-    }
-
-    /// The signal of `node` over the states `seg`, in pieces as [`Evaluator`] cuts them.
-    fn eval(&mut self, node: &Node, tables: &[Vec<f64>], seg: &[usize]) -> Vec<f64> {
-        let n = seg.len();
-        let piece = match (&node.op, node.horizon) {
-            (Op::State(_), _) | (_, None) => usize::MAX,
-            (_, Some(h)) => piece_len(h),
-        };
-        if n / 2 <= piece {
-            return self.eval_whole(node, tables, seg);
-        }
-        let h = node.horizon.unwrap_or(0);
-        let mut out = self.take(n);
-        let mut lo = 0;
-        while lo < n {
-            let hi = (lo + piece).min(n);
-            let end = hi.saturating_add(h).min(n);
-            let v = self.eval_whole(node, tables, &seg[lo..end]);
-            out[lo..hi].copy_from_slice(&v[..hi - lo]);
-            self.pool.push(v);
-            lo = hi;
-        }
-        out
-    }
-
-    /// [`Work::eval`] in one piece, operator by operator as [`Evaluator`] does.
-    fn eval_whole(&mut self, node: &Node, tables: &[Vec<f64>], seg: &[usize]) -> Vec<f64> {
-        match &node.op {
-            Op::State(j) => {
-                let table = &tables[*j];
-                let nan_row = table.len() - 1;
-                let mut out = self.take(seg.len());
-                for (o, &s) in out.iter_mut().zip(seg) {
-                    *o = table[s.min(nan_row)];
-                }
-                out
-            }
-            Op::Not(g) => {
-                let mut out = self.eval(g, tables, seg);
-                out.iter_mut().for_each(|v| *v = -*v);
-                out
-            }
-            Op::And(gs) => self.fold::<Min>(gs, tables, seg),
-            Op::Or(gs) => self.fold::<Max>(gs, tables, seg),
-            Op::Implies(g, h) => {
-                let mut out = self.eval(g, tables, seg);
-                let rhs = self.eval(h, tables, seg);
-                out.iter_mut().zip(&rhs).for_each(|(a, b)| *a = (-*a).max(*b));
-                self.pool.push(rhs);
-                out
-            }
-            Op::Always(i, g) => {
-                let mut out = self.eval(g, tables, seg);
-                self.window::<Min>(i, &mut out, Kernels::always);
-                out
-            }
-            Op::Eventually(i, g) => {
-                let mut out = self.eval(g, tables, seg);
-                self.window::<Max>(i, &mut out, Kernels::eventually);
-                out
-            }
-            Op::Until(i, g, h) => {
-                let mut lhs = self.eval(g, tables, seg);
-                let mut out = self.eval(h, tables, seg);
-                self.kernels.until(i, &mut lhs, &mut out);
-                self.pool.push(lhs);
-                out
-            }
-        }
-    }
-
-    /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, as `kernel`
-    /// (the kernels' `L`-window) computes it; the common case (a bounded window of two
-    /// steps or more that starts inside `buf`) runs [`van_herk`] below.
-    fn window<L: Lattice>(
-        &mut self,
-        i: &Interval,
-        buf: &mut [f64],
-        kernel: fn(&mut Kernels, &Interval, &mut [f64]),
-    ) {
-        let n = buf.len();
-        let len = match i.last_offset() {
-            Some(last) if !i.is_empty() && i.start < n => (last - i.start).saturating_add(1),
-            _ => 1,
-        };
-        if len == 1 {
-            kernel(&mut self.kernels, i, buf);
-            return;
-        }
-        van_herk::<L>(buf, i.start, len.min(n), &mut self.pre, &mut self.suf);
-    }
-
-    fn fold<L: Lattice>(&mut self, gs: &[Node], tables: &[Vec<f64>], seg: &[usize]) -> Vec<f64> {
-        let Some((first, rest)) = gs.split_first() else {
-            let mut out = self.take(seg.len());
-            out.fill(L::ID);
-            return out;
-        };
-        let mut out = self.eval(first, tables, seg);
-        if rest.is_empty() {
-            fold_operand::<L>(&mut out, None, true);
-        }
-        for (k, g) in rest.iter().enumerate() {
-            let v = self.eval(g, tables, seg);
-            fold_operand::<L>(&mut out, Some(&v), k == 0);
-            self.pool.push(v);
-        }
-        out
+        self.runner.put(sig);
     }
 }
 
@@ -376,7 +216,7 @@ impl Work {
 /// with `2 <= len <= n` and `a < n`: the blocks, folds and combinations of the evaluator's
 /// van Herk/Gil-Werman kernel, in the same order and so with the same bits (signed zeros
 /// included), in straight loops for the short segments of option executions.
-fn van_herk<L: Lattice>(
+pub(crate) fn van_herk<L: Lattice>(
     buf: &mut [f64],
     a: usize,
     len: usize,
@@ -436,45 +276,13 @@ fn columns(trace: &Trace) -> Vec<&[f64]> {
     (0..trace.vars()).map(|i| trace.column(i)).collect()
 }
 
-/// `f` with each comparison replaced by `a_j > 0`, `a_j` being a variable that holds the
-/// comparison's robustness; `atoms` collects the comparisons, equal ones shared.
-/// `v - 0` is `v` for every `f64`, so the values do not change.
-fn lift_atoms(f: &Formula, atoms: &mut Vec<(Expr, CmpOp, Expr)>) -> Formula {
-    let mut lift = |g: &Formula| Box::new(lift_atoms(g, atoms));
-    match f {
-        Formula::True => Formula::True,
-        Formula::False => Formula::False,
-        Formula::Cmp { lhs, op, rhs } => {
-            let key = (lhs.clone(), *op, rhs.clone());
-            let j = atoms.iter().position(|a| *a == key).unwrap_or_else(|| {
-                atoms.push(key);
-                atoms.len() - 1
-            });
-            Formula::Cmp { lhs: Expr::Var(j), op: CmpOp::Gt, rhs: Expr::Const(0.0) }
-        }
-        Formula::Not(g) => Formula::Not(lift(g)),
-        Formula::Implies(g, h) => {
-            let g = lift(g);
-            Formula::Implies(g, lift(h))
-        }
-        Formula::Always(i, g) => Formula::Always(*i, lift(g)),
-        Formula::Eventually(i, g) => Formula::Eventually(*i, lift(g)),
-        Formula::Until(i, g, h) => {
-            let g = lift(g);
-            Formula::Until(*i, g, lift(h))
-        }
-        Formula::And(gs) => Formula::And(gs.iter().map(|g| lift_atoms(g, atoms)).collect()),
-        Formula::Or(gs) => Formula::Or(gs.iter().map(|g| lift_atoms(g, atoms)).collect()),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Bound;
+    use crate::{Bound, CmpOp, Expr, Interval};
 
     fn x(op: CmpOp, c: f64) -> Formula {
-        Formula::Cmp { lhs: Expr::Var(0), op, rhs: Expr::Const(c) }
+        Formula::cmp(Expr::var(0), op, Expr::constant(c))
     }
 
     fn window(a: usize, b: Bound) -> Interval {
@@ -482,15 +290,15 @@ mod tests {
     }
 
     fn not(f: Formula) -> Formula {
-        Formula::Not(Box::new(f))
+        Formula::not(f)
     }
 
     fn ev(i: Interval, f: Formula) -> Formula {
-        Formula::Eventually(i, Box::new(f))
+        Formula::eventually(i, f)
     }
 
     fn alw(i: Interval, f: Formula) -> Formula {
-        Formula::Always(i, Box::new(f))
+        Formula::always(i, f)
     }
 
     /// Tasks over `x` with every operator, persistent or not; the negations make signed
@@ -498,23 +306,23 @@ mod tests {
     fn tasks() -> Vec<Formula> {
         use Bound::{Exclusive, Inclusive, Unbounded};
         use CmpOp::{Ge, Gt, Le, Lt};
-        let band = Formula::And(vec![x(Gt, 3.0), x(Lt, 7.0)]);
-        let body = Formula::And(vec![
+        let band = Formula::and(vec![x(Gt, 3.0), x(Lt, 7.0)]);
+        let body = Formula::and(vec![
             ev(window(0, Exclusive(5)), x(Gt, 7.0)),
             ev(window(0, Exclusive(5)), x(Lt, 2.0)),
             ev(window(0, Exclusive(5)), band.clone()),
         ]);
-        let until = Formula::Until(
+        let until = Formula::until(
             window(1, Inclusive(4)),
-            Box::new(not(x(Ge, 5.0))),
-            Box::new(Formula::Or(vec![x(Le, 5.0), not(band.clone())])),
+            not(x(Ge, 5.0)),
+            Formula::or(vec![x(Le, 5.0), not(band.clone())]),
         );
-        let implies = Formula::Implies(
-            Box::new(not(ev(window(1, Inclusive(3)), band.clone()))),
-            Box::new(alw(window(0, Inclusive(2)), x(Lt, 9.0))),
+        let implies = Formula::implies(
+            not(ev(window(1, Inclusive(3)), band.clone())),
+            alw(window(0, Inclusive(2)), x(Lt, 9.0)),
         );
         // `-0` at x = 5 and `+0` at x = 8 in one state formula's values.
-        let zeros = Formula::Or(vec![not(x(Ge, 5.0)), x(Ge, 8.0)]);
+        let zeros = Formula::or(vec![not(x(Ge, 5.0)), x(Ge, 8.0)]);
         vec![
             ev(window(0, Exclusive(5)), zeros.clone()),
             alw(window(0, Exclusive(5)), zeros.clone()),
@@ -522,17 +330,17 @@ mod tests {
             alw(Interval::ALL, body.clone()),
             alw(Interval::ALL, until.clone()),
             alw(Interval::ALL, implies.clone()),
-            alw(Interval::ALL, Formula::Or(vec![not(body.clone()), x(Gt, 5.0)])),
+            alw(Interval::ALL, Formula::or(vec![not(body.clone()), x(Gt, 5.0)])),
             body,
             until,
             implies,
             not(ev(window(2, Unbounded), not(x(Gt, 5.0)))),
-            Formula::Until(window(0, Unbounded), Box::new(x(Lt, 8.0)), Box::new(x(Gt, 8.0))),
+            Formula::until(window(0, Unbounded), x(Lt, 8.0), x(Gt, 8.0)),
             not(band),
             alw(window(6, Inclusive(9)), x(Gt, 5.0)),
             alw(Interval::ALL, ev(window(30, Exclusive(70)), x(Lt, 1.0))),
-            Formula::And(vec![]),
-            alw(window(0, Inclusive(3)), Formula::True),
+            Formula::and(vec![]),
+            alw(window(0, Inclusive(3)), Formula::bool(true)),
         ]
     }
 

@@ -1,13 +1,16 @@
-//! Streaming evaluation of bounded formulas: one node per operator, each turning its
-//! operands' final values into its own as soon as they are determined.
+//! Streaming evaluation of bounded formulas: one stream per formula node, each turning
+//! its operands' final values into its own as soon as they are determined.
 //!
 //! A node with horizon `h` emits `rho(t)` when state `t + h` arrives, so every node emits
-//! exactly one value per state once warmed up, and keeps `O(h)` values. Windows use
-//! monotonic deques; bounded until uses the block decomposition of the offline evaluator,
-//! run forwards. Values equal the offline evaluator's exactly (same min/max selections,
-//! same NaN policy). Only windows clipped by the end of the trace are left out: the
-//! monitor evaluates those offline at `finish`.
+//! exactly one value per state once warmed up. Each node keeps its recent values for the
+//! parents that read them later (at most the difference of their horizons), and a window
+//! or until keeps `O(h)` values. Windows use monotonic deques; bounded until uses the
+//! block decomposition of the offline evaluator, run forwards. Values equal the offline
+//! evaluator's (same min/max selections, same NaN policy). Only windows clipped by the end
+//! of the trace are left out: the monitor evaluates those offline at `finish`. The nodes
+//! are walked in order on every push: nothing recurses, and a shared node is computed once.
 
+use crate::formula::{Node, expr_value};
 use crate::offline::{Lattice, Max, Min};
 use crate::{Bound, Formula, Interval};
 use std::collections::VecDeque;
@@ -15,24 +18,40 @@ use std::collections::VecDeque;
 const INF: f64 = f64::INFINITY;
 const NEG_INF: f64 = f64::NEG_INFINITY;
 
-/// One operator of the formula with the final values it has produced and not yet handed on.
+/// The streams of every node of one bounded formula.
 #[derive(Clone, Debug)]
-pub(crate) struct Node {
+pub(crate) struct Stream {
+    nodes: Vec<Slot>,
+    /// Each node's value on the current state (state nodes only).
+    vals: Vec<f64>,
+    /// States pushed so far.
+    pushed: usize,
+    root: usize,
+}
+
+/// One node's stream.
+#[derive(Clone, Debug)]
+struct Slot {
     kind: Kind,
-    /// Final values for consecutive steps, oldest first.
-    out: VecDeque<f64>,
+    /// Final values for consecutive steps, the oldest (step `base`) first.
+    hist: VecDeque<f64>,
+    base: usize,
+    /// How many values to keep for the readers that lag behind.
+    keep: usize,
+    /// At push `j` the node reads its operands at step `j - lag` (the largest operand
+    /// horizon).
+    lag: usize,
 }
 
 #[derive(Clone, Debug)]
 enum Kind {
-    /// A formula without temporal operators, evaluated on each state.
-    State(Formula),
-    Not(Box<Node>),
-    Fold {
-        max: bool,
-        kids: Vec<Node>,
-    },
-    Implies(Box<Node>, Box<Node>),
+    /// An expression, or a state formula no temporal node reads: nothing streamed.
+    Skip,
+    /// A state formula a temporal node reads: its value on each state.
+    State,
+    Not,
+    Fold,
+    Implies,
     Window(Box<Window>),
     Until(Box<Until>),
 }
@@ -46,7 +65,6 @@ struct Window {
     last: Option<usize>,
     /// The node emits step `t` when its operand's step `t + end` arrives.
     end: usize,
-    kid: Node,
     /// Operand values received so far.
     seen: usize,
     /// Monotonic deque of `(step, value)`: the front is the window's min (or max).
@@ -59,8 +77,6 @@ struct Until {
     a: usize,
     last: Option<usize>,
     end: usize,
-    f: Node,
-    g: Node,
     seen: usize,
     /// Step of the front of `fv`, `gv`, `su`, `sf` and `p`.
     base: usize,
@@ -77,121 +93,145 @@ struct Until {
     a_next: usize,
 }
 
-impl Node {
-    /// The node tree of a formula with a finite horizon; `None` for an unbounded one.
-    pub(crate) fn build(f: &Formula) -> Option<Node> {
+impl Stream {
+    /// The streams of a formula with a finite horizon; `None` for an unbounded one.
+    pub(crate) fn build(f: &Formula) -> Option<Stream> {
         f.horizon()?;
-        Some(Node::new(f))
-    }
-
-    fn new(f: &Formula) -> Node {
-        let kind = if f.is_state_formula() {
-            Kind::State(f.clone())
-        } else {
-            match f {
-                Formula::Not(g) => Kind::Not(Box::new(Node::new(g))),
-                Formula::And(gs) => {
-                    Kind::Fold { max: false, kids: gs.iter().map(Node::new).collect() }
-                }
-                Formula::Or(gs) => {
-                    Kind::Fold { max: true, kids: gs.iter().map(Node::new).collect() }
-                }
-                Formula::Implies(g, h) => {
-                    Kind::Implies(Box::new(Node::new(g)), Box::new(Node::new(h)))
-                }
-                Formula::Always(i, g) | Formula::Eventually(i, g) => {
-                    Kind::Window(Box::new(Window {
-                        max: matches!(f, Formula::Eventually(..)),
+        let nodes = f.nodes();
+        let h = |k: usize| f.horizon_of(crate::NodeId::from_index(k)).unwrap_or(0);
+        let root = f.root().index();
+        let mut slots: Vec<Slot> = nodes
+            .iter()
+            .enumerate()
+            .map(|(v, node)| {
+                let state = f.is_state(crate::NodeId::from_index(v)) && !node.is_expr();
+                let lag = node.children().map(h).max().unwrap_or(0);
+                let kind = match node {
+                    _ if state => Kind::Skip,
+                    Node::Not(_) => Kind::Not,
+                    Node::And(_) | Node::Or(_) => Kind::Fold,
+                    Node::Implies(..) => Kind::Implies,
+                    Node::Always(i, _) | Node::Eventually(i, _) => Kind::Window(Box::new(Window {
+                        max: matches!(node, Node::Eventually(..)),
                         a: i.start,
                         last: last(i),
                         end: end(i),
-                        kid: Node::new(g),
                         seen: 0,
                         deque: VecDeque::new(),
-                    }))
-                }
-                Formula::Until(i, g, h) => Kind::Until(Box::new(Until {
-                    a: i.start,
-                    last: last(i),
-                    end: end(i),
-                    f: Node::new(g),
-                    g: Node::new(h),
-                    seen: 0,
-                    base: 0,
-                    fv: VecDeque::new(),
-                    gv: VecDeque::new(),
-                    su: VecDeque::new(),
-                    sf: VecDeque::new(),
-                    p: VecDeque::new(),
-                    pf: INF,
-                    pu: NEG_INF,
-                    a_deque: VecDeque::new(),
-                    a_next: 0,
-                })),
-                // State formulas took the branch above.
-                Formula::True | Formula::False | Formula::Cmp { .. } => Kind::State(f.clone()),
+                    })),
+                    Node::Until(i, ..) => Kind::Until(Box::new(Until {
+                        a: i.start,
+                        last: last(i),
+                        end: end(i),
+                        seen: 0,
+                        base: 0,
+                        fv: VecDeque::new(),
+                        gv: VecDeque::new(),
+                        su: VecDeque::new(),
+                        sf: VecDeque::new(),
+                        p: VecDeque::new(),
+                        pf: INF,
+                        pu: NEG_INF,
+                        a_deque: VecDeque::new(),
+                        a_next: 0,
+                    })),
+                    _ => Kind::Skip,
+                };
+                Slot { kind, hist: VecDeque::new(), base: 0, keep: 1, lag }
+            })
+            .collect();
+        // A state node read by a temporal node (or the root) streams its values; every
+        // node keeps what its slowest reader still needs.
+        for (v, node) in nodes.iter().enumerate() {
+            let temporal = !matches!(slots[v].kind, Kind::Skip | Kind::State);
+            if !temporal {
+                continue;
             }
-        };
-        Node { kind, out: VecDeque::new() }
+            for c in node.children() {
+                if matches!(slots[c].kind, Kind::Skip) {
+                    slots[c].kind = Kind::State;
+                }
+                let keep = slots[v].lag - h(c) + 1;
+                slots[c].keep = slots[c].keep.max(keep);
+            }
+        }
+        if matches!(slots[root].kind, Kind::Skip) {
+            slots[root].kind = Kind::State;
+        }
+        Some(Stream { nodes: slots, vals: vec![f64::NAN; nodes.len()], pushed: 0, root })
     }
 
-    /// Takes the oldest final value not yet handed on.
-    pub(crate) fn pop(&mut self) -> Option<f64> {
-        self.out.pop_front()
+    /// Feeds one state; returns the root's value that became final, if any.
+    pub(crate) fn push(&mut self, f: &Formula, row: &[f64]) -> Option<f64> {
+        let j = self.pushed;
+        self.pushed += 1;
+        let nodes = f.nodes();
+        for (v, node) in nodes.iter().enumerate() {
+            let x = match &self.nodes[v].kind {
+                Kind::Skip | Kind::State => {
+                    let x = state_value(node, &self.vals, row);
+                    self.vals[v] = x;
+                    if matches!(self.nodes[v].kind, Kind::Skip) {
+                        continue;
+                    }
+                    Some(x)
+                }
+                _ => {
+                    let lag = self.nodes[v].lag;
+                    let Some(s) = j.checked_sub(lag) else { continue };
+                    self.temporal(node, v, s)
+                }
+            };
+            if let Some(x) = x {
+                let slot = &mut self.nodes[v];
+                slot.hist.push_back(x);
+                if slot.hist.len() > slot.keep {
+                    slot.hist.pop_front();
+                    slot.base += 1;
+                }
+            }
+        }
+        let root = &self.nodes[self.root];
+        let h = f.horizon().unwrap_or(0);
+        // The root emits step `j - h` at push `j`.
+        j.checked_sub(h).and_then(|t| root.hist.get(t.wrapping_sub(root.base)).copied())
     }
 
-    /// Feeds one state to the tree and lets every node emit what became final.
-    pub(crate) fn push(&mut self, row: &[f64]) {
-        match &mut self.kind {
-            Kind::State(f) => self.out.push_back(state_value(f, row)),
-            Kind::Not(g) => {
-                g.push(row);
-                while let Some(v) = g.pop() {
-                    self.out.push_back(-v);
+    /// Node `c`'s final value at step `s`.
+    fn at(&self, c: usize, s: usize) -> f64 {
+        let slot = &self.nodes[c];
+        slot.hist.get(s.wrapping_sub(slot.base)).copied().unwrap_or(f64::NAN)
+    }
+
+    /// Temporal node `v` takes its operands at step `s`; returns its next value if final.
+    fn temporal(&mut self, node: &Node, v: usize, s: usize) -> Option<f64> {
+        match node {
+            Node::Not(g) => Some(-self.at(g.index(), s)),
+            Node::And(gs) | Node::Or(gs) => {
+                let max = matches!(node, Node::Or(_));
+                let mut acc = if max { NEG_INF } else { INF };
+                for g in gs {
+                    let x = self.at(g.index(), s);
+                    acc = if max { Max::acc(acc, x) } else { Min::acc(acc, x) };
+                }
+                Some(acc)
+            }
+            Node::Implies(g, h) => Some((-self.at(g.index(), s)).max(self.at(h.index(), s))),
+            Node::Always(_, g) | Node::Eventually(_, g) => {
+                let x = self.at(g.index(), s);
+                match &mut self.nodes[v].kind {
+                    Kind::Window(w) => w.take(x),
+                    _ => None,
                 }
             }
-            Kind::Fold { max, kids } => {
-                kids.iter_mut().for_each(|k| k.push(row));
-                // Operands with shorter horizons run ahead; a step is final once all have it.
-                while kids.iter().all(|k| !k.out.is_empty()) {
-                    let id = if *max { NEG_INF } else { INF };
-                    let mut acc = id;
-                    for k in kids.iter_mut() {
-                        let v = k.pop().unwrap_or(id);
-                        acc = if *max { Max::acc(acc, v) } else { Min::acc(acc, v) };
-                    }
-                    self.out.push_back(acc);
-                    if kids.is_empty() {
-                        break;
-                    }
+            Node::Until(_, g, h) => {
+                let (x, y) = (self.at(g.index(), s), self.at(h.index(), s));
+                match &mut self.nodes[v].kind {
+                    Kind::Until(u) => u.take(x, y),
+                    _ => None,
                 }
             }
-            Kind::Implies(g, h) => {
-                g.push(row);
-                h.push(row);
-                while !g.out.is_empty() && !h.out.is_empty() {
-                    let (a, b) = (g.pop().unwrap_or(NEG_INF), h.pop().unwrap_or(NEG_INF));
-                    self.out.push_back((-a).max(b));
-                }
-            }
-            Kind::Window(w) => {
-                w.kid.push(row);
-                while let Some(v) = w.kid.pop() {
-                    if let Some(r) = w.take(v) {
-                        self.out.push_back(r);
-                    }
-                }
-            }
-            Kind::Until(u) => {
-                u.f.push(row);
-                u.g.push(row);
-                while !u.f.out.is_empty() && !u.g.out.is_empty() {
-                    let (f, g) = (u.f.pop().unwrap_or(NEG_INF), u.g.pop().unwrap_or(NEG_INF));
-                    if let Some(r) = u.take(f, g) {
-                        self.out.push_back(r);
-                    }
-                }
-            }
+            _ => None,
         }
     }
 }
@@ -313,17 +353,18 @@ fn end(i: &Interval) -> usize {
     }
 }
 
-/// `rho(f)` of a state formula on one state, as the reference evaluator computes it.
-fn state_value(f: &Formula, row: &[f64]) -> f64 {
-    match f {
-        Formula::True => INF,
-        Formula::False => NEG_INF,
-        Formula::Cmp { lhs, op, rhs } => op.robustness(lhs.eval(row), rhs.eval(row)),
-        Formula::Not(g) => -state_value(g, row),
-        Formula::And(gs) => gs.iter().map(|g| state_value(g, row)).fold(INF, f64::min),
-        Formula::Or(gs) => gs.iter().map(|g| state_value(g, row)).fold(NEG_INF, f64::max),
-        Formula::Implies(g, h) => (-state_value(g, row)).max(state_value(h, row)),
-        // Temporal operators never reach here: `Node::new` sends state formulas only.
-        Formula::Always(..) | Formula::Eventually(..) | Formula::Until(..) => f64::NAN,
+/// `rho` of state node `node` on one state, given the values of earlier nodes on it, as
+/// the reference evaluator computes it.
+fn state_value(node: &Node, vals: &[f64], row: &[f64]) -> f64 {
+    let v = |k: &crate::NodeId| vals[k.index()];
+    match node {
+        Node::True => INF,
+        Node::False => NEG_INF,
+        Node::Cmp { lhs, op, rhs } => op.robustness(vals[lhs.index()], vals[rhs.index()]),
+        Node::Not(g) => -v(g),
+        Node::And(gs) => gs.iter().map(v).fold(INF, f64::min),
+        Node::Or(gs) => gs.iter().map(v).fold(NEG_INF, f64::max),
+        Node::Implies(g, h) => (-v(g)).max(v(h)),
+        _ => expr_value(node, vals, row),
     }
 }

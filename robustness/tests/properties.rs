@@ -4,7 +4,7 @@
 mod common;
 
 use common::{check_all, parse};
-use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace, complete, reference};
+use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Node, Trace, complete, reference};
 use proptest::prelude::*;
 
 fn value() -> impl Strategy<Value = f64> {
@@ -40,18 +40,18 @@ fn interval() -> impl Strategy<Value = Interval> {
 
 fn expr() -> impl Strategy<Value = Expr> {
     let leaf = prop_oneof![
-        3 => (0usize..2).prop_map(Expr::Var),
-        2 => (-4i32..=4).prop_map(|c| Expr::Const(f64::from(c))),
+        3 => (0usize..2).prop_map(Expr::var),
+        2 => (-4i32..=4).prop_map(|c| Expr::constant(f64::from(c))),
     ];
     leaf.prop_recursive(2, 6, 2, |e| {
         prop_oneof![
-            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Add(Box::new(a), Box::new(b))),
-            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Sub(Box::new(a), Box::new(b))),
-            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Mul(Box::new(a), Box::new(b))),
-            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::Div(Box::new(a), Box::new(b))),
-            e.clone().prop_map(|a| Expr::Neg(Box::new(a))),
-            e.clone().prop_map(|a| Expr::Abs(Box::new(a))),
-            e.prop_map(|a| Expr::Sqrt(Box::new(a))),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::add(a, b)),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::sub(a, b)),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::mul(a, b)),
+            (e.clone(), e.clone()).prop_map(|(a, b)| Expr::div(a, b)),
+            e.clone().prop_map(|a| Expr::neg(a)),
+            e.clone().prop_map(|a| Expr::abs(a)),
+            e.prop_map(|a| Expr::sqrt(a)),
         ]
     })
 }
@@ -62,41 +62,33 @@ fn cmp_op() -> impl Strategy<Value = CmpOp> {
 
 /// Formulas over `x` and `y`; `min_kids` is the least number of `&&`/`||` operands.
 fn formula(min_kids: usize) -> impl Strategy<Value = Formula> {
-    let simple = (0usize..2, cmp_op(), -4i32..=4).prop_map(|(v, op, c)| Formula::Cmp {
-        lhs: Expr::Var(v),
-        op,
-        rhs: Expr::Const(f64::from(c)),
-    });
-    let general =
-        (expr(), cmp_op(), expr()).prop_map(|(lhs, op, rhs)| Formula::Cmp { lhs, op, rhs });
+    let simple = (0usize..2, cmp_op(), -4i32..=4)
+        .prop_map(|(v, op, c)| Formula::cmp(Expr::var(v), op, Expr::constant(f64::from(c))));
+    let general = (expr(), cmp_op(), expr()).prop_map(|(lhs, op, rhs)| Formula::cmp(lhs, op, rhs));
     let leaf = prop_oneof![
         6 => simple,
         2 => general,
-        1 => Just(Formula::True),
-        1 => Just(Formula::False),
+        1 => Just(Formula::bool(true)),
+        1 => Just(Formula::bool(false)),
     ];
     leaf.prop_recursive(4, 24, 3, move |f| {
         let kids = proptest::collection::vec(f.clone(), min_kids..=3);
         prop_oneof![
-            f.clone().prop_map(|g| Formula::Not(Box::new(g))),
-            kids.clone().prop_map(Formula::And),
-            kids.prop_map(Formula::Or),
-            (f.clone(), f.clone()).prop_map(|(g, h)| Formula::Implies(Box::new(g), Box::new(h))),
-            (interval(), f.clone()).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
-            (interval(), f.clone()).prop_map(|(i, g)| Formula::Eventually(i, Box::new(g))),
-            (interval(), f.clone(), f.clone()).prop_map(|(i, g, h)| Formula::Until(
-                i,
-                Box::new(g),
-                Box::new(h)
-            )),
-            (interval(), f).prop_map(|(i, g)| Formula::Always(i, Box::new(g))),
+            f.clone().prop_map(|g| Formula::not(g)),
+            kids.clone().prop_map(Formula::and),
+            kids.prop_map(Formula::or),
+            (f.clone(), f.clone()).prop_map(|(g, h)| Formula::implies(g, h)),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::always(i, g)),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::eventually(i, g)),
+            (interval(), f.clone(), f.clone()).prop_map(|(i, g, h)| Formula::until(i, g, h)),
+            (interval(), f).prop_map(|(i, g)| Formula::always(i, g)),
         ]
     })
 }
 
 /// A persistent task `always[0..] f`, the shape whose segment reward cuts the horizon.
 fn persistent() -> impl Strategy<Value = Formula> {
-    formula(0).prop_map(|f| Formula::Always(Interval::ALL, Box::new(f)))
+    formula(0).prop_map(|f| Formula::always(Interval::ALL, f))
 }
 
 proptest! {
@@ -144,7 +136,7 @@ proptest! {
 /// A variable the trace lacks reads as NaN everywhere, never a panic.
 #[test]
 fn missing_variable_is_nan() {
-    let f = Formula::Cmp { lhs: Expr::Var(5), op: CmpOp::Gt, rhs: Expr::Const(0.0) };
+    let f = Formula::cmp(Expr::var(5), CmpOp::Gt, Expr::constant(0.0));
     let t = common::trace_xy(&[1.0, 2.0], &[3.0, 4.0]);
     check_all(&f, &t, &reference::signal(&f, &t));
     assert!(reference::signal(&f, &t).iter().all(|v| v.is_nan()));
@@ -153,58 +145,74 @@ fn missing_variable_is_nan() {
 /// Complete windows read literally: `(complete steps, rho(f, t))` where every operator's
 /// window is cut at its operands' complete prefix (the table in `complete`'s docs).
 fn complete_reference(f: &Formula, trace: &Trace) -> (usize, Vec<f64>) {
+    complete_at(f, f.root().index(), trace)
+}
+
+fn complete_at(f: &Formula, id: usize, trace: &Trace) -> (usize, Vec<f64>) {
     let n = trace.len();
-    let cut = |(c, v): (usize, Vec<f64>)| v[..c].to_vec();
+    let node = &f.nodes()[id];
+    let sub = |k: usize| {
+        let (c, v) = complete_at(f, k, trace);
+        v[..c].to_vec()
+    };
     let fold = |vals: &mut dyn Iterator<Item = f64>, min: bool| {
         vals.fold(if min { f64::INFINITY } else { f64::NEG_INFINITY }, |a, b| {
             if min { a.min(b) } else { a.max(b) }
         })
     };
-    // The steps `t' ` of interval `i` at `t` within `m` steps, and the node's own prefix.
-    let window = |i: &Interval, t: usize, m: usize| i.window(t, m);
     let own = |i: &Interval, m: usize| match i.end {
         Bound::Unbounded => m.saturating_sub(i.start),
         _ => m.saturating_sub(i.last_offset().unwrap_or(0)),
     };
-    match f {
-        Formula::True | Formula::False | Formula::Cmp { .. } => (n, reference::signal(f, trace)),
-        Formula::Not(g) => {
-            let g = cut(complete_reference(g, trace));
+    match node {
+        Node::Not(g) => {
+            let g = sub(g.index());
             (g.len(), g.iter().map(|v| -v).collect())
         }
-        Formula::And(gs) | Formula::Or(gs) => {
-            let kids: Vec<Vec<f64>> =
-                gs.iter().map(|g| cut(complete_reference(g, trace))).collect();
+        Node::And(gs) | Node::Or(gs) => {
+            let kids: Vec<Vec<f64>> = gs.iter().map(|g| sub(g.index())).collect();
             let m = kids.iter().map(Vec::len).min().unwrap_or(n);
-            let min = matches!(f, Formula::And(_));
+            let min = matches!(node, Node::And(_));
             (m, (0..m).map(|t| fold(&mut kids.iter().map(|k| k[t]), min)).collect())
         }
-        Formula::Implies(g, h) => {
-            let (g, h) = (cut(complete_reference(g, trace)), cut(complete_reference(h, trace)));
+        Node::Implies(g, h) => {
+            let (g, h) = (sub(g.index()), sub(h.index()));
             let m = g.len().min(h.len());
             (m, (0..m).map(|t| (-g[t]).max(h[t])).collect())
         }
-        Formula::Always(i, g) | Formula::Eventually(i, g) => {
-            let g = cut(complete_reference(g, trace));
+        Node::Always(i, g) | Node::Eventually(i, g) => {
+            let g = sub(g.index());
             let m = g.len();
-            let min = matches!(f, Formula::Always(..));
-            let v = (0..m).map(|t| fold(&mut window(i, t, m).map(|u| g[u]), min)).collect();
+            let min = matches!(node, Node::Always(..));
+            let v = (0..m).map(|t| fold(&mut i.window(t, m).map(|u| g[u]), min)).collect();
             (own(i, m), v)
         }
-        Formula::Until(i, g, h) => {
-            let (g, h) = (cut(complete_reference(g, trace)), cut(complete_reference(h, trace)));
+        Node::Until(i, g, h) => {
+            let (g, h) = (sub(g.index()), sub(h.index()));
             let m = g.len().min(h.len());
             let v = (0..m)
                 .map(|t| {
-                    fold(
-                        &mut window(i, t, m)
-                            .map(|u| h[u].min(fold(&mut (t..u).map(|w| g[w]), true))),
-                        false,
-                    )
+                    let mut candidates =
+                        i.window(t, m).map(|u| h[u].min(fold(&mut (t..u).map(|w| g[w]), true)));
+                    fold(&mut candidates, false)
                 })
                 .collect();
             (own(i, m), v)
         }
+        Node::True => (n, vec![f64::INFINITY; n]),
+        Node::False => (n, vec![f64::NEG_INFINITY; n]),
+        Node::Cmp { lhs, op, rhs } => {
+            let (lhs, rhs) = (f.expr_at(*lhs), f.expr_at(*rhs));
+            let mut row = Vec::new();
+            let v = (0..n)
+                .map(|t| {
+                    trace.row_into(t, &mut row);
+                    op.robustness(lhs.eval(&row), rhs.eval(&row))
+                })
+                .collect();
+            (n, v)
+        }
+        _ => unreachable!("an expression node is no formula's operand"),
     }
 }
 

@@ -85,6 +85,8 @@ pub struct RegionTable {
     /// Row `s`: state `s`'s values in the spec's variable order.
     trace: Trace,
     task: hstl_robustness::Formula,
+    /// `f` of a task `always[0..] f`.
+    body: Option<hstl_robustness::Formula>,
 }
 
 /// A greedy [`Agent`] executing options: the options policy picks an option where none
@@ -158,7 +160,8 @@ impl RegionTable {
             })
             .collect();
         let horizons = spec.regions.iter().map(|r| r.horizon).collect();
-        Ok(RegionTable { holds, horizons, trace, task: spec.task.clone() })
+        let body = reference::persistent_body(&spec.task).map(|(b, _)| spec.task.sub(b));
+        Ok(RegionTable { holds, horizons, trace, task: spec.task.clone(), body })
     }
 
     /// The task's robustness over the states of a rollout (by the offline evaluator, which
@@ -176,8 +179,7 @@ impl RegionTable {
     /// For a task `always[0..] f`, the share of the rollout's complete steps where `f`
     /// holds; `None` for another task or a rollout too short for a complete window.
     pub fn kept_share(&self, states: &[usize]) -> Option<f64> {
-        let (body, _) = reference::persistent_body(&self.task)?;
-        let signal = complete::signal(body, &self.rollout_trace(states)?);
+        let signal = complete::signal(self.body.as_ref()?, &self.rollout_trace(states)?);
         let kept = signal.iter().filter(|&&v| v > 0.0).count();
         (!signal.is_empty()).then(|| kept as f64 / signal.len() as f64)
     }

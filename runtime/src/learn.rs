@@ -560,7 +560,7 @@ mod tests {
 
     /// `x op c` on the one-row grids below.
     fn x(op: CmpOp, c: f64) -> Formula {
-        Formula::Cmp { lhs: Expr::Var(0), op, rhs: Expr::Const(c) }
+        Formula::cmp(Expr::var(0), op, Expr::constant(c))
     }
 
     /// A 5 x 1 deterministic line: P1 reaches `x > 1` (stops there), P2 reaches `x > 3`
@@ -570,7 +570,7 @@ mod tests {
         let prim = |name: &str, reach: Formula, terminate| PrimitiveOption {
             name: name.into(),
             reach,
-            init: Formula::True,
+            init: Formula::bool(true),
             terminate,
         };
         TaskSpec {
@@ -579,9 +579,9 @@ mod tests {
                 StateVar { name: "x".into(), domain: Some(0..=4) },
                 StateVar { name: "y".into(), domain: Some(0..=0) },
             ],
-            task: Formula::Eventually(
+            task: Formula::eventually(
                 Interval { start: 0, end: Bound::Exclusive(10) },
-                Box::new(x(CmpOp::Lt, 1.0)),
+                x(CmpOp::Lt, 1.0),
             ),
             primitives: vec![
                 prim("P1", x(CmpOp::Gt, 1.0), Terminate::Formula(x(CmpOp::Gt, 1.0))),
@@ -656,7 +656,7 @@ mod tests {
     fn persistent_line() -> TaskSpec {
         let (r1, r2) = (x(CmpOp::Lt, 1.0), x(CmpOp::Gt, 3.0));
         let window = Interval { start: 0, end: Bound::Exclusive(6) };
-        let ev = |r: &Formula| Formula::Eventually(window, Box::new(r.clone()));
+        let ev = |r: &Formula| Formula::eventually(window, r.clone());
         let prim = |name: &str, reach: &Formula, init| PrimitiveOption {
             name: name.into(),
             reach: reach.clone(),
@@ -664,7 +664,7 @@ mod tests {
             terminate: Terminate::Formula(reach.clone()),
         };
         let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
-        spec.task = Formula::Always(Interval::ALL, Box::new(Formula::And(vec![ev(&r1), ev(&r2)])));
+        spec.task = Formula::always(Interval::ALL, Formula::and(vec![ev(&r1), ev(&r2)]));
         spec.primitives =
             vec![prim("Right", &r2, x(CmpOp::Lt, 4.0)), prim("Left", &r1, x(CmpOp::Gt, 0.0))];
         spec.options = vec![
@@ -761,7 +761,7 @@ mod tests {
         let mut learner = rightward(&spec, &env);
         assert_eq!(run(&mut learner, 1, 4).0.states, [4, 4]);
         // A leg that never terminates is cut off after max_steps steps, then the next runs.
-        let spec = line(Intra::Paper, 3, Terminate::Formula(Formula::False));
+        let spec = line(Intra::Paper, 3, Terminate::Formula(Formula::bool(false)));
         let mut learner = rightward(&spec, &env);
         let (r, _) = run(&mut learner, 1, 0);
         assert_eq!(r.states, [0, 1, 2, 3]);

@@ -6,7 +6,7 @@
 
 use std::ops::RangeInclusive;
 
-use hstl_robustness::{Bound, Formula, Interval};
+use hstl_robustness::{Bound, Formula, Interval, Node, NodeId};
 
 use crate::Error;
 
@@ -316,18 +316,18 @@ impl TaskSpec {
 /// The conjuncts `(R_j, N_j)` of a task `always[0..] (eventually[0..N1] R1 && ...)` whose
 /// `R_j` are state formulas, or `None` for a task of another form.
 pub fn persistent_regions(task: &Formula) -> Option<Vec<(Formula, usize)>> {
-    let Formula::Always(outer, body) = task else { return None };
+    let Node::Always(outer, body) = task.root_node() else { return None };
     if *outer != Interval::ALL {
         return None;
     }
-    let conjuncts: Vec<&Formula> = match body.as_ref() {
-        Formula::And(fs) => fs.iter().collect(),
-        f => vec![f],
+    let conjuncts: Vec<NodeId> = match &task[*body] {
+        Node::And(fs) => fs.clone(),
+        _ => vec![*body],
     };
     let mut out = Vec::with_capacity(conjuncts.len());
     for c in conjuncts {
-        let Formula::Eventually(i, r) = c else { return None };
-        if i.start != 0 || !r.is_state_formula() {
+        let Node::Eventually(i, r) = &task[c] else { return None };
+        if i.start != 0 || !task.is_state(*r) {
             return None;
         }
         let n = match i.end {
@@ -338,7 +338,7 @@ pub fn persistent_regions(task: &Formula) -> Option<Vec<(Formula, usize)>> {
         if n == 0 {
             return None;
         }
-        out.push((r.as_ref().clone(), n));
+        out.push((task.sub(*r), n));
     }
     if out.is_empty() { None } else { Some(out) }
 }

@@ -167,7 +167,7 @@ fn bad_specs_are_errors() {
         ("the options set is empty", |s| s.options.clear()),
         ("no primitive option", |s| s.primitives.clear()),
         ("no option of the set can start", |s| {
-            s.primitives.iter_mut().for_each(|p| p.init = Formula::False)
+            s.primitives.iter_mut().for_each(|p| p.init = Formula::bool(false))
         }),
         ("flat gamma", |s| s.learn.flat.gamma = 1.5),
         ("episodes must be > 0", |s| s.learn.episodes = 0),
@@ -388,24 +388,24 @@ fn persistent_regions_are_read_off_the_task() {
     use hstl_runtime::robustness::{Bound, CmpOp, Interval};
     use hstl_runtime::spec::persistent_regions;
     let r = common::cmp(0, CmpOp::Gt, 3.0);
-    let ev = |start, end| Formula::Eventually(Interval { start, end }, Box::new(r.clone()));
-    let always = |f: Formula| Formula::Always(Interval::ALL, Box::new(f));
+    let ev = |start, end| Formula::eventually(Interval { start, end }, r.clone());
+    let always = |f: Formula| Formula::always(Interval::ALL, f);
     // (task, the N_j read off it, or None when the task has another form)
     let cases = [
         (always(ev(0, Bound::Exclusive(40))), Some(vec![40])),
         (always(ev(0, Bound::Inclusive(40))), Some(vec![41])),
         (
-            always(Formula::And(vec![ev(0, Bound::Exclusive(5)), ev(0, Bound::Inclusive(7))])),
+            always(Formula::and(vec![ev(0, Bound::Exclusive(5)), ev(0, Bound::Inclusive(7))])),
             Some(vec![5, 8]),
         ),
         (always(ev(1, Bound::Exclusive(40))), None),
         (always(ev(0, Bound::Unbounded)), None),
-        (always(Formula::Or(vec![ev(0, Bound::Exclusive(5))])), None),
+        (always(Formula::or(vec![ev(0, Bound::Exclusive(5))])), None),
         (ev(0, Bound::Exclusive(40)), None),
         (
-            Formula::Always(
+            Formula::always(
                 Interval { start: 0, end: Bound::Exclusive(9) },
-                Box::new(ev(0, Bound::Exclusive(4))),
+                ev(0, Bound::Exclusive(4)),
             ),
             None,
         ),

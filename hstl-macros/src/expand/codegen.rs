@@ -29,6 +29,7 @@ pub fn spec_module(
     let task = match &spec.task {
         Some(t) if g.valid(&t.formula) => g.monitor(
             &t.formula,
+            None,
             &quote!(super::lets),
             &quote!(super::State),
             &doc_or(t.doc.as_deref(), "The task: its robustness monitors."),
@@ -69,6 +70,12 @@ struct Gen<'a> {
     // The path generated code names the facade by: `$crate` through `hstl::hstl!`, or
     // `::hstl` when the proc macro is called directly.
     root: TokenStream,
+    // Per let, computed once in dependency order so that no analysis walks a chain of
+    // lets (or a let used twice) more than once: whether it checked (with every let it
+    // uses), its horizon, and its value on the empty trace.
+    let_valid: Vec<bool>,
+    let_horizon: Vec<Option<usize>>,
+    let_empty: Vec<f64>,
 }
 
 impl<'a> Gen<'a> {
@@ -88,39 +95,42 @@ impl<'a> Gen<'a> {
             .iter()
             .map(|o| unique(&mut taken, camel_case(&o.name), "Option"))
             .collect();
-        Gen { spec, let_names, prim_variants, option_variants, root }
+        let n = spec.lets.len();
+        let mut g = Gen {
+            spec,
+            let_names,
+            prim_variants,
+            option_variants,
+            root,
+            let_valid: vec![false; n],
+            let_horizon: vec![None; n],
+            let_empty: vec![f64::NAN; n],
+        };
+        // `let_order` lists every let after the lets it uses (and leaves out cycles).
+        for &i in &spec.let_order {
+            let f = &spec.lets[i].formula;
+            g.let_valid[i] = g.valid(f);
+            g.let_horizon[i] = g.horizon(f);
+            g.let_empty[i] = g.empty_value(f);
+        }
+        g
     }
 
     /// Whether a formula (and every let it uses) checked.
     fn valid(&self, f: &CFormula) -> bool {
-        let mut seen = HashSet::new();
-        self.valid_in(f, &mut seen)
-    }
-
-    fn valid_in(&self, f: &CFormula, seen: &mut HashSet<usize>) -> bool {
         match &f.kind {
             CFormulaKind::Invalid => false,
             CFormulaKind::True | CFormulaKind::False => true,
-            CFormulaKind::Let(i) => {
-                if !seen.insert(*i) {
-                    // A let met twice on one path is a cycle; one met on two paths is fine,
-                    // but cycles are left out of `let_order`, so that decides.
-                    return self.spec.let_order.contains(i);
-                }
-                let ok = self.spec.let_order.contains(i)
-                    && self.spec.lets.get(*i).is_some_and(|l| self.valid_in(&l.formula, seen));
-                seen.remove(i);
-                ok
-            }
+            CFormulaKind::Let(i) => self.let_valid.get(*i).copied().unwrap_or(false),
             CFormulaKind::Cmp(_, a, b) => valid_expr(a) && valid_expr(b),
             CFormulaKind::Not(a) | CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => {
-                self.valid_in(a, seen)
+                self.valid(a)
             }
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
-                !v.is_empty() && v.iter().all(|g| self.valid_in(g, seen))
+                !v.is_empty() && v.iter().all(|g| self.valid(g))
             }
             CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
-                self.valid_in(a, seen) && self.valid_in(b, seen)
+                self.valid(a) && self.valid(b)
             }
         }
     }
@@ -286,71 +296,208 @@ impl<'a> Gen<'a> {
         }
     }
 
+    /// The lets module: a monitor module per valid let, and what they share: `__build`
+    /// (every let's node, each added once), `__sig_<i>` (let `i`'s signal given the
+    /// signals of the lets it uses) and `__signals` (the signals a formula needs, each let
+    /// computed once, in dependency order). The code is linear in the spec: a let's code
+    /// names the lets it uses, never their bodies.
     fn lets(&self) -> TokenStream {
-        self.spec
-            .let_order
+        let hstl = &self.root;
+        let kernels = quote!(#hstl::robustness::kernels::Kernels);
+        let n = self.spec.lets.len();
+        let valid: Vec<usize> =
+            self.spec.let_order.iter().copied().filter(|&i| self.let_valid[i]).collect();
+        let mods: TokenStream = valid
             .iter()
-            .filter_map(|&i| {
-                let l = self.spec.lets.get(i)?;
-                if !self.valid(&l.formula) {
-                    return None;
-                }
+            .map(|&i| {
+                let l = &self.spec.lets[i];
                 let doc = doc_or(l.doc.as_deref(), &format!("The `let` `{}`.", l.name));
-                Some(self.monitor(
+                let name = &self.let_names[i];
+                self.monitor(
                     &l.formula,
+                    Some(i),
                     &quote!(super),
                     &quote!(super::super::State),
                     &doc,
-                    &{
-                        let name = &self.let_names[i];
-                        quote!(#name)
-                    },
-                ))
+                    &quote!(#name),
+                )
             })
-            .collect()
+            .collect();
+        let sigs: TokenStream = valid
+            .iter()
+            .map(|&i| {
+                let f = &self.spec.lets[i].formula;
+                let mut b = Body::new(self);
+                let body = b.block(f);
+                let k = if b.uses_kernels { quote!(k) } else { quote!(_k) };
+                let name = format_ident!("__sig_{}", i);
+                quote! {
+                    #[doc(hidden)]
+                    #[allow(unused_variables)]
+                    pub fn #name(trace: &[super::State], #k: &mut #kernels, __l: &[::std::vec::Vec<f64>]) -> ::std::vec::Vec<f64> {
+                        let __off = 0usize;
+                        #body
+                    }
+                }
+            })
+            .collect();
+        let deps = (0..n).map(|i| {
+            let d =
+                if self.let_valid[i] { let_deps(&self.spec.lets[i].formula) } else { Vec::new() };
+            quote!(&[#(#d),*])
+        });
+        let arms = valid.iter().map(|&i| {
+            let name = format_ident!("__sig_{}", i);
+            quote!(#i => #name(trace, k, &__l),)
+        });
+        let build = self.build_lets();
+        quote! {
+            #build
+            #sigs
+
+            #[doc(hidden)]
+            /// The signals of the lets `roots` name and of every let they use, each
+            /// computed once; the others are left empty.
+            pub fn __signals(trace: &[super::State], k: &mut #kernels, roots: &[usize]) -> ::std::vec::Vec<::std::vec::Vec<f64>> {
+                const DEPS: &[&[usize]] = &[#(#deps),*];
+                const ORDER: &[usize] = &[#(#valid),*];
+                let mut need = ::std::vec![false; #n];
+                let mut stack: ::std::vec::Vec<usize> = roots.to_vec();
+                while let ::core::option::Option::Some(i) = stack.pop() {
+                    if !need[i] {
+                        need[i] = true;
+                        stack.extend_from_slice(DEPS[i]);
+                    }
+                }
+                let mut __l: ::std::vec::Vec<::std::vec::Vec<f64>> = ::std::vec![::std::vec::Vec::new(); #n];
+                for &i in ORDER {
+                    if need[i] {
+                        #[allow(clippy::match_single_binding)]
+                        let v = match i {
+                            #(#arms)*
+                            _ => ::std::vec::Vec::new(),
+                        };
+                        __l[i] = v;
+                    }
+                }
+                __l
+            }
+
+            #mods
+        }
     }
 
-    /// A module of monitors for one formula. `lets` is the path of the lets module seen
-    /// from inside it.
+    /// A module of monitors for one formula: let `index`'s, or the task's (`None`).
+    /// `lets` is the path of the lets module seen from inside it.
     fn monitor(
         &self,
         f: &CFormula,
+        index: Option<usize>,
         lets: &TokenStream,
         state: &TokenStream,
         doc: &TokenStream,
         name: &TokenStream,
     ) -> TokenStream {
         let hstl = &self.root;
-        let data = self.formula_data(f, lets);
-        let empty = lit_f64(self.empty_value(f, &mut Vec::new()));
+        let data = match index {
+            Some(i) => quote! {{
+                let mut __b = #hstl::robustness::FormulaBuilder::new();
+                let __l = #lets::__build(&mut __b);
+                __b.build(__l[#i])
+            }},
+            None => self.formula_expr(f, lets),
+        };
+        let empty = lit_f64(self.empty_value(f));
         let kernels = quote!(#hstl::robustness::kernels::Kernels);
+        // The lets the monitor reads (each computed once by `__signals`).
+        let roots: Vec<usize> = match index {
+            Some(i) => vec![i],
+            None => let_deps(f),
+        };
+        let signals = |trace: TokenStream, k: TokenStream| {
+            if roots.is_empty() {
+                TokenStream::new()
+            } else {
+                quote!(let __l = #lets::__signals(#trace, #k, &[#(#roots),*]);)
+            }
+        };
         let (at, signal_with, robustness) = if self.spec.is_state_formula(f) {
-            let mut b = Body::new(self, lets);
-            let p = b.point(f);
-            let arg = if b.uses_state { quote!(s) } else { quote!(_s) };
+            let (arg, p) = match index {
+                Some(i) => (quote!(s), quote!(__l[#i][0])),
+                None => {
+                    let mut b = Body::new(self);
+                    let p = b.point(f);
+                    let arg =
+                        if b.uses_state || !roots.is_empty() { quote!(s) } else { quote!(_s) };
+                    (arg, p)
+                }
+            };
+            let prelude = signals(quote!(::core::slice::from_ref(s)), quote!(&mut #kernels::new()));
             let at = quote! {
                 /// Robustness on one state (a state formula reads no other).
+                #[allow(unused_variables)]
                 pub fn at(#arg: &#state) -> f64 {
+                    #prelude
+                    let (__off, __t) = (0usize, 0usize);
                     #p
                 }
             };
-            let signal_with = quote! {
-                /// [`signal`]; a state formula needs no kernels.
-                pub fn signal_with(trace: &[#state], _k: &mut #kernels) -> ::std::vec::Vec<f64> {
-                    trace.iter().map(at).collect()
+            let signal_with = match index {
+                Some(i) => quote! {
+                    /// [`signal`] with the caller's kernel buffers.
+                    pub fn signal_with(trace: &[#state], k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                        let mut __l = #lets::__signals(trace, k, &[#i]);
+                        ::core::mem::take(&mut __l[#i])
+                    }
+                },
+                None if roots.is_empty() => quote! {
+                    /// [`signal`]; a state formula needs no kernels.
+                    pub fn signal_with(trace: &[#state], _k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                        trace.iter().map(at).collect()
+                    }
+                },
+                None => {
+                    let mut b = Body::new(self);
+                    let body = b.block(f);
+                    let prelude = signals(quote!(trace), quote!(k));
+                    quote! {
+                        /// [`signal`] with the caller's kernel buffers: the lets it reads
+                        /// are computed once for the whole trace.
+                        pub fn signal_with(trace: &[#state], k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                            #prelude
+                            let __off = 0usize;
+                            #body
+                        }
+                    }
                 }
             };
             let robustness = quote!(trace.first().map_or(#empty, at));
             (at, signal_with, robustness)
         } else {
-            let mut b = Body::new(self, lets);
-            let body = b.block(f);
-            let k = if b.uses_kernels { quote!(k) } else { quote!(_k) };
-            let signal_with = quote! {
-                /// [`signal`] with the caller's kernel buffers: reused over many calls,
-                /// they are allocated once.
-                pub fn signal_with(trace: &[#state], #k: &mut #kernels) -> ::std::vec::Vec<f64> {
-                    #body
+            let signal_with = match index {
+                Some(i) => quote! {
+                    /// [`signal`] with the caller's kernel buffers: reused over many calls,
+                    /// they are allocated once.
+                    pub fn signal_with(trace: &[#state], k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                        let mut __l = #lets::__signals(trace, k, &[#i]);
+                        ::core::mem::take(&mut __l[#i])
+                    }
+                },
+                None => {
+                    let mut b = Body::new(self);
+                    let body = b.block(f);
+                    let k =
+                        if b.uses_kernels || !roots.is_empty() { quote!(k) } else { quote!(_k) };
+                    let prelude = signals(quote!(trace), quote!(k));
+                    quote! {
+                        /// [`signal`] with the caller's kernel buffers: reused over many calls,
+                        /// they are allocated once.
+                        pub fn signal_with(trace: &[#state], #k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                            #prelude
+                            let __off = 0usize;
+                            #body
+                        }
+                    }
                 }
             };
             // With a finite horizon `H`, step 0 reads only the first `H + 1` steps.
@@ -446,8 +593,7 @@ impl<'a> Gen<'a> {
             | CFormulaKind::False
             | CFormulaKind::Cmp(..)
             | CFormulaKind::Invalid => Some(0),
-            // Lets form no cycle in a valid formula, the only kind generated.
-            CFormulaKind::Let(i) => self.horizon(&self.spec.lets.get(*i)?.formula),
+            CFormulaKind::Let(i) => self.let_horizon.get(*i).copied().flatten(),
             CFormulaKind::Not(a) => self.horizon(a),
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
                 v.iter().try_fold(0, |acc, g| self.horizon(g).map(|h| acc.max(h)))
@@ -463,55 +609,34 @@ impl<'a> Gen<'a> {
     }
 
     /// The reference evaluator's `rho(f, 0)` on an empty trace.
-    fn empty_value(&self, f: &CFormula, stack: &mut Vec<usize>) -> f64 {
+    fn empty_value(&self, f: &CFormula) -> f64 {
         match &f.kind {
             CFormulaKind::True | CFormulaKind::Always(..) => f64::INFINITY,
             CFormulaKind::False | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
                 f64::NEG_INFINITY
             }
             CFormulaKind::Cmp(..) | CFormulaKind::Invalid => f64::NAN,
-            CFormulaKind::Let(i) => {
-                if stack.contains(i) {
-                    return f64::NAN;
-                }
-                stack.push(*i);
-                let v = self
-                    .spec
-                    .lets
-                    .get(*i)
-                    .map_or(f64::NAN, |l| self.empty_value(&l.formula, stack));
-                stack.pop();
-                v
-            }
-            CFormulaKind::Not(a) => -self.empty_value(a, stack),
+            CFormulaKind::Let(i) => self.let_empty.get(*i).copied().unwrap_or(f64::NAN),
+            CFormulaKind::Not(a) => -self.empty_value(a),
             CFormulaKind::And(v) => {
-                v.iter().map(|g| self.empty_value(g, stack)).fold(f64::INFINITY, f64::min)
+                v.iter().map(|g| self.empty_value(g)).fold(f64::INFINITY, f64::min)
             }
             CFormulaKind::Or(v) => {
-                v.iter().map(|g| self.empty_value(g, stack)).fold(f64::NEG_INFINITY, f64::max)
+                v.iter().map(|g| self.empty_value(g)).fold(f64::NEG_INFINITY, f64::max)
             }
-            CFormulaKind::Implies(a, b) => {
-                (-self.empty_value(a, stack)).max(self.empty_value(b, stack))
-            }
+            CFormulaKind::Implies(a, b) => (-self.empty_value(a)).max(self.empty_value(b)),
         }
     }
 
-    /// Code building the runtime's `Formula`; lets are calls to their `formula()`.
-    fn formula_data(&self, f: &CFormula, lets: &TokenStream) -> TokenStream {
+    /// Statements adding `f` to the builder `__b` (the lets' nodes in `__l`), one node
+    /// a statement: no nesting, however deep `f` is. Returns the variable of its node.
+    fn formula_data(&self, f: &CFormula, out: &mut Data) -> Ident {
         let hstl = &self.root;
-        let boxed = |g: &CFormula| {
-            let d = self.formula_data(g, lets);
-            quote!(::std::boxed::Box::new(#d))
-        };
-        match &f.kind {
-            CFormulaKind::True => quote!(#hstl::robustness::Formula::True),
-            CFormulaKind::False | CFormulaKind::Invalid => {
-                quote!(#hstl::robustness::Formula::False)
-            }
-            CFormulaKind::Let(i) => {
-                let name = &self.let_names[*i];
-                quote!(#lets::#name::formula())
-            }
+        let rob = quote!(#hstl::robustness);
+        let node = match &f.kind {
+            CFormulaKind::True => quote!(__b.bool(true)),
+            CFormulaKind::False | CFormulaKind::Invalid => quote!(__b.bool(false)),
+            CFormulaKind::Let(i) => quote!(__l[#i]),
             CFormulaKind::Cmp(op, a, b) => {
                 let op = match op {
                     CmpOp::Lt => quote!(Lt),
@@ -519,37 +644,83 @@ impl<'a> Gen<'a> {
                     CmpOp::Gt => quote!(Gt),
                     CmpOp::Ge => quote!(Ge),
                 };
-                let (a, b) = (expr_data(a, hstl), expr_data(b, hstl));
-                quote!(#hstl::robustness::Formula::Cmp { lhs: #a, op: #hstl::robustness::CmpOp::#op, rhs: #b })
+                let (a, b) = (out.expr(a), out.expr(b));
+                quote!(__b.cmp(#a, #rob::CmpOp::#op, #b))
             }
             CFormulaKind::Not(a) => {
-                let a = boxed(a);
-                quote!(#hstl::robustness::Formula::Not(#a))
+                let a = self.formula_data(a, out);
+                quote!(__b.not(#a))
             }
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
-                let parts = v.iter().map(|g| self.formula_data(g, lets));
+                let parts: Vec<Ident> = v.iter().map(|g| self.formula_data(g, out)).collect();
                 let kind =
-                    if matches!(f.kind, CFormulaKind::And(_)) { quote!(And) } else { quote!(Or) };
-                quote!(#hstl::robustness::Formula::#kind(::std::vec![#(#parts),*]))
+                    if matches!(f.kind, CFormulaKind::And(_)) { quote!(and) } else { quote!(or) };
+                quote!(__b.#kind(::std::vec![#(#parts),*]))
             }
             CFormulaKind::Implies(a, b) => {
-                let (a, b) = (boxed(a), boxed(b));
-                quote!(#hstl::robustness::Formula::Implies(#a, #b))
+                let (a, b) = (self.formula_data(a, out), self.formula_data(b, out));
+                quote!(__b.implies(#a, #b))
             }
             CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
                 let kind = if matches!(f.kind, CFormulaKind::Always(..)) {
-                    quote!(Always)
+                    quote!(always)
                 } else {
-                    quote!(Eventually)
+                    quote!(eventually)
                 };
-                let (iv, a) = (interval_data(iv, hstl), boxed(a));
-                quote!(#hstl::robustness::Formula::#kind(#iv, #a))
+                let (iv, a) = (interval_data(iv, hstl), self.formula_data(a, out));
+                quote!(__b.#kind(#iv, #a))
             }
             CFormulaKind::Until(iv, a, b) => {
-                let (iv, a, b) = (interval_data(iv, hstl), boxed(a), boxed(b));
-                quote!(#hstl::robustness::Formula::Until(#iv, #a, #b))
+                let iv = interval_data(iv, hstl);
+                let (a, b) = (self.formula_data(a, out), self.formula_data(b, out));
+                quote!(__b.until(#iv, #a, #b))
+            }
+        };
+        out.push(node)
+    }
+
+    /// The lets module's `__build`: every valid let added to a builder once, in
+    /// dependency order; `__l[i]` is let `i`'s node (`false` for a let that did not check,
+    /// which no generated formula uses).
+    fn build_lets(&self) -> TokenStream {
+        let hstl = &self.root;
+        let n = self.spec.lets.len();
+        let mut data = Data::default();
+        let mut stmts = Vec::new();
+        for &i in &self.spec.let_order {
+            if !self.let_valid[i] {
+                continue;
+            }
+            let id = self.formula_data(&self.spec.lets[i].formula, &mut data);
+            let body = data.take();
+            stmts.push(quote! { { #(#body)* __l[#i] = #id; } });
+        }
+        quote! {
+            #[doc(hidden)]
+            /// Every valid let into `__b`, each once; the node of let `i` at index `i`.
+            pub fn __build(__b: &mut #hstl::robustness::FormulaBuilder) -> ::std::vec::Vec<#hstl::robustness::NodeId> {
+                let __false = __b.bool(false);
+                #[allow(unused_mut)]
+                let mut __l = ::std::vec![__false; #n];
+                #(#stmts)*
+                __l
             }
         }
+    }
+
+    /// Code evaluating to the runtime's `Formula` of `f`, built with the lets module at
+    /// `lets`.
+    fn formula_expr(&self, f: &CFormula, lets: &TokenStream) -> TokenStream {
+        let hstl = &self.root;
+        let mut data = Data::default();
+        let id = self.formula_data(f, &mut data);
+        let body = data.take();
+        quote! {{
+            let mut __b = #hstl::robustness::FormulaBuilder::new();
+            let __l = #lets::__build(&mut __b);
+            #(#body)*
+            __b.build(#id)
+        }}
     }
 
     fn spec_impl(&self, src: &str) -> TokenStream {
@@ -565,7 +736,9 @@ impl<'a> Gen<'a> {
             _ => ident(&camel),
         };
         let name = &self.spec.name;
-        let lets = quote!(lets);
+        // Every formula of the spec goes into one builder: the lets' nodes are shared.
+        let mut data = Data::default();
+        let task_id = self.formula_data(&task.formula, &mut data);
         let vars = self.spec.state_vars.iter().map(|v| {
             let name = &v.name;
             let domain = match v.domain {
@@ -576,20 +749,20 @@ impl<'a> Gen<'a> {
         });
         let prims = self.spec.primitives.iter().map(|p| {
             let name = &p.name;
-            let reach = self.formula_data(&p.reach, &lets);
-            let init = self.formula_data(&p.init, &lets);
+            let reach = self.formula_data(&p.reach, &mut data);
+            let init = self.formula_data(&p.init, &mut data);
             let terminate = match &p.terminate {
                 Terminate::Argmax => quote!(#hstl::runtime::Terminate::Argmax),
                 Terminate::Formula(f) => {
-                    let f = self.formula_data(f, &lets);
-                    quote!(#hstl::runtime::Terminate::Formula(#f))
+                    let f = self.formula_data(f, &mut data);
+                    quote!(#hstl::runtime::Terminate::Formula(__b.build(#f)))
                 }
             };
             quote! {
                 #hstl::runtime::PrimitiveOption {
                     name: ::std::string::String::from(#name),
-                    reach: #reach,
-                    init: #init,
+                    reach: __b.build(#reach),
+                    init: __b.build(#init),
                     terminate: #terminate,
                 }
             }
@@ -604,19 +777,22 @@ impl<'a> Gen<'a> {
                 }
             }
         });
+        let prims: Vec<TokenStream> = prims.collect();
         let regions =
             self.spec.persistent_conjuncts(src).unwrap_or_default().into_iter().map(|c| {
                 let name = c.name;
-                let formula = self.formula_data(&c.region, &lets);
+                let formula = self.formula_data(&c.region, &mut data);
                 let steps = Literal::u64_unsuffixed(c.steps);
                 quote! {
                     #hstl::runtime::Region {
                         name: ::std::string::String::from(#name),
-                        formula: #formula,
+                        formula: __b.build(#formula),
                         horizon: #steps,
                     }
                 }
             });
+        let regions: Vec<TokenStream> = regions.collect();
+        let stmts = data.take();
         let l = &self.spec.learn;
         let level = |q: &hstl_lang::QParams| {
             let (g, a, e, m, d) = (
@@ -655,10 +831,13 @@ impl<'a> Gen<'a> {
             impl #ty {
                 /// The spec as the runtime's plain data.
                 pub fn task_spec() -> #hstl::runtime::TaskSpec {
+                    let mut __b = #hstl::robustness::FormulaBuilder::new();
+                    let __l = lets::__build(&mut __b);
+                    #(#stmts)*
                     #hstl::runtime::TaskSpec {
                         name: ::std::string::String::from(#name),
                         state_vars: ::std::vec![#(#vars),*],
-                        task: task::formula(),
+                        task: __b.build(#task_id),
                         primitives: ::std::vec![#(#prims),*],
                         options: ::std::vec![#(#options),*],
                         learn: #hstl::runtime::LearnParams {
@@ -692,7 +871,6 @@ impl<'a> Gen<'a> {
 /// the evaluator itself runs it.
 struct Body<'g, 'a> {
     g: &'g Gen<'a>,
-    lets: &'g TokenStream,
     /// The statements of the block being written (a closure body opens a new one).
     stmts: Vec<TokenStream>,
     /// The number of `sig<n>` variables so far.
@@ -717,8 +895,8 @@ impl Sig {
 }
 
 impl<'g, 'a> Body<'g, 'a> {
-    fn new(g: &'g Gen<'a>, lets: &'g TokenStream) -> Body<'g, 'a> {
-        Body { g, lets, stmts: Vec::new(), vars: 0, uses_state: false, uses_kernels: false }
+    fn new(g: &'g Gen<'a>) -> Body<'g, 'a> {
+        Body { g, stmts: Vec::new(), vars: 0, uses_state: false, uses_kernels: false }
     }
 
     /// The statements and the final expression of the signal of `f`.
@@ -761,6 +939,7 @@ impl<'g, 'a> Body<'g, 'a> {
                 let h = Literal::usize_unsuffixed(h);
                 Sig::Expr(quote! {
                     #hstl::robustness::kernels::pieces(trace.len(), #h, |steps| {
+                        let __off = steps.start;
                         let trace = &trace[steps];
                         #(#stmts)*
                         #sig
@@ -774,13 +953,11 @@ impl<'g, 'a> Body<'g, 'a> {
     /// alone when `fold` is `None`, else all of `fs` folded from the identity with `min`
     /// (`Some(true)`) or `max`, which drops NaN.
     fn map(&mut self, fs: &[&CFormula], fold: Option<bool>) -> TokenStream {
-        // A state `let` alone: its `at` function.
+        // A `let` alone: its signal, computed once for the whole trace.
         if let ([f], None) = (fs, fold)
             && let CFormulaKind::Let(i) = f.kind
         {
-            let lets = self.lets;
-            let name = &self.g.let_names[i];
-            return quote!(trace.iter().map(#lets::#name::at).collect::<::std::vec::Vec<f64>>());
+            return quote!(__l[#i][__off..__off + trace.len()].to_vec());
         }
         let before = self.uses_state;
         self.uses_state = false;
@@ -794,7 +971,7 @@ impl<'g, 'a> Body<'g, 'a> {
         };
         let arg = if self.uses_state { quote!(s) } else { quote!(_) };
         self.uses_state = before;
-        quote!(trace.iter().map(|#arg| #p).collect::<::std::vec::Vec<f64>>())
+        quote!(trace.iter().enumerate().map(|(__t, #arg)| #p).collect::<::std::vec::Vec<f64>>())
     }
 
     /// [`Body::signal`] of a formula that is not a state formula, without pieces.
@@ -802,11 +979,7 @@ impl<'g, 'a> Body<'g, 'a> {
         let hstl = &self.g.root;
         let kernels = quote!(#hstl::robustness::kernels);
         match &f.kind {
-            CFormulaKind::Let(i) => {
-                let lets = self.lets;
-                let name = &self.g.let_names[*i];
-                Sig::Expr(quote!(#lets::#name::signal_with(trace, k)))
-            }
+            CFormulaKind::Let(i) => Sig::Expr(quote!(__l[#i][__off..__off + trace.len()].to_vec())),
             CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
                 let a = self.signal(a, in_piece);
                 let v = self.var(a);
@@ -895,12 +1068,7 @@ impl<'g, 'a> Body<'g, 'a> {
         match &f.kind {
             CFormulaKind::True => quote!(f64::INFINITY),
             CFormulaKind::False | CFormulaKind::Invalid => quote!(f64::NEG_INFINITY),
-            CFormulaKind::Let(i) => {
-                let lets = self.lets;
-                let name = &self.g.let_names[*i];
-                self.uses_state = true;
-                quote!(#lets::#name::at(s))
-            }
+            CFormulaKind::Let(i) => quote!(__l[#i][__off + __t]),
             CFormulaKind::Cmp(op, a, b) => {
                 self.uses_state |= reads_state(a) || reads_state(b);
                 let (a, b) = (self.operand(a), self.operand(b));
@@ -1004,41 +1172,72 @@ fn interval_data(iv: &Interval, hstl: &TokenStream) -> TokenStream {
     quote!(#hstl::robustness::Interval { start: #start, end: #end })
 }
 
-fn expr_data(e: &CExpr, hstl: &TokenStream) -> TokenStream {
-    let boxed = |a: &CExpr| {
-        let d = expr_data(a, hstl);
-        quote!(::std::boxed::Box::new(#d))
-    };
-    match &e.kind {
-        CExprKind::Const(c) => {
-            let c = lit_f64(*c);
-            quote!(#hstl::robustness::Expr::Const(#c))
-        }
-        CExprKind::Invalid => quote!(#hstl::robustness::Expr::Const(f64::NAN)),
-        CExprKind::Var(i) => quote!(#hstl::robustness::Expr::Var(#i)),
-        CExprKind::Neg(a) | CExprKind::Abs(a) | CExprKind::Sqrt(a) => {
-            let kind = match e.kind {
-                CExprKind::Neg(_) => quote!(Neg),
-                CExprKind::Abs(_) => quote!(Abs),
-                _ => quote!(Sqrt),
-            };
-            let a = boxed(a);
-            quote!(#hstl::robustness::Expr::#kind(#a))
-        }
-        CExprKind::Add(a, b)
-        | CExprKind::Sub(a, b)
-        | CExprKind::Mul(a, b)
-        | CExprKind::Div(a, b) => {
-            let kind = match e.kind {
-                CExprKind::Add(..) => quote!(Add),
-                CExprKind::Sub(..) => quote!(Sub),
-                CExprKind::Mul(..) => quote!(Mul),
-                _ => quote!(Div),
-            };
-            let (a, b) = (boxed(a), boxed(b));
-            quote!(#hstl::robustness::Expr::#kind(#a, #b))
-        }
+/// Statements building formula nodes in generated code, one node each (see
+/// [`Gen::formula_data`]).
+#[derive(Default)]
+struct Data {
+    stmts: Vec<TokenStream>,
+    vars: usize,
+}
+
+impl Data {
+    /// A statement `let __n<k> = node;`; returns `__n<k>`.
+    fn push(&mut self, node: TokenStream) -> Ident {
+        let v = format_ident!("__n{}", self.vars);
+        self.vars += 1;
+        self.stmts.push(quote!(let #v = #node;));
+        v
     }
+
+    fn take(&mut self) -> Vec<TokenStream> {
+        std::mem::take(&mut self.stmts)
+    }
+
+    /// Statements adding expression `e` to `__b`; returns the variable of its node.
+    fn expr(&mut self, e: &CExpr) -> Ident {
+        let node = match &e.kind {
+            CExprKind::Const(c) => {
+                let c = lit_f64(*c);
+                quote!(__b.constant(#c))
+            }
+            CExprKind::Invalid => quote!(__b.constant(f64::NAN)),
+            CExprKind::Var(i) => quote!(__b.var(#i)),
+            CExprKind::Neg(a) | CExprKind::Abs(a) | CExprKind::Sqrt(a) => {
+                let kind = match e.kind {
+                    CExprKind::Neg(_) => quote!(neg),
+                    CExprKind::Abs(_) => quote!(abs),
+                    _ => quote!(sqrt),
+                };
+                let a = self.expr(a);
+                quote!(__b.#kind(#a))
+            }
+            CExprKind::Add(a, b)
+            | CExprKind::Sub(a, b)
+            | CExprKind::Mul(a, b)
+            | CExprKind::Div(a, b) => {
+                let kind = match e.kind {
+                    CExprKind::Add(..) => quote!(add_expr),
+                    CExprKind::Sub(..) => quote!(sub_expr),
+                    CExprKind::Mul(..) => quote!(mul_expr),
+                    _ => quote!(div_expr),
+                };
+                let (a, b) = (self.expr(a), self.expr(b));
+                quote!(__b.#kind(#a, #b))
+            }
+        };
+        self.push(node)
+    }
+}
+
+/// The lets `f` names directly, each once, in order of first use.
+fn let_deps(f: &CFormula) -> Vec<usize> {
+    let (mut out, mut seen) = (Vec::new(), HashSet::new());
+    hstl_lang::visit_lets(f, &mut |i| {
+        if seen.insert(i) {
+            out.push(i);
+        }
+    });
+    out
 }
 
 fn valid_expr(e: &CExpr) -> bool {

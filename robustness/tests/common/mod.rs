@@ -187,11 +187,7 @@ impl Parser {
 
     fn formula(&mut self) -> Formula {
         let lhs = self.or();
-        if self.eat_sym("->") {
-            Formula::Implies(Box::new(lhs), Box::new(self.formula()))
-        } else {
-            lhs
-        }
+        if self.eat_sym("->") { Formula::implies(lhs, self.formula()) } else { lhs }
     }
 
     fn or(&mut self) -> Formula {
@@ -199,7 +195,7 @@ impl Parser {
         while self.eat_sym("||") {
             fs.push(self.and());
         }
-        if fs.len() == 1 { fs.pop().expect("one") } else { Formula::Or(fs) }
+        if fs.len() == 1 { fs.pop().expect("one") } else { Formula::or(fs) }
     }
 
     fn and(&mut self) -> Formula {
@@ -207,7 +203,7 @@ impl Parser {
         while self.eat_sym("&&") {
             fs.push(self.until());
         }
-        if fs.len() == 1 { fs.pop().expect("one") } else { Formula::And(fs) }
+        if fs.len() == 1 { fs.pop().expect("one") } else { Formula::and(fs) }
     }
 
     fn until(&mut self) -> Formula {
@@ -216,7 +212,7 @@ impl Parser {
             self.pos += 1;
             let i = self.interval();
             let rhs = self.unary();
-            Formula::Until(i, Box::new(lhs), Box::new(rhs))
+            Formula::until(i, lhs, rhs)
         } else {
             lhs
         }
@@ -224,17 +220,17 @@ impl Parser {
 
     fn unary(&mut self) -> Formula {
         if self.eat_sym("!") {
-            return Formula::Not(Box::new(self.unary()));
+            return Formula::not(self.unary());
         }
         for kw in ["always", "eventually"] {
             if self.peek_ident(kw) {
                 self.pos += 1;
                 let i = self.interval();
-                let f = Box::new(self.unary());
+                let f = self.unary();
                 return if kw == "always" {
-                    Formula::Always(i, f)
+                    Formula::always(i, f)
                 } else {
-                    Formula::Eventually(i, f)
+                    Formula::eventually(i, f)
                 };
             }
         }
@@ -245,9 +241,9 @@ impl Parser {
         if self.peek_ident("true") || self.peek_ident("false") {
             self.pos += 1;
             return if self.toks[self.pos - 1] == Tok::Ident("true".into()) {
-                Formula::True
+                Formula::bool(true)
             } else {
-                Formula::False
+                Formula::bool(false)
             };
         }
         // A comparison is tried first, as the grammar says.
@@ -267,13 +263,13 @@ impl Parser {
         let mut parts = Vec::new();
         while let Some(op) = self.cmp_op() {
             let rhs = self.try_expr()?;
-            parts.push(Formula::Cmp { lhs: lhs.clone(), op, rhs: rhs.clone() });
+            parts.push(Formula::cmp(lhs.clone(), op, rhs.clone()));
             lhs = rhs;
         }
         match parts.len() {
             0 => None,
             1 => parts.pop(),
-            _ => Some(Formula::And(parts)),
+            _ => Some(Formula::and(parts)),
         }
     }
 
@@ -289,9 +285,9 @@ impl Parser {
         let mut e = self.try_term()?;
         loop {
             if self.eat_sym("+") {
-                e = Expr::Add(Box::new(e), Box::new(self.try_term()?));
+                e = Expr::add(e, self.try_term()?);
             } else if self.eat_sym("-") {
-                e = Expr::Sub(Box::new(e), Box::new(self.try_term()?));
+                e = Expr::sub(e, self.try_term()?);
             } else {
                 return Some(e);
             }
@@ -302,9 +298,9 @@ impl Parser {
         let mut e = self.try_factor()?;
         loop {
             if self.eat_sym("*") {
-                e = Expr::Mul(Box::new(e), Box::new(self.try_factor()?));
+                e = Expr::mul(e, self.try_factor()?);
             } else if self.eat_sym("/") {
-                e = Expr::Div(Box::new(e), Box::new(self.try_factor()?));
+                e = Expr::div(e, self.try_factor()?);
             } else {
                 return Some(e);
             }
@@ -313,7 +309,7 @@ impl Parser {
 
     fn try_factor(&mut self) -> Option<Expr> {
         if self.eat_sym("-") {
-            return Some(Expr::Neg(Box::new(self.try_factor()?)));
+            return Some(Expr::neg(self.try_factor()?));
         }
         if self.eat_sym("(") {
             let e = self.try_expr()?;
@@ -322,16 +318,16 @@ impl Parser {
         match self.toks.get(self.pos).cloned()? {
             Tok::Num(v) => {
                 self.pos += 1;
-                Some(Expr::Const(v))
+                Some(Expr::constant(v))
             }
             Tok::Ident(name) if name == "abs" || name == "sqrt" => {
                 self.pos += 1;
                 if !self.eat_sym("(") {
                     return None;
                 }
-                let e = Box::new(self.try_expr()?);
+                let e = self.try_expr()?;
                 self.eat_sym(")").then_some(())?;
-                Some(if name == "abs" { Expr::Abs(e) } else { Expr::Sqrt(e) })
+                Some(if name == "abs" { Expr::abs(e) } else { Expr::sqrt(e) })
             }
             Tok::Ident(name) => {
                 let i = VARS
@@ -339,7 +335,7 @@ impl Parser {
                     .position(|v| *v == name)
                     .or_else(|| name.strip_prefix('v').and_then(|d| d.parse().ok()))?;
                 self.pos += 1;
-                Some(Expr::Var(i))
+                Some(Expr::var(i))
             }
             Tok::Sym(_) => None,
         }

@@ -9,12 +9,12 @@ use hstl_runtime::{
 
 /// `var op c` for the case study's integer variables (`x` is 0, `y` is 1).
 pub fn cmp(var: usize, op: CmpOp, c: f64) -> Formula {
-    Formula::Cmp { lhs: Expr::Var(var), op, rhs: Expr::Const(c) }
+    Formula::cmp(Expr::var(var), op, Expr::constant(c))
 }
 
 /// `lo < var < hi` for `x` (0) and `y` (1), as the conjunction of its four comparisons.
 pub fn rect(x: (f64, f64), y: (f64, f64)) -> Formula {
-    Formula::And(vec![
+    Formula::and(vec![
         cmp(0, CmpOp::Gt, x.0),
         cmp(0, CmpOp::Lt, x.1),
         cmp(1, CmpOp::Gt, y.0),
@@ -74,18 +74,16 @@ fn permute(rest: &[usize], prefix: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
 pub fn case_study(permutations: bool, entry: bool) -> TaskSpec {
     let regions = regions();
     let window = Interval { start: 0, end: Bound::Exclusive(40) };
-    let task = Formula::Always(
+    let task = Formula::always(
         Interval::ALL,
-        Box::new(Formula::And(
-            regions.iter().map(|(_, f)| Formula::Eventually(window, Box::new(f.clone()))).collect(),
-        )),
+        Formula::and(regions.iter().map(|(_, f)| Formula::eventually(window, f.clone())).collect()),
     );
     let primitives = regions
         .iter()
         .map(|(name, f)| PrimitiveOption {
             name: name.to_string(),
             reach: f.clone(),
-            init: Formula::True,
+            init: Formula::bool(true),
             terminate: if entry { Terminate::Formula(f.clone()) } else { Terminate::Argmax },
         })
         .collect();
@@ -119,7 +117,7 @@ pub fn case_study(permutations: bool, entry: bool) -> TaskSpec {
 pub fn case_study_memory() -> TaskSpec {
     let mut spec = case_study(false, true);
     for p in &mut spec.primitives {
-        p.init = Formula::Not(Box::new(p.reach.clone()));
+        p.init = Formula::not(p.reach.clone());
     }
     spec.options = spec
         .primitives
