@@ -9,9 +9,9 @@ use hstl::runtime::optimum::SolveConfig;
 
 use crate::cli_error::CliError;
 use crate::output::outln;
-use crate::study::{mean, range};
 use crate::world_arg::world_words;
 use crate::{CmdResult, Status, input};
+use hstl::study::Stats;
 
 /// Arguments of `hstlc eval`.
 #[derive(Args, Debug)]
@@ -76,7 +76,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         }
         Evaluation::Window { report } => report,
     };
-    let (lo, hi) = range(&report.per_rollout);
+    let Stats { min: lo, max: hi, .. } = Stats::of(&report.per_rollout);
     outln!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
         report.rate,
@@ -113,8 +113,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
 }
 
 fn print_robustness(values: &[f64]) -> Result<(), CliError> {
-    let mean = mean(values);
-    let (lo, hi) = range(values);
+    let Stats { mean, min: lo, max: hi, .. } = Stats::of(values);
     let satisfied = values.iter().filter(|&&v| v > 0.0).count();
     outln!(
         "  task robustness over each run: mean {mean:.3}, min {lo:.3}, max {hi:.3}; satisfied in {satisfied} of {} runs",
