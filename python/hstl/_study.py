@@ -15,15 +15,14 @@ from . import _hstl
 from ._hstl import Spec, World
 from ._train import _count_of, _seed_of
 
-#: Seeds per Ray task at most. A seed of the case study trains in 0.15-0.4 s; a Ray task
-#: costs about 1-3 ms on a local cluster (submit, schedule, unpickle the spec and world,
-#: check the spec, pickle the figures back; BENCHMARKS.md "Sweeps on Ray") and more across
-#: machines, so a task of a few seeds keeps that cost under 1%. Larger batches would leave
-#: cores idle at the end of a sweep (the last wave of tasks), so batches are only as large
-#: as needed for about ``_TASKS_PER_CPU`` tasks per CPU.
-_MAX_BATCH = 8
-#: Tasks per CPU of the cluster: enough that cores finishing early take more work.
-_TASKS_PER_CPU = 4
+#: What a Ray task costs beside its training, as a share of one seed's training. Measured
+#: (BENCHMARKS.md, "Sweeps on Ray"): on a local cluster an empty task takes about 1 ms and
+#: a task that unpickles the spec and world and checks the spec about 2.4 ms of the
+#: cluster's time (about 5 ms of a core), against 0.15-0.4 s to train a seed of the case
+#: study: about 1-2%. Across machines each task also pays the network, so this takes 2%.
+_TASK_COST = 0.02
+#: Seeds per Ray task at most.
+_MAX_BATCH = 16
 
 
 class StudyResult(list):
@@ -76,8 +75,10 @@ def study(
     regions).
 
     ``backend="local"`` trains on this machine's cores (``num_cpus`` threads, default
-    all), the GIL released. ``backend="ray"`` sends the seeds to Ray as tasks of a few
-    seeds each (``batch``, default: see ``_MAX_BATCH``): it joins the cluster at
+    all), the GIL released. ``backend="ray"`` sends the seeds to Ray as tasks of one or a
+    few seeds each (``batch``; by default chosen from the seeds and the cluster's CPUs so
+    that neither the cost of a task, about 1-2% of a seed's training, nor the cores idle
+    at the end of the sweep add much: one seed a task for 100 seeds on 2 CPUs): it joins the cluster at
     ``address`` (``"auto"`` for one started with ``ray start``), or, without one, starts a
     local cluster of ``num_cpus`` CPUs and shuts it down when done; a Ray already
     initialised in this process is used as it is. Specs and worlds travel pickled; a task
@@ -249,9 +250,13 @@ def _path_of(spec: Spec) -> str:
 
 
 def _batch_size(seeds: int, cpus: int) -> int:
-    """Seeds per Ray task: about ``_TASKS_PER_CPU`` tasks per CPU, at most ``_MAX_BATCH``
-    seeds each."""
-    return max(1, min(_MAX_BATCH, math.ceil(seeds / (max(1, cpus) * _TASKS_PER_CPU))))
+    """Seeds per Ray task: the batch ``b`` that makes the least of what tasks cost
+    (``_TASK_COST / b`` of the sweep) and of the cores left idle at its end (on average
+    half a batch per core: ``b * cpus / (2 * seeds)`` of the sweep), which is
+    ``sqrt(2 * _TASK_COST * seeds / cpus)``: one seed a task for 100 seeds on 2 cores,
+    4 for 1,000, 10 for 10,000 on 4 cores; at most ``_MAX_BATCH``."""
+    best = math.sqrt(2 * _TASK_COST * seeds / max(1, cpus))
+    return max(1, min(_MAX_BATCH, round(best)))
 
 
 def _train_batch(
@@ -293,7 +298,13 @@ def _on_ray(
     started = False
     if not ray.is_initialized():
         if address is None:
-            ray.init(num_cpus=num_cpus, include_dashboard=False, logging_level="warning")
+            # A cluster of this machine alone: its processes talk over the loopback.
+            ray.init(
+                num_cpus=num_cpus,
+                include_dashboard=False,
+                logging_level="warning",
+                _node_ip_address="127.0.0.1",
+            )
         else:
             ray.init(address=address, logging_level="warning")
         started = True
