@@ -270,7 +270,7 @@ class _StudyOut:
         world: World,
         runs: Sequence[Sequence[SeedRun]],
         episodes: Optional[int] = None,
-    ) -> list[str]: ...
+    ) -> list[PathLike[str]]: ...
 
 def _train_chunks(
     spec: Spec,

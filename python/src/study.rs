@@ -224,10 +224,21 @@ impl _StudyOut {
         episodes: Option<usize>,
     ) -> PyResult<Vec<PathBuf>> {
         let Some(dirs) = self.dirs.take() else {
-            return Err(value_error("this study's folder is written already", None));
+            return Err(value_error(
+                "this study's folder is written already",
+                Some("make a new one for another study".into()),
+            ));
         };
         if specs.len() != dirs.len() || runs.len() != dirs.len() {
-            return Err(value_error("one list of runs per spec, please", None));
+            return Err(value_error(
+                format!(
+                    "`specs` and `runs` must hold one entry per folder: {} folders, {} specs, {} lists of runs",
+                    dirs.len(),
+                    specs.len(),
+                    runs.len()
+                ),
+                None,
+            ));
         }
         let labels = facade::labels(&self.paths);
         let world = world.get();
