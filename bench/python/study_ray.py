@@ -3,7 +3,8 @@
 
 Usage: study_ray.py HSTLC [--seeds N] [--cpus N] [--spec FILE] [--tasks N]
 
-- Ray's start-up: ``ray.init(num_cpus=N)`` of a new local cluster, and its shutdown;
+- Ray's start-up: ``ray.init(num_cpus=N)`` of a new local cluster, its first tasks (the
+  workers start and import hstl), and its shutdown;
 - the cost of one Ray task beside a seed's training: a round trip of an empty task, and of
   a task that takes the spec and world from the object store and checks the spec (what
   every batch does before it trains), each the mean over ``--tasks`` tasks;
@@ -52,7 +53,7 @@ def main() -> None:
     print(f"load before: {os.getloadavg()[0]:.2f}")
 
     start = time.perf_counter()
-    ray.init(num_cpus=args.cpus, include_dashboard=False, logging_level="warning")
+    ray.init(num_cpus=args.cpus, include_dashboard=False, logging_level="warning", _node_ip_address="127.0.0.1")
     started = time.perf_counter() - start
     print(f"ray.init(num_cpus={args.cpus}): {started:.2f} s")
 
@@ -61,8 +62,10 @@ def main() -> None:
     noop = ray.remote(num_cpus=1)(_noop)
     check = ray.remote(num_cpus=1)(_check)
     spec_ref, world_ref = ray.put(spec), ray.put(world)
-    # Warm the workers (their first task imports hstl), then time.
+    # Warm the workers (they start on the first tasks and import hstl), then time.
+    t = time.perf_counter()
     ray.get([check.remote(spec_ref, world_ref) for _ in range(4 * args.cpus)])
+    print(f"first {4 * args.cpus} tasks (the workers start): {time.perf_counter() - t:.2f} s")
     for name, f, fargs in (("empty task", noop, ()), ("spec check task", check, (spec_ref, world_ref))):
         t = time.perf_counter()
         ray.get([f.remote(*fargs) for _ in range(args.tasks)])

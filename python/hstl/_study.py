@@ -78,10 +78,10 @@ def study(
     all), the GIL released. ``backend="ray"`` sends the seeds to Ray as tasks of one or a
     few seeds each (``batch``; by default chosen from the seeds and the cluster's CPUs so
     that neither the cost of a task, about 1-2% of a seed's training, nor the cores idle
-    at the end of the sweep add much: one seed a task for 100 seeds on 2 CPUs): it joins the cluster at
-    ``address`` (``"auto"`` for one started with ``ray start``), or, without one, starts a
-    local cluster of ``num_cpus`` CPUs and shuts it down when done; a Ray already
-    initialised in this process is used as it is. Specs and worlds travel pickled; a task
+    at the end of the sweep add much: one seed a task for 100 seeds on 2 CPUs, see
+    ``_batch_size``). It joins the cluster at ``address`` (``"auto"`` for one started with
+    ``ray start``), or, without one, starts a local cluster of ``num_cpus`` CPUs and shuts
+    it down when done; a Ray already initialised in this process is used as it is. Specs and worlds travel pickled; a task
     whose worker dies is retried up to ``max_retries`` times; an error in a task (a spec
     the worker cannot train) is raised here as the exception it was.
 
