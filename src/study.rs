@@ -6,7 +6,7 @@
 //! Library code reads no clock: the caller passes one ([`Clock`]) to time each seed.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use hstl_lang::CheckedSpec;
 use hstl_runtime::eval::RegionTable;
@@ -93,9 +93,11 @@ pub fn run_seed(
     Ok((run, trained))
 }
 
-/// Trains `spec` for each of `seeds` on up to `threads` threads (seed `i` of the list on
-/// thread `i % threads`); results in the order of `seeds`. With `keep`, each run's policy
-/// and agent are kept while the budget allows.
+/// Trains `spec` for each of `seeds` on up to `threads` threads, each thread taking the next
+/// seed not yet taken (seeds differ in length); results in the order of `seeds`. With
+/// `keep`, each run's policy and agent are kept while the budget allows. Once `stop` is
+/// set, no further seed starts and the call fails (the Python package sets it on Ctrl-C).
+#[allow(clippy::too_many_arguments)]
 pub fn run_seeds(
     spec: &TaskSpec,
     env: &GridWorld,
@@ -104,6 +106,7 @@ pub fn run_seeds(
     file: &str,
     clock: Clock<'_>,
     keep: Option<&Keep<'_>>,
+    stop: Option<&AtomicBool>,
 ) -> Result<Vec<(SeedRun, Option<Kept>)>, Problem> {
     let threads = threads.min(seeds.len()).max(1);
     let one = |seed: u64| -> Result<(SeedRun, Option<Kept>), Problem> {
@@ -126,29 +129,33 @@ pub fn run_seeds(
         Ok((run, kept))
     };
     type Done = Vec<(usize, Result<(SeedRun, Option<Kept>), Problem>)>;
-    let share = |w: usize| -> Done {
-        seeds
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| i % threads == w)
-            .map(|(i, &seed)| (i, one(seed)))
-            .collect()
+    let next = AtomicUsize::new(0);
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let work = || -> Done {
+        let mut done = Vec::new();
+        while !stopped() {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&seed) = seeds.get(i) else { break };
+            done.push((i, one(seed)));
+        }
+        done
     };
     let mut all: Done = std::thread::scope(|scope| {
-        let share = &share;
-        let workers: Vec<_> = (0..threads)
-            .map(|w| (w, std::thread::Builder::new().spawn_scoped(scope, move || share(w))))
+        let work = &work;
+        // The calling thread is one of the workers; a thread the system would not start
+        // leaves its seeds to the others.
+        let workers: Vec<_> = (1..threads)
+            .filter_map(|_| std::thread::Builder::new().spawn_scoped(scope, work).ok())
             .collect();
-        let mut all = Vec::new();
-        for (w, worker) in workers {
-            match worker {
-                Ok(handle) => all.extend(handle.join().unwrap_or_default()),
-                // A thread the system would not start: its seeds run here.
-                Err(_) => all.extend(share(w)),
-            }
+        let mut all = work();
+        for worker in workers {
+            all.extend(worker.join().unwrap_or_default());
         }
         all
     });
+    if stopped() {
+        return Err(Problem::new("the study was stopped before every seed was trained", None));
+    }
     if all.len() != seeds.len() {
         return Err(Problem::new("a training thread failed", None));
     }
@@ -511,10 +518,10 @@ mod tests {
     fn threads_do_not_change_a_seed_s_figures() {
         let (_, spec, world) = small();
         let seeds = [4, 0, 7, 1, 2];
-        let one =
-            run_seeds(&spec, &world, &seeds, 1, "small.hstl", &no_clock, None).expect("trains");
-        let three =
-            run_seeds(&spec, &world, &seeds, 3, "small.hstl", &no_clock, None).expect("trains");
+        let one = run_seeds(&spec, &world, &seeds, 1, "small.hstl", &no_clock, None, None)
+            .expect("trains");
+        let three = run_seeds(&spec, &world, &seeds, 3, "small.hstl", &no_clock, None, None)
+            .expect("trains");
         let runs =
             |v: Vec<(SeedRun, Option<Kept>)>| v.into_iter().map(|(r, _)| r).collect::<Vec<_>>();
         let (one, three) = (runs(one), runs(three));
@@ -526,6 +533,15 @@ mod tests {
         assert_eq!(trained.curve, one[2].curve);
         assert_eq!(run.reward, tail_mean(&trained.curve, TAIL));
         assert!(run.window_rate.is_some_and(|w| (0.0..=1.0).contains(&w)));
+    }
+
+    #[test]
+    fn a_study_stopped_trains_no_further_seed() {
+        let (_, spec, world) = small();
+        let stop = AtomicBool::new(true);
+        let e = run_seeds(&spec, &world, &[0, 1], 2, "small.hstl", &no_clock, None, Some(&stop))
+            .expect_err("stopped");
+        assert_eq!(e.message, "the study was stopped before every seed was trained");
     }
 
     #[test]
@@ -571,8 +587,9 @@ mod tests {
         let (loaded, spec, world) = small();
         let budget = AtomicUsize::new(1 << 30);
         let keep = Keep { source: SMALL, budget: &budget };
-        let done = run_seeds(&spec, &world, &[0, 1, 2], 2, "small.hstl", &no_clock, Some(&keep))
-            .expect("trains");
+        let done =
+            run_seeds(&spec, &world, &[0, 1, 2], 2, "small.hstl", &no_clock, Some(&keep), None)
+                .expect("trains");
         let (runs, kept): (Vec<SeedRun>, Vec<Option<Kept>>) = done.into_iter().unzip();
         let m = median(&runs);
         let studied =

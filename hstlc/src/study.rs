@@ -193,7 +193,7 @@ fn run_seeds(
 ) -> Result<(Vec<SeedRun>, Vec<Option<Kept>>), CliError> {
     let start = Instant::now();
     let clock = move || start.elapsed().as_secs_f64();
-    let done = facade::run_seeds(spec, env, seeds, threads, &loaded.file, &clock, keep)?;
+    let done = facade::run_seeds(spec, env, seeds, threads, &loaded.file, &clock, keep, None)?;
     Ok(done.into_iter().unzip())
 }
 

@@ -6,7 +6,9 @@
 
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use std::time::Instant;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
 
 use hstl::lang::budget::MAX_EPISODES;
 use hstl::runtime::TaskSpec;
@@ -19,8 +21,8 @@ use crate::errors::{self, problem_error, value_error, write_error};
 use crate::spec::Spec;
 use crate::world::World;
 
-/// How many seeds `_study_seeds` trains between two checks for Ctrl-C, per thread.
-const SEEDS_PER_CHECK: usize = 4;
+/// How often `_study_seeds` looks for Ctrl-C while seeds train.
+const SIGNAL_EVERY: Duration = Duration::from_millis(100);
 
 /// The spec checked against the world (the diagnostics of `hstlc check --world` as
 /// `hstl.SpecError`), with `episodes` and the `learn` values of `learn` set.
@@ -99,18 +101,54 @@ pub fn _study_seeds<'py>(
     let threads = threads.max(1);
     let start = Instant::now();
     let clock = move || start.elapsed().as_secs_f64();
-    let out = PyList::empty(py);
-    // A few seeds per thread at a time, so that Ctrl-C is seen between them.
-    for group in seeds.chunks(threads * SEEDS_PER_CHECK) {
-        let done = py
-            .detach(|| {
-                facade::run_seeds(&task, &world.world, group, threads, &spec.filename, &clock, None)
-            })
-            .map_err(|p| problem_error(&p))?;
-        for (run, _) in done {
-            out.append(run_dict(py, &run)?)?;
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = mpsc::channel();
+    // The seeds train on threads of their own while this one, holding the GIL only for a
+    // moment every `SIGNAL_EVERY`, watches for Ctrl-C: on it no further seed starts.
+    let done = std::thread::scope(|scope| {
+        let (task, stop, clock) = (&task, &stop, &clock);
+        let trainer = std::thread::Builder::new().spawn_scoped(scope, move || {
+            let done = facade::run_seeds(
+                task,
+                &world.world,
+                &seeds,
+                threads,
+                &spec.filename,
+                clock,
+                None,
+                Some(stop),
+            );
+            let _ = tx.send(done);
+        });
+        if trainer.is_err() {
+            return Err(value_error("cannot start a thread to train on", None));
         }
-        py.check_signals()?;
+        let mut rx = rx;
+        loop {
+            // The receiver goes along and back: it may not be shared with the GIL released.
+            let (back, got) = py.detach(move || {
+                let got = rx.recv_timeout(SIGNAL_EVERY);
+                (rx, got)
+            });
+            rx = back;
+            match got {
+                Ok(done) => return done.map_err(|p| problem_error(&p)),
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(e) = py.check_signals() {
+                        stop.store(true, Ordering::Relaxed);
+                        // The seeds under way end before the scope does.
+                        return Err(e);
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(value_error("a training thread failed", None));
+                }
+            }
+        }
+    })?;
+    let out = PyList::empty(py);
+    for (run, _) in done {
+        out.append(run_dict(py, &run)?)?;
     }
     Ok(out)
 }
