@@ -82,6 +82,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
                     Terminate::Argmax => rt::Terminate::Argmax,
                     Terminate::Formula(f) => rt::Terminate::Formula(lower.formula(f)?),
                 },
+                avoid: match &p.avoid {
+                    Some(f) => Some(lower.formula(f)?),
+                    None => None,
+                },
             })
         })
         .collect::<Option<Vec<_>>>()

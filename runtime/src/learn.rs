@@ -362,7 +362,15 @@ impl<'e, E: Env> Learner<'e, E> {
                     Some(state) => env.index(&env.step(state, a, rng)),
                     None => s,
                 };
-                update_flat(&mut q.flat, &tables.reach, flat, actions, s * actions + a, next);
+                update_flat(
+                    &mut q.flat,
+                    &tables.reach,
+                    &tables.avoided,
+                    flat,
+                    actions,
+                    s * actions + a,
+                    next,
+                );
                 run.states.push(next);
                 if let Some(c) = counters {
                     let (kept, new_code) = c.step(next, tau);
@@ -502,18 +510,21 @@ fn floor_from(level: &LevelParams) -> Option<u64> {
 
 /// The flat update of every primitive after the step from cell `cell` (state times
 /// actions plus action) into state `next`: each table bootstraps from its own best value at
-/// `next`, with reward `rho(reach_p, next)`.
+/// `next`, with reward `rho(reach_p, next)`; a primitive whose avoided region holds `next`
+/// does not bootstrap (its reward there is already the whole value of entering).
 #[inline]
 fn update_flat(
     tables: &mut [Vec<f64>],
     reach: &[Vec<f64>],
+    avoided: &[Option<Vec<bool>>],
     flat: LevelParams,
     actions: usize,
     cell: usize,
     next: usize,
 ) {
-    for (q, reach) in tables.iter_mut().zip(reach) {
-        let best = max_of(&q[next * actions..][..actions]);
+    for ((q, reach), avoided) in tables.iter_mut().zip(reach).zip(avoided) {
+        let ends = avoided.as_ref().is_some_and(|a| a[next]);
+        let best = if ends { 0.0 } else { max_of(&q[next * actions..][..actions]) };
         let cell = &mut q[cell];
         *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
     }
@@ -572,6 +583,7 @@ mod tests {
             reach,
             init: Formula::True,
             terminate,
+            avoid: None,
         };
         TaskSpec {
             name: "Line".into(),
@@ -662,6 +674,7 @@ mod tests {
             reach: reach.clone(),
             init,
             terminate: Terminate::Formula(reach.clone()),
+            avoid: None,
         };
         let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
         spec.task = Formula::Always(Interval::ALL, Box::new(Formula::And(vec![ev(&r1), ev(&r2)])));

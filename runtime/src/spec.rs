@@ -51,6 +51,10 @@ pub struct PrimitiveOption {
     pub init: Formula,
     /// Where it stops.
     pub terminate: Terminate,
+    /// A region the leg must stay out of (`avoid: R`): its flat reward also sees
+    /// `rho(!R, s')`, entering it costs as much as the worst state forever, and the leg
+    /// stops there. `None` (the paper's) leaves the leg alone.
+    pub avoid: Option<Formula>,
 }
 
 /// Where a primitive option terminates.
@@ -233,6 +237,9 @@ impl TaskSpec {
             let mut formulas = vec![("reach", &p.reach), ("init", &p.init)];
             if let Terminate::Formula(f) = &p.terminate {
                 formulas.push(("terminate", f));
+            }
+            if let Some(f) = &p.avoid {
+                formulas.push(("avoid", f));
             }
             for (part, f) in formulas {
                 if !f.is_state_formula() {

@@ -585,12 +585,20 @@ impl<'a> Gen<'a> {
                     quote!(#hstl::runtime::Terminate::Formula(#f))
                 }
             };
+            let avoid = match &p.avoid {
+                Some(f) => {
+                    let f = self.formula_data(f, &lets);
+                    quote!(::core::option::Option::Some(#f))
+                }
+                None => quote!(::core::option::Option::None),
+            };
             quote! {
                 #hstl::runtime::PrimitiveOption {
                     name: ::std::string::String::from(#name),
                     reach: #reach,
                     init: #init,
                     terminate: #terminate,
+                    avoid: #avoid,
                 }
             }
         });
