@@ -58,6 +58,8 @@ struct RunResult {
     steps: u64,
     tail_reward: f64,
     window: Option<f64>,
+    /// For a reach-avoid task: the satisfaction rate and the optimal one.
+    reach_avoid: Option<(f64, f64)>,
     curve: Vec<f64>,
     /// The run's `policy.json` and greedy agent, kept while they fit the budget: the
     /// median seed's are written without training it again.
@@ -113,6 +115,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     let labels = labels(&args.specs);
     // Every spec's (and variant's) curves, for the figure of all of them.
     let mut all_curves: Vec<(String, RewardKind, Vec<Vec<f64>>)> = Vec::new();
+    let mut summary = String::from("spec,measure,optimum,ratio_mean,ratio_min,train_secs_mean\n");
     for (((_, l, spec), label), out) in loaded.iter().zip(&labels).zip(outs) {
         let budget = AtomicUsize::new(KEEP_BUDGET);
         let results = run_seeds(spec, env, args.seeds, threads, l, Some(&budget))?;
@@ -132,6 +135,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             spec.learn.choices
         )?;
         print_table(&results, w_star)?;
+        summary.push_str(&summary_line(label, &results, w_star));
         let reward = mean(&results.iter().map(|r| r.tail_reward).collect::<Vec<_>>());
         // Rewards compare only under the same options-level reward.
         match &baseline {
@@ -177,13 +181,15 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         ));
         all_curves.extend(variant);
     }
-    let files = all_curves_files(&all_curves, args.seeds)?;
+    let mut files = all_curves_files(&all_curves, args.seeds)?;
+    files.push(OutFile::text("summary.csv", summary));
     artifacts::write_beside(&args.out, &files)?;
     outln!()?;
     outln!(
-        "wrote {} and {}: the learning curves of every spec",
+        "wrote {} and {}: the learning curves of every spec; {}: each spec's measure",
         args.out.join("curves.svg").display(),
-        args.out.join("curves.csv").display()
+        args.out.join("curves.csv").display(),
+        args.out.join("summary.csv").display()
     )?;
     Ok(Status::Clean)
 }
@@ -271,7 +277,16 @@ fn csv_field(text: &str) -> String {
 /// of the two middle ones, and the lower seed on a tie.
 fn median(results: &[RunResult]) -> Median {
     let by_window = results.iter().all(|r| r.window.is_some());
-    let key = |r: &RunResult| if by_window { r.window.unwrap_or(f64::NAN) } else { r.tail_reward };
+    let by_reach = !by_window && results.iter().all(|r| r.reach_avoid.is_some());
+    let key = |r: &RunResult| {
+        if by_window {
+            r.window.unwrap_or(f64::NAN)
+        } else if by_reach {
+            r.reach_avoid.map_or(f64::NAN, |p| p.0)
+        } else {
+            r.tail_reward
+        }
+    };
     let mut order: Vec<usize> = (0..results.len()).collect();
     order.sort_by(|&a, &b| key(&results[a]).total_cmp(&key(&results[b])).then(a.cmp(&b)));
     let index = order.get(results.len().saturating_sub(1) / 2).copied().unwrap_or(0);
@@ -283,6 +298,13 @@ fn median(results: &[RunResult]) -> Median {
     } else if by_window {
         format!(
             "seed {}, the median of {} seeds by window rate (W = {:.3})",
+            r.seed,
+            results.len(),
+            key(r)
+        )
+    } else if by_reach {
+        format!(
+            "seed {}, the median of {} seeds by satisfaction rate (P = {:.3})",
             r.seed,
             results.len(),
             key(r)
@@ -346,6 +368,9 @@ fn one_run(
 ) -> Result<RunResult, CliError> {
     let outcome = train::train(spec, env, seed, &loaded.file, |_, _| {})?;
     let window = train::window_report(spec, env, &outcome.agent, seed)?.map(|(rate, _)| rate);
+    let reach_avoid = hstl::train::reach_avoid_summary(spec, env, &outcome.agent, seed)
+        .map_err(|e| CliError::new(e.to_string(), None))?
+        .map(|r| (r.rate, r.optimum));
     let kept = match budget {
         Some(budget) if budget.load(Ordering::Relaxed) > 0 => {
             let json = train::policy_json(&outcome.policy, &loaded.source, seed)?;
@@ -363,6 +388,7 @@ fn one_run(
         steps: outcome.steps,
         tail_reward: tail_mean(&outcome.curve, 100),
         window,
+        reach_avoid,
         curve: outcome.curve,
         kept,
     })
@@ -426,7 +452,32 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) -> Result<(), CliErro
             row(&format!("W/W* (W* = {w:.4})"), windows.iter().map(|x| x / w).collect(), 3)?;
         }
     }
+    let reach: Vec<(f64, f64)> = results.iter().filter_map(|r| r.reach_avoid).collect();
+    if reach.len() == results.len()
+        && let Some(&(_, best)) = reach.first()
+    {
+        row("satisfaction rate P", reach.iter().map(|r| r.0).collect(), 3)?;
+        row(&format!("P/P* (P* = {best:.4})"), reach.iter().map(|r| r.0 / best).collect(), 3)?;
+    }
     Ok(())
+}
+
+/// One spec's line of `summary.csv`: the measure (`W/W*` for a persistent task, `P/P*` for
+/// a reach-avoid task), its mean and minimum over seeds, and the mean training time.
+fn summary_line(label: &str, results: &[RunResult], w_star: Option<f64>) -> String {
+    let secs = mean(&results.iter().map(|r| r.secs).collect::<Vec<_>>());
+    let reach: Vec<(f64, f64)> = results.iter().filter_map(|r| r.reach_avoid).collect();
+    let windows: Vec<f64> = results.iter().filter_map(|r| r.window).collect();
+    let (measure, best, ratios) = if !reach.is_empty() && reach.len() == results.len() {
+        let best = reach[0].1;
+        ("P/P*", best, reach.iter().map(|r| r.0 / best).collect::<Vec<_>>())
+    } else if let Some(w) = w_star.filter(|_| windows.len() == results.len()) {
+        ("W/W*", w, windows.iter().map(|x| x / w).collect())
+    } else {
+        return format!("{},,,,,{secs}\n", csv_field(label));
+    };
+    let (lo, _) = range(&ratios);
+    format!("{},{measure},{best},{},{lo},{secs}\n", csv_field(label), mean(&ratios))
 }
 
 /// The median seed's policy, curve and pictures, the learning curves of all seeds, and
@@ -464,10 +515,15 @@ fn write_outputs(
         None => files
             .extend(artifacts::agent_pictures(spec, env, &regions, &agent, &captions, &mut rng)?),
     }
-    let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
+    let mut seeds =
+        String::from("seed,train_secs,steps,reward_last_100,window_rate,satisfaction_rate\n");
     for r in results {
         let window = r.window.map_or(String::new(), |w| w.to_string());
-        seeds.push_str(&format!("{},{},{},{},{window}\n", r.seed, r.secs, r.steps, r.tail_reward));
+        let sat = r.reach_avoid.map_or(String::new(), |p| p.0.to_string());
+        seeds.push_str(&format!(
+            "{},{},{},{},{window},{sat}\n",
+            r.seed, r.secs, r.steps, r.tail_reward
+        ));
     }
     files.push(OutFile::text("seeds.csv", seeds));
     let curves: Vec<Vec<f64>> = results.iter().map(|r| r.curve.clone()).collect();

@@ -365,7 +365,7 @@ impl<'e, E: Env> Learner<'e, E> {
                 update_flat(
                     &mut q.flat,
                     &tables.reach,
-                    &tables.avoided,
+                    &tables.ends,
                     flat,
                     actions,
                     s * actions + a,
@@ -510,20 +510,20 @@ fn floor_from(level: &LevelParams) -> Option<u64> {
 
 /// The flat update of every primitive after the step from cell `cell` (state times
 /// actions plus action) into state `next`: each table bootstraps from its own best value at
-/// `next`, with reward `rho(reach_p, next)`; a primitive whose avoided region holds `next`
-/// does not bootstrap (its reward there is already the whole value of entering).
+/// `next`, with reward `reach_p[next]`; a primitive whose avoided region holds `next` does
+/// not bootstrap: its reward there is already the whole value of entering.
 #[inline]
 fn update_flat(
     tables: &mut [Vec<f64>],
     reach: &[Vec<f64>],
-    avoided: &[Option<Vec<bool>>],
+    ends: &[Option<Vec<bool>>],
     flat: LevelParams,
     actions: usize,
     cell: usize,
     next: usize,
 ) {
-    for ((q, reach), avoided) in tables.iter_mut().zip(reach).zip(avoided) {
-        let ends = avoided.as_ref().is_some_and(|a| a[next]);
+    for ((q, reach), ends) in tables.iter_mut().zip(reach).zip(ends) {
+        let ends = ends.as_ref().is_some_and(|a| a[next]);
         let best = if ends { 0.0 } else { max_of(&q[next * actions..][..actions]) };
         let cell = &mut q[cell];
         *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);

@@ -19,10 +19,10 @@ pub(crate) struct Tables {
     pub reach: Vec<Vec<f64>>,
     /// `term[p][s]`: primitive `p` stops at `s` (also where it enters its avoided region).
     pub term: Vec<Vec<bool>>,
-    /// `avoided[p][s]`: state `s` lies in primitive `p`'s avoided region (`avoid: R`,
+    /// `ends[p][s]`: state `s` lies in primitive `p`'s avoided region (`avoid: R`,
     /// `rho(R, s) >= 0`, as `always !R` fails there); `None` for a primitive without one.
     /// Entering it ends the flat level's episode: `reach[p][s]` is then the whole value.
-    pub avoided: Vec<Option<Vec<bool>>>,
+    pub ends: Vec<Option<Vec<bool>>>,
     /// `legs[o]`: the primitives option `o` runs, in order.
     pub legs: Vec<Vec<usize>>,
     /// `available[s]`: the options whose first leg may start at `s`, in set order.
@@ -52,7 +52,7 @@ impl Tables {
         // The termination sets of the formulas alone: a leg stopped by its avoided region
         // hands over to the next leg wherever that is (the sequence check is about these).
         let mut planned = Vec::new();
-        let mut avoided = Vec::new();
+        let mut ends = Vec::new();
         let gamma = spec.learn.flat.gamma;
         for p in &spec.primitives {
             let mut r = signal(&p.reach);
@@ -71,7 +71,7 @@ impl Tables {
                 }
             }
             term.push(stops);
-            avoided.push(inside);
+            ends.push(inside);
             init.push(holds(&p.init));
             reach.push(r);
         }
@@ -114,7 +114,17 @@ impl Tables {
                     .collect()
             })
             .collect();
-        Ok(Tables { states, actions, trace, reach, term, avoided, legs, available, remaining })
+        Ok(Tables {
+            states,
+            actions,
+            trace,
+            reach,
+            term,
+            ends,
+            legs,
+            available,
+            remaining,
+        })
     }
 }
 
