@@ -130,6 +130,7 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
             Reward::Segment => rt::RewardKind::Segment,
             Reward::Window => rt::RewardKind::Window,
         },
+        counterfactual: size(l.counterfactual)?,
         flat: level(&l.flat),
         options: level(&l.options),
     };

@@ -57,6 +57,9 @@ pub const MAX_DOMAIN_STATES: u64 = 1_000_000;
 /// formulas and lets evaluated per state).
 pub const MAX_DOMAIN_WORK: u64 = 20_000_000;
 
+/// At most this many counterfactual memory values per option execution.
+pub const MAX_COUNTERFACTUAL: u64 = 1000;
+
 /// The fields an option may have.
 const OPTION_FIELDS: [&str; 4] = ["reach", "init", "terminate", "avoid"];
 
@@ -374,6 +377,7 @@ impl Cx<'_> {
         let filled = self.options(&option_decls, options_item, spec, preset, &mut out);
         if let Some(l) = learn {
             self.learn(l, preset, &mut out);
+            self.counterfactual_needs(l, &out);
         }
         if preset == Preset::Auto {
             let (fields, set) = filled;
@@ -1252,7 +1256,7 @@ impl Cx<'_> {
     }
 
     fn learn(&mut self, l: &syntax::Learn, preset: Preset, out: &mut CheckedSpec) {
-        const TOP: [&str; 9] = [
+        const TOP: [&str; 10] = [
             "preset",
             "episodes",
             "choices",
@@ -1260,6 +1264,7 @@ impl Cx<'_> {
             "memory",
             "intra",
             "reward",
+            "counterfactual",
             "flat",
             "options",
         ];
@@ -1280,6 +1285,22 @@ impl Cx<'_> {
                 // Read before the options (`preset_of`); checked here.
                 "preset" => {
                     self.word(p, &["paper", "auto"]);
+                }
+                "counterfactual" => {
+                    if let Some(v) = self.whole(p, 0) {
+                        if v > MAX_COUNTERFACTUAL {
+                            self.push(
+                                Diagnostic::new(
+                                    "HSTL016",
+                                    value_range(&p.value),
+                                    format!("`counterfactual` must be at most {MAX_COUNTERFACTUAL}, found {v}"),
+                                )
+                                .with_help("a few memory values per option execution are enough, such as `counterfactual: 8`"),
+                            );
+                        } else {
+                            out.learn.counterfactual = v;
+                        }
+                    }
                 }
                 "episodes" | "choices" | "max_steps" | "memory" => {
                     let min = if key == "memory" { 0 } else { 1 };
@@ -1320,6 +1341,29 @@ impl Cx<'_> {
                 }
             }
         }
+    }
+
+    /// HSTL071: counterfactual updates replay the memory's counters and the window reward:
+    /// they need both.
+    fn counterfactual_needs(&mut self, l: &syntax::Learn, out: &CheckedSpec) {
+        let learn = &out.learn;
+        if learn.counterfactual == 0 || (learn.memory > 0 && learn.reward == Reward::Window) {
+            return;
+        }
+        let Some(p) = l.params.iter().find(|p| p.name.name == "counterfactual") else { return };
+        let missing = match (learn.memory > 0, learn.reward == Reward::Window) {
+            (false, false) => "`memory` and `reward: window`",
+            (false, true) => "`memory`",
+            _ => "`reward: window`",
+        };
+        self.push(
+            Diagnostic::new(
+                "HSTL071",
+                p.range.clone(),
+                format!("`counterfactual` needs {missing}"),
+            )
+            .with_help("counterfactual updates replay the memory's counters along each option's run and score it by the window reward: add `memory: 8, reward: window`, or write `learn { preset: auto }` on a persistent task"),
+        );
     }
 
     fn param_name_ok(

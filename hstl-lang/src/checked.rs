@@ -293,6 +293,8 @@ pub struct LearnParams {
     pub intra: Intra,
     /// Options-level reward (`segment`).
     pub reward: Reward,
+    /// Counterfactual memory values per option execution, 0 = off (0).
+    pub counterfactual: u64,
     /// Flat level (gamma 0.9, alpha 0.2, epsilon 0.8, min_epsilon 0.1, decay 1e-6).
     pub flat: QParams,
     /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
@@ -309,6 +311,7 @@ impl Default for LearnParams {
             memory: 0,
             intra: Intra::Paper,
             reward: Reward::Segment,
+            counterfactual: 0,
             flat: QParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 },
             options: QParams {
                 gamma: 0.9,

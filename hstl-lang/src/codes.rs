@@ -376,6 +376,20 @@ Example:\n    let Goal = x > 10;\n    let Hazard = x > 8;\n    option Goal { avo
 Fix: narrow the `avoid` region, or move the option's region out of it.",
     },
     CodeInfo {
+        code: "HSTL071",
+        name: "counterfactual-needs-memory",
+        severity: E,
+        summary: "`counterfactual` without `memory` and `reward: window`",
+        explanation: "`counterfactual: M` makes every option execution also update the options \
+value of M other memory values it could have started with: the memory's counters are run \
+again along the same states from each of them, and the run is scored by the window reward \
+it would have earned. Without `memory` the options level sees no memory values to update, \
+and without `reward: window` the reward does not depend on them.\n\n\
+Example:\n    learn { counterfactual: 8 }\n\n\
+Fix: add `memory: 8, reward: window` (the task must be persistent), or write \
+`learn { preset: auto }`, which sets all three on a persistent task.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,

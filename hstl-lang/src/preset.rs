@@ -15,8 +15,9 @@ use crate::checked::{CFormula, CFormulaKind, CheckedSpec, LearnParams, Terminate
 pub const FLAT_ALPHA: f64 = 0.05;
 /// The options level's discount of the preset (per step, with the window reward).
 pub const OPTIONS_GAMMA: f64 = 0.98;
-/// The options level's step size of the preset.
-pub const OPTIONS_ALPHA: f64 = 0.1;
+/// The options level's step size of the preset: 0.05 kept 0.903 of W* on the case study
+/// over 6 seeds, 0.1 (the hand-tuned variant's) 0.891.
+pub const OPTIONS_ALPHA: f64 = 0.05;
 /// The steps one memory bucket spans, at most.
 pub const BUCKET_STEPS: u64 = 5;
 /// The preset keeps the memory values `(B + 1)^k` at most this many, so that the options

@@ -101,6 +101,11 @@ pub struct LearnParams {
     pub intra: Intra,
     /// How an option execution is rewarded.
     pub reward: RewardKind,
+    /// Counterfactual memory values per option execution (0: off, as in the paper): with
+    /// `memory` and `reward: window`, each execution also updates the options value of this
+    /// many other memory values it could have started with, drawn at random, as
+    /// counterfactual reward machines do.
+    pub counterfactual: usize,
     /// The flat (primitive) level; epsilon decays per primitive step.
     pub flat: LevelParams,
     /// The options level; epsilon decays per option choice.
@@ -157,6 +162,7 @@ impl Default for LearnParams {
             memory: 0,
             intra: Intra::Paper,
             reward: RewardKind::Segment,
+            counterfactual: 0,
             flat: LevelParams::FLAT,
             options: LevelParams::OPTIONS,
         }
@@ -293,6 +299,9 @@ impl TaskSpec {
             if !same {
                 return err("the regions do not match the task's conjuncts".into());
             }
+        }
+        if l.counterfactual > 0 && (l.memory == 0 || l.reward != RewardKind::Window) {
+            return err("counterfactual updates need memory and reward: window".into());
         }
         if (l.memory > 0 || l.reward == RewardKind::Window) && self.regions.is_empty() {
             return err("memory and reward: window need a task of the form always[0..] \

@@ -114,17 +114,7 @@ impl Tables {
                     .collect()
             })
             .collect();
-        Ok(Tables {
-            states,
-            actions,
-            trace,
-            reach,
-            term,
-            ends,
-            legs,
-            available,
-            remaining,
-        })
+        Ok(Tables { states, actions, trace, reach, term, ends, legs, available, remaining })
     }
 }
 

@@ -645,6 +645,7 @@ impl<'a> Gen<'a> {
             Literal::u64_unsuffixed(l.max_steps),
             Literal::u64_unsuffixed(l.memory),
         );
+        let counterfactual = Literal::u64_unsuffixed(l.counterfactual);
         let intra = match l.intra {
             hstl_lang::Intra::Paper => quote!(Paper),
             hstl_lang::Intra::Remaining => quote!(Remaining),
@@ -676,6 +677,7 @@ impl<'a> Gen<'a> {
                             memory: #memory,
                             intra: #hstl::runtime::Intra::#intra,
                             reward: #hstl::runtime::RewardKind::#reward,
+                            counterfactual: #counterfactual,
                             flat: #flat,
                             options: #opts,
                         },
