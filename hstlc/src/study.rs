@@ -457,7 +457,9 @@ fn print_table(results: &[RunResult], w_star: Option<f64>) -> Result<(), CliErro
         && let Some(&(_, best)) = reach.first()
     {
         row("satisfaction rate P", reach.iter().map(|r| r.0).collect(), 3)?;
-        row(&format!("P/P* (P* = {best:.4})"), reach.iter().map(|r| r.0 / best).collect(), 3)?;
+        if best > 0.0 {
+            row(&format!("P/P* (P* = {best:.4})"), reach.iter().map(|r| r.0 / best).collect(), 3)?;
+        }
     }
     Ok(())
 }
@@ -468,14 +470,15 @@ fn summary_line(label: &str, results: &[RunResult], w_star: Option<f64>) -> Stri
     let secs = mean(&results.iter().map(|r| r.secs).collect::<Vec<_>>());
     let reach: Vec<(f64, f64)> = results.iter().filter_map(|r| r.reach_avoid).collect();
     let windows: Vec<f64> = results.iter().filter_map(|r| r.window).collect();
-    let (measure, best, ratios) = if !reach.is_empty() && reach.len() == results.len() {
-        let best = reach[0].1;
-        ("P/P*", best, reach.iter().map(|r| r.0 / best).collect::<Vec<_>>())
-    } else if let Some(w) = w_star.filter(|_| windows.len() == results.len()) {
-        ("W/W*", w, windows.iter().map(|x| x / w).collect())
-    } else {
-        return format!("{},,,,,{secs}\n", csv_field(label));
-    };
+    let (measure, best, ratios) =
+        if !reach.is_empty() && reach.len() == results.len() && reach[0].1 > 0.0 {
+            let best = reach[0].1;
+            ("P/P*", best, reach.iter().map(|r| r.0 / best).collect::<Vec<_>>())
+        } else if let Some(w) = w_star.filter(|_| windows.len() == results.len()) {
+            ("W/W*", w, windows.iter().map(|x| x / w).collect())
+        } else {
+            return format!("{},,,,,{secs}\n", csv_field(label));
+        };
     let (lo, _) = range(&ratios);
     format!("{},{measure},{best},{},{lo},{secs}\n", csv_field(label), mean(&ratios))
 }
