@@ -445,12 +445,27 @@ fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
             out.push_str(&format!(
                 "- reach: `{reach}` (flat reward: its robustness after each step)\n"
             ));
+            // What `preset: auto` filled in, where the option leaves a field out.
+            let prim = checked.and_then(|c| c.primitives.iter().find(|p| p.name == s.name));
+            let filled_init = prim.is_some_and(|p| {
+                matches!(p.init.kind, hstl::lang::CFormulaKind::Not(_)) && field("init").is_none()
+            });
+            let filled_term = prim.is_some_and(|p| {
+                matches!(p.terminate, hstl::lang::Terminate::Formula(_))
+                    && field("terminate").is_none()
+            });
             match field("init") {
                 Some(init) => out.push_str(&format!("- init: `{init}`\n")),
+                None if filled_init => out.push_str(&format!(
+                    "- init: `!{reach}` (from `preset: auto`: not chosen inside its region)\n"
+                )),
                 None => out.push_str("- init: `true` (default: may start anywhere)\n"),
             }
             match field("terminate") {
                 Some(t) if t != "argmax" => out.push_str(&format!("- terminate: `{t}`\n")),
+                None if filled_term => out.push_str(&format!(
+                    "- terminate: `{reach}` (from `preset: auto`: stops on entering its region)\n"
+                )),
                 _ => out.push_str(&format!(
                     "- terminate: `argmax` (where the robustness of `{reach}` is largest over the declared domain)\n"
                 )),

@@ -444,6 +444,8 @@ fn hover_on_preset_shows_its_expansion() {
     let text =
         c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
     assert!(text.contains("- avoid: `Pit`"), "{text}");
+    assert!(text.contains("- terminate: `Goal` (from `preset: auto`"), "{text}");
+    assert!(text.contains("- init: `true` (default"), "{text}");
     // `preset: paper` (the default) says so.
     let paper = PRESET.replace("preset: auto", "preset: paper");
     c.change(2, &paper);
