@@ -37,6 +37,9 @@ pub struct SeedRun {
     pub reward: f64,
     /// The greedy policy's window rate W, for a persistent task.
     pub window_rate: Option<f64>,
+    /// For a reach-avoid task: the greedy policy's satisfaction rate P and the exact
+    /// optimal one P*.
+    pub satisfaction: Option<(f64, f64)>,
     /// Reward per episode, every episode.
     pub curve: Vec<f64>,
 }
@@ -82,12 +85,16 @@ pub fn run_seed(
     let window = crate::train::window_summary(spec, env, &trained.agent, seed)
         .map_err(|e| Problem::new(e.to_string(), None))?
         .map(|s| s.rate);
+    let satisfaction = crate::train::reach_avoid_summary(spec, env, &trained.agent, seed)
+        .map_err(|e| Problem::new(e.to_string(), None))?
+        .map(|r| (r.rate, r.optimum));
     let run = SeedRun {
         seed,
         secs,
         steps: trained.steps,
         reward: tail_mean(&trained.curve, TAIL),
         window_rate: window,
+        satisfaction,
         curve: trained.curve.clone(),
     };
     Ok((run, trained))
@@ -211,6 +218,10 @@ pub struct Summary {
     pub window_rate: Option<Stats>,
     /// W / W*, when every seed has W and the optimum is known.
     pub ratio: Option<Stats>,
+    /// The satisfaction rate P, when every seed has one (a reach-avoid task).
+    pub satisfaction: Option<Stats>,
+    /// P / P* and P*, when every seed has P and P* is above 0.
+    pub satisfaction_ratio: Option<(Stats, f64)>,
 }
 
 /// The figures of `runs`, W/W* against `optimum`.
@@ -218,7 +229,13 @@ pub fn summary(runs: &[SeedRun], optimum: Option<f64>) -> Summary {
     let of = |f: &dyn Fn(&SeedRun) -> f64| Stats::of(&runs.iter().map(f).collect::<Vec<_>>());
     let windows: Vec<f64> = runs.iter().filter_map(|r| r.window_rate).collect();
     let all = windows.len() == runs.len();
+    let reach: Vec<(f64, f64)> = runs.iter().filter_map(|r| r.satisfaction).collect();
+    let all_reach = !runs.is_empty() && reach.len() == runs.len();
+    let best = reach.first().map_or(0.0, |r| r.1);
     Summary {
+        satisfaction: all_reach.then(|| Stats::of(&reach.iter().map(|r| r.0).collect::<Vec<_>>())),
+        satisfaction_ratio: (all_reach && best > 0.0)
+            .then(|| (Stats::of(&reach.iter().map(|r| r.0 / best).collect::<Vec<_>>()), best)),
         seconds: of(&|r| r.secs),
         steps_per_second: of(&|r| r.steps as f64 / r.secs.max(1e-9) / 1e6),
         reward: of(&|r| r.reward),
@@ -265,7 +282,16 @@ pub struct Median {
 /// of the two middle ones, and the earlier run on a tie.
 pub fn median(runs: &[SeedRun]) -> Median {
     let by_window = runs.iter().all(|r| r.window_rate.is_some());
-    let key = |r: &SeedRun| if by_window { r.window_rate.unwrap_or(f64::NAN) } else { r.reward };
+    let by_reach = !by_window && runs.iter().all(|r| r.satisfaction.is_some());
+    let key = |r: &SeedRun| {
+        if by_window {
+            r.window_rate.unwrap_or(f64::NAN)
+        } else if by_reach {
+            r.satisfaction.map_or(f64::NAN, |p| p.0)
+        } else {
+            r.reward
+        }
+    };
     let mut order: Vec<usize> = (0..runs.len()).collect();
     order.sort_by(|&a, &b| key(&runs[a]).total_cmp(&key(&runs[b])).then(a.cmp(&b)));
     let index = order.get(runs.len().saturating_sub(1) / 2).copied().unwrap_or(0);
@@ -277,6 +303,13 @@ pub fn median(runs: &[SeedRun]) -> Median {
     } else if by_window {
         format!(
             "seed {}, the median of {} seeds by window rate (W = {:.3})",
+            r.seed,
+            runs.len(),
+            key(r)
+        )
+    } else if by_reach {
+        format!(
+            "seed {}, the median of {} seeds by satisfaction rate (P = {:.3})",
             r.seed,
             runs.len(),
             key(r)
@@ -356,10 +389,12 @@ pub fn spec_files(
             &mut rng,
         )?);
     }
-    let mut seeds = String::from("seed,train_secs,steps,reward_last_100,window_rate\n");
+    let mut seeds =
+        String::from("seed,train_secs,steps,reward_last_100,window_rate,satisfaction_rate\n");
     for r in runs {
         let window = r.window_rate.map_or(String::new(), |w| w.to_string());
-        seeds.push_str(&format!("{},{},{},{},{window}\n", r.seed, r.secs, r.steps, r.reward));
+        let sat = r.satisfaction.map_or(String::new(), |p| p.0.to_string());
+        seeds.push_str(&format!("{},{},{},{},{window},{sat}\n", r.seed, r.secs, r.steps, r.reward));
     }
     files.push(OutFile::text("seeds.csv", seeds));
     let curves: Vec<Vec<f64>> = runs.iter().map(|r| r.curve.clone()).collect();
@@ -368,6 +403,24 @@ pub fn spec_files(
         &curves,
     )?);
     Ok((files, skipped))
+}
+
+/// The header of a study's `summary.csv`; [`summary_line`] gives its rows.
+pub const SUMMARY_HEADER: &str = "spec,measure,optimum,ratio_mean,ratio_min,train_secs_mean\n";
+
+/// One spec's line of `summary.csv`: the measure (`W/W*` for a persistent task, `P/P*` for
+/// a reach-avoid task), its mean and minimum over seeds, and the mean training time.
+pub fn summary_line(label: &str, runs: &[SeedRun], w_star: Option<f64>) -> String {
+    let s = summary(runs, w_star);
+    let secs = s.seconds.mean;
+    let (measure, best, ratio) = if let Some((ratio, best)) = s.satisfaction_ratio {
+        ("P/P*", best, ratio)
+    } else if let (Some(ratio), Some(w)) = (s.ratio, w_star) {
+        ("W/W*", w, ratio)
+    } else {
+        return format!("{},,,,,{secs}\n", csv_field(label));
+    };
+    format!("{},{measure},{best},{},{},{secs}\n", csv_field(label), ratio.mean, ratio.min)
 }
 
 /// One spec's (or variant's) learning curves in the figure of all of them.
@@ -563,6 +616,7 @@ mod tests {
             steps: 1_000_000,
             reward: seed as f64,
             window_rate: w,
+            satisfaction: None,
             curve: vec![],
         };
         let runs = [run(0, Some(0.4)), run(1, Some(0.8))];

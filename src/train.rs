@@ -360,3 +360,42 @@ mod tests {
         );
     }
 }
+
+/// Runs the reach-avoid measure takes: the satisfaction rate's standard error is at most
+/// 0.016 with this many.
+pub const REACH_AVOID_RUNS: usize = 1000;
+
+/// The satisfaction rate of a greedy agent on a reach-avoid task, and the most any policy
+/// can give it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReachAvoidSummary {
+    /// The share of [`REACH_AVOID_RUNS`] runs, from random starts, that satisfy the task.
+    pub rate: f64,
+    /// The exact optimal probability of satisfying it from a random start (dynamic
+    /// programming on step, state and whether the goal has held).
+    pub optimum: f64,
+    /// The states of each run: `max(T, T_avoid) + 1`, or the [`WindowConfig::default`]
+    /// steps for `always[0..] !R`.
+    pub run_len: usize,
+}
+
+/// [`ReachAvoidSummary`] of the greedy `agent` after training from `seed`, for a task of the
+/// reach-avoid form `eventually[0..T] Goal && always[I] !R ...` on a grid world (`None`
+/// for a task of another form).
+pub fn reach_avoid_summary(
+    spec: &TaskSpec,
+    env: &hstl_runtime::GridWorld,
+    agent: &Agent,
+    seed: u64,
+) -> Result<Option<ReachAvoidSummary>, Error> {
+    use hstl_runtime::optimum::Moves;
+    use hstl_runtime::reach_avoid::{ReachAvoid, solve_reach_avoid};
+    let Some(task) = ReachAvoid::of_spec(spec, env, WindowConfig::default().steps)? else {
+        return Ok(None);
+    };
+    let optimum = solve_reach_avoid(&Moves::of(env), &task, 1 << 26)?;
+    let mut rng = seeded_rng(seed ^ EVAL_SEED);
+    let mut controller = AgentController::new(agent);
+    let rate = task.satisfaction_rate(env, &mut controller, REACH_AVOID_RUNS, &mut rng);
+    Ok(Some(ReachAvoidSummary { rate, optimum: optimum.probability, run_len: task.run_len() }))
+}

@@ -72,6 +72,23 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let report = match evaluate::evaluate(&replay, runs)? {
         Evaluation::Robustness { values, complete } => {
             print_robustness(&values, &complete)?;
+            // A reach-avoid task: how often it is satisfied, against the best possible.
+            let summary = hstl::train::reach_avoid_summary(spec, env, &replay.agent, args.seed)
+                .map_err(|e| CliError::new(e.to_string(), None))?;
+            if let Some(r) = summary {
+                let ratio = if r.optimum > 0.0 {
+                    format!("; P/P* = {:.3}", r.rate / r.optimum)
+                } else {
+                    String::new()
+                };
+                outln!(
+                    "  reach-avoid: satisfied in {:.4} of {} runs of {} states; the optimum P* = {:.4} (dynamic programming){ratio}",
+                    r.rate,
+                    hstl::train::REACH_AVOID_RUNS,
+                    r.run_len,
+                    r.optimum
+                )?;
+            }
             return Ok(Status::Clean);
         }
         Evaluation::Window { report } => report,

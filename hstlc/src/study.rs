@@ -9,6 +9,7 @@ use std::sync::atomic::AtomicUsize;
 use std::time::Instant;
 
 use clap::Args;
+use hstl::artifacts::OutFile;
 use hstl::runtime::{GridWorld, Intra, Region, TaskSpec};
 use hstl::study::{self as facade, CurveSet, Keep, Kept, SeedRun, Stats, StudiedSpec};
 use hstl_outdir::{OutDir, Writer};
@@ -92,6 +93,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     let labels = facade::labels(&args.specs);
     // Every spec's (and variant's) curves, for the figure of all of them.
     let mut all_curves: Vec<CurveSet> = Vec::new();
+    let mut summary = String::from(facade::SUMMARY_HEADER);
     for (((_, l, spec), label), out) in loaded.iter().zip(&labels).zip(outs) {
         let budget = AtomicUsize::new(KEEP_BUDGET);
         let keep = Keep { source: &l.source, budget: &budget };
@@ -112,6 +114,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             spec.learn.choices
         )?;
         print_table(&results, w_star)?;
+        summary.push_str(&facade::summary_line(label, &results, w_star));
         let reward = facade::Stats::of(&results.iter().map(|r| r.reward).collect::<Vec<_>>()).mean;
         // Rewards compare only under the same options-level reward.
         match &baseline {
@@ -171,13 +174,15 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         });
         all_curves.extend(variant);
     }
-    let files = facade::curves_files(&all_curves, seeds.len())?;
+    let mut files = facade::curves_files(&all_curves, seeds.len())?;
+    files.push(OutFile::text("summary.csv", summary));
     hstl_outdir::write_beside(&args.out, &files)?;
     outln!()?;
     outln!(
-        "wrote {} and {}: the learning curves of every spec",
+        "wrote {} and {}: the learning curves of every spec; {}: each spec's measure",
         args.out.join("curves.svg").display(),
-        args.out.join("curves.csv").display()
+        args.out.join("curves.csv").display(),
+        args.out.join("summary.csv").display()
     )?;
     Ok(Status::Clean)
 }
@@ -236,6 +241,12 @@ fn print_table(results: &[SeedRun], w_star: Option<f64>) -> Result<(), CliError>
         row("window rate W", w, 3)?;
         if let (Some(r), Some(w)) = (s.ratio, w_star) {
             row(&format!("W/W* (W* = {w:.4})"), r, 3)?;
+        }
+    }
+    if let Some(p) = s.satisfaction {
+        row("satisfaction rate P", p, 3)?;
+        if let Some((r, best)) = s.satisfaction_ratio {
+            row(&format!("P/P* (P* = {best:.4})"), r, 3)?;
         }
     }
     Ok(())

@@ -157,6 +157,7 @@ fn run_dict<'py>(py: Python<'py>, run: &SeedRun) -> PyResult<Bound<'py, PyDict>>
     let d = PyDict::new(py);
     d.set_item("seed", run.seed)?;
     d.set_item("window_rate", run.window_rate)?;
+    d.set_item("satisfaction", run.satisfaction)?;
     d.set_item("reward", run.reward)?;
     d.set_item("seconds", run.secs)?;
     d.set_item("steps", run.steps)?;
@@ -173,6 +174,7 @@ fn run_of(d: &Bound<'_, PyAny>) -> PyResult<SeedRun> {
         steps: get("steps")?.extract()?,
         reward: get("reward")?.extract()?,
         window_rate: get("window_rate")?.extract()?,
+        satisfaction: get("satisfaction")?.extract()?,
         curve: get("curve")?.extract()?,
     })
 }
