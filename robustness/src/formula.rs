@@ -148,7 +148,7 @@ pub struct Expr {
     root: u32,
 }
 
-/// Builds formulas node by node, sharing equal nodes.
+/// Builds formulas node by node, sharing equal nodes (and dropping double negations).
 ///
 /// Every method adds (or finds) one node and returns its id; [`FormulaBuilder::build`]
 /// then takes the formula under one root. A builder may hold many formulas that share
@@ -260,8 +260,11 @@ impl FormulaBuilder {
         self.f(Node::Cmp { lhs, op, rhs })
     }
 
-    /// `!f`.
+    /// `!f`. Negation is exact, so `!!g` is `g` itself: a chain of `!` is at most one node.
     pub fn not(&mut self, f: NodeId) -> NodeId {
+        if let Some(Node::Not(g)) = self.nodes.get(f.index()) {
+            return *g;
+        }
         self.f(Node::Not(f))
     }
 
@@ -651,6 +654,18 @@ impl Formula {
     /// The horizon of node `id`.
     pub fn horizon_of(&self, id: NodeId) -> Option<usize> {
         self.horizon[id.index()]
+    }
+
+    /// The number of nodes of the formula written out as a tree (a shared node counted at
+    /// each use), saturating at `u64::MAX`: what [`Formula::display_with`] writes is about
+    /// this long. A chain of lets that each use the previous twice doubles it per let.
+    pub fn tree_len(&self) -> u64 {
+        let mut size: Vec<u64> = Vec::with_capacity(self.nodes.len());
+        for node in &self.nodes {
+            let s = node.children().fold(1u64, |acc, k| acc.saturating_add(size[k]));
+            size.push(s);
+        }
+        size[self.root as usize]
     }
 
     /// The largest state-variable index the formula reads, if it reads any.
@@ -1175,20 +1190,30 @@ mod tests {
     }
 
     #[test]
+    fn a_double_negation_is_the_formula_itself() {
+        let f = x_gt(1.0);
+        assert_eq!(Formula::not(Formula::not(f.clone())), f);
+        assert_eq!(Formula::not(Formula::not(Formula::not(f.clone()))), Formula::not(f));
+    }
+
+    #[test]
     fn deep_formulas_display_and_drop_without_recursion() {
         let mut b = FormulaBuilder::new();
         let (x, three) = (b.var(0), b.constant(3.0));
-        let mut f = b.cmp(x, CmpOp::Gt, three);
-        for _ in 0..200_000 {
-            f = b.not(f);
+        let atom = b.cmp(x, CmpOp::Gt, three);
+        let mut f = atom;
+        for _ in 0..100_000 {
+            let g = b.not(f);
+            f = b.or(vec![g, atom]);
         }
         let i = Interval { start: 0, end: Bound::Inclusive(2) };
         f = b.always(i, f);
         let f = b.build(f);
+        assert_eq!(f.len(), 200_004);
         assert_eq!(f.horizon(), Some(2));
         let text = f.to_string();
-        assert!(text.starts_with("always[0..=2] !!!"), "{}", &text[..40]);
-        assert!(text.ends_with("!v0 > 3"));
+        assert!(text.starts_with("always[0..=2] (!(!(!("), "{}", &text[..40]);
+        assert!(text.ends_with("|| v0 > 3)"), "{}", &text[text.len() - 40..]);
         drop(f);
     }
 }

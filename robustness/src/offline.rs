@@ -327,11 +327,6 @@ impl Plan {
         }
         Plan { groups, role, owner, state_reads, temporal_reads, ext_reads }
     }
-
-    /// How node `v` is held during evaluation.
-    pub(crate) fn role(&self, v: usize) -> Role {
-        self.role[v]
-    }
 }
 
 /// Whether node `v` is a comparison of two leaves (`x > 3`).
