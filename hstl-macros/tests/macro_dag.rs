@@ -5,6 +5,7 @@
 use hstl::robustness::{Trace, offline};
 
 hstl::hstl! {
+    /// 24 lets, each the last one twice.
     spec Doubling {
         state { x: int in 0..=14, y: int in 0..=14 }
         let L0 = x > 3 && y < 9;
@@ -33,14 +34,15 @@ hstl::hstl! {
         let L23 = L22 && L22;
         let Soon = eventually[0..=3] L23;
         let Both = Soon && always[0..=2] L23 && Soon;
-        task always[0..=5] L23;
+        task always[0..=5] L23 && Both;
     }
+    /// What the chain equals.
     spec Plain {
         state { x: int in 0..=14, y: int in 0..=14 }
         let L23 = x > 3 && y < 9;
         let Soon = eventually[0..=3] L23;
         let Both = Soon && always[0..=2] L23 && Soon;
-        task always[0..=5] L23;
+        task always[0..=5] L23 && Both;
     }
 }
 

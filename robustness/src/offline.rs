@@ -422,7 +422,7 @@ impl Runner {
 
     /// The signal of `f`'s root over the first `n` steps.
     pub(crate) fn run(&mut self, f: &Formula, src: Source<'_>, n: usize) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         let len = f.len();
         for v in [&mut self.full, &mut self.piece, &mut self.chunk] {
             v.resize_with(len, Vec::new);
@@ -481,7 +481,7 @@ impl Runner {
         m: usize,
         last: bool,
     ) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         for &s in &g.state {
             if plan.role[s] == Role::Piece {
                 self.piece[s] = self.take(m);
@@ -516,7 +516,7 @@ impl Runner {
 
     /// The stored state members of `g` over steps `lo .. lo + m`.
     fn state_phase(&mut self, f: &Formula, g: &Group, src: Source<'_>, lo: usize, m: usize) {
-        let plan = &f.plan;
+        let plan = f.plan();
         let cols = match src {
             Source::Tables { tables, seg } => {
                 for &s in &g.state {
@@ -569,6 +569,7 @@ impl Runner {
     }
 
     /// Operand `c` of state node `s` over chunk `c0 ..` of the piece at `lo`.
+    #[allow(clippy::too_many_arguments)]
     fn src<'a>(
         &'a self,
         f: &'a Formula,
@@ -579,7 +580,7 @@ impl Runner {
         c0: usize,
         len: usize,
     ) -> Src<'a> {
-        let plan = &f.plan;
+        let plan = f.plan();
         match &f.nodes()[c] {
             Node::Var(i) => match cols.get(*i) {
                 Some(col) => Src::Slice(&col[lo + c0..lo + c0 + len]),
@@ -654,7 +655,7 @@ impl Runner {
         for g in gs {
             let g = g.index();
             // `x op c` folds straight in: no pass through a buffer of its own.
-            if f.plan.role[g] == Role::Fused
+            if f.plan().role[g] == Role::Fused
                 && let Node::Cmp { lhs, op, rhs } = &f.nodes()[g]
             {
                 let (a, b) = (src(lhs.index()), src(rhs.index()));
@@ -670,6 +671,7 @@ impl Runner {
 
     /// Operand `c` of temporal node `v` over the piece, as a buffer of its own: the
     /// operand's buffer when this is its last read, else a copy.
+    #[allow(clippy::too_many_arguments)]
     fn own(
         &mut self,
         f: &Formula,
@@ -680,7 +682,7 @@ impl Runner {
         last: bool,
         whole: bool,
     ) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] {
             self.temporal_left[c] -= 1;
             if self.temporal_left[c] == 0 {
@@ -703,13 +705,13 @@ impl Runner {
 
     /// Operand `c` of temporal node `v` over the piece, borrowed.
     fn read(&self, f: &Formula, v: usize, c: usize, lo: usize, m: usize) -> &[f64] {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] { &self.piece[c][..m] } else { &self.full[c][lo..lo + m] }
     }
 
     /// Counts off a [`Runner::read`] of operand `c` by temporal node `v`.
     fn done(&mut self, f: &Formula, v: usize, c: usize, last: bool) {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] {
             self.temporal_left[c] -= 1;
             if self.temporal_left[c] == 0 {
