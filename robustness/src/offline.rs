@@ -1,7 +1,9 @@
 //! The fast offline evaluator: the whole robustness signal, bottom-up, one pass per operator.
 //!
-//! Every operator works on whole columns (one `Vec<f64>` per subformula, taken from a pool
-//! and reused between calls). State subformulas (no temporal operator) are evaluated in
+//! Every operator works on whole columns (one `Vec<f64>` per node of the formula's DAG,
+//! computed once however many parents read it, taken from a pool, given back after its
+//! last reader, and reused between calls); the nodes are walked in order, never
+//! recursively. State subformulas (no temporal operator) are evaluated in
 //! chunks of 512 steps that stay in L1, so `x > 3 && x < 9 && y > 10` writes its output
 //! once. A temporal subformula with a finite horizon `H` is evaluated in pieces of
 //! `max(8192, 16 H)` steps, each with the `H` steps after it, so its buffers stay in L2.
@@ -47,8 +49,10 @@ const MANY: u32 = u32::MAX - 1;
 ///
 /// It walks the formula's nodes bottom-up, one signal per node, so a node shared by
 /// several parents (a `let` used twice) is computed once per step. Nodes are evaluated in
-/// groups (see [`Plan`]): a bounded temporal group in cache-sized pieces, its state
-/// nodes in chunks of 512 steps. A node's buffer goes back to the pool after its last
+/// groups: a bounded temporal subformula with the nodes only it reads, in cache-sized
+/// pieces of `max(8192, 16 H)` steps (each with the `H` steps after it), its state nodes in
+/// chunks of 512 steps; an unbounded operator, or a node read from two groups, over the
+/// whole trace. A node's buffer goes back to the pool after its last
 /// reader has used it, so memory holds the signals still to be read, never one per node
 /// of the formula (a chain of 20,000 `!` holds two).
 #[derive(Clone, Debug, Default)]
