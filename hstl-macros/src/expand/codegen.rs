@@ -132,6 +132,12 @@ impl<'a> Gen<'a> {
             CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
                 self.valid(a) && self.valid(b)
             }
+            // Not generated yet: `expand` reports them as errors.
+            CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => false,
         }
     }
 
@@ -605,6 +611,12 @@ impl<'a> Gen<'a> {
             CFormulaKind::Until(iv, a, b) => {
                 end(iv)?.checked_add(self.horizon(a)?.max(self.horizon(b)?))
             }
+            // Past windows never look forward.
+            CFormulaKind::Once(_, a) | CFormulaKind::Historically(_, a) | CFormulaKind::Prev(a) => {
+                self.horizon(a)
+            }
+            CFormulaKind::Since(_, a, b) => Some(self.horizon(a)?.max(self.horizon(b)?)),
+            CFormulaKind::Next(a) => self.horizon(a)?.checked_add(1),
         }
     }
 
@@ -625,6 +637,10 @@ impl<'a> Gen<'a> {
                 v.iter().map(|g| self.empty_value(g)).fold(f64::NEG_INFINITY, f64::max)
             }
             CFormulaKind::Implies(a, b) => (-self.empty_value(a)).max(self.empty_value(b)),
+            CFormulaKind::Historically(..) | CFormulaKind::Prev(..) | CFormulaKind::Next(..) => {
+                f64::INFINITY
+            }
+            CFormulaKind::Once(..) | CFormulaKind::Since(..) => f64::NEG_INFINITY,
         }
     }
 
@@ -675,6 +691,12 @@ impl<'a> Gen<'a> {
                 let (a, b) = (self.formula_data(a, out), self.formula_data(b, out));
                 quote!(__b.until(#iv, #a, #b))
             }
+            // Not reached: `valid` refuses them, and no invalid formula is generated.
+            CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => quote!(__b.bool(false)),
         };
         out.push(node)
     }
@@ -1059,7 +1081,12 @@ impl<'g, 'a> Body<'g, 'a> {
             CFormulaKind::True
             | CFormulaKind::False
             | CFormulaKind::Cmp(..)
-            | CFormulaKind::Invalid => Sig::Expr(self.map(&[f], None)),
+            | CFormulaKind::Invalid
+            | CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => Sig::Expr(self.map(&[f], None)),
         }
     }
 
@@ -1090,9 +1117,14 @@ impl<'g, 'a> Body<'g, 'a> {
                 quote!((-(#a)).max(#b))
             }
             // Not reached: `point` is only asked for state formulas.
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                quote!(f64::NAN)
-            }
+            CFormulaKind::Always(..)
+            | CFormulaKind::Eventually(..)
+            | CFormulaKind::Until(..)
+            | CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => quote!(f64::NAN),
         }
     }
 

@@ -77,7 +77,8 @@ pub fn warnings(target: &Target, diagnostics: &[Diagnostic]) -> TokenStream {
         .collect()
 }
 
-fn spans(target: &Target, range: std::ops::Range<usize>) -> (Span, Span) {
+/// The first and last span of the tokens over `range`.
+pub fn spans(target: &Target, range: std::ops::Range<usize>) -> (Span, Span) {
     match target {
         Target::Tokens(src) => src.spans(range),
         Target::File { spans, .. } => *spans,
