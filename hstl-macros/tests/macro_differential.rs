@@ -113,6 +113,11 @@ fn lower(spec: &CheckedSpec, f: &CFormula) -> Formula {
         CFormulaKind::Always(i, a) => Formula::always(iv(i), b(a)),
         CFormulaKind::Eventually(i, a) => Formula::eventually(iv(i), b(a)),
         CFormulaKind::Until(i, x, y) => Formula::until(iv(i), b(x), b(y)),
+        CFormulaKind::Once(..)
+        | CFormulaKind::Historically(..)
+        | CFormulaKind::Since(..)
+        | CFormulaKind::Prev(..)
+        | CFormulaKind::Next(..) => panic!("the macro does not generate past-time operators yet"),
         CFormulaKind::Invalid => panic!("the differential spec checks"),
     }
 }
