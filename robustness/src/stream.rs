@@ -526,6 +526,10 @@ impl Until {
     /// trace, once every operand value has been taken: the offline kernel over the values
     /// still held, which start at the first step without a value.
     fn finish(&mut self) -> Vec<f64> {
+        if self.last.is_none() {
+            // An empty window keeps no values: `-inf` at every step still open.
+            return vec![NEG_INF; self.seen.min(self.end)];
+        }
         let mut lhs: Vec<f64> = self.fv.drain(..).collect();
         let mut out: Vec<f64> = self.gv.drain(..).collect();
         crate::kernels::Kernels::new().until(&self.interval, &mut lhs, &mut out);
