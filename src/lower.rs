@@ -34,13 +34,6 @@ pub enum LowerError {
         /// The lets the spec has, in declaration order.
         known: Vec<String>,
     },
-    /// The formula uses an operator that the monitors do not run yet.
-    Unsupported {
-        /// The spec's name.
-        spec: String,
-        /// The operator's keyword, such as `once`.
-        operator: &'static str,
-    },
 }
 
 impl fmt::Display for LowerError {
@@ -57,10 +50,6 @@ impl fmt::Display for LowerError {
                 "spec `{spec}` has no `let` named `{name}`; its lets are {}",
                 known.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
             ),
-            LowerError::Unsupported { spec, operator } => write!(
-                f,
-                "spec `{spec}` uses `{operator}`, a past-time operator that the monitors do not run yet"
-            ),
         }
     }
 }
@@ -73,7 +62,7 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
     let invalid = || LowerError::Invalid { spec: spec.name.clone() };
     let task = spec.task.as_ref().ok_or_else(invalid)?;
     let mut lower = Lowerer::new(spec);
-    let task = lower.formula(&task.formula).ok_or_else(|| lower.error())?;
+    let task = lower.formula(&task.formula).ok_or_else(invalid)?;
     let state_vars = spec
         .state_vars
         .iter()
@@ -157,9 +146,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
 
 /// The task's formula.
 pub fn task(spec: &CheckedSpec) -> Result<rob::Formula, LowerError> {
-    let t = spec.task.as_ref().ok_or_else(|| LowerError::Invalid { spec: spec.name.clone() })?;
-    let mut lower = Lowerer::new(spec);
-    lower.formula(&t.formula).ok_or_else(|| lower.error())
+    spec.task
+        .as_ref()
+        .and_then(|t| Lowerer::new(spec).formula(&t.formula))
+        .ok_or_else(|| LowerError::Invalid { spec: spec.name.clone() })
 }
 
 /// The formula of the `let` called `name`.
@@ -171,8 +161,9 @@ pub fn let_formula(spec: &CheckedSpec, name: &str) -> Result<rob::Formula, Lower
             known: spec.lets.iter().map(|l| l.name.clone()).collect(),
         });
     };
-    let mut lower = Lowerer::new(spec);
-    lower.formula(&l.formula).ok_or_else(|| lower.error())
+    Lowerer::new(spec)
+        .formula(&l.formula)
+        .ok_or_else(|| LowerError::Invalid { spec: spec.name.clone() })
 }
 
 /// Any checked formula of `spec`; `None` when part of it did not check.
@@ -242,29 +233,12 @@ struct Lowerer<'a> {
     lets: Vec<Option<rob::NodeId>>,
     /// Whether each let was tried.
     tried: Vec<bool>,
-    /// The first operator met that the monitors do not run.
-    unsupported: Option<&'static str>,
 }
 
 impl<'a> Lowerer<'a> {
     fn new(spec: &'a CheckedSpec) -> Lowerer<'a> {
         let n = spec.lets.len();
-        Lowerer {
-            spec,
-            b: rob::FormulaBuilder::new(),
-            lets: vec![None; n],
-            tried: vec![false; n],
-            unsupported: None,
-        }
-    }
-
-    /// Why a formula did not lower.
-    fn error(&self) -> LowerError {
-        let spec = self.spec.name.clone();
-        match self.unsupported {
-            Some(operator) => LowerError::Unsupported { spec, operator },
-            None => LowerError::Invalid { spec },
-        }
+        Lowerer { spec, b: rob::FormulaBuilder::new(), lets: vec![None; n], tried: vec![false; n] }
     }
 
     /// `f` as the runtime's formula; `None` when part of it (or of a let it uses) did not
@@ -344,17 +318,27 @@ impl<'a> Lowerer<'a> {
                 let (x, y) = (b(self, x)?, b(self, y)?);
                 self.b.until(interval(iv), x, y)
             }
-            CFormulaKind::Once(..) => return self.refuse("once"),
-            CFormulaKind::Historically(..) => return self.refuse("historically"),
-            CFormulaKind::Since(..) => return self.refuse("since"),
-            CFormulaKind::Prev(..) => return self.refuse("prev"),
-            CFormulaKind::Next(..) => return self.refuse("next"),
+            CFormulaKind::Once(iv, a) => {
+                let a = b(self, a)?;
+                self.b.once(interval(iv), a)
+            }
+            CFormulaKind::Historically(iv, a) => {
+                let a = b(self, a)?;
+                self.b.historically(interval(iv), a)
+            }
+            CFormulaKind::Since(iv, x, y) => {
+                let (x, y) = (b(self, x)?, b(self, y)?);
+                self.b.since(interval(iv), x, y)
+            }
+            CFormulaKind::Prev(a) => {
+                let a = b(self, a)?;
+                self.b.prev(a)
+            }
+            CFormulaKind::Next(a) => {
+                let a = b(self, a)?;
+                self.b.next(a)
+            }
             CFormulaKind::Invalid => return None,
         })
-    }
-
-    fn refuse(&mut self, operator: &'static str) -> Option<rob::NodeId> {
-        self.unsupported.get_or_insert(operator);
-        None
     }
 }

@@ -113,8 +113,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             hstl::lower::LowerError::UnknownLet { .. } => {
                 Some("leave out `--formula` to score the task".to_string())
             }
-            hstl::lower::LowerError::Invalid { .. }
-            | hstl::lower::LowerError::Unsupported { .. } => None,
+            hstl::lower::LowerError::Invalid { .. } => None,
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;

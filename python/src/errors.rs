@@ -75,7 +75,7 @@ pub fn batch_error(py: Python<'_>, e: &BatchError) -> PyErr {
 pub fn lower_error(file: &str, e: &LowerError) -> PyErr {
     let help = match e {
         LowerError::UnknownLet { .. } => Some("leave out `formula` to score the task".to_string()),
-        LowerError::Invalid { .. } | LowerError::Unsupported { .. } => None,
+        LowerError::Invalid { .. } => None,
     };
     value_error(format!("{file}: {e}"), help)
 }
