@@ -107,53 +107,9 @@ fn emit(
         out.extend(codegen::spec_module(spec, text, complete, root));
     }
     out.extend(report::warnings(target, &checked.diagnostics));
-    for spec in &checked.specs {
-        for (range, operator) in past_operators(spec) {
-            let (first, last) = report::spans(target, range);
-            let message = format!(
-                "`{operator}` is a past-time operator that the macro's monitors do not run yet"
-            );
-            out.extend(report::spanned_error(first, last, &message).to_compile_error());
-        }
-    }
     if let Some(e) = report::errors(target, &checked.diagnostics) {
         // `compile_error! { ... }` with braces: valid in item position without a `;`.
         out.extend(e.to_compile_error());
-    }
-    out
-}
-
-/// Every past-time operator in a spec's lets and task, with its keyword: the macro does not
-/// generate monitors for them yet. The walk keeps its own stack.
-fn past_operators(spec: &hstl_lang::CheckedSpec) -> Vec<(std::ops::Range<usize>, &'static str)> {
-    use hstl_lang::CFormulaKind as K;
-    let mut stack: Vec<&hstl_lang::CFormula> = spec.lets.iter().map(|l| &l.formula).collect();
-    stack.extend(spec.task.iter().map(|t| &t.formula));
-    let mut out = Vec::new();
-    while let Some(f) = stack.pop() {
-        let word = match &f.kind {
-            K::Once(..) => Some("once"),
-            K::Historically(..) => Some("historically"),
-            K::Since(..) => Some("since"),
-            K::Prev(..) => Some("prev"),
-            K::Next(..) => Some("next"),
-            _ => None,
-        };
-        if let Some(word) = word {
-            out.push((f.range.clone(), word));
-        }
-        match &f.kind {
-            K::Not(a)
-            | K::Always(_, a)
-            | K::Eventually(_, a)
-            | K::Once(_, a)
-            | K::Historically(_, a)
-            | K::Prev(a)
-            | K::Next(a) => stack.push(a),
-            K::And(v) | K::Or(v) => stack.extend(v),
-            K::Implies(a, b) | K::Until(_, a, b) | K::Since(_, a, b) => stack.extend([&**a, &**b]),
-            K::True | K::False | K::Let(_) | K::Cmp(..) | K::Invalid => {}
-        }
     }
     out
 }

@@ -77,8 +77,7 @@ pub fn warnings(target: &Target, diagnostics: &[Diagnostic]) -> TokenStream {
         .collect()
 }
 
-/// The first and last span of the tokens over `range`.
-pub fn spans(target: &Target, range: std::ops::Range<usize>) -> (Span, Span) {
+fn spans(target: &Target, range: std::ops::Range<usize>) -> (Span, Span) {
     match target {
         Target::Tokens(src) => src.spans(range),
         Target::File { spans, .. } => *spans,
