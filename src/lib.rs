@@ -11,7 +11,10 @@
 //! command line takes); [`world`] reads grid worlds and checks specs against them,
 //! [`train`] trains a spec as `hstlc train` does, [`evaluate`] replays a `policy.json`
 //! as `hstlc eval` does, and [`reward`] scores an episode state by state (the Python
-//! package's `STLReward`). Every front end words what it refuses with a [`Problem`].
+//! package's `STLReward`); [`study`] trains specs over many seeds and compares them (what
+//! `hstlc study` and `hstl.study` report), and [`artifacts`] makes the files of a trained
+//! agent's output folder as plain data. Every front end words what it refuses with a
+//! [`Problem`].
 //!
 //! ```
 //! let src = "spec S { state { x: int in 0..=9 } let Goal = x > 6; task eventually[0..5] Goal;
@@ -22,12 +25,14 @@
 //! assert_eq!(spec.primitives[0].name, "Goal");
 //! ```
 
+pub mod artifacts;
 pub mod evaluate;
 pub mod load;
 pub mod lower;
 pub mod monitor;
 mod problem;
 pub mod reward;
+pub mod study;
 pub mod train;
 pub mod world;
 

@@ -86,6 +86,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
                     Terminate::Argmax => rt::Terminate::Argmax,
                     Terminate::Formula(f) => rt::Terminate::Formula(lower.formula(f)?),
                 },
+                avoid: match &p.avoid {
+                    Some(f) => Some(lower.formula(f)?),
+                    None => None,
+                },
             })
         })
         .collect::<Option<Vec<_>>>()
@@ -130,6 +134,7 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
             Reward::Segment => rt::RewardKind::Segment,
             Reward::Window => rt::RewardKind::Window,
         },
+        counterfactual: size(l.counterfactual)?,
         flat: level(&l.flat),
         options: level(&l.options),
     };

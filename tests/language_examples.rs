@@ -1,6 +1,7 @@
-//! Every spec in docs/LANGUAGE.md, README.md and examples/specs checks without errors, as
-//! `hstlc check` would report them (warnings allowed, exit status 0): against the world its
-//! doc comment names (`--world NAME|FILE.toml`), or the default `paper`.
+//! Every spec in docs/LANGUAGE.md, README.md, examples/specs and examples/suite checks
+//! without errors, as `hstlc check` would report them (warnings allowed, exit status 0):
+//! against the world its doc comment names (`--world NAME|FILE.toml`, or the suite's
+//! ``World: `NAME|FILE.toml` ``), or the default `paper`.
 
 use std::path::Path;
 
@@ -9,11 +10,11 @@ use hstl::world::GridWorld;
 /// The world a spec's text names with `--world`, as `hstlc` resolves it (paths are relative
 /// to the package root).
 fn world_of(src: &str) -> (GridWorld, String) {
-    let Some(arg) = src.split("--world").nth(1).and_then(|rest| rest.split_whitespace().next())
-    else {
+    let named = src.split("--world").nth(1).or_else(|| src.split("World: ").nth(1));
+    let Some(arg) = named.and_then(|rest| rest.split_whitespace().next()) else {
         return (GridWorld::default(), "world `paper`".into());
     };
-    let arg = arg.trim_end_matches(['`', ')', '.', ',']);
+    let arg = arg.trim_start_matches('`').trim_end_matches(['`', ')', '.', ',']);
     if let Some(world) = GridWorld::builtin(arg) {
         return (world, format!("world `{arg}`"));
     }
@@ -67,6 +68,32 @@ fn every_spec_in_the_language_document_and_the_readme_checks() {
             assert_checks(&format!("{doc} spec block {}", i + 1), block);
         }
     }
+}
+
+/// The suite's tasks check against their worlds with no diagnostic at all: in particular no
+/// `HSTL170`, since the preset gives every option the task's avoided regions.
+#[test]
+fn every_suite_task_checks_cleanly_against_its_world() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/suite");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).expect("examples/suite") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "hstl") {
+            let src = std::fs::read_to_string(&path).expect("readable");
+            let (world, label) = world_of(&src);
+            assert!(src.contains("World: "), "{} names no world", path.display());
+            let checked = hstl::world::check(&src, &world, &label);
+            assert!(
+                checked.diagnostics.is_empty(),
+                "{}:\n{}",
+                path.display(),
+                hstl::lang::render_plain(&src, "suite", &checked.diagnostics)
+            );
+            assert!(checked.specs.iter().all(|s| s.preset_expansion.is_some()));
+            n += 1;
+        }
+    }
+    assert!(n >= 8, "only {n} suite tasks");
 }
 
 #[test]

@@ -17,6 +17,12 @@ mod entry {
 mod assembly {
     hstl::hstl! { include "examples/specs/assembly.hstl" }
 }
+mod auto {
+    hstl::hstl! { include "examples/specs/surveillance_auto.hstl" }
+}
+mod reach_avoid {
+    hstl::hstl! { include "examples/suite/field_reach_avoid.hstl" }
+}
 
 fn lowered(path: &str) -> TaskSpec {
     let full = format!("{}/{path}", env!("CARGO_MANIFEST_DIR"));
@@ -32,11 +38,21 @@ fn lowered(path: &str) -> TaskSpec {
 
 #[test]
 fn macro_and_lowering_build_the_same_task_spec() {
-    let cases: [(&str, TaskSpec); 4] = [
+    // The preset expands in the checker, so both paths see what it filled in (the entry
+    // form, one option per region, memory, `avoid`).
+    let cases: [(&str, TaskSpec); 6] = [
         ("examples/specs/surveillance_ot1.hstl", ot1::surveillance::Surveillance.task_spec()),
         ("examples/specs/surveillance_ot2.hstl", ot2::surveillance::Surveillance.task_spec()),
         ("examples/specs/surveillance_entry.hstl", entry::surveillance::Surveillance.task_spec()),
         ("examples/specs/assembly.hstl", assembly::assembly::Assembly.task_spec()),
+        (
+            "examples/specs/surveillance_auto.hstl",
+            auto::surveillance_auto::SurveillanceAuto.task_spec(),
+        ),
+        (
+            "examples/suite/field_reach_avoid.hstl",
+            reach_avoid::field_reach_avoid::FieldReachAvoid.task_spec(),
+        ),
     ];
     for (path, from_macro) in cases {
         assert_eq!(lowered(path), from_macro, "{path}");

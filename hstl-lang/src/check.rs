@@ -57,8 +57,11 @@ pub const MAX_DOMAIN_STATES: u64 = 1_000_000;
 /// formulas and lets evaluated per state).
 pub const MAX_DOMAIN_WORK: u64 = 20_000_000;
 
+/// At most this many counterfactual memory values per option execution.
+pub const MAX_COUNTERFACTUAL: u64 = 1000;
+
 /// The fields an option may have.
-const OPTION_FIELDS: [&str; 3] = ["reach", "init", "terminate"];
+const OPTION_FIELDS: [&str; 4] = ["reach", "init", "terminate", "avoid"];
 
 /// The expanded options set may hold at most this many options.
 pub const MAX_OPTIONS: u64 = 10_000;
@@ -304,6 +307,7 @@ impl Cx<'_> {
             primitives: Vec::new(),
             options: Vec::new(),
             learn: LearnParams::default(),
+            preset_expansion: None,
         };
         // Once-only items.
         let mut firsts: HashMap<&'static str, Range<usize>> = HashMap::new();
@@ -370,10 +374,17 @@ impl Cx<'_> {
                 );
             }
         }
-        self.options(&option_decls, options_item, spec, &mut out);
+        let preset = learn.map_or(Preset::Paper, preset_of);
+        let filled = self.options(&option_decls, options_item, spec, preset, &mut out);
         if let Some(l) = learn {
-            self.learn(l, &mut out);
+            self.learn(l, preset, &mut out);
+            self.counterfactual_needs(l, &out);
         }
+        if preset == Preset::Auto {
+            let (fields, set) = filled;
+            out.preset_expansion = Some(crate::preset::expansion(&out, self.src, &fields, set));
+        }
+        self.safety_unseen(&out);
         self.persistent_needs(learn, &out);
         if let Some(l) = learn {
             self.diags.extend(crate::budget::learning(self.src, l, &out));
@@ -939,13 +950,25 @@ impl Cx<'_> {
         }
     }
 
+    /// Checks the options and builds the set; with `preset: auto`, fills in what the preset
+    /// gives. Returns which of `init`, `terminate` and `avoid` it filled in per primitive, and
+    /// whether it chose the options set.
     fn options(
         &mut self,
         decls: &[&syntax::OptionDecl],
         item: Option<&syntax::OptionsItem>,
         spec: &syntax::Spec,
+        preset: Preset,
         out: &mut CheckedSpec,
-    ) {
+    ) -> (Vec<[bool; 3]>, bool) {
+        let auto = preset == Preset::Auto;
+        let persistent = auto && out.persistent_conjuncts(self.src).is_some();
+        let auto_avoid = if auto {
+            crate::preset::avoid_formula(&crate::preset::safety_conjuncts(out))
+        } else {
+            None
+        };
+        let mut filled: Vec<[bool; 3]> = Vec::new();
         let mut by_name: HashMap<String, (usize, Range<usize>)> = HashMap::new();
         for o in decls {
             if let Some((_, first)) = by_name.get(&o.name.name) {
@@ -964,6 +987,7 @@ impl Cx<'_> {
             let mut reach = None;
             let mut init = None;
             let mut terminate = None;
+            let mut avoid = None;
             let mut seen: HashMap<String, Range<usize>> = HashMap::new();
             for f in o.fields.iter().flatten() {
                 let key = f.name.name.as_str();
@@ -975,7 +999,9 @@ impl Cx<'_> {
                     );
                     d = match closest(key, OPTION_FIELDS.into_iter(), &mut u64::MAX.clone()) {
                         Some(c) => d.with_help(format!("did you mean `{c}`?")),
-                        None => d.with_help("an option has `reach`, `init` and `terminate`"),
+                        None => {
+                            d.with_help("an option has `reach`, `init`, `terminate` and `avoid`")
+                        }
                     };
                     self.push(d);
                     continue;
@@ -1015,6 +1041,7 @@ impl Cx<'_> {
                 match key {
                     "reach" => reach = Some(value),
                     "init" => init = Some(value),
+                    "avoid" => avoid = Some(value),
                     _ => terminate = Some(Terminate::Formula(value)),
                 }
             }
@@ -1066,12 +1093,34 @@ impl Cx<'_> {
                 }
             };
             by_name.insert(o.name.name.clone(), (out.primitives.len(), o.name.range.clone()));
+            // The preset fills in only what was not written: the entry form (`init: !R` on a
+            // persistent task, `terminate: R`) and the task's avoided regions.
+            let valid = !matches!(reach.kind, CFormulaKind::Invalid);
+            let fill = [
+                persistent && valid && init.is_none(),
+                auto && valid && terminate.is_none(),
+                avoid.is_none() && auto_avoid.is_some(),
+            ];
+            filled.push(fill);
+            if fill[0] {
+                init = Some(CFormula {
+                    kind: CFormulaKind::Not(Box::new(reach.clone())),
+                    range: reach.range.clone(),
+                });
+            }
+            if fill[1] {
+                terminate = Some(Terminate::Formula(reach.clone()));
+            }
+            if fill[2] {
+                avoid = auto_avoid.clone();
+            }
             out.primitives.push(PrimitiveOption {
                 name: o.name.name.clone(),
                 reach,
                 init: init
                     .unwrap_or(CFormula { kind: CFormulaKind::True, range: o.name.range.clone() }),
                 terminate: terminate.unwrap_or(Terminate::Argmax),
+                avoid,
                 doc: doc_text(&o.doc),
                 name_range: o.name.range.clone(),
                 range: o.range.clone(),
@@ -1152,6 +1201,7 @@ impl Cx<'_> {
             ok.then_some(seq)
         };
         let mut set: Vec<CombinedOption> = Vec::new();
+        let mut set_filled = false;
         let make = |seq: Vec<usize>, range: Range<usize>| CombinedOption {
             name: seq.iter().map(|&i| names[i].as_str()).collect(),
             sequence: seq,
@@ -1174,6 +1224,14 @@ impl Cx<'_> {
                     for seq in expand(&base, perm) {
                         set.push(make(seq, r.clone()));
                     }
+                }
+            }
+            None if persistent => {
+                // One option per region: with memory the options policy chains them.
+                let r = decls.first().map_or(spec.name.range.clone(), |d| d.name.range.clone());
+                set_filled = true;
+                for i in 0..out.primitives.len() {
+                    set.push(make(vec![i], r.clone()));
                 }
             }
             None => {
@@ -1199,6 +1257,7 @@ impl Cx<'_> {
             seen.insert(o.name.clone(), o.range.clone());
             out.options.push(o);
         }
+        (filled, set_filled)
     }
 
     fn set_size_ok(&mut self, n: usize, perm: bool, range: Range<usize>) -> bool {
@@ -1222,9 +1281,26 @@ impl Cx<'_> {
         true
     }
 
-    fn learn(&mut self, l: &syntax::Learn, out: &mut CheckedSpec) {
-        const TOP: [&str; 8] =
-            ["episodes", "choices", "max_steps", "memory", "intra", "reward", "flat", "options"];
+    fn learn(&mut self, l: &syntax::Learn, preset: Preset, out: &mut CheckedSpec) {
+        const TOP: [&str; 10] = [
+            "preset",
+            "episodes",
+            "choices",
+            "max_steps",
+            "memory",
+            "intra",
+            "reward",
+            "counterfactual",
+            "flat",
+            "options",
+        ];
+        if preset == Preset::Auto {
+            // The preset first: every value written beside it overrides it.
+            let horizons: Option<Vec<u64>> =
+                out.persistent_conjuncts(self.src).map(|cs| cs.iter().map(|c| c.steps).collect());
+            out.learn.preset = Preset::Auto;
+            crate::preset::learn(horizons.as_deref(), &mut out.learn);
+        }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();
         for p in &l.params {
             let key = p.name.name.as_str();
@@ -1232,6 +1308,26 @@ impl Cx<'_> {
                 continue;
             }
             match key {
+                // Read before the options (`preset_of`); checked here.
+                "preset" => {
+                    self.word(p, &["paper", "auto"]);
+                }
+                "counterfactual" => {
+                    if let Some(v) = self.whole(p, 0) {
+                        if v > MAX_COUNTERFACTUAL {
+                            self.push(
+                                Diagnostic::new(
+                                    "HSTL016",
+                                    value_range(&p.value),
+                                    format!("`counterfactual` must be at most {MAX_COUNTERFACTUAL}, found {v}"),
+                                )
+                                .with_help("a few memory values per option execution are enough, such as `counterfactual: 8`"),
+                            );
+                        } else {
+                            out.learn.counterfactual = v;
+                        }
+                    }
+                }
                 "episodes" | "choices" | "max_steps" | "memory" => {
                     let min = if key == "memory" { 0 } else { 1 };
                     if let Some(v) = self.whole(p, min) {
@@ -1271,6 +1367,29 @@ impl Cx<'_> {
                 }
             }
         }
+    }
+
+    /// HSTL071: counterfactual updates replay the memory's counters and the window reward:
+    /// they need both.
+    fn counterfactual_needs(&mut self, l: &syntax::Learn, out: &CheckedSpec) {
+        let learn = &out.learn;
+        if learn.counterfactual == 0 || (learn.memory > 0 && learn.reward == Reward::Window) {
+            return;
+        }
+        let Some(p) = l.params.iter().find(|p| p.name.name == "counterfactual") else { return };
+        let missing = match (learn.memory > 0, learn.reward == Reward::Window) {
+            (false, false) => "`memory` and `reward: window`",
+            (false, true) => "`memory`",
+            _ => "`reward: window`",
+        };
+        self.push(
+            Diagnostic::new(
+                "HSTL071",
+                p.range.clone(),
+                format!("`counterfactual` needs {missing}"),
+            )
+            .with_help("counterfactual updates replay the memory's counters along each option's run and score it by the window reward: add `memory: 8, reward: window`, or write `learn { preset: auto }` on a persistent task"),
+        );
     }
 
     fn param_name_ok(
@@ -1435,6 +1554,38 @@ impl Cx<'_> {
         }
     }
 
+    /// HSTL170: a safety conjunct `always !R` of the task that no option's `avoid` covers:
+    /// the legs' reward never sees it, so nothing below the options level keeps out of `R`.
+    fn safety_unseen(&mut self, out: &CheckedSpec) {
+        if out.primitives.is_empty() {
+            return;
+        }
+        for c in crate::preset::safety_conjuncts(out) {
+            let seen = out.primitives.iter().any(|p| {
+                p.avoid.as_ref().is_some_and(|a| crate::preset::covers(a, c.region, self.src))
+            });
+            if seen {
+                continue;
+            }
+            let name = match c.region.kind {
+                CFormulaKind::Let(i) => out.lets.get(i).map_or(String::new(), |l| l.name.clone()),
+                _ => self.src.get(c.region.range.clone()).unwrap_or("").trim().to_string(),
+            };
+            self.push(
+                Diagnostic::new(
+                    "HSTL170",
+                    c.conjunct.range.clone(),
+                    format!(
+                        "no option's reward sees the safety conjunct: the legs may enter `{name}`"
+                    ),
+                )
+                .with_help(format!(
+                    "give the options `avoid: {name}`, or write `learn {{ preset: auto }}`"
+                )),
+            );
+        }
+    }
+
     fn persistent_needs(&mut self, learn: Option<&syntax::Learn>, out: &CheckedSpec) {
         let Some(l) = learn else { return };
         let Some(task) = &out.task else { return };
@@ -1548,6 +1699,9 @@ impl Cx<'_> {
             roots.push(&p.reach);
             roots.push(&p.init);
             if let Terminate::Formula(f) = &p.terminate {
+                roots.push(f);
+            }
+            if let Some(f) = &p.avoid {
                 roots.push(f);
             }
         }
@@ -1702,8 +1856,10 @@ impl Cx<'_> {
             return;
         }
         // Pass 2: termination sets.
+        // With them, per primitive, the termination states outside its avoided region.
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut term_set = vec![Vec::with_capacity(ks.len()); np];
+            let mut safe_stops = vec![0u64; np];
             for k in ks {
                 if !present(k) {
                     term_set.iter_mut().for_each(|set| set.push(false));
@@ -1712,18 +1868,45 @@ impl Cx<'_> {
                 let s = states(k);
                 ev.load(&s);
                 for (p, prim) in out.primitives.iter().enumerate() {
-                    term_set[p].push(match &prim.terminate {
+                    let stops = match &prim.terminate {
                         Terminate::Argmax => ev.robustness(&prim.reach, &s) == reach_max[p],
                         Terminate::Formula(f) => ev.robustness(f, &s) > 0.0,
-                    });
+                    };
+                    term_set[p].push(stops);
+                    let avoided = prim.avoid.as_ref().is_some_and(|a| ev.robustness(a, &s) >= 0.0);
+                    safe_stops[p] += u64::from(stops && !avoided);
                 }
             }
-            term_set
+            (term_set, safe_stops)
         });
         let mut term_set: Vec<Vec<bool>> = vec![Vec::with_capacity(n); np];
-        for chunk in chunks {
+        let mut safe_stops = vec![0u64; np];
+        for (chunk, safe) in chunks {
             for (set, part) in term_set.iter_mut().zip(chunk) {
                 set.extend(part);
+            }
+            for (total, c) in safe_stops.iter_mut().zip(safe) {
+                *total += c;
+            }
+        }
+        // HSTL070: every state where a leg stops lies in the region it avoids.
+        for (p, prim) in out.primitives.iter().enumerate() {
+            if let Some(a) = &prim.avoid
+                && safe_stops[p] == 0
+                && term_set[p].iter().any(|&t| t)
+            {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL070",
+                        a.range.clone(),
+                        format!(
+                            "option `{}` avoids every state where it stops: it cannot succeed without entering its `avoid` region",
+                            prim.name
+                        ),
+                    )
+                    .with_label(prim.name_range.clone(), format!("`{}` is declared here", prim.name))
+                    .with_help("narrow the `avoid` region, or move the option's region out of it"),
+                );
             }
         }
         // HSTL032: a termination set with no state (argmax sets never are empty).
@@ -1816,6 +1999,15 @@ pub(crate) fn thousands(n: u64) -> String {
 
 /// Where a formula stops being a state formula, and the temporal let it goes through.
 type TemporalSite = (Range<usize>, Option<(Range<usize>, String)>);
+
+/// The preset a `learn` item names: `auto` when its first `preset` parameter is `auto`, the
+/// paper's otherwise (a bad value is reported where the `learn` item is checked).
+fn preset_of(l: &syntax::Learn) -> Preset {
+    match l.params.iter().find(|p| p.name.name == "preset").map(|p| &p.value) {
+        Some(ParamValue::Word(w)) if w.name == "auto" => Preset::Auto,
+        _ => Preset::Paper,
+    }
+}
 
 fn value_range(v: &ParamValue) -> Range<usize> {
     match v {

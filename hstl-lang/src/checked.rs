@@ -238,6 +238,9 @@ pub struct PrimitiveOption {
     pub init: CFormula,
     /// Where it stops (`argmax` by default).
     pub terminate: Terminate,
+    /// A region the leg must stay out of (`avoid: R`): its flat reward sees `rho(!R)` and it
+    /// stops on entering `R`. `None` by default.
+    pub avoid: Option<CFormula>,
     /// Doc comment text.
     pub doc: Option<String>,
     /// Byte range of the name.
@@ -275,6 +278,16 @@ pub enum Reward {
     Window,
 }
 
+/// The configuration a `learn { preset: ... }` starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Preset {
+    /// The paper's settings (the default): nothing is filled in.
+    #[default]
+    Paper,
+    /// The recommended settings for the task's form (LANGUAGE.md, "Presets").
+    Auto,
+}
+
 /// Q-learning parameters of one level.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct QParams {
@@ -293,6 +306,8 @@ pub struct QParams {
 /// Learning parameters with the paper's defaults filled in.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LearnParams {
+    /// The preset the parameters start from (`paper`).
+    pub preset: Preset,
     /// Episodes (1200).
     pub episodes: u64,
     /// Option choices per episode (200).
@@ -305,6 +320,8 @@ pub struct LearnParams {
     pub intra: Intra,
     /// Options-level reward (`segment`).
     pub reward: Reward,
+    /// Counterfactual memory values per option execution, 0 = off (0).
+    pub counterfactual: u64,
     /// Flat level (gamma 0.9, alpha 0.2, epsilon 0.8, min_epsilon 0.1, decay 1e-6).
     pub flat: QParams,
     /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
@@ -314,12 +331,14 @@ pub struct LearnParams {
 impl Default for LearnParams {
     fn default() -> Self {
         LearnParams {
+            preset: Preset::Paper,
             episodes: 1200,
             choices: 200,
             max_steps: 500,
             memory: 0,
             intra: Intra::Paper,
             reward: Reward::Segment,
+            counterfactual: 0,
             flat: QParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 },
             options: QParams {
                 gamma: 0.9,
@@ -358,6 +377,10 @@ pub struct CheckedSpec {
     pub options: Vec<CombinedOption>,
     /// Learning parameters.
     pub learn: LearnParams,
+    /// What `learn { preset: auto }` filled in, as hstl text (one line per option, the
+    /// options set and the `learn` values), for `hstlc check` and the editor's hover;
+    /// `None` for the paper's preset.
+    pub preset_expansion: Option<String>,
 }
 
 /// One conjunct `eventually[0..N] R` of a persistent task.

@@ -379,6 +379,33 @@ Fix: keep the expression defined on the whole domain (`sqrt(abs(x - 3))`, a divi
 never 0), or narrow the `int` ranges to the states the system can be in.",
     },
     CodeInfo {
+        code: "HSTL070",
+        name: "option-avoids-its-goal",
+        severity: E,
+        summary: "an option's `avoid` region holds in every state where it stops",
+        explanation: "`avoid: R` keeps a leg out of `R`: its flat reward also sees `rho(!R)`, \
+entering `R` costs more than any path that stays out, and the leg stops there. A state is in \
+`R` where the robustness of `R` is 0 or more (`always !R` fails there). Every state where this \
+option stops (its `terminate` set, or where its region is most robust) lies in `R`, so the leg \
+can only succeed by entering the region it must avoid.\n\n\
+Example:\n    let Goal = x > 10;\n    let Hazard = x > 8;\n    option Goal { avoid: Hazard }\n\n\
+Fix: narrow the `avoid` region, or move the option's region out of it.",
+    },
+    CodeInfo {
+        code: "HSTL071",
+        name: "counterfactual-needs-memory",
+        severity: E,
+        summary: "`counterfactual` without `memory` and `reward: window`",
+        explanation: "`counterfactual: M` makes every option execution also update the options \
+value of M other memory values it could have started with: the memory's counters are run \
+again along the same states from each of them, and the run is scored by the window reward \
+it would have earned. Without `memory` the options level sees no memory values to update, \
+and without `reward: window` the reward does not depend on them.\n\n\
+Example:\n    learn { counterfactual: 8 }\n\n\
+Fix: add `memory: 8, reward: window` (the task must be persistent), or write \
+`learn { preset: auto }`, which sets all three on a persistent task.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,
@@ -433,5 +460,19 @@ cell, where the robustness is exactly 0: `x <= 3` does not hold at `x = 3`, and 
 `2 <= y <= 3` holds in no cell at all, though it reads as the cells 2 and 3.\n\n\
 Example:\n    state { y: int in 0..=14 }\n    let Door = 2 <= y <= 3;\n\n\
 Fix: write strict comparisons one step outside the cells you mean: `1 < y < 4`.",
+    },
+    CodeInfo {
+        code: "HSTL170",
+        name: "safety-unseen-by-options",
+        severity: W,
+        summary: "a safety conjunct `always !R` of the task that no option's reward sees",
+        explanation: "The options level is rewarded by the task's robustness, but each leg is \
+learned from its own region alone (`rho(reach, s')` per step): a conjunct `always !R` of the \
+task (bounded or not) shapes nothing below the options level, and the learned legs take the \
+shortest way to their region, through `R` if it lies on the way. Give the options \
+`avoid: R`: the leg's reward then also sees `rho(!R)`, entering `R` costs more than any path \
+that stays out, and the leg stops there. `learn { preset: auto }` fills it in on every option.\n\n\
+Example:\n    task eventually[0..=30] Goal && always !Pit;\n    option Goal;   // its leg may cross Pit\n\n\
+Fix: `option Goal { avoid: Pit }`, or `learn { preset: auto }`.",
     },
 ];

@@ -60,6 +60,7 @@ pub mod incremental;
 pub mod lints;
 pub mod parser;
 pub mod position;
+pub mod preset;
 pub mod render;
 pub mod syntax;
 pub mod world;

@@ -145,10 +145,15 @@ fn valid_fixtures_check_without_errors() {
     }
 }
 
-fn text<'a>(src: &'a str, f: &CFormula) -> &'a str {
+fn text(src: &str, f: &CFormula) -> String {
     let t = src.get(f.range.clone()).unwrap_or("?");
-    // A default `init: true` carries the option name's range.
-    if f.kind == CFormulaKind::True && t != "true" { "true (default)" } else { t }
+    // A default `init: true` carries the option name's range, and so does the `init: !A`
+    // that `preset: auto` fills in.
+    match &f.kind {
+        CFormulaKind::True if t != "true" => "true (default)".into(),
+        CFormulaKind::Not(_) if !t.starts_with('!') => format!("!{t} (preset)"),
+        _ => t.to_string(),
+    }
 }
 
 /// A readable summary of a checked spec for snapshots.
@@ -190,15 +195,19 @@ fn summarise(out: &mut String, spec: &CheckedSpec, src: &str) {
     for p in &spec.primitives {
         let term = match &p.terminate {
             Terminate::Argmax => "argmax".to_string(),
-            Terminate::Formula(f) => text(src, f).to_string(),
+            Terminate::Formula(f) => text(src, f),
         };
+        let avoid = p.avoid.as_ref().map_or(String::new(), |a| format!(", avoid {}", text(src, a)));
         let _ = writeln!(
             out,
-            "  option {}: reach {}, init {}, terminate {term}",
+            "  option {}: reach {}, init {}, terminate {term}{avoid}",
             p.name,
             text(src, &p.reach),
             text(src, &p.init)
         );
+    }
+    if let Some(e) = &spec.preset_expansion {
+        let _ = writeln!(out, "  preset: auto expands to:\n    {}", e.replace('\n', "\n    "));
     }
     let set: Vec<String> = spec
         .options

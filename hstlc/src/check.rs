@@ -60,11 +60,17 @@ pub fn run(args: &CheckArgs) -> CmdResult {
         .iter()
         .map(|path| read_input(path, &args.stdin_filename))
         .collect::<Result<Vec<_>, _>>()?;
+    let mut notes = String::new();
     let checked: Vec<Checked> = inputs
         .into_iter()
         .map(|(name, source)| {
-            let diagnostics = hstl::world::check(&source, &world.world, &world.label).diagnostics;
-            Checked { name, source, diagnostics }
+            let result = hstl::world::check(&source, &world.world, &world.label);
+            for spec in &result.specs {
+                if let Some(e) = &spec.preset_expansion {
+                    notes.push_str(&preset_note(&name, &spec.name, e));
+                }
+            }
+            Checked { name, source, diagnostics: result.diagnostics }
         })
         .collect();
     let out = match args.format {
@@ -74,8 +80,20 @@ pub fn run(args: &CheckArgs) -> CmdResult {
         Format::Sarif => render::sarif(&checked),
     };
     out!("{out}")?;
+    // The machine formats stay one document each.
+    if matches!(args.format, Format::Full | Format::Concise) {
+        out!("{notes}")?;
+    }
     let errors = checked.iter().flat_map(|c| &c.diagnostics).any(|d| d.severity == Severity::Error);
     Ok(if errors { Status::Errors } else { Status::Clean })
+}
+
+/// The note that says what `preset: auto` expanded to in spec `spec` of file `file`.
+pub fn preset_note(file: &str, spec: &str, expansion: &str) -> String {
+    format!(
+        "note: {file}: in spec `{spec}`, `preset: auto` stands for\n    {}\n",
+        expansion.replace('\n', "\n    ")
+    )
 }
 
 /// Reads a spec file, or standard input for `-`, and names it for reports (see

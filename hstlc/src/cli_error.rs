@@ -66,3 +66,12 @@ impl From<hstl::Problem> for CliError {
         CliError::new(p.message, p.help)
     }
 }
+
+impl From<hstl_outdir::Error> for CliError {
+    fn from(e: hstl_outdir::Error) -> CliError {
+        match e {
+            hstl_outdir::Error::Write { path, source } => CliError::Write { path, source },
+            hstl_outdir::Error::Refused(p) => p.into(),
+        }
+    }
+}

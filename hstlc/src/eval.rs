@@ -9,9 +9,9 @@ use hstl::runtime::optimum::SolveConfig;
 
 use crate::cli_error::CliError;
 use crate::output::outln;
-use crate::study::{mean, range};
 use crate::world_arg::world_words;
 use crate::{CmdResult, Status, input};
+use hstl::study::Stats;
 
 /// Arguments of `hstlc eval`.
 #[derive(Args, Debug)]
@@ -72,11 +72,28 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let report = match evaluate::evaluate(&replay, runs)? {
         Evaluation::Robustness { values, complete } => {
             print_robustness(&values, &complete)?;
+            // A reach-avoid task: how often it is satisfied, against the best possible.
+            let summary = hstl::train::reach_avoid_summary(spec, env, &replay.agent, args.seed)
+                .map_err(|e| CliError::new(e.to_string(), None))?;
+            if let Some(r) = summary {
+                let ratio = if r.optimum > 0.0 {
+                    format!("; P/P* = {:.3}", r.rate / r.optimum)
+                } else {
+                    String::new()
+                };
+                outln!(
+                    "  reach-avoid: satisfied in {:.4} of {} runs of {} states; the optimum P* = {:.4} (dynamic programming){ratio}",
+                    r.rate,
+                    hstl::train::REACH_AVOID_RUNS,
+                    r.run_len,
+                    r.optimum
+                )?;
+            }
             return Ok(Status::Clean);
         }
         Evaluation::Window { report } => report,
     };
-    let (lo, hi) = range(&report.per_rollout);
+    let Stats { min: lo, max: hi, .. } = Stats::of(&report.per_rollout);
     outln!(
         "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
         report.rate,
@@ -90,10 +107,10 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     print_robustness(&report.robustness, &report.complete)?;
     let shares: Vec<f64> = report.kept.iter().flatten().copied().collect();
     if !shares.is_empty() {
-        let (lo, hi) = range(&shares);
+        let Stats { mean, min: lo, max: hi, .. } = Stats::of(&shares);
         outln!(
             "  windows kept, over complete windows: the task's body holds on {:.1}% of each run's complete steps (runs {:.1}-{:.1}%)",
-            100.0 * mean(&shares),
+            100.0 * mean,
             100.0 * lo,
             100.0 * hi
         )?;
@@ -126,19 +143,17 @@ pub fn run(args: &EvalArgs) -> CmdResult {
 /// counted over complete windows, since clipped ones fail a persistent task at the end of
 /// nearly every finite run.
 fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
-    let mean_of = |v: &[f64]| mean(v);
-    let (lo, hi) = range(values);
+    let Stats { mean, min: lo, max: hi, .. } = Stats::of(values);
     outln!(
-        "  task robustness over each run (windows clipped at the run's end): mean {:.3}, min {lo:.3}, max {hi:.3}",
-        mean_of(values)
+        "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
     )?;
     let determined: Vec<f64> = complete.iter().flatten().copied().collect();
     let satisfied = evaluate::satisfied(values, complete);
     let figures = if determined.is_empty() {
         "no run is long enough for one".to_string()
     } else {
-        let (lo, hi) = range(&determined);
-        format!("mean {:.3}, min {lo:.3}, max {hi:.3}", mean_of(&determined))
+        let Stats { mean, min: lo, max: hi, .. } = Stats::of(&determined);
+        format!("mean {mean:.3}, min {lo:.3}, max {hi:.3}")
     };
     let short = complete.len() - determined.len();
     let short = match short {

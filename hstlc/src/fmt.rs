@@ -112,7 +112,7 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
         return Err(fail(source));
     }
     if let Some(dir) = real.parent() {
-        crate::artifacts::sync_dir(dir);
+        hstl_outdir::sync_dir(dir);
     }
     Ok(())
 }

@@ -4,7 +4,6 @@
 //! errors, 2 when the command could not run (a missing file, a bad flag, a failed write),
 //! 141 when the reader of standard output stopped reading (see [`output`]).
 
-mod artifacts;
 mod check;
 mod cli_error;
 mod eval;

@@ -8,11 +8,12 @@ use clap::Args;
 use hstl::runtime::eval::WindowConfig;
 use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
-use crate::artifacts::{self, OutDir, OutFile};
 use crate::cli_error::CliError;
 use crate::output::outln;
 use crate::world_arg::{LoadedWorld, WORLD_HELP};
 use crate::{CmdResult, Status, spec_file};
+use hstl::artifacts::{self, OutFile};
+use hstl_outdir::{OutDir, Writer};
 
 /// Arguments of `hstlc train`.
 #[derive(Args, Debug)]
@@ -64,7 +65,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     }
     let env = &world.world;
     // Before the long part: a folder another run holds is refused at once.
-    let out = OutDir::lock(&args.out)?;
+    let out = OutDir::lock(&args.out, Writer::CLI)?;
     let bar = progress_bar(spec.learn.episodes as u64);
     let outcome = train(&spec, env, args.seed, &loaded.file, |episode, reward| {
         bar.set_position(episode as u64 + 1);
@@ -77,7 +78,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         OutFile::text("curve.csv", artifacts::curve_csv(&outcome.curve)),
     ];
     let mut rng = seeded_rng(args.seed ^ PICTURE_SEED);
-    let regions = artifacts::pictured_regions(&loaded)?;
+    let regions = artifacts::pictured_regions(&loaded.spec, &loaded.file)?;
     let captions = artifacts::Captions {
         subject: artifacts::subject(&loaded.file, args.spec_name.as_deref()),
         note: format!("seed {}", args.seed),
@@ -178,11 +179,7 @@ pub fn window_report(
     Ok(summary.map(|s| (s.rate, s.kept)))
 }
 
-/// The mean of the last `n` values.
-pub fn tail_mean(curve: &[f64], n: usize) -> f64 {
-    let tail = &curve[curve.len().saturating_sub(n)..];
-    tail.iter().sum::<f64>() / tail.len().max(1) as f64
-}
+pub use hstl::study::tail_mean;
 
 fn names(files: &[OutFile]) -> String {
     files.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ")

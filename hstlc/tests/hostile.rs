@@ -349,7 +349,7 @@ fn output_folders_are_whole_or_nothing() {
     assert_eq!(run.status, Some(0), "{}", run.stderr);
     assert_eq!(
         listing(&d.join("st")),
-        [".spec-2.lock", ".spec.lock", "curves.csv", "curves.svg", "spec", "spec-2"]
+        [".spec-2.lock", ".spec.lock", "curves.csv", "curves.svg", "spec", "spec-2", "summary.csv"]
     );
     let curves = std::fs::read_to_string(d.join("st/curves.csv")).expect("curves.csv");
     assert!(curves.contains("a/spec.hstl") && curves.contains("b/spec.hstl"), "{curves}");

@@ -443,3 +443,55 @@ fn a_world_too_large_to_draw_trains_without_grid_pictures() {
     written.sort();
     assert_eq!(written, [".hstlc-run", "curve.csv", "curve.svg", "policy.json"]);
 }
+
+/// `check` says what `preset: auto` stands for (after the diagnostics, in the human formats
+/// only); `study` measures a reach-avoid task against its exact optimum and writes
+/// `summary.csv`; `eval` reports the same measure for the policy.
+#[test]
+fn a_reach_avoid_preset_is_noted_studied_and_evaluated() {
+    let check = hstlc(&["check", "reach_avoid.hstl"]);
+    assert_eq!(check.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        text.contains(
+            "`preset: auto` stands for\n    option Goal { terminate: Goal, avoid: Band }"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("learn { episodes: 300, choices: 10, flat: { alpha: 0.05 } }"), "{text}");
+    let json = hstlc(&["check", "reach_avoid.hstl", "--format", "json"]);
+    assert_eq!(String::from_utf8_lossy(&json.stdout).trim(), "[]");
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("study");
+    let s = hstlc(&[
+        "study",
+        "reach_avoid.hstl",
+        "--seeds",
+        "2",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(s.status.code(), Some(0), "{}", String::from_utf8_lossy(&s.stderr));
+    let stdout = String::from_utf8_lossy(&s.stdout);
+    assert!(stdout.contains("satisfaction rate P") && stdout.contains("P/P* (P* = "), "{stdout}");
+    let summary = read(&out.join("summary.csv"));
+    let row: Vec<&str> = summary.lines().nth(1).expect("a row").split(',').collect();
+    assert_eq!(row[..2], ["reach_avoid.hstl", "P/P*"], "{summary}");
+    let (best, ratio): (f64, f64) = (row[2].parse().expect("P*"), row[3].parse().expect("mean"));
+    assert!(best > 0.0 && best <= 1.0 && ratio >= 0.0, "{summary}");
+    let seeds = read(&out.join("reach_avoid/seeds.csv"));
+    assert!(
+        seeds.starts_with("seed,train_secs,steps,reward_last_100,window_rate,satisfaction_rate\n")
+    );
+
+    let e = hstlc(&["eval", out.join("reach_avoid/policy.json").to_str().expect("utf-8")]);
+    assert_eq!(e.status.code(), Some(0), "{}", String::from_utf8_lossy(&e.stderr));
+    let stdout = String::from_utf8_lossy(&e.stdout);
+    assert!(
+        stdout.contains("reach-avoid: satisfied in")
+            && stdout.contains("of 1000 runs of 31 states"),
+        "{stdout}"
+    );
+    assert!(stdout.contains(&format!("P* = {best:.4}")), "{stdout} vs {summary}");
+}

@@ -21,10 +21,15 @@ does (the same ``policy.json``, byte for byte); ``policy.evaluate()`` measures i
 ``hstlc eval`` does. With gymnasium installed, ``hstl.GridWorldEnv`` is a grid world as a
 ``gymnasium.Env`` (``gymnasium.make("hstl/GridWorld-v0")``, ``"hstl/FourRooms-v0"``) and
 ``hstl.STLReward`` rewards any environment by robustness.
+
+``hstl.study(specs, seeds=20)`` trains specs over many seeds and compares them as
+``hstlc study`` does, on this machine's cores or on a Ray cluster (``backend="ray"``);
+``hstl.tune.trainable`` tunes a spec's ``learn`` values with Ray Tune.
 """
 
 from ._errors import MissingVariableError, PolicyError, SpecError, WorldError
 from ._hstl import MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__
+from ._study import StudyResult, study
 from ._train import train
 
 __all__ = [
@@ -36,9 +41,11 @@ __all__ = [
     "PolicyError",
     "Spec",
     "SpecError",
+    "StudyResult",
     "World",
     "WorldError",
     "__version__",
+    "study",
     "train",
 ]
 

@@ -103,6 +103,8 @@ class OnlineMonitor:
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
+#: The `learn` values `hstl.tune` takes from a config (see `hstl.tune.LEARN_KEYS`).
+LEARN_KEYS: list[str]
 
 #: A world file's path, as ``World.load`` and ``hstl.train`` take it.
 PathArg = Union[str, PathLike[str]]
@@ -227,3 +229,57 @@ def _train_env(
     episodes: Optional[int] = None,
     progress: Any = None,
 ) -> Policy: ...
+
+# Studies and Ray Tune (hstl.study, hstl.tune): the facade's hstl::study and hstl::train.
+
+#: One seed's figures: ``seed``, ``window_rate`` (or None), ``reward``, ``seconds``,
+#: ``steps`` and ``curve``.
+SeedRun = dict
+
+def _study_task(
+    spec: Spec, world: World, episodes: Optional[int] = None
+) -> Tuple[str, int, Optional[str]]:
+    """Checks the spec against the world: (name, episodes, a key of its regions or None)."""
+    ...
+
+def _study_seeds(
+    spec: Spec,
+    world: World,
+    seeds: Sequence[int],
+    episodes: Optional[int] = None,
+    threads: int = 1,
+) -> list[SeedRun]:
+    """Trains the spec for each seed on ``threads`` threads, the GIL released."""
+    ...
+
+def _study_optimum(spec: Spec, world: World) -> Optional[float]:
+    """W* of the spec's regions in the world, or None for a task without regions."""
+    ...
+
+def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> dict:
+    """Mean, sd, min and max of ``seconds``, ``reward``, ``window_rate`` and ``ratio``."""
+    ...
+
+class _StudyOut:
+    """A study's output folder, each spec's folder locked from now on and written whole."""
+
+    def __init__(self, out: PathArg, paths: Sequence[PathArg]) -> None: ...
+    def write(
+        self,
+        specs: Sequence[Spec],
+        world: World,
+        runs: Sequence[Sequence[SeedRun]],
+        episodes: Optional[int] = None,
+    ) -> list[PathLike[str]]: ...
+
+def _train_chunks(
+    spec: Spec,
+    world: World,
+    seed: int,
+    chunk: int,
+    report: Any,
+    learn: Optional[Mapping[str, float]] = None,
+) -> int:
+    """Trains in chunks of episodes, ``report(episodes, reward, window_rate, robustness)``
+    after each (True stops); the episodes trained."""
+    ...

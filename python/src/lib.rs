@@ -1,6 +1,6 @@
 //! `hstl._hstl`: the Python package's native module, a thin PyO3 shell over the `hstl`
 //! facade (`hstl::load`, `hstl::monitor`, `hstl::world`, `hstl::train`,
-//! `hstl::evaluate`, `hstl::reward`), as the `hstl!` macro is over hstl-lang.
+//! `hstl::evaluate`, `hstl::reward`, `hstl::study`), as the `hstl!` macro is over hstl-lang.
 //!
 //! Everything that computes lives in the facade and is tested there. This crate converts
 //! Python values into borrowed samples (contiguous float64 arrays are read in place; other
@@ -14,6 +14,7 @@ mod online;
 mod policy;
 mod reward;
 mod spec;
+mod study;
 mod trace;
 mod train;
 mod world;
@@ -32,6 +33,13 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
+    m.add_class::<study::_StudyOut>()?;
+    m.add_function(wrap_pyfunction!(study::_study_task, m)?)?;
+    m.add_function(wrap_pyfunction!(study::_study_seeds, m)?)?;
+    m.add_function(wrap_pyfunction!(study::_study_optimum, m)?)?;
+    m.add_function(wrap_pyfunction!(study::_study_summary, m)?)?;
+    m.add_function(wrap_pyfunction!(study::_train_chunks, m)?)?;
+    m.add("LEARN_KEYS", hstl::train::LEARN_KEYS.to_vec())?;
     m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -296,6 +296,9 @@ impl<'e, E: Env> Learner<'e, E> {
             self.suffix_rewards(run, rewards);
             total += rewards[0];
             self.update_options(o, run, rewards);
+            if self.spec.learn.counterfactual > 0 {
+                self.counterfactual_updates(o, run, rng);
+            }
             s = *run.states.last().unwrap_or(&s);
         }
         total
@@ -362,7 +365,15 @@ impl<'e, E: Env> Learner<'e, E> {
                     Some(state) => env.index(&env.step(state, a, rng)),
                     None => s,
                 };
-                update_flat(&mut q.flat, &tables.reach, flat, actions, s * actions + a, next);
+                update_flat(
+                    &mut q.flat,
+                    &tables.reach,
+                    &tables.ends,
+                    flat,
+                    actions,
+                    s * actions + a,
+                    next,
+                );
                 run.states.push(next);
                 if let Some(c) = counters {
                     let (kept, new_code) = c.step(next, tau);
@@ -375,6 +386,59 @@ impl<'e, E: Env> Learner<'e, E> {
                     break;
                 }
             }
+        }
+    }
+
+    /// The counterfactual updates after option `o` ran along `run`: for
+    /// `learn.counterfactual` memory values drawn at random (a bucket per region, then a
+    /// counter value inside it; 0 for a region the start state satisfies), the counters
+    /// are run along the same states, and the options value of that start observation is
+    /// updated with the window reward the run would have earned from it.
+    fn counterfactual_updates(&mut self, o: usize, run: &Run, rng: &mut Rng) {
+        let (Some(m), Some(c)) = (&self.memory, &self.counters) else { return };
+        let n = self.tables.legs.len();
+        let params = self.spec.learn.options;
+        let (s0, end) = (run.states[0], run.states[run.states.len() - 1]);
+        let b = m.buckets;
+        let mut tau = Vec::with_capacity(m.len());
+        'samples: for _ in 0..self.spec.learn.counterfactual {
+            tau.clear();
+            for j in 0..m.len() {
+                let horizon = m.horizons[j];
+                if m.holds(j, s0) {
+                    tau.push(0);
+                    continue;
+                }
+                let bucket = rng.random_range(0..=b);
+                if bucket == b {
+                    tau.push(horizon);
+                    continue;
+                }
+                // The counter values of the bucket, from 1: outside its region tau > 0.
+                let lo = (bucket * horizon).div_ceil(b).max(1);
+                let hi = ((bucket + 1) * horizon).div_ceil(b);
+                if lo >= hi {
+                    continue 'samples;
+                }
+                tau.push(rng.random_range(lo..hi));
+            }
+            let start = s0 * self.values + c.code(&tau);
+            let (mut reward, mut discount, mut code) = (0.0, 1.0, 0);
+            for &s in &run.states[1..] {
+                let (kept, next_code) = c.step(s, &mut tau);
+                if kept {
+                    reward += discount;
+                }
+                discount *= params.gamma;
+                code = next_code;
+            }
+            let end_row = (end * self.values + code) * n;
+            let best = self.tables.available[end]
+                .iter()
+                .map(|&a| self.q.options[end_row + a])
+                .fold(f64::NEG_INFINITY, f64::max);
+            let cell = &mut self.q.options[start * n + o];
+            *cell += params.alpha * (reward + discount * best - *cell);
         }
     }
 
@@ -502,18 +566,21 @@ fn floor_from(level: &LevelParams) -> Option<u64> {
 
 /// The flat update of every primitive after the step from cell `cell` (state times
 /// actions plus action) into state `next`: each table bootstraps from its own best value at
-/// `next`, with reward `rho(reach_p, next)`.
+/// `next`, with reward `reach_p[next]`; a primitive whose avoided region holds `next` does
+/// not bootstrap: its reward there is already the whole value of entering.
 #[inline]
 fn update_flat(
     tables: &mut [Vec<f64>],
     reach: &[Vec<f64>],
+    ends: &[Option<Vec<bool>>],
     flat: LevelParams,
     actions: usize,
     cell: usize,
     next: usize,
 ) {
-    for (q, reach) in tables.iter_mut().zip(reach) {
-        let best = max_of(&q[next * actions..][..actions]);
+    for ((q, reach), ends) in tables.iter_mut().zip(reach).zip(ends) {
+        let ends = ends.as_ref().is_some_and(|a| a[next]);
+        let best = if ends { 0.0 } else { max_of(&q[next * actions..][..actions]) };
         let cell = &mut q[cell];
         *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
     }
@@ -572,6 +639,7 @@ mod tests {
             reach,
             init: Formula::bool(true),
             terminate,
+            avoid: None,
         };
         TaskSpec {
             name: "Line".into(),
@@ -662,6 +730,7 @@ mod tests {
             reach: reach.clone(),
             init,
             terminate: Terminate::Formula(reach.clone()),
+            avoid: None,
         };
         let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
         spec.task = Formula::always(Interval::ALL, Formula::and(vec![ev(&r1), ev(&r2)]));
@@ -732,6 +801,47 @@ mod tests {
         assert_eq!(agent.options[3], usize::MAX);
     }
 
+    /// A counterfactual update starts the counters of the unvisited region from a drawn
+    /// bucket and scores the same run from there. On the line, Right from x = 0 (R1 holds
+    /// there, so tau_1 = 0) to x = 4 (R2), with tau_2 drawn as t: psi at the four steps is
+    /// tau_2 = t + 1, t + 2, t + 3 below 6, then R2 holds. By hand, with gamma 0.5: t in
+    /// 1..3 (bucket 0) earns 1.875; t = 3, 4, 5 (bucket 1) 1.625, 1.125, 0.125; expired
+    /// (bucket 2) 0.125. The Q-values start at 0: the cell becomes alpha times that.
+    #[test]
+    fn counterfactual_updates_score_the_run_from_a_drawn_memory() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let mut spec = persistent_line();
+        spec.learn.counterfactual = 1;
+        let learner = Learner::new(&spec, &env).unwrap();
+        let mut q = learner.q().clone();
+        for s in 0..5 {
+            q.flat[0][s * 4 + 3] = 10.0;
+        }
+        let zero = learner.with_tables(q).unwrap();
+        let allowed = [vec![1.875], vec![1.625, 1.125, 0.125], vec![0.125]];
+        let mut seen = [false; 3];
+        let mut rng = seeded_rng(7);
+        for _ in 0..40 {
+            let mut learner = zero.clone();
+            let mut run = Run::default();
+            learner.begin(0);
+            learner.run_option(0, 0, &mut rng, &mut run);
+            learner.counterfactual_updates(0, &run, &mut rng);
+            // Only the options of state 0 (observations 0..9) with b_1 = 0 may change, and
+            // only option Right (column 0).
+            let changed: Vec<usize> =
+                (0..learner.q().options.len()).filter(|&i| learner.q().options[i] != 0.0).collect();
+            assert_eq!(changed.len(), 1, "{changed:?}");
+            let (obs, o) = (changed[0] / 2, changed[0] % 2);
+            assert_eq!(o, 0);
+            assert!(obs < 3, "state 0 with b_1 = 0: {obs}");
+            let value = learner.q().options[changed[0]] / 0.5;
+            assert!(allowed[obs].contains(&value), "bucket {obs}: {value}");
+            seen[obs] = true;
+        }
+        assert_eq!(seen, [true; 3], "every bucket is drawn");
+    }
+
     #[test]
     fn without_memory_the_window_reward_sees_the_state_alone() {
         let env = GridWorld::new(5, 1, 1.0).unwrap();
@@ -751,6 +861,44 @@ mod tests {
         learner.suffix_rewards(&run, &mut rewards);
         assert_eq!(run.obs, [0, 1, 2, 3, 4]);
         assert_eq!(rewards, [0.125, 0.25, 0.5, 1.0, 0.0]);
+    }
+
+    /// `avoid` on the line: P2 (reach `x > 3`, stop at x = 4) avoids `1.5 < x < 2.5`, the
+    /// cell x = 2. Its flat reward elsewhere is `min(rho(x > 3), -rho(avoid))`, inside it the
+    /// worst of those less one, forever: (-3 - 1) / (1 - 0.9) = -40; the leg stops there and
+    /// the flat update into it does not bootstrap. P1 is left as it was.
+    #[test]
+    fn avoid_shapes_the_flat_reward_and_stops_the_leg() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
+        let band = Formula::And(vec![x(CmpOp::Gt, 1.5), x(CmpOp::Lt, 2.5)]);
+        spec.primitives[1].avoid = Some(band);
+        let learner = Learner::new(&spec, &env).unwrap();
+        let t = learner.tables();
+        let penalty = -4.0 * (1.0 / (1.0 - 0.9));
+        assert_eq!(t.reach[1], [-3.0, -2.0, penalty, 0.0, 1.0]);
+        assert_eq!(t.term[1], [false, false, true, false, true]);
+        assert_eq!(t.ends[1].as_deref(), Some(&[false, false, true, false, false][..]));
+        assert_eq!(t.reach[0], [-1.0, 0.0, 1.0, 2.0, 3.0]);
+        assert!(t.ends[0].is_none());
+        // Bootstrapping values at x = 2 that the update into it must not read.
+        let mut q = learner.q().clone();
+        for table in &mut q.flat {
+            table[2 * 4..3 * 4].fill(5.0);
+        }
+        let mut learner = learner.with_tables(q).unwrap();
+        let mut run = Run::default();
+        learner.begin(1);
+        // P2's option from x = 1 goes Right (ties go to the lowest action, Up, which stays:
+        // make Right the best).
+        let mut q = learner.q().clone();
+        q.flat[1][4 + 3] = 1.0;
+        learner = learner.with_tables(q).unwrap();
+        learner.run_option(1, 1, &mut seeded_rng(0), &mut run);
+        assert_eq!(run.states, [1, 2], "the leg stops on entering the avoided cell");
+        // P2: 1 + 0.2 (-40 + 0 - 1); P1: 0 + 0.2 (1 + 0.9 * 5 - 0).
+        assert_eq!(learner.q().flat[1][4 + 3], 1.0 + 0.2 * (penalty - 1.0));
+        assert_eq!(learner.q().flat[0][4 + 3], 0.2 * (1.0 + 0.9 * 5.0));
     }
 
     #[test]

@@ -16,8 +16,69 @@
 use crate::Error;
 use std::fmt;
 
-use crate::eval::{Controller, Decision};
+use hstl_robustness::{Bound, Formula, Node, reference};
+
+use crate::eval::{Controller, Decision, rollout};
 use crate::optimum::Moves;
+use crate::{Env, Rng, TaskSpec};
+
+/// A task of the reach-avoid form `eventually[0..T] Goal && always[I] !R1 && ...`, read off
+/// its formula by [`reach_avoid_form`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReachAvoidForm {
+    /// The goal's state formula.
+    pub goal: Formula,
+    /// `T`: the last step at which the goal may hold (inclusive).
+    pub reach_by: usize,
+    /// The avoided regions' state formulas, one per `always !R` conjunct.
+    pub avoid: Vec<Formula>,
+    /// The last step they must not hold at (inclusive), or `None` for `always[0..]`.
+    pub avoid_through: Option<usize>,
+}
+
+/// The last step of a window `[0..b]` or `[0..=b]` (inclusive), `None` for `[0..]`, and
+/// `Some(None)` when the window starts later or is empty.
+fn last_step(i: &hstl_robustness::Interval) -> Option<Option<usize>> {
+    if i.start != 0 {
+        return None;
+    }
+    match i.end {
+        Bound::Unbounded => Some(None),
+        Bound::Inclusive(b) => Some(Some(b)),
+        Bound::Exclusive(b) => b.checked_sub(1).map(Some),
+    }
+}
+
+/// The reach-avoid form of `task`: one conjunct `eventually[0..T] Goal` (bounded) and one or
+/// more `always[0..T'] !R` with one window among them, every `Goal` and `R` a state formula;
+/// `None` for a task of any other form.
+pub fn reach_avoid_form(task: &Formula) -> Option<ReachAvoidForm> {
+    let nodes = task.nodes();
+    let Node::And(parts) = task.root_node() else { return None };
+    let (mut goal, mut avoid, mut through) = (None, Vec::new(), None);
+    for part in parts {
+        match &nodes[part.index()] {
+            Node::Eventually(i, g) if task.is_state(*g) && goal.is_none() => {
+                goal = Some((task.sub(*g), last_step(i)??));
+            }
+            Node::Always(i, body) => {
+                let Node::Not(r) = &nodes[body.index()] else { return None };
+                if !task.is_state(*r) {
+                    return None;
+                }
+                let last = last_step(i)?;
+                if through.is_some_and(|t| t != last) {
+                    return None;
+                }
+                through = Some(last);
+                avoid.push(task.sub(*r));
+            }
+            _ => return None,
+        }
+    }
+    let (goal, reach_by) = goal?;
+    Some(ReachAvoidForm { goal, reach_by, avoid, avoid_through: through? })
+}
 
 /// A reach-avoid task over the states of a world.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +122,71 @@ pub struct ReachAvoidController<'a> {
 }
 
 impl ReachAvoid {
+    /// The reach-avoid task of `spec` on the states of `env`, over runs of `len` states when
+    /// its avoided regions are unbounded (`always[0..] !R`); `None` when the task is not of
+    /// the reach-avoid form. The goal holds where its robustness is above 0, a region is
+    /// avoided where its robustness is 0 or more (`!R` fails there).
+    pub fn of_spec<E: Env>(
+        spec: &TaskSpec,
+        env: &E,
+        len: usize,
+    ) -> Result<Option<ReachAvoid>, Error> {
+        let Some(form) = reach_avoid_form(&spec.task) else { return Ok(None) };
+        let trace = crate::tables::valuations(spec, env)?;
+        let n = trace.len();
+        let goal = (0..n).map(|s| reference::robustness(&form.goal, &trace, s) > 0.0).collect();
+        let avoid = (0..n)
+            .map(|s| form.avoid.iter().any(|r| reference::robustness(r, &trace, s) >= 0.0))
+            .collect();
+        match form.avoid_through {
+            None => ReachAvoid::over_run(goal, avoid, form.reach_by, len).map(Some),
+            Some(t) => {
+                Ok(Some(ReachAvoid { goal, avoid, reach_by: form.reach_by, avoid_through: t }))
+            }
+        }
+    }
+
+    /// The states a run needs to decide the task: `max(T, T_avoid) + 1`.
+    pub fn run_len(&self) -> usize {
+        self.reach_by.max(self.avoid_through).saturating_add(1)
+    }
+
+    /// Whether a run through `states` (from step 0) satisfies the task; a run that ends
+    /// before the task is decided satisfies it when the goal has held.
+    pub fn satisfied(&self, states: &[usize]) -> bool {
+        let mut reached = false;
+        for (t, &s) in states.iter().enumerate().take(self.run_len()) {
+            if s >= self.goal.len() || s >= self.avoid.len() {
+                return false;
+            }
+            match self.settle(t, s, reached) {
+                (Some(v), _) => return v > 0.0,
+                (None, r) => reached = r,
+            }
+        }
+        reached
+    }
+
+    /// The share of `runs` runs of [`ReachAvoid::run_len`] states, each from a start drawn by
+    /// `env.reset`, that satisfy the task under `controller`.
+    pub fn satisfaction_rate<E: Env, C: Controller>(
+        &self,
+        env: &E,
+        controller: &mut C,
+        runs: usize,
+        rng: &mut Rng,
+    ) -> f64 {
+        let len = self.run_len();
+        let mut kept = 0usize;
+        for _ in 0..runs {
+            let start = env.index(&env.reset(rng));
+            let states: Vec<usize> =
+                rollout(env, controller, start, len, rng).iter().map(|s| s.state).collect();
+            kept += usize::from(self.satisfied(&states));
+        }
+        kept as f64 / runs.max(1) as f64
+    }
+
     /// `eventually[0..=reach_by] Goal && always[0..] !Avoid` over runs of `len` states: the
     /// avoided states must not occur in the whole run, and the goal's window is clipped to
     /// it (a goal at step `len` or later is past the run's end).
@@ -188,19 +314,7 @@ impl ReachAvoidOptimum {
 
     /// Whether a run through `states` (from step 0) satisfies the task.
     pub fn satisfied(&self, states: &[usize]) -> bool {
-        let mut reached = false;
-        for (t, &s) in states.iter().enumerate().take(self.last + 1) {
-            if s >= self.dest.len() {
-                return false;
-            }
-            match self.task.settle(t, s, reached) {
-                (Some(v), _) => return v > 0.0,
-                (None, r) => reached = r,
-            }
-        }
-        // The run ended before the task was decided: the goal held but the avoided states
-        // could still come, which a run this short satisfies; or the goal never held.
-        reached
+        self.task.satisfied(states)
     }
 }
 

@@ -51,6 +51,10 @@ pub struct PrimitiveOption {
     pub init: Formula,
     /// Where it stops.
     pub terminate: Terminate,
+    /// A region the leg must stay out of (`avoid: R`): its flat reward also sees
+    /// `rho(!R, s')`, entering it costs as much as the worst state forever, and the leg
+    /// stops there. `None` (the paper's) leaves the leg alone.
+    pub avoid: Option<Formula>,
 }
 
 /// Where a primitive option terminates.
@@ -97,6 +101,11 @@ pub struct LearnParams {
     pub intra: Intra,
     /// How an option execution is rewarded.
     pub reward: RewardKind,
+    /// Counterfactual memory values per option execution (0: off, as in the paper): with
+    /// `memory` and `reward: window`, each execution also updates the options value of this
+    /// many other memory values it could have started with, drawn at random, as
+    /// counterfactual reward machines do.
+    pub counterfactual: usize,
     /// The flat (primitive) level; epsilon decays per primitive step.
     pub flat: LevelParams,
     /// The options level; epsilon decays per option choice.
@@ -153,6 +162,7 @@ impl Default for LearnParams {
             memory: 0,
             intra: Intra::Paper,
             reward: RewardKind::Segment,
+            counterfactual: 0,
             flat: LevelParams::FLAT,
             options: LevelParams::OPTIONS,
         }
@@ -234,6 +244,9 @@ impl TaskSpec {
             if let Terminate::Formula(f) = &p.terminate {
                 formulas.push(("terminate", f));
             }
+            if let Some(f) = &p.avoid {
+                formulas.push(("avoid", f));
+            }
             for (part, f) in formulas {
                 if !f.is_state_formula() {
                     return err(format!("the {part} formula of option {} is temporal", p.name));
@@ -286,6 +299,9 @@ impl TaskSpec {
             if !same {
                 return err("the regions do not match the task's conjuncts".into());
             }
+        }
+        if l.counterfactual > 0 && (l.memory == 0 || l.reward != RewardKind::Window) {
+            return err("counterfactual updates need memory and reward: window".into());
         }
         if (l.memory > 0 || l.reward == RewardKind::Window) && self.regions.is_empty() {
             return err("memory and reward: window need a task of the form always[0..] \

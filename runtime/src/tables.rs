@@ -17,8 +17,12 @@ pub(crate) struct Tables {
     pub trace: Trace,
     /// `reach[p][s]`: robustness of primitive `p`'s reach formula at `s`.
     pub reach: Vec<Vec<f64>>,
-    /// `term[p][s]`: primitive `p` stops at `s`.
+    /// `term[p][s]`: primitive `p` stops at `s` (also where it enters its avoided region).
     pub term: Vec<Vec<bool>>,
+    /// `ends[p][s]`: state `s` lies in primitive `p`'s avoided region (`avoid: R`,
+    /// `rho(R, s) >= 0`, as `always !R` fails there); `None` for a primitive without one.
+    /// Entering it ends the flat level's episode: `reach[p][s]` is then the whole value.
+    pub ends: Vec<Option<Vec<bool>>>,
     /// `legs[o]`: the primitives option `o` runs, in order.
     pub legs: Vec<Vec<usize>>,
     /// `available[s]`: the options whose first leg may start at `s`, in set order.
@@ -45,15 +49,29 @@ impl Tables {
         let mut reach = Vec::new();
         let mut init = Vec::new();
         let mut term = Vec::new();
+        // The termination sets of the formulas alone: a leg stopped by its avoided region
+        // hands over to the next leg wherever that is (the sequence check is about these).
+        let mut planned = Vec::new();
+        let mut ends = Vec::new();
+        let gamma = spec.learn.flat.gamma;
         for p in &spec.primitives {
-            let r = signal(&p.reach);
-            term.push(match &p.terminate {
+            let mut r = signal(&p.reach);
+            let mut stops: Vec<bool> = match &p.terminate {
                 Terminate::Argmax => {
                     let max = r.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                     r.iter().map(|&v| v == max).collect()
                 }
                 Terminate::Formula(f) => holds(f),
-            });
+            };
+            planned.push(stops.clone());
+            let inside = p.avoid.as_ref().map(|f| shape_avoid(&mut r, &signal(f), gamma, spec));
+            if let Some(inside) = &inside {
+                for (t, &a) in stops.iter_mut().zip(inside) {
+                    *t |= a;
+                }
+            }
+            term.push(stops);
+            ends.push(inside);
             init.push(holds(&p.init));
             reach.push(r);
         }
@@ -80,7 +98,7 @@ impl Tables {
         for (o, seq) in spec.options.iter().zip(&legs) {
             for pair in seq.windows(2) {
                 let (a, b) = (pair[0], pair[1]);
-                if (0..states).any(|s| term[a][s] && !init[b][s]) {
+                if (0..states).any(|s| planned[a][s] && !init[b][s]) {
                     return Err(Error::Spec(format!(
                         "in option {}, {} can terminate outside the initiation set of {}",
                         o.name, spec.primitives[a].name, spec.primitives[b].name
@@ -96,8 +114,34 @@ impl Tables {
                     .collect()
             })
             .collect();
-        Ok(Tables { states, actions, trace, reach, term, legs, available, remaining })
+        Ok(Tables { states, actions, trace, reach, term, ends, legs, available, remaining })
     }
+}
+
+/// Shapes a leg's flat reward `r` by its avoided region, whose robustness per state is
+/// `avoid`, and returns the states inside it (`rho >= 0`). Outside, the reward is
+/// `min(rho(reach), rho(!R))`: the leg keeps a margin. Inside, it is the worst reward of any
+/// state outside, less one, earned forever (`/ (1 - gamma)`; `max_steps` times when gamma
+/// is 1): entering is worse than any path that stays out.
+fn shape_avoid(r: &mut [f64], avoid: &[f64], gamma: f64, spec: &TaskSpec) -> Vec<bool> {
+    let inside: Vec<bool> = avoid.iter().map(|&a| a >= 0.0).collect();
+    for (v, &a) in r.iter_mut().zip(avoid) {
+        *v = v.min(-a);
+    }
+    let worst = r
+        .iter()
+        .zip(&inside)
+        .filter(|(v, i)| !**i && v.is_finite())
+        .map(|(v, _)| *v)
+        .fold(0.0f64, f64::min);
+    let forever = if gamma < 1.0 { 1.0 / (1.0 - gamma) } else { spec.learn.max_steps as f64 };
+    let penalty = (worst - 1.0) * forever;
+    for (v, &i) in r.iter_mut().zip(&inside) {
+        if i {
+            *v = penalty;
+        }
+    }
+    inside
 }
 
 /// Row `s`: the values of state `s` of `env` in the spec's variable order. Fails when a

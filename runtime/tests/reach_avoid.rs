@@ -5,6 +5,7 @@ use hstl_runtime::env::{Cell, Env};
 use hstl_runtime::eval::rollout;
 use hstl_runtime::optimum::Moves;
 use hstl_runtime::reach_avoid::{ReachAvoid, solve_reach_avoid};
+use hstl_runtime::robustness::{Bound, Expr, Formula, Interval};
 use hstl_runtime::{Error, GridWorld, seeded_rng};
 
 const BUDGET: usize = 1 << 24;
@@ -118,4 +119,114 @@ fn bad_tasks_are_errors() {
         panic!("a billion steps were solved");
     };
     assert!(message.contains("10000000010 states") && message.contains("limit of 16777216"));
+}
+
+/// `x op c` on the grid.
+fn cmp(var: usize, op: hstl_runtime::robustness::CmpOp, c: f64) -> Formula {
+    Formula::Cmp { lhs: Expr::Var(var), op, rhs: Expr::Const(c) }
+}
+
+/// The reach-avoid form is read off a task: one bounded `eventually` of a state formula and
+/// `always !R` conjuncts sharing one window; anything else is not of the form.
+#[test]
+fn the_reach_avoid_form_is_read_off_the_task() {
+    use hstl_runtime::reach_avoid::reach_avoid_form;
+    use hstl_runtime::robustness::CmpOp::{Gt, Lt};
+    let (goal, pit, pond) = (cmp(0, Gt, 11.0), cmp(1, Lt, 2.0), cmp(0, Lt, 2.0));
+    let ev = |end| Formula::Eventually(Interval { start: 0, end }, Box::new(goal.clone()));
+    let avoid = |end, r: &Formula| {
+        Formula::Always(Interval { start: 0, end }, Box::new(Formula::Not(Box::new(r.clone()))))
+    };
+    let task = Formula::And(vec![
+        ev(Bound::Inclusive(30)),
+        avoid(Bound::Unbounded, &pit),
+        avoid(Bound::Unbounded, &pond),
+    ]);
+    let form = reach_avoid_form(&task).expect("reach-avoid");
+    assert_eq!((form.reach_by, form.avoid_through), (30, None));
+    assert_eq!(form.avoid, [pit.clone(), pond.clone()]);
+    // `[0..30]` ends at step 29; a bounded avoid is kept.
+    let task = Formula::And(vec![ev(Bound::Exclusive(30)), avoid(Bound::Exclusive(41), &pit)]);
+    let form = reach_avoid_form(&task).expect("reach-avoid");
+    assert_eq!((form.reach_by, form.avoid_through), (29, Some(40)));
+    let not_of_the_form = [
+        // No avoided region, or no goal.
+        Formula::And(vec![ev(Bound::Inclusive(30))]),
+        Formula::And(vec![avoid(Bound::Unbounded, &pit)]),
+        // An unbounded goal, two windows for the avoided regions, a later start.
+        Formula::And(vec![ev(Bound::Unbounded), avoid(Bound::Unbounded, &pit)]),
+        Formula::And(vec![
+            ev(Bound::Inclusive(30)),
+            avoid(Bound::Unbounded, &pit),
+            avoid(Bound::Inclusive(9), &pond),
+        ]),
+        Formula::And(vec![
+            Formula::Eventually(
+                Interval { start: 2, end: Bound::Inclusive(30) },
+                Box::new(goal.clone()),
+            ),
+            avoid(Bound::Unbounded, &pit),
+        ]),
+        // `always R` without the negation.
+        Formula::And(vec![
+            ev(Bound::Inclusive(30)),
+            Formula::Always(Interval::ALL, Box::new(pit.clone())),
+        ]),
+    ];
+    for task in not_of_the_form {
+        assert!(reach_avoid_form(&task).is_none(), "{task:?}");
+    }
+}
+
+/// `ReachAvoid::of_spec` on the corridor: the goal where its robustness is above 0, the
+/// avoided cells where theirs is 0 or more (the boundary too); the satisfaction rate of the
+/// optimal controller is the optimum, within five standard deviations.
+#[test]
+fn a_spec_gives_its_reach_avoid_task_and_its_satisfaction_rate() {
+    use hstl_runtime::robustness::CmpOp::{Gt, Lt};
+    use hstl_runtime::{
+        CombinedOption, LearnParams, PrimitiveOption, StateVar, TaskSpec, Terminate,
+    };
+    let env = GridWorld::new(5, 1, 0.7).unwrap();
+    let goal = cmp(0, Gt, 3.0);
+    // x < 1 has robustness 0 at x = 1: x = 0 and x = 1 are avoided.
+    let pit = cmp(0, Lt, 1.0);
+    let task = Formula::And(vec![
+        Formula::Eventually(
+            Interval { start: 0, end: Bound::Inclusive(6) },
+            Box::new(goal.clone()),
+        ),
+        Formula::Always(Interval::ALL, Box::new(Formula::Not(Box::new(pit)))),
+    ]);
+    let spec = TaskSpec {
+        name: "Corridor".into(),
+        state_vars: vec![
+            StateVar { name: "x".into(), domain: Some(0..=4) },
+            StateVar { name: "y".into(), domain: Some(0..=0) },
+        ],
+        task,
+        primitives: vec![PrimitiveOption {
+            name: "Goal".into(),
+            reach: goal.clone(),
+            init: Formula::True,
+            terminate: Terminate::Formula(goal),
+            avoid: None,
+        }],
+        options: vec![CombinedOption { name: "Goal".into(), sequence: vec![0] }],
+        learn: LearnParams::default(),
+        regions: vec![],
+    };
+    let task = ReachAvoid::of_spec(&spec, &env, 20).unwrap().expect("reach-avoid");
+    assert_eq!(task.goal, [false, false, false, false, true]);
+    assert_eq!(task.avoid, [true, true, false, false, false]);
+    assert_eq!((task.reach_by, task.avoid_through, task.run_len()), (6, 19, 20));
+    let o = solve_reach_avoid(&Moves::of(&env), &task, BUDGET).unwrap();
+    let runs = 20_000;
+    let rate = task.satisfaction_rate(&env, &mut o.controller(), runs, &mut seeded_rng(3));
+    let sd = (o.probability * (1.0 - o.probability) / runs as f64).sqrt();
+    assert!((rate - o.probability).abs() < 5.0 * sd, "{rate} vs {}", o.probability);
+    // A task of another form has none.
+    let mut other = spec.clone();
+    other.task = Formula::Eventually(Interval::ALL, Box::new(cmp(0, Gt, 3.0)));
+    assert!(ReachAvoid::of_spec(&other, &env, 20).unwrap().is_none());
 }

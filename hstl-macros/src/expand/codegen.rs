@@ -795,12 +795,20 @@ impl<'a> Gen<'a> {
                     quote!(#hstl::runtime::Terminate::Formula(__b.build(#f)))
                 }
             };
+            let avoid = match &p.avoid {
+                Some(f) => {
+                    let f = self.formula_data(f, &mut data);
+                    quote!(::core::option::Option::Some(__b.build(#f)))
+                }
+                None => quote!(::core::option::Option::None),
+            };
             quote! {
                 #hstl::runtime::PrimitiveOption {
                     name: ::std::string::String::from(#name),
                     reach: __b.build(#reach),
                     init: __b.build(#init),
                     terminate: #terminate,
+                    avoid: #avoid,
                 }
             }
         });
@@ -850,6 +858,7 @@ impl<'a> Gen<'a> {
             Literal::u64_unsuffixed(l.max_steps),
             Literal::u64_unsuffixed(l.memory),
         );
+        let counterfactual = Literal::u64_unsuffixed(l.counterfactual);
         let intra = match l.intra {
             hstl_lang::Intra::Paper => quote!(Paper),
             hstl_lang::Intra::Remaining => quote!(Remaining),
@@ -884,6 +893,7 @@ impl<'a> Gen<'a> {
                             memory: #memory,
                             intra: #hstl::runtime::Intra::#intra,
                             reward: #hstl::runtime::RewardKind::#reward,
+                            counterfactual: #counterfactual,
                             flat: #flat,
                             options: #opts,
                         },

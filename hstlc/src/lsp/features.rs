@@ -325,12 +325,42 @@ pub fn hover(a: &Analysis, pos: Position) -> Option<Hover> {
     let option = a.occurrences_at(offset).find(|o| o.symbol.kind == SymKind::Option);
     let (range, text) = match option.or_else(|| a.symbol_at(offset)) {
         Some(o) => (o.range.clone(), symbol_hover(a, &o.symbol)?),
-        None => operator_hover(a, offset)?,
+        None => match preset_hover(a, offset) {
+            Some(found) => found,
+            None => operator_hover(a, offset)?,
+        },
     };
     Some(Hover {
         contents: HoverContents::Markup(MarkupContent { kind: MarkupKind::Markdown, value: text }),
         range: Some(a.conv.range(&a.text, &range)),
     })
+}
+
+/// On `preset` in a `learn` item (its name or its value): what the preset sets, and for
+/// `auto` what it expanded to in this spec.
+fn preset_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)> {
+    for (i, spec) in a.checked.file.specs.iter().enumerate() {
+        for item in &spec.items {
+            let Item::Learn(l) = item else { continue };
+            let Some(p) = l.params.iter().find(|p| {
+                p.name.name == "preset" && p.range.start <= offset && offset <= p.range.end
+            }) else {
+                continue;
+            };
+            let text = match a.checked_spec(i).and_then(|c| c.preset_expansion.as_ref()) {
+                Some(e) => format!(
+                    "**preset: auto**: the recommended settings for this task's form; values \
+                     written beside it override them. Here it stands for:\n```hstl\n{e}\n```"
+                ),
+                None => "**preset: paper** (the default): the paper's settings, Table II of \
+                         Li & Belta (2016); `preset: auto` fills in the recommended ones for the \
+                         task's form"
+                    .to_string(),
+            };
+            return Some((p.range.clone(), text));
+        }
+    }
+    None
 }
 
 fn snippet(text: &str, r: &Range<usize>) -> String {
@@ -421,12 +451,27 @@ fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
             out.push_str(&format!(
                 "- reach: `{reach}` (flat reward: its robustness after each step)\n"
             ));
+            // What `preset: auto` filled in, where the option leaves a field out.
+            let prim = checked.and_then(|c| c.primitives.iter().find(|p| p.name == s.name));
+            let filled_init = prim.is_some_and(|p| {
+                matches!(p.init.kind, hstl::lang::CFormulaKind::Not(_)) && field("init").is_none()
+            });
+            let filled_term = prim.is_some_and(|p| {
+                matches!(p.terminate, hstl::lang::Terminate::Formula(_))
+                    && field("terminate").is_none()
+            });
             match field("init") {
                 Some(init) => out.push_str(&format!("- init: `{init}`\n")),
+                None if filled_init => out.push_str(&format!(
+                    "- init: `!{reach}` (from `preset: auto`: not chosen inside its region)\n"
+                )),
                 None => out.push_str("- init: `true` (default: may start anywhere)\n"),
             }
             match field("terminate") {
                 Some(t) if t != "argmax" => out.push_str(&format!("- terminate: `{t}`\n")),
+                None if filled_term => out.push_str(&format!(
+                    "- terminate: `{reach}` (from `preset: auto`: stops on entering its region)\n"
+                )),
                 _ => out.push_str(&format!(
                     "- terminate: `argmax` (where the robustness of `{reach}` is largest over the declared domain)\n"
                 )),
@@ -434,6 +479,20 @@ fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
             if let Some(c) = checked
                 && let Some(p) = c.primitives.iter().position(|p| p.name == s.name)
             {
+                if let Some(avoid) = &c.primitives[p].avoid {
+                    let text = match field("avoid") {
+                        Some(t) => t,
+                        None => match &avoid.kind {
+                            hstl::lang::CFormulaKind::Let(k) => {
+                                c.lets.get(*k).map_or(String::new(), |l| l.name.clone())
+                            }
+                            _ => "the task's avoided regions (`preset: auto`)".to_string(),
+                        },
+                    };
+                    out.push_str(&format!(
+                        "- avoid: `{text}` (the leg's reward also sees its robustness, and the leg stops on entering it)\n"
+                    ));
+                }
                 let seqs: Vec<String> = c
                     .options
                     .iter()

@@ -420,6 +420,42 @@ fn keystrokes_publish_checks_diagnostics() {
     c.shutdown();
 }
 
+/// Hover on `preset` shows what it stands for in this spec; on an option, the `avoid` it
+/// was given.
+#[test]
+fn hover_on_preset_shows_its_expansion() {
+    const PRESET: &str = "spec R {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let Goal = x > 11 && y > 11;
+    let Pit = 5 < x < 9 && 5 < y < 9;
+    task eventually[0..=30] Goal && always !Pit;
+    option Goal;
+    learn { preset: auto }
+}
+";
+    let (mut c, _) = Client::start(json!({}));
+    assert_eq!(c.open(PRESET), Vec::<Value>::new());
+    let (line, col) = pos_of(PRESET, "preset", 0, 2);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("preset: auto") && text.contains("avoid: Pit"), "{text}");
+    assert!(text.contains("episodes: 6000, choices: 10"), "{text}");
+    let (line, col) = pos_of(PRESET, "option Goal", 0, 7);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("- avoid: `Pit`"), "{text}");
+    assert!(text.contains("- terminate: `Goal` (from `preset: auto`"), "{text}");
+    assert!(text.contains("- init: `true` (default"), "{text}");
+    // `preset: paper` (the default) says so.
+    let paper = PRESET.replace("preset: auto", "preset: paper");
+    c.change(2, &paper);
+    let (line, col) = pos_of(&paper, "paper", 0, 1);
+    let text =
+        c.at("textDocument/hover", line, col).result.unwrap()["contents"]["value"].to_string();
+    assert!(text.contains("preset: paper") && text.contains("Table II"), "{text}");
+    c.shutdown();
+}
+
 /// A tall formula (250 nested `!`, under the parser's height limit) and a long `&&`
 /// chain: hover, references and symbols answer from the innermost name outwards (the
 /// walks keep their own stacks).

@@ -85,6 +85,7 @@ pub fn case_study(permutations: bool, entry: bool) -> TaskSpec {
             reach: f.clone(),
             init: Formula::bool(true),
             terminate: if entry { Terminate::Formula(f.clone()) } else { Terminate::Argmax },
+            avoid: None,
         })
         .collect();
     let options = option_set(3, permutations)

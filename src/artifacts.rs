@@ -1,19 +1,21 @@
-//! What `train` and `study` write: pictures of a trained agent, the learning curve, and the
-//! all-or-nothing write of an output folder ([`OutDir`]).
+//! What a trained agent's output folder holds, as plain data: the pictures of the paper's
+//! Figures 2 and 3 (flat policies, the options policy, sample runs, the learning curve) and
+//! the learning curve as CSV, each an [`OutFile`] (a name and its bytes). `hstlc train`,
+//! `hstlc study` and the Python package's `hstl.study` make their files here and write them
+//! through `hstl-outdir`, so the folders they write are the same, byte for byte.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use hstl::robustness::{Formula, Trace, reference};
-use hstl::runtime::eval::{AgentController, sample_runs};
-use hstl::runtime::{Agent, Env, GridWorld, Rng, TaskSpec};
+use hstl_lang::{CFormula, CFormulaKind, CheckedSpec, LetKind};
 use hstl_pictures as pic;
+use hstl_robustness::{Formula, Trace, reference};
+use hstl_runtime::eval::{AgentController, sample_runs};
+use hstl_runtime::{Agent, Env, GridWorld, Rng, TaskSpec};
 
-use hstl::lang::{CFormula, CFormulaKind, CheckedSpec, LetKind};
-
-use crate::cli_error::CliError;
-use crate::spec_file::LoadedSpec;
+use crate::Problem;
 
 /// A file to write: its name inside the output folder and its bytes.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OutFile {
     /// The file name, such as `policy.json`.
     pub name: String,
@@ -26,282 +28,6 @@ impl OutFile {
     pub fn text(name: impl Into<String>, text: String) -> OutFile {
         OutFile { name: name.into(), contents: text.into_bytes() }
     }
-}
-
-/// The file that marks a folder as one run's output: a later run may replace the folder.
-pub const MARKER: &str = ".hstlc-run";
-
-/// An output folder that this run holds (see [`OutDir::lock`]) and will write whole.
-///
-/// The files go to a hidden sibling folder first, each one synced to disk; then the folder
-/// is synced and renamed into place. A folder an earlier run wrote is moved aside just
-/// before and removed just after, so at every moment `dir` is the old run's folder, no
-/// folder, or the new run's folder, never a mix. A run killed on the way leaves only hidden
-/// siblings (`.NAME.tmp-*`, `.NAME.old-*`), which the next run into `dir` removes. Another
-/// run into the same folder is refused while this one holds it: the lock is the operating
-/// system's lock on `.NAME.lock` beside the folder, released when the process ends however
-/// it ends, so a killed run leaves no stale lock.
-pub struct OutDir {
-    dir: PathBuf,
-    parent: PathBuf,
-    name: String,
-    /// Holds the lock while this value lives.
-    _lock: std::fs::File,
-}
-
-impl OutDir {
-    /// Takes the folder `dir` for this run: refuses it when another run holds it, or when
-    /// it holds files no run writes (it will be replaced as a whole). Call it before the
-    /// long work, so that a refusal comes at once.
-    pub fn lock(dir: &Path) -> Result<OutDir, CliError> {
-        let write_err = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| CliError::Write { path, source }
-        };
-        // `--out .`, or a symbolic link: the folder it names.
-        let dir = if dir.file_name().is_none() || dir.is_symlink() {
-            std::fs::canonicalize(dir).map_err(write_err(dir))?
-        } else {
-            dir.to_path_buf()
-        };
-        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let parent = match dir.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        std::fs::create_dir_all(&parent).map_err(write_err(&dir))?;
-        let lock_path = parent.join(format!(".{name}.lock"));
-        let lock = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&lock_path)
-            .map_err(write_err(&lock_path))?;
-        match lock.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                return Err(CliError::new(
-                    format!("`{}` is being written by another hstlc run", dir.display()),
-                    Some("wait for that run to finish, or choose another `--out`".to_string()),
-                ));
-            }
-            // A file system without locks: go on without one.
-            Err(std::fs::TryLockError::Error(_)) => {}
-        }
-        // This run holds the folder: hidden siblings left by killed runs are stale.
-        if let Ok(entries) = std::fs::read_dir(&parent) {
-            let (tmp, old) = (format!(".{name}.tmp-"), format!(".{name}.old-"));
-            for entry in entries.flatten() {
-                let n = entry.file_name().to_string_lossy().into_owned();
-                if n.starts_with(&tmp) || n.starts_with(&old) {
-                    let _ = std::fs::remove_dir_all(entry.path());
-                }
-            }
-        }
-        let out = OutDir { dir, parent, name, _lock: lock };
-        out.replaceable()?;
-        Ok(out)
-    }
-
-    /// Writes `files` as the folder, whole or not at all (see [`OutDir`]); the paths
-    /// written, in order.
-    pub fn write(self, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
-        check_names(files)?;
-        self.replaceable()?;
-        let tmp = unique_sibling(&self.parent, &format!(".{}.tmp-", self.name), true)
-            .map_err(|source| CliError::Write { path: self.dir.clone(), source })?;
-        let guard = RemoveOnDrop(Some(tmp.clone()));
-        for file in files {
-            let path = tmp.join(&file.name);
-            write_synced(&path, &file.contents)
-                .map_err(|source| CliError::Write { path: self.dir.join(&file.name), source })?;
-        }
-        let marker = "This folder is one run of hstlc, written as a whole; the next run into it \
-                      replaces it.\n";
-        write_synced(&tmp.join(MARKER), marker.as_bytes())
-            .map_err(|source| CliError::Write { path: self.dir.join(MARKER), source })?;
-        sync_dir(&tmp);
-        let swap_err = |source| CliError::Write { path: self.dir.clone(), source };
-        if std::fs::symlink_metadata(&self.dir).is_ok() {
-            let old = unique_sibling(&self.parent, &format!(".{}.old-", self.name), false)
-                .map_err(swap_err)?;
-            std::fs::rename(&self.dir, &old).map_err(swap_err)?;
-            if let Err(source) = std::fs::rename(&tmp, &self.dir) {
-                // Put the old run back.
-                let _ = std::fs::rename(&old, &self.dir);
-                return Err(swap_err(source));
-            }
-            sync_dir(&self.parent);
-            let _ = std::fs::remove_dir_all(&old);
-        } else {
-            std::fs::rename(&tmp, &self.dir).map_err(swap_err)?;
-            sync_dir(&self.parent);
-        }
-        std::mem::forget(guard);
-        Ok(files.iter().map(|f| self.dir.join(&f.name)).collect())
-    }
-
-    /// The folder to be written.
-    pub fn path(&self) -> &Path {
-        &self.dir
-    }
-
-    /// Refuses a folder this run may not replace: a file, or a folder holding anything
-    /// that is not a run's output (a folder that an older hstlc wrote, before the marker,
-    /// holds only files named as a run's).
-    fn replaceable(&self) -> Result<(), CliError> {
-        let meta = match std::fs::symlink_metadata(&self.dir) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-            Err(source) => return Err(CliError::Write { path: self.dir.clone(), source }),
-            Ok(meta) => meta,
-        };
-        if !meta.is_dir() {
-            return Err(CliError::new(
-                format!("`{}` is a file, not a folder", self.dir.display()),
-                Some("choose another `--out`".to_string()),
-            ));
-        }
-        let entries = std::fs::read_dir(&self.dir)
-            .map_err(|source| CliError::Write { path: self.dir.clone(), source })?;
-        let mut foreign = Vec::new();
-        for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if name == MARKER {
-                return Ok(());
-            }
-            let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-            if !(is_file && is_run_file(&name)) {
-                foreign.push(format!("`{name}`"));
-            }
-        }
-        if foreign.is_empty() {
-            return Ok(());
-        }
-        foreign.sort();
-        let shown = foreign.len().min(5);
-        let more = if foreign.len() > shown {
-            format!(" and {} more", foreign.len() - shown)
-        } else {
-            String::new()
-        };
-        Err(CliError::new(
-            format!(
-                "`{}` holds {}{more}, which no hstlc run writes",
-                self.dir.display(),
-                foreign[..shown].join(", ")
-            ),
-            Some(
-                "hstlc replaces its output folder as a whole: choose a new or empty `--out`, \
-                 or move those out of it"
-                    .to_string(),
-            ),
-        ))
-    }
-}
-
-/// Writes `files` into the folder `dir` (made if missing) beside what it holds, each file
-/// whole or not at all (written to a hidden temporary file, synced, renamed over the old
-/// one): for files such as a study's `curves.svg` that sit beside the runs' folders.
-pub fn write_beside(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, CliError> {
-    check_names(files)?;
-    let err = |path: PathBuf| move |source| CliError::Write { path, source };
-    std::fs::create_dir_all(dir).map_err(err(dir.to_path_buf()))?;
-    let mut written = Vec::new();
-    for file in files {
-        let path = dir.join(&file.name);
-        let tmp = (0..1000)
-            .map(|n| dir.join(format!(".{}.{}-{n}.tmp", file.name, std::process::id())))
-            .find(|p| std::fs::symlink_metadata(p).is_err())
-            .ok_or_else(|| {
-                err(path.clone())(std::io::Error::new(
-                    std::io::ErrorKind::AlreadyExists,
-                    "no free temporary name",
-                ))
-            })?;
-        if let Err(source) = write_synced(&tmp, &file.contents) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(CliError::Write { path, source });
-        }
-        if let Err(source) = std::fs::rename(&tmp, &path) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(CliError::Write { path, source });
-        }
-        written.push(path);
-    }
-    sync_dir(dir);
-    Ok(written)
-}
-
-/// Removes a folder when dropped (a write that failed half way), unless forgotten.
-struct RemoveOnDrop(Option<PathBuf>);
-
-impl Drop for RemoveOnDrop {
-    fn drop(&mut self) {
-        if let Some(path) = self.0.take() {
-            let _ = std::fs::remove_dir_all(path);
-        }
-    }
-}
-
-/// Whether a run of this or an earlier hstlc writes a file of this name.
-fn is_run_file(name: &str) -> bool {
-    matches!(name, "policy.json" | "curve.csv" | "seeds.csv")
-        || name.ends_with(".svg")
-        || (name.starts_with('.') && name.ends_with(".tmp"))
-}
-
-/// Refuses names that are not plain file names, or that two files share (also when they
-/// differ only in case, as they would on a case-insensitive file system).
-fn check_names(files: &[OutFile]) -> Result<(), CliError> {
-    let mut seen = std::collections::HashSet::new();
-    for f in files {
-        let plain = !f.name.is_empty()
-            && f.name != "."
-            && f.name != ".."
-            && f.name != MARKER
-            && f.name.len() <= 255
-            && !f.name.contains(['/', '\\', '\0']);
-        if !plain || !seen.insert(f.name.to_lowercase()) {
-            return Err(CliError::new(
-                format!("cannot write `{}`: the name is not a plain file name of its own", f.name),
-                None,
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Creates a new, empty file (never an existing one), writes `bytes` and syncs them.
-fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(path)?;
-    file.write_all(bytes)?;
-    file.sync_all()
-}
-
-/// Syncs a folder's entries to disk, where the file system allows it.
-pub fn sync_dir(dir: &Path) {
-    if let Ok(d) = std::fs::File::open(dir) {
-        let _ = d.sync_all();
-    }
-}
-
-/// A path `parent/PREFIX<pid>-<n>` that no entry has, created as a folder when `create`.
-fn unique_sibling(parent: &Path, prefix: &str, create: bool) -> std::io::Result<PathBuf> {
-    for n in 0..1000 {
-        let path = parent.join(format!("{prefix}{}-{n}", std::process::id()));
-        if create {
-            match std::fs::create_dir(&path) {
-                Ok(()) => return Ok(path),
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(e),
-            }
-        } else if std::fs::symlink_metadata(&path).is_err() {
-            return Ok(path);
-        }
-    }
-    Err(std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name"))
 }
 
 /// What the pictures of a trained agent say about where they come from.
@@ -368,7 +94,7 @@ pub fn agent_pictures(
     agent: &Agent,
     captions: &Captions,
     rng: &mut Rng,
-) -> Result<Vec<OutFile>, CliError> {
+) -> Result<Vec<OutFile>, Problem> {
     let title = |what: &str| format!("{}: {what}\n{}", captions.subject, captions.note);
     let cells = cells(env);
     let states = state_trace(spec, env)?;
@@ -440,7 +166,7 @@ fn run_steps(
     env: &GridWorld,
     cells: &[(i64, i64)],
     names: &[String],
-    run: &[hstl::runtime::eval::Step],
+    run: &[hstl_runtime::eval::Step],
 ) -> Vec<pic::RunStep> {
     let cell = |s: usize| cells.get(s).copied().unwrap_or((-1, -1));
     let name = |o: usize| names.get(o).cloned().unwrap_or_default();
@@ -463,7 +189,7 @@ fn run_steps(
 }
 
 /// The learning curve of one or more seeds (a band over seeds), as in the paper's Figure 3.
-pub fn curve_picture(title: &str, curves: &[Vec<f64>]) -> Result<OutFile, CliError> {
+pub fn curve_picture(title: &str, curves: &[Vec<f64>]) -> Result<OutFile, Problem> {
     let smooth = (curves.first().map_or(0, Vec::len) / 60).max(1);
     let svg = pic::learning_curve(title, curves, smooth).map_err(picture_error)?;
     Ok(OutFile::text("curve.svg", svg))
@@ -529,20 +255,18 @@ fn picture_grid(
 /// every state `let` the task names, directly or through temporal lets: to avoid when the
 /// task only negates it (an obstacle in `always !Obstacle`), another region otherwise.
 /// Lets used only inside other state lets are not drawn.
-pub fn pictured_regions(loaded: &LoadedSpec) -> Result<Vec<PicturedRegion>, CliError> {
-    let spec = &loaded.spec;
-    let lower_err =
-        |e: hstl::lower::LowerError| CliError::new(format!("{}: {e}", loaded.file), None);
+pub fn pictured_regions(spec: &CheckedSpec, file: &str) -> Result<Vec<PicturedRegion>, Problem> {
+    let lower_err = |e: crate::lower::LowerError| Problem::new(format!("{file}: {e}"), None);
     let mut out: Vec<PicturedRegion> = Vec::new();
     for p in &spec.primitives {
-        let formula = hstl::lower::formula(spec, &p.reach).ok_or_else(|| {
-            lower_err(hstl::lower::LowerError::Invalid { spec: spec.name.clone() })
+        let formula = crate::lower::formula(spec, &p.reach).ok_or_else(|| {
+            lower_err(crate::lower::LowerError::Invalid { spec: spec.name.clone() })
         })?;
         out.push(PicturedRegion { name: p.name.clone(), formula, kind: pic::RegionKind::Reach });
     }
     for (i, negated_only) in task_lets(spec) {
         let Some(l) = spec.lets.get(i) else { continue };
-        let formula = hstl::lower::let_formula(spec, &l.name).map_err(lower_err)?;
+        let formula = crate::lower::let_formula(spec, &l.name).map_err(lower_err)?;
         // An option's region drawn already under the option's name.
         if out.iter().any(|r| r.formula == formula) {
             continue;
@@ -617,8 +341,8 @@ fn cells(env: &GridWorld) -> Vec<(i64, i64)> {
 
 /// Every state of `env` as one step of a trace (step `s` is state index `s`), in the
 /// spec's variable order (the facade's, which `eval` uses too).
-pub fn state_trace(spec: &TaskSpec, env: &GridWorld) -> Result<Trace, CliError> {
-    Ok(hstl::evaluate::state_trace(spec, env)?)
+pub fn state_trace(spec: &TaskSpec, env: &GridWorld) -> Result<Trace, Problem> {
+    crate::evaluate::state_trace(spec, env)
 }
 
 /// The cells where the state formula `f` holds.
@@ -659,14 +383,13 @@ fn uniquify(files: &mut [OutFile]) {
     }
 }
 
-fn picture_error(e: pic::PictureError) -> CliError {
-    CliError::new(format!("cannot draw a picture: {e}"), None)
+fn picture_error(e: pic::PictureError) -> Problem {
+    Problem::new(format!("cannot draw a picture: {e}"), None)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::world_arg::LoadedWorld;
 
     fn kinds(task: &str) -> Vec<(String, pic::RegionKind)> {
         let source = format!(
@@ -677,13 +400,14 @@ mod tests {
              let Safe = always[0..20] !Obstacle;\n    task {task};\n    \
              option Goal;\n    options {{ Goal }}\n}}\n"
         );
-        let dir = tempfile::tempdir().expect("temp dir");
-        let path = dir.path().join("kinds.hstl");
-        std::fs::write(&path, source).expect("write the spec");
-        let world = LoadedWorld::load("paper").expect("paper");
-        let loaded =
-            crate::spec_file::load(&path, None, Some(&world)).expect("loads").expect("checks");
-        pictured_regions(&loaded).expect("regions").into_iter().map(|r| (r.name, r.kind)).collect()
+        let world = GridWorld::builtin("paper").expect("paper");
+        let loaded = crate::load::load_in_world(&source, None, &world, "world `paper`")
+            .unwrap_or_else(|e| panic!("{e}"));
+        pictured_regions(&loaded.spec, "kinds.hstl")
+            .expect("regions")
+            .into_iter()
+            .map(|r| (r.name, r.kind))
+            .collect()
     }
 
     #[test]
