@@ -468,3 +468,111 @@ fn write_errors_are_errors_and_a_closed_pipe_ends_quietly() {
         assert_eq!((status, stderr.as_str()), (Some(141), ""), "{args:?}");
     }
 }
+
+/// `SMALL` with `lets` added and region `B` replaced by `region`.
+fn small_with(lets: &str, region: &str) -> String {
+    SMALL.replace("let B = x > 11 && y > 11;", &format!("{lets}let B = {region};")).replace(
+        "learn { episodes: 5, choices: 5 }",
+        "learn { episodes: 3, choices: 5, memory: 2 }",
+    )
+}
+
+/// Classes 1 and 2: lets are shared, not inlined, and nothing recurses as deep as a chain
+/// of them. A doubling chain of 30 lets (a tree of 2^29 atoms) and 80 lets of 250 `!`
+/// each (a chain 20,000 deep) run through `monitor`, `train`, `eval` (the spec read back
+/// from `policy.json`) and `study`, with the values of the equivalent small spec; a chain
+/// of 300 lets checks clean and monitors.
+#[test]
+fn shared_and_deep_lets_run_in_linear_time() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let mut doubling = String::from("let L0 = x > 11 && y > 11;\n");
+    for k in 1..30 {
+        doubling.push_str(&format!("let L{k} = L{} && L{};\n", k - 1, k - 1));
+    }
+    let mut deep = String::from("let M0 = x > 11 && y > 11;\n");
+    for k in 1..=80 {
+        deep.push_str(&format!("let M{k} = {}M{};\n", "!".repeat(250), k - 1));
+    }
+    let mut temporal = String::from("let T0 = x > 11 && y > 11;\n");
+    for k in 1..=80 {
+        temporal.push_str(&format!("let T{k} = {}T{};\n", "always[0..=0] ".repeat(250), k - 1));
+    }
+    write(d, "plain.hstl", small_with("", "x > 11 && y > 11"));
+    write(
+        d,
+        "temporal.hstl",
+        format!("spec T {{ state {{ x: int in 0..=14, y: int in 0..=14 }} {temporal} task T80; }}"),
+    );
+    write(d, "doubling.hstl", small_with(&doubling, "L29"));
+    write(d, "deep.hstl", small_with(&deep, "M80"));
+    let rows: String = (0..200).map(|t| format!("{},{}\n", t % 15, (t * 7) % 15)).collect();
+    write(d, "t.csv", format!("x,y\n{rows}"));
+    let monitor = |spec: &str, formula: &str| {
+        let run = hstlc_in(d, &["monitor", spec, "--trace", "t.csv", "--formula", formula], b"");
+        assert_eq!(run.status, Some(0), "{spec}: {}", run.stderr);
+        run.stdout
+    };
+    let want = monitor("plain.hstl", "B");
+    assert_eq!(monitor("doubling.hstl", "L29"), want);
+    assert_eq!(monitor("deep.hstl", "M80"), want);
+    // 20,000 nested windows (no NaN in the trace, so each is the identity), also online.
+    assert_eq!(monitor("temporal.hstl", "T80"), want);
+    let signal = |args: &[&str]| {
+        let run = hstlc_in(d, args, b"");
+        assert_eq!(run.status, Some(0), "{args:?}: {}", run.stderr);
+        run.stdout
+    };
+    let base = ["monitor", "temporal.hstl", "--trace", "t.csv", "--formula", "T80", "--signal"];
+    let plain = ["monitor", "plain.hstl", "--trace", "t.csv", "--formula", "B", "--signal"];
+    assert_eq!(signal(&base), signal(&plain));
+    let rows = std::fs::read(d.join("t.csv")).expect("trace");
+    let online = hstlc_in(
+        d,
+        &["monitor", "temporal.hstl", "--trace", "-", "--formula", "T80", "--online"],
+        &rows,
+    );
+    let plain_online = hstlc_in(
+        d,
+        &["monitor", "plain.hstl", "--trace", "-", "--formula", "B", "--online"],
+        &rows,
+    );
+    assert_eq!(online.status, Some(0), "{}", online.stderr);
+    assert_eq!(online.stdout, plain_online.stdout);
+    let task = hstlc_in(d, &["monitor", "plain.hstl", "--trace", "t.csv", "--signal"], b"");
+    for spec in ["doubling.hstl", "deep.hstl"] {
+        let run = hstlc_in(d, &["monitor", spec, "--trace", "t.csv", "--signal"], b"");
+        assert_eq!((run.status, &run.stdout), (Some(0), &task.stdout), "{spec}: {}", run.stderr);
+        // Training, and the policy replayed from the spec it holds, as the plain spec's.
+        let out = format!("run_{spec}");
+        let run = hstlc_in(d, &["train", spec, "--out", &out, "--seed", "3"], b"");
+        assert_eq!(run.status, Some(0), "{spec}: {}", run.stderr);
+        let policy = format!("{out}/policy.json");
+        let run = hstlc_in(d, &["eval", &policy, "--no-optimum", "--starts", "2"], b"");
+        assert_eq!(run.status, Some(0), "{spec}: {}", run.stderr);
+        let study = format!("study_{spec}");
+        let run =
+            hstlc_in(d, &["study", spec, "--seeds", "1", "--no-optimum", "--out", &study], b"");
+        assert_eq!(run.status, Some(0), "{spec}: {}", run.stderr);
+    }
+    let trained = |spec: &str| {
+        let out = format!("same_{spec}");
+        let run = hstlc_in(d, &["train", spec, "--out", &out, "--seed", "3"], b"");
+        assert_eq!(run.status, Some(0), "{spec}: {}", run.stderr);
+        let text = std::fs::read_to_string(d.join(out).join("policy.json")).expect("policy");
+        let policy: serde_json::Value = serde_json::from_str(&text).expect("policy is JSON");
+        policy["q_tables"].clone()
+    };
+    // The same task, so the same draws and the same tables, bit for bit.
+    assert_eq!(trained("deep.hstl"), trained("plain.hstl"));
+
+    // A chain of 300 lets (the old limit was 256): `check` and `monitor` agree.
+    let mut chain = String::from("let C0 = x > 11;\n");
+    for k in 1..300 {
+        chain.push_str(&format!("let C{k} = C{} && y > 11;\n", k - 1));
+    }
+    write(d, "chain.hstl", small_with(&chain, "C299"));
+    let run = hstlc_in(d, &["check", "chain.hstl"], b"");
+    assert_eq!((run.status, run.stdout.as_str()), (Some(0), "checked 1 file: no problems\n"));
+    assert_eq!(monitor("chain.hstl", "C299"), want);
+}

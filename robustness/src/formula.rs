@@ -139,15 +139,22 @@ pub struct Interval {
 /// nodes are exactly those reachable from the root, in a canonical order (children
 /// before parents, in the order of a depth-first walk from the root), so two formulas
 /// are equal exactly when they denote the same formula tree.
+///
+/// A formula is immutable and shares its nodes: cloning one is cheap.
 #[derive(Clone)]
 pub struct Formula {
+    inner: std::sync::Arc<Inner>,
+}
+
+/// A [`Formula`]'s nodes and what the evaluators read off them once.
+struct Inner {
     nodes: Vec<Node>,
     root: u32,
     /// `horizon[i]`: the horizon of node `i` (`Some(0)` for expressions).
     horizon: Vec<Option<usize>>,
     /// `state[i]`: node `i` has no temporal operator below it.
     state: Vec<bool>,
-    pub(crate) plan: crate::offline::Plan,
+    plan: crate::offline::Plan,
 }
 
 /// An arithmetic expression over the state variables of one sample: a DAG of expression
@@ -158,7 +165,7 @@ pub struct Expr {
     root: u32,
 }
 
-/// Builds formulas node by node, sharing equal nodes.
+/// Builds formulas node by node, sharing equal nodes (and dropping double negations).
 ///
 /// Every method adds (or finds) one node and returns its id; [`FormulaBuilder::build`]
 /// then takes the formula under one root. A builder may hold many formulas that share
@@ -270,8 +277,11 @@ impl FormulaBuilder {
         self.f(Node::Cmp { lhs, op, rhs })
     }
 
-    /// `!f`.
+    /// `!f`. Negation is exact, so `!!g` is `g` itself: a chain of `!` is at most one node.
     pub fn not(&mut self, f: NodeId) -> NodeId {
+        if let Some(Node::Not(g)) = self.nodes.get(f.index()) {
+            return *g;
+        }
         self.f(Node::Not(f))
     }
 
@@ -332,7 +342,7 @@ impl FormulaBuilder {
 
     /// Adds every node of `f`; returns the id of its root.
     pub fn formula(&mut self, f: &Formula) -> NodeId {
-        NodeId(self.insert(&f.nodes, f.root))
+        NodeId(self.insert(&f.inner.nodes, f.inner.root))
     }
 
     /// Adds every node of `e`; returns the id of its root.
@@ -701,78 +711,98 @@ impl Formula {
             state.push(s);
         }
         let plan = crate::offline::Plan::new(&nodes, root as usize, &horizon, &state);
-        Formula { nodes, root, horizon, state, plan }
+        Formula { inner: std::sync::Arc::new(Inner { nodes, root, horizon, state, plan }) }
     }
 
     /// The nodes, children before parents; the last one is the root.
     pub fn nodes(&self) -> &[Node] {
-        &self.nodes
+        &self.inner.nodes
     }
 
     /// The root node's id.
     pub fn root(&self) -> NodeId {
-        NodeId(self.root)
+        NodeId(self.inner.root)
     }
 
     /// The root node.
     pub fn root_node(&self) -> &Node {
-        &self.nodes[self.root as usize]
+        &self.inner.nodes[self.inner.root as usize]
     }
 
     /// The number of distinct nodes (a shared subformula counts once).
     pub fn len(&self) -> usize {
-        self.nodes.len()
+        self.inner.nodes.len()
     }
 
     /// Always false: a formula has at least its root.
     pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
+        self.inner.nodes.is_empty()
     }
 
     /// The formula under node `id` of this formula.
     pub fn sub(&self, id: NodeId) -> Formula {
-        let (nodes, root) = extract(&self.nodes, id.0);
+        let (nodes, root) = extract(&self.inner.nodes, id.0);
         Formula::from_nodes(nodes, root)
     }
 
     /// The expression under expression node `id` of this formula.
     pub fn expr_at(&self, id: ExprId) -> Expr {
-        let (nodes, root) = extract(&self.nodes, id.0);
+        let (nodes, root) = extract(&self.inner.nodes, id.0);
         Expr { nodes, root }
     }
 
     /// The formula's horizon: how many steps past `t` its robustness at `t` may read.
     /// `None` means infinite.
     pub fn horizon(&self) -> Option<usize> {
-        self.horizon[self.root as usize]
+        self.inner.horizon[self.inner.root as usize]
     }
 
     /// The horizon of node `id`.
     pub fn horizon_of(&self, id: NodeId) -> Option<usize> {
-        self.horizon[id.index()]
+        self.inner.horizon[id.index()]
+    }
+
+    /// The number of nodes of the formula written out as a tree (a shared node counted at
+    /// each use), saturating at `u64::MAX`: what [`Formula::display_with`] writes is about
+    /// this long. A chain of lets that each use the previous twice doubles it per let.
+    pub fn tree_len(&self) -> u64 {
+        let mut size: Vec<u64> = Vec::with_capacity(self.inner.nodes.len());
+        for node in &self.inner.nodes {
+            let s = node.children().fold(1u64, |acc, k| acc.saturating_add(size[k]));
+            size.push(s);
+        }
+        size[self.inner.root as usize]
     }
 
     /// The largest state-variable index the formula reads, if it reads any.
     pub fn max_var(&self) -> Option<usize> {
-        self.nodes.iter().filter_map(|n| if let Node::Var(i) = n { Some(*i) } else { None }).max()
+        self.inner
+            .nodes
+            .iter()
+            .filter_map(|n| if let Node::Var(i) = n { Some(*i) } else { None })
+            .max()
     }
 
     /// Whether the formula has no temporal operator: its robustness at `t` reads `s_t` only.
     pub fn is_state_formula(&self) -> bool {
-        self.state[self.root as usize]
+        self.inner.state[self.inner.root as usize]
     }
 
     /// Whether node `id` has no temporal operator below it.
     pub fn is_state(&self, id: NodeId) -> bool {
-        self.state[id.index()]
+        self.inner.state[id.index()]
     }
 
     pub(crate) fn horizons(&self) -> &[Option<usize>] {
-        &self.horizon
+        &self.inner.horizon
     }
 
     pub(crate) fn states(&self) -> &[bool] {
-        &self.state
+        &self.inner.state
+    }
+
+    pub(crate) fn plan(&self) -> &crate::offline::Plan {
+        &self.inner.plan
     }
 
     fn one(node: impl FnOnce(&mut FormulaBuilder) -> NodeId) -> Formula {
@@ -795,6 +825,8 @@ impl Formula {
     }
 
     /// `!f`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn not(f: Formula) -> Formula {
         Formula::one(|b| {
             let f = b.formula(&f);
@@ -893,7 +925,7 @@ impl Formula {
     /// Whether some node is a past-time operator: then `rho(f, t)` also reads steps before
     /// `t`, and a suffix of a trace does not give the signal's values.
     pub fn has_past(&self) -> bool {
-        self.nodes.iter().any(Node::is_past)
+        self.nodes().iter().any(Node::is_past)
     }
 }
 
@@ -901,7 +933,7 @@ impl std::ops::Index<NodeId> for Formula {
     type Output = Node;
 
     fn index(&self, id: NodeId) -> &Node {
-        &self.nodes[id.index()]
+        &self.inner.nodes[id.index()]
     }
 }
 
@@ -909,20 +941,23 @@ impl std::ops::Index<ExprId> for Formula {
     type Output = Node;
 
     fn index(&self, id: ExprId) -> &Node {
-        &self.nodes[id.index()]
+        &self.inner.nodes[id.index()]
     }
 }
 
 /// Equal when both denote the same formula tree (constants compared by their bits).
 impl PartialEq for Formula {
     fn eq(&self, other: &Formula) -> bool {
-        self.root == other.root && self.nodes == other.nodes
+        self.inner.root == other.inner.root && self.inner.nodes == other.inner.nodes
     }
 }
 
 impl fmt::Debug for Formula {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("Formula").field("nodes", &self.nodes).field("root", &self.root).finish()
+        f.debug_struct("Formula")
+            .field("nodes", &self.inner.nodes)
+            .field("root", &self.inner.root)
+            .finish()
     }
 }
 
@@ -964,6 +999,8 @@ impl Expr {
     }
 
     /// `-e`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn neg(e: Expr) -> Expr {
         e.unary(FormulaBuilder::neg)
     }
@@ -979,21 +1016,29 @@ impl Expr {
     }
 
     /// `a + b`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn add(a: Expr, b: Expr) -> Expr {
         a.binary(b, FormulaBuilder::add_expr)
     }
 
     /// `a - b`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn sub(a: Expr, b: Expr) -> Expr {
         a.binary(b, FormulaBuilder::sub_expr)
     }
 
     /// `a * b`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn mul(a: Expr, b: Expr) -> Expr {
         a.binary(b, FormulaBuilder::mul_expr)
     }
 
     /// `a / b`.
+    // A constructor named after the operator it builds, not an operator on values.
+    #[allow(clippy::should_implement_trait)]
     pub fn div(a: Expr, b: Expr) -> Expr {
         a.binary(b, FormulaBuilder::div_expr)
     }
@@ -1078,7 +1123,7 @@ pub struct Display<'a> {
 impl Formula {
     /// The formula in hstl syntax, `names[i]` naming variable `i`.
     pub fn display_with<'a>(&'a self, names: &'a [&'a str]) -> Display<'a> {
-        Display { nodes: &self.nodes, root: self.root, names }
+        Display { nodes: &self.inner.nodes, root: self.inner.root, names }
     }
 }
 
@@ -1339,20 +1384,30 @@ mod tests {
     }
 
     #[test]
+    fn a_double_negation_is_the_formula_itself() {
+        let f = x_gt(1.0);
+        assert_eq!(Formula::not(Formula::not(f.clone())), f);
+        assert_eq!(Formula::not(Formula::not(Formula::not(f.clone()))), Formula::not(f));
+    }
+
+    #[test]
     fn deep_formulas_display_and_drop_without_recursion() {
         let mut b = FormulaBuilder::new();
         let (x, three) = (b.var(0), b.constant(3.0));
-        let mut f = b.cmp(x, CmpOp::Gt, three);
-        for _ in 0..200_000 {
-            f = b.not(f);
+        let atom = b.cmp(x, CmpOp::Gt, three);
+        let mut f = atom;
+        for _ in 0..100_000 {
+            let g = b.not(f);
+            f = b.or(vec![g, atom]);
         }
         let i = Interval { start: 0, end: Bound::Inclusive(2) };
         f = b.always(i, f);
         let f = b.build(f);
+        assert_eq!(f.len(), 200_004);
         assert_eq!(f.horizon(), Some(2));
         let text = f.to_string();
-        assert!(text.starts_with("always[0..=2] !!!"), "{}", &text[..40]);
-        assert!(text.ends_with("!v0 > 3"));
+        assert!(text.starts_with("always[0..=2] (!(!(!("), "{}", &text[..40]);
+        assert!(text.ends_with("|| v0 > 3)"), "{}", &text[text.len() - 40..]);
         drop(f);
     }
 }

@@ -1,7 +1,9 @@
 //! The fast offline evaluator: the whole robustness signal, bottom-up, one pass per operator.
 //!
-//! Every operator works on whole columns (one `Vec<f64>` per subformula, taken from a pool
-//! and reused between calls). State subformulas (no temporal operator) are evaluated in
+//! Every operator works on whole columns (one `Vec<f64>` per node of the formula's DAG,
+//! computed once however many parents read it, taken from a pool, given back after its
+//! last reader, and reused between calls); the nodes are walked in order, never
+//! recursively. State subformulas (no temporal operator) are evaluated in
 //! chunks of 512 steps that stay in L1, so `x > 3 && x < 9 && y > 10` writes its output
 //! once. A temporal subformula with a finite horizon `H` is evaluated in pieces of
 //! `max(8192, 16 H)` steps, each with the `H` steps after it, so its buffers stay in L2.
@@ -47,8 +49,10 @@ const MANY: u32 = u32::MAX - 1;
 ///
 /// It walks the formula's nodes bottom-up, one signal per node, so a node shared by
 /// several parents (a `let` used twice) is computed once per step. Nodes are evaluated in
-/// groups (see [`Plan`]): a bounded temporal group in cache-sized pieces, its state
-/// nodes in chunks of 512 steps. A node's buffer goes back to the pool after its last
+/// groups: a bounded temporal subformula with the nodes only it reads, in cache-sized
+/// pieces of `max(8192, 16 H)` steps (each with the `H` steps after it), its state nodes in
+/// chunks of 512 steps; an unbounded operator, or a node read from two groups, over the
+/// whole trace. A node's buffer goes back to the pool after its last
 /// reader has used it, so memory holds the signals still to be read, never one per node
 /// of the formula (a chain of 20,000 `!` holds two).
 #[derive(Clone, Debug, Default)]
@@ -330,11 +334,6 @@ impl Plan {
         }
         Plan { groups, role, owner, state_reads, temporal_reads, ext_reads }
     }
-
-    /// How node `v` is held during evaluation.
-    pub(crate) fn role(&self, v: usize) -> Role {
-        self.role[v]
-    }
 }
 
 /// Whether node `v` is a comparison of two leaves (`x > 3`).
@@ -430,7 +429,7 @@ impl Runner {
 
     /// The signal of `f`'s root over the first `n` steps.
     pub(crate) fn run(&mut self, f: &Formula, src: Source<'_>, n: usize) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         let len = f.len();
         for v in [&mut self.full, &mut self.piece, &mut self.chunk] {
             v.resize_with(len, Vec::new);
@@ -489,7 +488,7 @@ impl Runner {
         m: usize,
         last: bool,
     ) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         for &s in &g.state {
             if plan.role[s] == Role::Piece {
                 self.piece[s] = self.take(m);
@@ -524,7 +523,7 @@ impl Runner {
 
     /// The stored state members of `g` over steps `lo .. lo + m`.
     fn state_phase(&mut self, f: &Formula, g: &Group, src: Source<'_>, lo: usize, m: usize) {
-        let plan = &f.plan;
+        let plan = f.plan();
         let cols = match src {
             Source::Tables { tables, seg } => {
                 for &s in &g.state {
@@ -577,6 +576,7 @@ impl Runner {
     }
 
     /// Operand `c` of state node `s` over chunk `c0 ..` of the piece at `lo`.
+    #[allow(clippy::too_many_arguments)]
     fn src<'a>(
         &'a self,
         f: &'a Formula,
@@ -587,7 +587,7 @@ impl Runner {
         c0: usize,
         len: usize,
     ) -> Src<'a> {
-        let plan = &f.plan;
+        let plan = f.plan();
         match &f.nodes()[c] {
             Node::Var(i) => match cols.get(*i) {
                 Some(col) => Src::Slice(&col[lo + c0..lo + c0 + len]),
@@ -669,7 +669,7 @@ impl Runner {
         for g in gs {
             let g = g.index();
             // `x op c` folds straight in: no pass through a buffer of its own.
-            if f.plan.role[g] == Role::Fused
+            if f.plan().role[g] == Role::Fused
                 && let Node::Cmp { lhs, op, rhs } = &f.nodes()[g]
             {
                 let (a, b) = (src(lhs.index()), src(rhs.index()));
@@ -685,6 +685,7 @@ impl Runner {
 
     /// Operand `c` of temporal node `v` over the piece, as a buffer of its own: the
     /// operand's buffer when this is its last read, else a copy.
+    #[allow(clippy::too_many_arguments)]
     fn own(
         &mut self,
         f: &Formula,
@@ -695,7 +696,7 @@ impl Runner {
         last: bool,
         whole: bool,
     ) -> Vec<f64> {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] {
             self.temporal_left[c] -= 1;
             if self.temporal_left[c] == 0 {
@@ -718,13 +719,13 @@ impl Runner {
 
     /// Operand `c` of temporal node `v` over the piece, borrowed.
     fn read(&self, f: &Formula, v: usize, c: usize, lo: usize, m: usize) -> &[f64] {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] { &self.piece[c][..m] } else { &self.full[c][lo..lo + m] }
     }
 
     /// Counts off a [`Runner::read`] of operand `c` by temporal node `v`.
     fn done(&mut self, f: &Formula, v: usize, c: usize, last: bool) {
-        let plan = &f.plan;
+        let plan = f.plan();
         if plan.owner[c] == plan.owner[v] {
             self.temporal_left[c] -= 1;
             if self.temporal_left[c] == 0 {

@@ -24,7 +24,56 @@ pub fn robustness(f: &Formula, trace: &Trace, t: usize) -> f64 {
         None => n.max(t + 1),
     };
     let from = if f.has_past() { 0 } else { t };
+    if from == t && stop == t + 1 {
+        return at_one_step(f, trace, t);
+    }
     signals(f, trace, from, stop)[f.root().index()][t - from]
+}
+
+/// `rho(f, t)` when it reads step `t` alone (a state formula, or a step past the end):
+/// one value per node, windows holding `t` or nothing.
+fn at_one_step(f: &Formula, trace: &Trace, t: usize) -> f64 {
+    let n = trace.len();
+    let mut vals: Vec<f64> = Vec::with_capacity(f.len());
+    for node in f.nodes() {
+        let at = |k: usize| vals[k];
+        let window = |i: &crate::Interval| i.window(t, n.min(t + 1));
+        let x = match node {
+            Node::True => f64::INFINITY,
+            Node::False => f64::NEG_INFINITY,
+            Node::Const(c) => *c,
+            Node::Var(i) if t < n && *i < trace.vars() => trace.column(*i)[t],
+            Node::Var(_) => f64::NAN,
+            Node::Neg(e) => -at(e.index()),
+            Node::Abs(e) => at(e.index()).abs(),
+            Node::Sqrt(e) => at(e.index()).sqrt(),
+            Node::Add(a, b) => at(a.index()) + at(b.index()),
+            Node::Sub(a, b) => at(a.index()) - at(b.index()),
+            Node::Mul(a, b) => at(a.index()) * at(b.index()),
+            Node::Div(a, b) => at(a.index()) / at(b.index()),
+            Node::Cmp { .. } if t >= n => f64::NAN,
+            Node::Cmp { lhs, op, rhs } => op.robustness(at(lhs.index()), at(rhs.index())),
+            Node::Not(g) => -at(g.index()),
+            Node::And(gs) => gs.iter().map(|g| at(g.index())).fold(f64::INFINITY, f64::min),
+            Node::Or(gs) => gs.iter().map(|g| at(g.index())).fold(f64::NEG_INFINITY, f64::max),
+            Node::Implies(g, h) => (-at(g.index())).max(at(h.index())),
+            Node::Always(i, g) => window(i).map(|_| at(g.index())).fold(f64::INFINITY, f64::min),
+            Node::Eventually(i, g) => {
+                window(i).map(|_| at(g.index())).fold(f64::NEG_INFINITY, f64::max)
+            }
+            // The left side's minimum is over no step before `t`.
+            Node::Until(i, _, h) => window(i)
+                .map(|_| at(h.index()).min(f64::INFINITY))
+                .fold(f64::NEG_INFINITY, f64::max),
+            // Step `t + 1` is not read.
+            Node::Next(_) => f64::INFINITY,
+            // Not reached: a formula with a past-time operator reads from step 0.
+            Node::Historically(..) | Node::Prev(_) => f64::INFINITY,
+            Node::Once(..) | Node::Since(..) => f64::NEG_INFINITY,
+        };
+        vals.push(x);
+    }
+    vals[f.root().index()]
 }
 
 /// `rho(f, t)` for every step `t` of `trace`.

@@ -12,8 +12,8 @@
 //! on its own (quadratic in the segment's length).
 
 use crate::formula::{Node, expr_value};
-use crate::offline::{Evaluator, Lattice, Max, Min, Role, Runner, Source};
-use crate::{Formula, Trace, reference};
+use crate::offline::{Evaluator, Lattice, Max, Min, Runner, Source};
+use crate::{CmpOp, Formula, FormulaBuilder, NodeId, Trace, reference};
 
 /// Scores segments of a trace against one task, reusing its buffers between calls.
 #[derive(Clone, Debug)]
@@ -114,17 +114,30 @@ pub struct TabularScorer {
 impl TabularScorer {
     /// A scorer for `task` over `states`, whose row `i` is the state with index `i`.
     pub fn new(task: &Formula, states: &Trace) -> TabularScorer {
+        let past = task.has_past();
         let (plan, persistent) = match reference::persistent_body(task) {
             Some((body, h)) => (task.sub(body), Some(h)),
             None => (task.clone(), None),
         };
         let nodes = plan.nodes();
-        let stored: Vec<bool> = (0..nodes.len())
-            .map(|v| plan.states()[v] && plan.plan.role(v) == Role::Piece)
-            .collect();
-        let mut tables: Vec<Vec<f64>> = stored
+        let state = plan.states();
+        // The state nodes a temporal node reads (or the root, when a state formula).
+        let mut stored = vec![false; nodes.len()];
+        for (v, node) in nodes.iter().enumerate() {
+            if !state[v] {
+                node.children().for_each(|c| stored[c] |= state[c]);
+            }
+        }
+        stored[plan.root().index()] |= state[plan.root().index()];
+        let mut tables: Vec<Vec<f64>> = Vec::new();
+        let slot: Vec<Option<usize>> = stored
             .iter()
-            .map(|&s| if s { Vec::with_capacity(states.len() + 1) } else { Vec::new() })
+            .map(|&s| {
+                s.then(|| {
+                    tables.push(Vec::with_capacity(states.len() + 1));
+                    tables.len() - 1
+                })
+            })
             .collect();
         let mut row = Vec::with_capacity(states.vars());
         let mut vals = vec![f64::NAN; nodes.len()];
@@ -135,7 +148,7 @@ impl TabularScorer {
                 states.row_into(s, &mut row);
             }
             for (v, node) in nodes.iter().enumerate() {
-                if !plan.states()[v] {
+                if !state[v] {
                     continue;
                 }
                 let x = |k: &crate::NodeId| vals[k.index()];
@@ -155,13 +168,52 @@ impl TabularScorer {
                     _ => f64::NAN,
                 };
             }
-            for (v, table) in tables.iter_mut().enumerate() {
-                if stored[v] {
-                    table.push(vals[v]);
+            for (v, j) in slot.iter().enumerate() {
+                if let Some(j) = j {
+                    tables[*j].push(vals[v]);
                 }
             }
         }
-        TabularScorer { plan, tables, persistent, past: task.has_past(), runner: Runner::tabular() }
+        // The temporal skeleton alone, each stored state node an atom `a_j > 0` whose
+        // values are looked up in `tables[j]`: a segment costs nothing per state node.
+        let mut b = FormulaBuilder::new();
+        let mut map: Vec<Option<NodeId>> = vec![None; nodes.len()];
+        let (zero, gt) = (b.constant(0.0), CmpOp::Gt);
+        for (v, node) in nodes.iter().enumerate() {
+            let m = |c: &NodeId| map[c.index()].unwrap_or(c.to_owned());
+            map[v] = match (slot[v], node) {
+                (Some(j), _) => {
+                    let a = b.var(j);
+                    Some(b.cmp(a, gt, zero))
+                }
+                _ if state[v] => None,
+                (_, Node::Not(g)) => Some(b.not(m(g))),
+                (_, Node::And(gs)) => Some(b.and(gs.iter().map(m).collect())),
+                (_, Node::Or(gs)) => Some(b.or(gs.iter().map(m).collect())),
+                (_, Node::Implies(g, h)) => Some(b.implies(m(g), m(h))),
+                (_, Node::Always(i, g)) => Some(b.always(*i, m(g))),
+                (_, Node::Eventually(i, g)) => Some(b.eventually(*i, m(g))),
+                (_, Node::Until(i, g, h)) => Some(b.until(*i, m(g), m(h))),
+                (_, Node::Once(i, g)) => Some(b.once(*i, m(g))),
+                (_, Node::Historically(i, g)) => Some(b.historically(*i, m(g))),
+                (_, Node::Since(i, g, h)) => Some(b.since(*i, m(g), m(h))),
+                (_, Node::Prev(g)) => Some(b.prev(m(g))),
+                (_, Node::Next(g)) => Some(b.next(m(g))),
+                _ => None,
+            };
+        }
+        let root = map[plan.root().index()].unwrap_or_else(|| b.bool(false));
+        let plan = b.build(root);
+        // The tables by the skeleton's node ids.
+        let mut by_node = vec![Vec::new(); plan.len()];
+        for (v, node) in plan.nodes().iter().enumerate() {
+            if let Node::Cmp { lhs, .. } = node
+                && let Node::Var(j) = plan[*lhs]
+            {
+                by_node[v] = std::mem::take(&mut tables[j]);
+            }
+        }
+        TabularScorer { plan, tables: by_node, persistent, past, runner: Runner::tabular() }
     }
 
     fn signal(&mut self, seg: &[usize]) -> Vec<f64> {

@@ -50,9 +50,9 @@ fn expr() -> impl Strategy<Value = Expr> {
             (e.clone(), e.clone()).prop_map(|(a, b)| Expr::sub(a, b)),
             (e.clone(), e.clone()).prop_map(|(a, b)| Expr::mul(a, b)),
             (e.clone(), e.clone()).prop_map(|(a, b)| Expr::div(a, b)),
-            e.clone().prop_map(|a| Expr::neg(a)),
-            e.clone().prop_map(|a| Expr::abs(a)),
-            e.prop_map(|a| Expr::sqrt(a)),
+            e.clone().prop_map(Expr::neg),
+            e.clone().prop_map(Expr::abs),
+            e.prop_map(Expr::sqrt),
         ]
     })
 }
@@ -75,7 +75,7 @@ fn formula(min_kids: usize) -> impl Strategy<Value = Formula> {
     leaf.prop_recursive(4, 24, 3, move |f| {
         let kids = proptest::collection::vec(f.clone(), min_kids..=3);
         prop_oneof![
-            f.clone().prop_map(|g| Formula::not(g)),
+            f.clone().prop_map(Formula::not),
             kids.clone().prop_map(Formula::and),
             kids.prop_map(Formula::or),
             (f.clone(), f.clone()).prop_map(|(g, h)| Formula::implies(g, h)),

@@ -871,7 +871,7 @@ mod tests {
     fn avoid_shapes_the_flat_reward_and_stops_the_leg() {
         let env = GridWorld::new(5, 1, 1.0).unwrap();
         let mut spec = line(Intra::Paper, 500, Terminate::Argmax);
-        let band = Formula::And(vec![x(CmpOp::Gt, 1.5), x(CmpOp::Lt, 2.5)]);
+        let band = Formula::and(vec![x(CmpOp::Gt, 1.5), x(CmpOp::Lt, 2.5)]);
         spec.primitives[1].avoid = Some(band);
         let learner = Learner::new(&spec, &env).unwrap();
         let t = learner.tables();

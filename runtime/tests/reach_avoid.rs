@@ -123,7 +123,7 @@ fn bad_tasks_are_errors() {
 
 /// `x op c` on the grid.
 fn cmp(var: usize, op: hstl_runtime::robustness::CmpOp, c: f64) -> Formula {
-    Formula::Cmp { lhs: Expr::Var(var), op, rhs: Expr::Const(c) }
+    Formula::cmp(Expr::var(var), op, Expr::constant(c))
 }
 
 /// The reach-avoid form is read off a task: one bounded `eventually` of a state formula and
@@ -133,11 +133,10 @@ fn the_reach_avoid_form_is_read_off_the_task() {
     use hstl_runtime::reach_avoid::reach_avoid_form;
     use hstl_runtime::robustness::CmpOp::{Gt, Lt};
     let (goal, pit, pond) = (cmp(0, Gt, 11.0), cmp(1, Lt, 2.0), cmp(0, Lt, 2.0));
-    let ev = |end| Formula::Eventually(Interval { start: 0, end }, Box::new(goal.clone()));
-    let avoid = |end, r: &Formula| {
-        Formula::Always(Interval { start: 0, end }, Box::new(Formula::Not(Box::new(r.clone()))))
-    };
-    let task = Formula::And(vec![
+    let ev = |end| Formula::eventually(Interval { start: 0, end }, goal.clone());
+    let avoid =
+        |end, r: &Formula| Formula::always(Interval { start: 0, end }, Formula::not(r.clone()));
+    let task = Formula::and(vec![
         ev(Bound::Inclusive(30)),
         avoid(Bound::Unbounded, &pit),
         avoid(Bound::Unbounded, &pond),
@@ -146,32 +145,26 @@ fn the_reach_avoid_form_is_read_off_the_task() {
     assert_eq!((form.reach_by, form.avoid_through), (30, None));
     assert_eq!(form.avoid, [pit.clone(), pond.clone()]);
     // `[0..30]` ends at step 29; a bounded avoid is kept.
-    let task = Formula::And(vec![ev(Bound::Exclusive(30)), avoid(Bound::Exclusive(41), &pit)]);
+    let task = Formula::and(vec![ev(Bound::Exclusive(30)), avoid(Bound::Exclusive(41), &pit)]);
     let form = reach_avoid_form(&task).expect("reach-avoid");
     assert_eq!((form.reach_by, form.avoid_through), (29, Some(40)));
     let not_of_the_form = [
         // No avoided region, or no goal.
-        Formula::And(vec![ev(Bound::Inclusive(30))]),
-        Formula::And(vec![avoid(Bound::Unbounded, &pit)]),
+        Formula::and(vec![ev(Bound::Inclusive(30))]),
+        Formula::and(vec![avoid(Bound::Unbounded, &pit)]),
         // An unbounded goal, two windows for the avoided regions, a later start.
-        Formula::And(vec![ev(Bound::Unbounded), avoid(Bound::Unbounded, &pit)]),
-        Formula::And(vec![
+        Formula::and(vec![ev(Bound::Unbounded), avoid(Bound::Unbounded, &pit)]),
+        Formula::and(vec![
             ev(Bound::Inclusive(30)),
             avoid(Bound::Unbounded, &pit),
             avoid(Bound::Inclusive(9), &pond),
         ]),
-        Formula::And(vec![
-            Formula::Eventually(
-                Interval { start: 2, end: Bound::Inclusive(30) },
-                Box::new(goal.clone()),
-            ),
+        Formula::and(vec![
+            Formula::eventually(Interval { start: 2, end: Bound::Inclusive(30) }, goal.clone()),
             avoid(Bound::Unbounded, &pit),
         ]),
         // `always R` without the negation.
-        Formula::And(vec![
-            ev(Bound::Inclusive(30)),
-            Formula::Always(Interval::ALL, Box::new(pit.clone())),
-        ]),
+        Formula::and(vec![ev(Bound::Inclusive(30)), Formula::always(Interval::ALL, pit.clone())]),
     ];
     for task in not_of_the_form {
         assert!(reach_avoid_form(&task).is_none(), "{task:?}");
@@ -191,12 +184,9 @@ fn a_spec_gives_its_reach_avoid_task_and_its_satisfaction_rate() {
     let goal = cmp(0, Gt, 3.0);
     // x < 1 has robustness 0 at x = 1: x = 0 and x = 1 are avoided.
     let pit = cmp(0, Lt, 1.0);
-    let task = Formula::And(vec![
-        Formula::Eventually(
-            Interval { start: 0, end: Bound::Inclusive(6) },
-            Box::new(goal.clone()),
-        ),
-        Formula::Always(Interval::ALL, Box::new(Formula::Not(Box::new(pit)))),
+    let task = Formula::and(vec![
+        Formula::eventually(Interval { start: 0, end: Bound::Inclusive(6) }, goal.clone()),
+        Formula::always(Interval::ALL, Formula::not(pit)),
     ]);
     let spec = TaskSpec {
         name: "Corridor".into(),
@@ -208,7 +198,7 @@ fn a_spec_gives_its_reach_avoid_task_and_its_satisfaction_rate() {
         primitives: vec![PrimitiveOption {
             name: "Goal".into(),
             reach: goal.clone(),
-            init: Formula::True,
+            init: Formula::bool(true),
             terminate: Terminate::Formula(goal),
             avoid: None,
         }],
@@ -227,6 +217,6 @@ fn a_spec_gives_its_reach_avoid_task_and_its_satisfaction_rate() {
     assert!((rate - o.probability).abs() < 5.0 * sd, "{rate} vs {}", o.probability);
     // A task of another form has none.
     let mut other = spec.clone();
-    other.task = Formula::Eventually(Interval::ALL, Box::new(cmp(0, Gt, 3.0)));
+    other.task = Formula::eventually(Interval::ALL, cmp(0, Gt, 3.0));
     assert!(ReachAvoid::of_spec(&other, &env, 20).unwrap().is_none());
 }

@@ -76,6 +76,10 @@ struct Gen<'a> {
     let_valid: Vec<bool>,
     let_horizon: Vec<Option<usize>>,
     let_empty: Vec<f64>,
+    // Valid state lets that name no other let: their values are fused into each step's
+    // expression through `__at_<i>` (no chain can grow from them), where other lets are
+    // read from the signals `__signals` computed once.
+    let_leaf: Vec<bool>,
 }
 
 impl<'a> Gen<'a> {
@@ -105,6 +109,7 @@ impl<'a> Gen<'a> {
             let_valid: vec![false; n],
             let_horizon: vec![None; n],
             let_empty: vec![f64::NAN; n],
+            let_leaf: vec![false; n],
         };
         // `let_order` lists every let after the lets it uses (and leaves out cycles).
         for &i in &spec.let_order {
@@ -112,6 +117,9 @@ impl<'a> Gen<'a> {
             g.let_valid[i] = g.valid(f);
             g.let_horizon[i] = g.horizon(f);
             g.let_empty[i] = g.empty_value(f);
+            g.let_leaf[i] = g.let_valid[i]
+                && spec.lets[i].kind == hstl_lang::LetKind::State
+                && let_deps(f).is_empty();
         }
         g
     }
@@ -331,7 +339,8 @@ impl<'a> Gen<'a> {
             .iter()
             .map(|&i| {
                 let f = &self.spec.lets[i].formula;
-                let mut b = Body::new(self);
+                let lets = quote!(self);
+                let mut b = Body::new(self, &lets);
                 let body = b.block(f);
                 let k = if b.uses_kernels { quote!(k) } else { quote!(_k) };
                 let name = format_ident!("__sig_{}", i);
@@ -346,10 +355,28 @@ impl<'a> Gen<'a> {
             })
             .collect();
         let deps = (0..n).map(|i| {
-            let d =
-                if self.let_valid[i] { let_deps(&self.spec.lets[i].formula) } else { Vec::new() };
+            let valid = self.let_valid[i];
+            let d = if valid { self.signal_deps(&self.spec.lets[i].formula) } else { Vec::new() };
             quote!(&[#(#d),*])
         });
+        let ats: TokenStream = valid
+            .iter()
+            .filter(|&&i| self.let_leaf[i])
+            .map(|&i| {
+                let lets = quote!(self);
+                let mut b = Body::new(self, &lets);
+                let p = b.point(&self.spec.lets[i].formula);
+                let arg = if b.uses_state { quote!(s) } else { quote!(_s) };
+                let name = format_ident!("__at_{}", i);
+                quote! {
+                    #[doc(hidden)]
+                    #[inline]
+                    pub fn #name(#arg: &super::State) -> f64 {
+                        #p
+                    }
+                }
+            })
+            .collect();
         let arms = valid.iter().map(|&i| {
             let name = format_ident!("__sig_{}", i);
             quote!(#i => #name(trace, k, &__l),)
@@ -357,6 +384,7 @@ impl<'a> Gen<'a> {
         let build = self.build_lets();
         quote! {
             #build
+            #ats
             #sigs
 
             #[doc(hidden)]
@@ -416,8 +444,14 @@ impl<'a> Gen<'a> {
         // The lets the monitor reads (each computed once by `__signals`).
         let roots: Vec<usize> = match index {
             Some(i) => vec![i],
-            None => let_deps(f),
+            None => self.signal_deps(f),
         };
+        // A leaf state let: its fused expression, and no signal of another let.
+        if let Some(i) = index
+            && self.let_leaf[i]
+        {
+            return self.leaf_monitor(i, f, lets, state, doc, name, data);
+        }
         let signals = |trace: TokenStream, k: TokenStream| {
             if roots.is_empty() {
                 TokenStream::new()
@@ -429,7 +463,7 @@ impl<'a> Gen<'a> {
             let (arg, p) = match index {
                 Some(i) => (quote!(s), quote!(__l[#i][0])),
                 None => {
-                    let mut b = Body::new(self);
+                    let mut b = Body::new(self, lets);
                     let p = b.point(f);
                     let arg =
                         if b.uses_state || !roots.is_empty() { quote!(s) } else { quote!(_s) };
@@ -461,7 +495,7 @@ impl<'a> Gen<'a> {
                     }
                 },
                 None => {
-                    let mut b = Body::new(self);
+                    let mut b = Body::new(self, lets);
                     let body = b.block(f);
                     let prelude = signals(quote!(trace), quote!(k));
                     quote! {
@@ -488,7 +522,7 @@ impl<'a> Gen<'a> {
                     }
                 },
                 None => {
-                    let mut b = Body::new(self);
+                    let mut b = Body::new(self, lets);
                     let body = b.block(f);
                     let k =
                         if b.uses_kernels || !roots.is_empty() { quote!(k) } else { quote!(_k) };
@@ -760,6 +794,103 @@ impl<'a> Gen<'a> {
         }}
     }
 
+    /// The lets `f` names whose signals it reads (the leaf state lets are fused instead).
+    fn signal_deps(&self, f: &CFormula) -> Vec<usize> {
+        let leaf = |i: usize| self.let_leaf.get(i).copied().unwrap_or(false);
+        let_deps(f).into_iter().filter(|&i| !leaf(i)).collect()
+    }
+
+    /// The monitors of leaf state let `i`: its fused expression on each state.
+    #[allow(clippy::too_many_arguments)]
+    fn leaf_monitor(
+        &self,
+        i: usize,
+        f: &CFormula,
+        lets: &TokenStream,
+        state: &TokenStream,
+        doc: &TokenStream,
+        name: &TokenStream,
+        data: TokenStream,
+    ) -> TokenStream {
+        let hstl = &self.root;
+        let kernels = quote!(#hstl::robustness::kernels::Kernels);
+        let empty = lit_f64(self.empty_value(f));
+        let at = format_ident!("__at_{}", i);
+        quote! {
+            #doc
+            pub mod #name {
+                /// Robustness on one state (a state formula reads no other).
+                pub fn at(s: &#state) -> f64 {
+                    #lets::#at(s)
+                }
+
+                /// The formula as the runtime's data.
+                pub fn formula() -> #hstl::robustness::Formula {
+                    #data
+                }
+
+                /// Robustness at every step of the trace.
+                pub fn signal(trace: &[#state]) -> ::std::vec::Vec<f64> {
+                    trace.iter().map(at).collect()
+                }
+
+                /// [`signal`]; a state formula needs no kernels.
+                pub fn signal_with(trace: &[#state], _k: &mut #kernels) -> ::std::vec::Vec<f64> {
+                    signal(trace)
+                }
+
+                /// Robustness of the trace: at step 0 (what the reference evaluator gives
+                /// for an empty trace when it is empty).
+                pub fn robustness(trace: &[#state]) -> f64 {
+                    trace.first().map_or(#empty, at)
+                }
+
+                /// Monitors the formula on states pushed one at a time (the runtime's
+                /// streaming monitor over [`formula`]).
+                #[derive(Clone, Debug)]
+                pub struct Online {
+                    monitor: #hstl::robustness::OnlineMonitor,
+                }
+
+                impl Online {
+                    /// A monitor at step 0.
+                    pub fn new() -> Online {
+                        Online { monitor: #hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
+                    }
+
+                    /// Appends one state; returns the verdict it completes, if any.
+                    pub fn push(&mut self, state: &#state) -> ::core::option::Option<#hstl::robustness::Verdict> {
+                        // The row always has VARS values, so the monitor cannot refuse it.
+                        self.monitor.push(&state.values()).ok().flatten()
+                    }
+
+                    /// The value the first open step would get if the trace ended now.
+                    pub fn provisional(&mut self) -> ::core::option::Option<f64> {
+                        self.monitor.provisional()
+                    }
+
+                    /// Ends the trace: the verdicts of every open step; the monitor then
+                    /// starts a new trace.
+                    pub fn finish(&mut self) -> ::std::vec::Vec<#hstl::robustness::Verdict> {
+                        self.monitor.finish()
+                    }
+
+                    /// Steps a verdict lags behind the last pushed state; `None` when
+                    /// unbounded.
+                    pub fn horizon(&self) -> ::core::option::Option<usize> {
+                        self.monitor.horizon()
+                    }
+                }
+
+                impl ::core::default::Default for Online {
+                    fn default() -> Online {
+                        Online::new()
+                    }
+                }
+            }
+        }
+    }
+
     fn spec_impl(&self, src: &str) -> TokenStream {
         let hstl = &self.root;
         let Some(task) = &self.spec.task else { return TokenStream::new() };
@@ -946,6 +1077,8 @@ fn has_past_node(f: &CFormula) -> bool {
 /// the evaluator itself runs it.
 struct Body<'g, 'a> {
     g: &'g Gen<'a>,
+    /// The path of the lets module (its `__at_<i>` functions).
+    lets: &'g TokenStream,
     /// The statements of the block being written (a closure body opens a new one).
     stmts: Vec<TokenStream>,
     /// The number of `sig<n>` variables so far.
@@ -970,8 +1103,8 @@ impl Sig {
 }
 
 impl<'g, 'a> Body<'g, 'a> {
-    fn new(g: &'g Gen<'a>) -> Body<'g, 'a> {
-        Body { g, stmts: Vec::new(), vars: 0, uses_state: false, uses_kernels: false }
+    fn new(g: &'g Gen<'a>, lets: &'g TokenStream) -> Body<'g, 'a> {
+        Body { g, lets, stmts: Vec::new(), vars: 0, uses_state: false, uses_kernels: false }
     }
 
     /// The statements and the final expression of the signal of `f`.
@@ -1035,6 +1168,10 @@ impl<'g, 'a> Body<'g, 'a> {
         if let ([f], None) = (fs, fold)
             && let CFormulaKind::Let(i) = f.kind
         {
+            if self.g.let_leaf[i] {
+                let (lets, at) = (self.lets, format_ident!("__at_{}", i));
+                return quote!(trace.iter().map(#lets::#at).collect::<::std::vec::Vec<f64>>());
+            }
             return quote!(__l[#i][__off..__off + trace.len()].to_vec());
         }
         let before = self.uses_state;
@@ -1057,6 +1194,7 @@ impl<'g, 'a> Body<'g, 'a> {
         let hstl = &self.g.root;
         let kernels = quote!(#hstl::robustness::kernels);
         match &f.kind {
+            CFormulaKind::Let(i) if self.g.let_leaf[*i] => Sig::Expr(self.map(&[f], None)),
             CFormulaKind::Let(i) => Sig::Expr(quote!(__l[#i][__off..__off + trace.len()].to_vec())),
             CFormulaKind::Always(iv, a) | CFormulaKind::Eventually(iv, a) => {
                 let a = self.signal(a, in_piece);
@@ -1174,6 +1312,11 @@ impl<'g, 'a> Body<'g, 'a> {
         match &f.kind {
             CFormulaKind::True => quote!(f64::INFINITY),
             CFormulaKind::False | CFormulaKind::Invalid => quote!(f64::NEG_INFINITY),
+            CFormulaKind::Let(i) if self.g.let_leaf[*i] => {
+                self.uses_state = true;
+                let (lets, at) = (self.lets, format_ident!("__at_{}", i));
+                quote!(#lets::#at(s))
+            }
             CFormulaKind::Let(i) => quote!(__l[#i][__off + __t]),
             CFormulaKind::Cmp(op, a, b) => {
                 self.uses_state |= reads_state(a) || reads_state(b);

@@ -218,6 +218,57 @@ mod tests {
         out.lines().map(str::trim_end).collect::<Vec<_>>().join("\n")
     }
 
+    /// The deepest group nesting and the number of token trees of `tokens`, by an explicit
+    /// stack.
+    fn shape(tokens: TokenStream) -> (usize, usize) {
+        let (mut deepest, mut count) = (0, 0);
+        let mut stack = vec![(tokens.into_iter(), 0usize)];
+        while let Some((mut iter, depth)) = stack.pop() {
+            if let Some(tt) = iter.next() {
+                count += 1;
+                stack.push((iter, depth));
+                if let TokenTree::Group(g) = tt {
+                    deepest = deepest.max(depth + 1);
+                    stack.push((g.stream().into_iter(), depth + 1));
+                }
+            }
+        }
+        (deepest, count)
+    }
+
+    /// Issue 11, classes 1 and 2: the code for a chain of lets names each let once and is
+    /// never nested deeper than one let's body, so rustc sees neither a tree as large as
+    /// the lets written out nor an expression as deep as the chain.
+    #[test]
+    fn chains_of_lets_give_linear_flat_code() {
+        let expand_lets = |lets: &str, top: &str| {
+            let src = format!(
+                "spec S {{ state {{ x: int in 0..=14 }} {lets} task always[0..=5] {top}; }}"
+            );
+            shape(expand(src.parse().expect("lexes")))
+        };
+        let doubling = |n: usize| {
+            let mut lets = String::from("let L0 = x > 3;");
+            for k in 1..n {
+                lets.push_str(&format!("let L{k} = L{} && L{};", k - 1, k - 1));
+            }
+            expand_lets(&lets, &format!("L{}", n - 1))
+        };
+        let (depth12, size12) = doubling(12);
+        let (depth24, size24) = doubling(24);
+        // Twice the lets, about twice the code (a tree would be 4096 times larger).
+        assert!(size24 < 3 * size12, "{size12} then {size24} token trees");
+        assert_eq!(depth12, depth24);
+        // 255 lets of 250 nested `always` each: as deep as 12 lets of 1, bar one let's body.
+        let mut lets = String::from("let T0 = x > 3;");
+        for k in 1..255 {
+            lets.push_str(&format!("let T{k} = {}T{};", "always[0..=1] ".repeat(250), k - 1));
+        }
+        let (depth, size) = expand_lets(&lets, "T254");
+        assert!(depth <= depth12 + 4, "nested {depth} deep");
+        assert!(size < 300 * 255 * 250, "{size} token trees");
+    }
+
     #[test]
     fn case_study_expansion() {
         let text = include_str!("../../specs/case_study.hstl");
