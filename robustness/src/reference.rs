@@ -24,7 +24,7 @@ pub fn robustness(f: &Formula, trace: &Trace, t: usize) -> f64 {
         None => n.max(t + 1),
     };
     let from = if f.has_past() { 0 } else { t };
-    if from == t && stop == t + 1 {
+    if !f.has_past() && stop == t + 1 {
         return at_one_step(f, trace, t);
     }
     signals(f, trace, from, stop)[f.root().index()][t - from]
