@@ -306,7 +306,12 @@ fn task_lets(spec: &CheckedSpec) -> Vec<(usize, bool)> {
                 }
             }
             CFormulaKind::Not(a) => stack.push((a, negated.map(|n| !n))),
-            CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => stack.push((a, negated)),
+            CFormulaKind::Always(_, a)
+            | CFormulaKind::Eventually(_, a)
+            | CFormulaKind::Once(_, a)
+            | CFormulaKind::Historically(_, a)
+            | CFormulaKind::Prev(a)
+            | CFormulaKind::Next(a) => stack.push((a, negated)),
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
                 stack.extend(v.iter().rev().map(|g| (g, negated)))
             }
@@ -314,7 +319,7 @@ fn task_lets(spec: &CheckedSpec) -> Vec<(usize, bool)> {
                 stack.push((b, negated));
                 stack.push((a, None));
             }
-            CFormulaKind::Until(_, a, b) => {
+            CFormulaKind::Until(_, a, b) | CFormulaKind::Since(_, a, b) => {
                 stack.push((b, negated));
                 stack.push((a, negated));
             }

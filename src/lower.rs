@@ -323,6 +323,26 @@ impl<'a> Lowerer<'a> {
                 let (x, y) = (b(self, x)?, b(self, y)?);
                 self.b.until(interval(iv), x, y)
             }
+            CFormulaKind::Once(iv, a) => {
+                let a = b(self, a)?;
+                self.b.once(interval(iv), a)
+            }
+            CFormulaKind::Historically(iv, a) => {
+                let a = b(self, a)?;
+                self.b.historically(interval(iv), a)
+            }
+            CFormulaKind::Since(iv, x, y) => {
+                let (x, y) = (b(self, x)?, b(self, y)?);
+                self.b.since(interval(iv), x, y)
+            }
+            CFormulaKind::Prev(a) => {
+                let a = b(self, a)?;
+                self.b.prev(a)
+            }
+            CFormulaKind::Next(a) => {
+                let a = b(self, a)?;
+                self.b.next(a)
+            }
             CFormulaKind::Invalid => return None,
         })
     }

@@ -4,10 +4,12 @@
 //! An [`EpisodeMonitor`] takes the states `s_0, s_1, ...` of one episode and gives, after
 //! state `s_t`:
 //! - the **reward** `rho(formula, t)` over the trace so far, `s_0 ..= s_t`, for the task or
-//!   a `let`. hstl's operators look only forward and windows are clipped at the end of the
-//!   trace, so this is the formula on `s_t` alone: for a state formula (a region) it is the
-//!   value of the full trace's signal at `t`; a temporal operator sees only the present
-//!   (`eventually[0..40] A` is `A` at `t`, `eventually[5..9] A` is `-inf`);
+//!   a `let`. The future operators' windows are clipped at the end of the trace, so without
+//!   a past-time operator this is the formula on `s_t` alone: for a state formula (a
+//!   region) it is the value of the full trace's signal at `t`; a temporal operator sees
+//!   only the present (`eventually[0..40] A` is `A` at `t`, `eventually[5..9] A` is
+//!   `-inf`). A formula with a past-time operator (`once[0..10] A`) reads the states before
+//!   `s_t` too: it is evaluated over the states so far, `O(t)` a step;
 //! - the **task's robustness** `rho(task, 0)` over `s_0 ..= s_t`, the value
 //!   `hstlc monitor` prints for the trace so far;
 //! - for a persistent task (`always[0..] (eventually[0..N1] R1 && ...)`), whether the
@@ -15,7 +17,7 @@
 //!   its last `N_j` steps), the measure the window rate counts.
 //!
 //! Cost per state: the reward is `O(|formula|)` (the formula on one state, each shared
-//! node once). The task's
+//! node once; `O(t |formula|)` with a past-time operator). The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
 //! distributes over `&&` (`eventually` over `||`); `always[c..] eventually[J] f` and
@@ -55,6 +57,8 @@ pub struct EpisodeMonitor {
     task: Running,
     /// Scratch values of [`at_state`].
     scratch: Vec<f64>,
+    /// The states so far, when the reward formula has a past-time operator.
+    history: Option<Columns>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
     /// `tau_j`: steps since region `j` last held, capped at `N_j`.
@@ -167,11 +171,13 @@ impl EpisodeMonitor {
         let nan_prone = NanProne::of_all(&scored, &vars);
         let task = Running::new(&task, vars.len());
         let scratch = Vec::new();
+        let history = reward.has_past().then(|| Columns::new(vars.len()));
         Ok(EpisodeMonitor {
             vars,
             reward,
             task,
             scratch,
+            history,
             regions,
             tau,
             steps: 0,
@@ -198,6 +204,9 @@ impl EpisodeMonitor {
     /// Starts a new episode.
     pub fn reset(&mut self) {
         self.task.reset();
+        if let Some(h) = &mut self.history {
+            h.clear();
+        }
         self.tau.iter_mut().zip(&self.regions).for_each(|(t, r)| *t = r.1);
         self.steps = 0;
     }
@@ -213,7 +222,14 @@ impl EpisodeMonitor {
         }
         self.nan_prone.check_state(state, self.steps)?;
         self.steps += 1;
-        let reward = at_state(&self.reward, state, &mut self.scratch);
+        let reward = match &mut self.history {
+            Some(history) => {
+                history.push(state);
+                let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
+                signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
+            }
+            None => at_state(&self.reward, state, &mut self.scratch),
+        };
         let window_kept = if self.regions.is_empty() {
             None
         } else {
@@ -341,7 +357,9 @@ impl Part {
                     settled: identity(always),
                 }
             }
-            Node::Always(interval, body) | Node::Eventually(interval, body) => {
+            // The window drops the states before its first open position, which a
+            // past-time operator would read.
+            Node::Always(interval, body) | Node::Eventually(interval, body) if !f.has_past() => {
                 match f.horizon_of(*body) {
                     Some(horizon) => Part::Window {
                         always: matches!(f.root_node(), Node::Always(..)),
@@ -486,6 +504,17 @@ fn at_state(f: &Formula, state: &[f64], vals: &mut Vec<f64>) -> f64 {
             // Nothing comes before step 0, so the left side's minimum is over no step.
             Node::Until(i, _, h) if holds_now(i) => f64::NEG_INFINITY.max(v(h).min(f64::INFINITY)),
             Node::Until(..) => f64::NEG_INFINITY,
+            // Past windows at step 0 hold step 0 when they start there.
+            Node::Historically(i, g) if i.past_window(0).contains(&0) => f64::INFINITY.min(v(g)),
+            Node::Historically(..) => f64::INFINITY,
+            Node::Once(i, g) if i.past_window(0).contains(&0) => f64::NEG_INFINITY.max(v(g)),
+            Node::Once(..) => f64::NEG_INFINITY,
+            Node::Since(i, _, h) if i.past_window(0).contains(&0) => {
+                f64::NEG_INFINITY.max(v(h).min(f64::INFINITY))
+            }
+            Node::Since(..) => f64::NEG_INFINITY,
+            // Weak: the step before (or after) a one-state trace does not exist.
+            Node::Prev(_) | Node::Next(_) => f64::INFINITY,
         };
         vals.push(x);
     }

@@ -9,6 +9,9 @@ use hstl::robustness::{Trace, offline};
 use serde_json::Value;
 
 const ORACLE: &str = include_str!("../robustness/tests/data/rtamt-cases.jsonl");
+/// The past-time cases: `once`, `historically`, `since`, `prev`, `next` (no `robustness`
+/// field: it is the signal's first value).
+const PAST: &str = include_str!("../robustness/tests/data/rtamt-past-cases.jsonl");
 
 struct Case {
     id: u64,
@@ -32,18 +35,26 @@ fn numbers(v: &Value) -> Vec<f64> {
 }
 
 fn cases() -> Vec<Case> {
-    ORACLE
-        .lines()
+    cases_of(ORACLE)
+}
+
+fn cases_of(data: &str) -> Vec<Case> {
+    data.lines()
         .filter(|l| !l.trim().is_empty())
         .map(|line| {
             let c: Value = serde_json::from_str(line).expect("one JSON object a line");
+            let signal = numbers(&c["signal"]);
+            let robustness = match c.get("robustness") {
+                Some(r) => number(r),
+                None => signal[0],
+            };
             Case {
                 id: c["id"].as_u64().expect("an id"),
                 task: c["task"].as_str().expect("a task").to_string(),
                 x: numbers(&c["trace"]["x"]),
                 y: numbers(&c["trace"]["y"]),
-                signal: numbers(&c["signal"]),
-                robustness: number(&c["robustness"]),
+                signal,
+                robustness,
             }
         })
         .collect()
@@ -76,7 +87,18 @@ fn assert_signal(what: &str, got: &[f64], want: &[f64]) {
 fn oracle_cases_through_columns_rows_batches_and_online() {
     let cases = cases();
     assert_eq!(cases.len(), 100, "the oracle file holds 100 cases");
-    for c in &cases {
+    check_cases(&cases);
+}
+
+#[test]
+fn past_time_oracle_cases_through_columns_rows_batches_and_online() {
+    let cases = cases_of(PAST);
+    assert_eq!(cases.len(), 1500, "the past-time oracle file holds 1,500 cases");
+    check_cases(&cases);
+}
+
+fn check_cases(cases: &[Case]) {
+    for c in cases {
         let m = case_monitor(&c.task);
         let label = format!("case {}: {}", c.id, c.task);
         let columns = Samples::Columns(vec![&c.x, &c.y]);

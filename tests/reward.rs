@@ -1,8 +1,8 @@
 //! The episode monitor (`hstl::reward`) against the offline evaluator on every prefix of
 //! a trace: the reward at step `t` is the last value of the signal over `s_0 ..= s_t`, the
 //! task's robustness is `rho(task, 0)` over it, and the window kept is the window rate's
-//! `psi(t)`. Tasks: every task of the rtamt oracle file and random formulas of every shape
-//! (unbounded, nested, until).
+//! `psi(t)`. Tasks: every task of the rtamt oracle files (past-time operators included)
+//! and random formulas of every shape (unbounded, nested, until).
 
 use hstl::load::load;
 use hstl::reward::EpisodeMonitor;
@@ -115,6 +115,23 @@ fn the_oracle_tasks_agree_with_the_offline_evaluator_on_every_prefix() {
         cases += 1;
     }
     assert!(cases >= 100);
+}
+
+/// The past-time tasks: the reward at `t` reads the states before `s_t` too.
+#[test]
+fn the_past_time_oracle_tasks_agree_with_the_offline_evaluator_on_every_prefix() {
+    let past = include_str!("../robustness/tests/data/rtamt-past-cases.jsonl");
+    let mut cases = 0;
+    for line in past.lines().filter(|l| !l.trim().is_empty()) {
+        let c: Value = serde_json::from_str(line).unwrap();
+        let column = |v: &Value| -> Vec<f64> {
+            v.as_array().unwrap().iter().map(|n| n.as_f64().unwrap()).collect()
+        };
+        let task = c["task"].as_str().unwrap();
+        check_prefixes(task, &column(&c["trace"]["x"]), &column(&c["trace"]["y"]));
+        cases += 1;
+    }
+    assert_eq!(cases, 1500);
 }
 
 #[test]

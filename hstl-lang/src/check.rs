@@ -808,6 +808,33 @@ impl Cx<'_> {
                     None => return invalid,
                 }
             }
+            FormulaKind::Once(i, g) => {
+                let iv = self.interval(i);
+                let g = self.formula(g);
+                match iv {
+                    Some(iv) => CFormulaKind::Once(iv, Box::new(g)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::Historically(i, g) => {
+                let iv = self.interval(i);
+                let g = self.formula(g);
+                match iv {
+                    Some(iv) => CFormulaKind::Historically(iv, Box::new(g)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::Since(a, i, b) => {
+                let a = self.formula(a);
+                let iv = self.interval(i);
+                let b = self.formula(b);
+                match iv {
+                    Some(iv) => CFormulaKind::Since(iv, Box::new(a), Box::new(b)),
+                    None => return invalid,
+                }
+            }
+            FormulaKind::Prev(g) => CFormulaKind::Prev(Box::new(self.formula(g))),
+            FormulaKind::Next(g) => CFormulaKind::Next(Box::new(self.formula(g))),
             FormulaKind::And(v) => CFormulaKind::And(v.iter().map(|g| self.formula(g)).collect()),
             FormulaKind::Or(v) => CFormulaKind::Or(v.iter().map(|g| self.formula(g)).collect()),
             FormulaKind::Implies(a, b) => {
@@ -891,9 +918,7 @@ impl Cx<'_> {
     /// to a temporal let (with that let's name range).
     fn temporal_site(&self, f: &CFormula, lets: &[LetInfo]) -> Option<TemporalSite> {
         match &f.kind {
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                Some((f.range.clone(), None))
-            }
+            kind if kind.is_temporal() => Some((f.range.clone(), None)),
             CFormulaKind::Let(i) => {
                 let l = lets.get(*i)?;
                 (l.kind == LetKind::Temporal)
@@ -917,7 +942,7 @@ impl Cx<'_> {
                 r,
                 format!("temporal operator in the `{field}` of option `{option}`"),
             )
-            .with_help("reach, init and terminate are evaluated on one state: use a formula without `always`, `eventually` or `until`");
+            .with_help("reach, init and terminate are evaluated on one state: use a formula without temporal operators (`always`, `eventually`, `until`, `once`, `historically`, `since`, `prev`, `next`)");
             if let Some((lr, name)) = via {
                 d = d.with_label(lr, format!("`{name}` is a temporal formula"));
             }
@@ -2050,7 +2075,7 @@ fn over_states<T: Send>(
 
 fn has_temporal_node(f: &CFormula) -> bool {
     match &f.kind {
-        CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => true,
+        kind if kind.is_temporal() => true,
         CFormulaKind::Not(a) => has_temporal_node(a),
         CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().any(has_temporal_node),
         CFormulaKind::Implies(a, b) => has_temporal_node(a) || has_temporal_node(b),

@@ -74,8 +74,35 @@ pub enum CFormulaKind {
     Eventually(Interval, Box<CFormula>),
     /// `f until[I] g`.
     Until(Interval, Box<CFormula>, Box<CFormula>),
+    /// `once[I] f`: the maximum over the past window.
+    Once(Interval, Box<CFormula>),
+    /// `historically[I] f`: the minimum over the past window.
+    Historically(Interval, Box<CFormula>),
+    /// `f since[I] g`.
+    Since(Interval, Box<CFormula>, Box<CFormula>),
+    /// `prev f`: `f` one step back, `+inf` at the first step.
+    Prev(Box<CFormula>),
+    /// `next f`: `f` one step ahead, `+inf` at the last step.
+    Next(Box<CFormula>),
     /// Stands for a part that did not check; only present when an error was reported.
     Invalid,
+}
+
+impl CFormulaKind {
+    /// Whether this node is a temporal operator (future or past), which needs a trace.
+    pub fn is_temporal(&self) -> bool {
+        matches!(
+            self,
+            CFormulaKind::Always(..)
+                | CFormulaKind::Eventually(..)
+                | CFormulaKind::Until(..)
+                | CFormulaKind::Once(..)
+                | CFormulaKind::Historically(..)
+                | CFormulaKind::Since(..)
+                | CFormulaKind::Prev(..)
+                | CFormulaKind::Next(..)
+        )
+    }
 }
 
 /// A checked expression node.
@@ -157,7 +184,7 @@ pub struct StateVarInfo {
 pub enum LetKind {
     /// No temporal operator, also not through other lets: usable as a region.
     State,
-    /// Contains `always`, `eventually` or `until` (directly or through other lets).
+    /// Contains a temporal operator, future or past (directly or through other lets).
     Temporal,
 }
 
@@ -413,9 +440,14 @@ impl CheckedSpec {
                 v.iter().all(|g| self.is_state_formula(g))
             }
             CFormulaKind::Implies(a, b) => self.is_state_formula(a) && self.is_state_formula(b),
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                false
-            }
+            CFormulaKind::Always(..)
+            | CFormulaKind::Eventually(..)
+            | CFormulaKind::Until(..)
+            | CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => false,
         }
     }
 
@@ -495,11 +527,17 @@ impl<'a> StateEvaluator<'a> {
 pub fn visit_lets(f: &CFormula, visit: &mut dyn FnMut(usize)) {
     match &f.kind {
         CFormulaKind::Let(i) => visit(*i),
-        CFormulaKind::Not(a) | CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => {
-            visit_lets(a, visit)
-        }
+        CFormulaKind::Not(a)
+        | CFormulaKind::Always(_, a)
+        | CFormulaKind::Eventually(_, a)
+        | CFormulaKind::Once(_, a)
+        | CFormulaKind::Historically(_, a)
+        | CFormulaKind::Prev(a)
+        | CFormulaKind::Next(a) => visit_lets(a, visit),
         CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().for_each(|g| visit_lets(g, visit)),
-        CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+        CFormulaKind::Implies(a, b)
+        | CFormulaKind::Until(_, a, b)
+        | CFormulaKind::Since(_, a, b) => {
             visit_lets(a, visit);
             visit_lets(b, visit);
         }
@@ -533,6 +571,11 @@ fn eval_formula(f: &CFormula, lets: &[f64], s: &[f64]) -> f64 {
         CFormulaKind::Always(..)
         | CFormulaKind::Eventually(..)
         | CFormulaKind::Until(..)
+        | CFormulaKind::Once(..)
+        | CFormulaKind::Historically(..)
+        | CFormulaKind::Since(..)
+        | CFormulaKind::Prev(..)
+        | CFormulaKind::Next(..)
         | CFormulaKind::Invalid => f64::NAN,
     }
 }

@@ -126,8 +126,8 @@ Fix: compare the variables themselves, or combine formulas with `&&`, `||`.",
         severity: E,
         summary: "a temporal operator in `reach`, `init` or `terminate`",
         explanation: "An option's reach, initiation and termination conditions are evaluated on \
-one state, so they must be state formulas: no `always`, `eventually` or `until`, also not \
-through a `let`.\n\n\
+one state, so they must be state formulas: no temporal operator (`always`, `eventually`, \
+`until`, `once`, `historically`, `since`, `prev`, `next`), also not through a `let`.\n\n\
 Example:\n    let A = eventually[0..5] x > 3;\n    option A;\n\n\
 Fix: reach a state formula, such as `let A = x > 3;`.",
     },
@@ -255,8 +255,9 @@ Fix: widen `B`'s `init`, or narrow `A`'s `terminate`.",
         name: "until-chain",
         severity: E,
         summary: "`a until b until c` without parentheses",
-        explanation: "`until` is not associative, so a chain is ambiguous and rejected.\n\n\
-Example:\n    task a until b until c;\n\n\
+        explanation: "`until` is not associative, so a chain is ambiguous and rejected. The same \
+holds for `since`, and for `until` and `since` together.\n\n\
+Example:\n    task a until b until c;\n    task a since b since c;\n\n\
 Fix: add parentheses: `(a until b) until c` or `a until (b until c)`.",
     },
     CodeInfo {

@@ -261,7 +261,11 @@ impl Plan {
         while let FormulaKind::Paren(x)
         | FormulaKind::Not(x)
         | FormulaKind::Always(_, x)
-        | FormulaKind::Eventually(_, x) = &g.kind
+        | FormulaKind::Eventually(_, x)
+        | FormulaKind::Once(_, x)
+        | FormulaKind::Historically(_, x)
+        | FormulaKind::Prev(x)
+        | FormulaKind::Next(x) = &g.kind
         {
             g = x;
         }
@@ -322,7 +326,18 @@ fn minus_is_prefix(src: &str, prev: Option<Tok>) -> bool {
             let text = &src[p.start..p.end];
             match p.kind {
                 Kind::Number => false,
-                Kind::Word => matches!(text, "always" | "eventually" | "until" | "in"),
+                Kind::Word => matches!(
+                    text,
+                    "always"
+                        | "eventually"
+                        | "until"
+                        | "once"
+                        | "historically"
+                        | "since"
+                        | "prev"
+                        | "next"
+                        | "in"
+                ),
                 _ => text != ")",
             }
         }
@@ -335,7 +350,8 @@ fn spacing(a: &str, prefix_minus: bool, b: &str) -> &'static str {
         || matches!(a, "(" | "[" | ".." | "..=" | "!")
         || (a == "-" && prefix_minus)
         || (b == "(" && matches!(a, "abs" | "sqrt" | "sequences" | "permutations"))
-        || (b == "[" && matches!(a, "always" | "eventually" | "until"))
+        || (b == "["
+            && matches!(a, "always" | "eventually" | "until" | "once" | "historically" | "since"))
     {
         ""
     } else {

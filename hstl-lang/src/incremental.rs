@@ -543,12 +543,18 @@ fn shift_formula(f: &mut Formula, d: isize) {
                 shift_expr(e, d);
             }
         }
-        FormulaKind::Not(a) | FormulaKind::Paren(a) => shift_formula(a, d),
-        FormulaKind::Always(iv, a) | FormulaKind::Eventually(iv, a) => {
+        FormulaKind::Not(a)
+        | FormulaKind::Paren(a)
+        | FormulaKind::Prev(a)
+        | FormulaKind::Next(a) => shift_formula(a, d),
+        FormulaKind::Always(iv, a)
+        | FormulaKind::Eventually(iv, a)
+        | FormulaKind::Once(iv, a)
+        | FormulaKind::Historically(iv, a) => {
             shift_interval(iv, d);
             shift_formula(a, d);
         }
-        FormulaKind::Until(a, iv, b) => {
+        FormulaKind::Until(a, iv, b) | FormulaKind::Since(a, iv, b) => {
             shift_formula(a, d);
             shift_interval(iv, d);
             shift_formula(b, d);

@@ -104,11 +104,19 @@ fn refers_to_state(f: &CFormula, lets: &[bool]) -> bool {
                 }
             }
             CFormulaKind::Cmp(_, a, b) => exprs.extend([a, b]),
-            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
+            CFormulaKind::Not(g)
+            | CFormulaKind::Always(_, g)
+            | CFormulaKind::Eventually(_, g)
+            | CFormulaKind::Once(_, g)
+            | CFormulaKind::Historically(_, g)
+            | CFormulaKind::Prev(g)
+            | CFormulaKind::Next(g) => {
                 formulas.push(g);
             }
             CFormulaKind::And(gs) | CFormulaKind::Or(gs) => formulas.extend(gs),
-            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+            CFormulaKind::Implies(a, b)
+            | CFormulaKind::Until(_, a, b)
+            | CFormulaKind::Since(_, a, b) => {
                 formulas.extend([&**a, &**b]);
             }
         }
@@ -147,11 +155,19 @@ pub(crate) fn inclusive_int_bounds(spec: &CheckedSpec, src: &str, out: &mut Vec<
                 chain_warning(spec, src, f, parts, out);
             }
             CFormulaKind::Cmp(..) => chain_warning(spec, src, f, std::slice::from_ref(f), out),
-            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
+            CFormulaKind::Not(g)
+            | CFormulaKind::Always(_, g)
+            | CFormulaKind::Eventually(_, g)
+            | CFormulaKind::Once(_, g)
+            | CFormulaKind::Historically(_, g)
+            | CFormulaKind::Prev(g)
+            | CFormulaKind::Next(g) => {
                 stack.push(g);
             }
             CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs),
-            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+            CFormulaKind::Implies(a, b)
+            | CFormulaKind::Until(_, a, b)
+            | CFormulaKind::Since(_, a, b) => {
                 stack.extend([&**a, &**b]);
             }
             CFormulaKind::True
@@ -299,11 +315,17 @@ pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec
                     atoms.push((a, b, &f.range));
                 }
             }
-            CFormulaKind::Not(g) | CFormulaKind::Always(_, g) | CFormulaKind::Eventually(_, g) => {
-                stack.push(g)
-            }
+            CFormulaKind::Not(g)
+            | CFormulaKind::Always(_, g)
+            | CFormulaKind::Eventually(_, g)
+            | CFormulaKind::Once(_, g)
+            | CFormulaKind::Historically(_, g)
+            | CFormulaKind::Prev(g)
+            | CFormulaKind::Next(g) => stack.push(g),
             CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs.iter()),
-            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+            CFormulaKind::Implies(a, b)
+            | CFormulaKind::Until(_, a, b)
+            | CFormulaKind::Since(_, a, b) => {
                 stack.push(a);
                 stack.push(b);
             }

@@ -604,6 +604,23 @@ impl Splitter<'_, '_> {
         if found == ";" && expects("`let`") {
             return Some("remove this `;`: an item ends with its own".into());
         }
+        if found == "[" {
+            let before = text(k.wrapping_sub(1));
+            if before == Some("prev") {
+                return Some(
+                    "`prev` takes no interval: it looks one step back; for a window write \
+                     `once[a..=b] f` or `historically[a..=b] f`"
+                        .into(),
+                );
+            }
+            if before == Some("next") {
+                return Some(
+                    "`next` takes no interval: it looks one step ahead; for a window write \
+                     `eventually[a..=b] f` or `always[a..=b] f`"
+                        .into(),
+                );
+            }
+        }
         if found == "," && expects("`..`") {
             let number =
                 |j: usize| self.toks.get(j).filter(|t| t.kind == TokKind::Number).map(|_| text(j));
@@ -674,7 +691,10 @@ fn describe_tokens(tokens: Vec<String>) -> Vec<String> {
         }
         any
     };
-    if take(&mut set, &["!", "always", "eventually", "true", "false"]) {
+    if take(
+        &mut set,
+        &["!", "always", "eventually", "once", "historically", "prev", "next", "true", "false"],
+    ) {
         take(&mut set, &["(", "-", "abs", "sqrt", "_"]);
         out.push("a formula".to_string());
     } else if take(&mut set, &["abs", "sqrt"]) {
@@ -686,9 +706,9 @@ fn describe_tokens(tokens: Vec<String>) -> Vec<String> {
     }
     let cmp = take(&mut set, &["<", "<=", ">", ">=", "==", "!="]);
     let arith = take(&mut set, &["plus", "-", "*", "/"]);
-    let logic = ["&&", "||", "->", "until"].iter().any(|t| set.contains(*t));
+    let logic = ["&&", "||", "->", "until", "since"].iter().any(|t| set.contains(*t));
     if cmp as u8 + arith as u8 + logic as u8 >= 2 {
-        take(&mut set, &["&&", "||", "->", "until"]);
+        take(&mut set, &["&&", "||", "->", "until", "since"]);
         out.push("an operator".to_string());
     } else if cmp {
         out.push("a comparison operator".to_string());
@@ -712,12 +732,17 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         Rule::add_op | Rule::mul_op => "an arithmetic operator",
         Rule::implies_op => "`->`",
         Rule::until_op => "`until`",
+        Rule::since_op => "`since`",
         Rule::not_op => "`!`",
         Rule::or_op => "`||`",
         Rule::and_op => "`&&`",
         Rule::neg_op => "`-`",
         Rule::always_op => "`always`",
         Rule::eventually_op => "`eventually`",
+        Rule::once_op => "`once`",
+        Rule::historically_op => "`historically`",
+        Rule::prev_op => "`prev`",
+        Rule::next_op => "`next`",
         Rule::interval => "an interval such as `[0..40]`",
         Rule::incl_op | Rule::excl_op | Rule::range_op => "`..` or `..=`",
         Rule::var => "a state variable",
@@ -756,6 +781,11 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         Rule::k_always => "`always`",
         Rule::k_eventually => "`eventually`",
         Rule::k_until => "`until`",
+        Rule::k_once => "`once`",
+        Rule::k_historically => "`historically`",
+        Rule::k_since => "`since`",
+        Rule::k_prev => "`prev`",
+        Rule::k_next => "`next`",
         Rule::k_true => "`true`",
         Rule::k_false => "`false`",
         Rule::k_abs => "`abs`",
@@ -800,16 +830,64 @@ type Res<T> = Result<T, Fail>;
 /// height.
 type Factor = (Option<BinOp>, (Expr, usize));
 
-/// A formula operator: prefix (`!`, `always`, `eventually`) or infix.
+/// A formula operator: prefix (`!`, `always`, `eventually`, `once`, `historically`,
+/// `prev`, `next`) or infix.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum OpKind {
     Not,
     Always,
     Eventually,
+    Once,
+    Historically,
+    Prev,
+    Next,
     Implies,
     Or,
     And,
     Until,
+    Since,
+}
+
+impl OpKind {
+    /// Whether the operator comes before its one operand.
+    fn is_prefix(self) -> bool {
+        matches!(
+            self,
+            OpKind::Not
+                | OpKind::Always
+                | OpKind::Eventually
+                | OpKind::Once
+                | OpKind::Historically
+                | OpKind::Prev
+                | OpKind::Next
+        )
+    }
+
+    /// Whether the operator takes an interval.
+    fn takes_interval(self) -> bool {
+        matches!(
+            self,
+            OpKind::Always
+                | OpKind::Eventually
+                | OpKind::Once
+                | OpKind::Historically
+                | OpKind::Until
+                | OpKind::Since
+        )
+    }
+
+    /// The prefix operator applied to `b`.
+    fn apply(self, interval: Option<Interval>, b: Box<Formula>) -> FormulaKind {
+        match self {
+            OpKind::Not => FormulaKind::Not(b),
+            OpKind::Always => FormulaKind::Always(interval, b),
+            OpKind::Once => FormulaKind::Once(interval, b),
+            OpKind::Historically => FormulaKind::Historically(interval, b),
+            OpKind::Prev => FormulaKind::Prev(b),
+            OpKind::Next => FormulaKind::Next(b),
+            _ => FormulaKind::Eventually(interval, b),
+        }
+    }
 }
 
 /// A formula operator with its byte range (keyword and interval) and interval.
@@ -1111,17 +1189,22 @@ impl Builder<'_> {
             Rule::not_op => OpKind::Not,
             Rule::always_op => OpKind::Always,
             Rule::eventually_op => OpKind::Eventually,
+            Rule::once_op => OpKind::Once,
+            Rule::historically_op => OpKind::Historically,
+            Rule::prev_op => OpKind::Prev,
+            Rule::next_op => OpKind::Next,
             Rule::implies_op => OpKind::Implies,
             Rule::or_op => OpKind::Or,
             Rule::and_op => OpKind::And,
             Rule::until_op => OpKind::Until,
+            Rule::since_op => OpKind::Since,
             _ => {
                 let (f, h) = self.primary(c)?;
                 return Ok(Piece::Operand(f, h));
             }
         };
         let range = self.range(&c);
-        let interval = if matches!(kind, OpKind::Always | OpKind::Eventually | OpKind::Until) {
+        let interval = if kind.takes_interval() {
             c.into_inner().find(|c| c.as_rule() == Rule::interval).map(|i| self.interval(i))
         } else {
             None
@@ -1142,9 +1225,7 @@ impl Builder<'_> {
         let mut prefixes: Vec<Op> = Vec::new();
         while let Some(piece) = next(self) {
             match piece? {
-                Piece::Op(op)
-                    if matches!(op.kind, OpKind::Not | OpKind::Always | OpKind::Eventually) =>
-                {
+                Piece::Op(op) if op.kind.is_prefix() => {
                     if prefixes.len() >= MAX_HEIGHT {
                         return Err(self.too_tall(range));
                     }
@@ -1154,12 +1235,7 @@ impl Builder<'_> {
                 Piece::Operand(mut f, mut h) => {
                     for op in prefixes.drain(..).rev() {
                         let r = op.range.start..f.range.end;
-                        let b = Box::new(f);
-                        let kind = match op.kind {
-                            OpKind::Not => FormulaKind::Not(b),
-                            OpKind::Always => FormulaKind::Always(op.interval, b),
-                            _ => FormulaKind::Eventually(op.interval, b),
-                        };
+                        let kind = op.kind.apply(op.interval, Box::new(f));
                         f = Formula { kind, range: r };
                         h += 1;
                     }
@@ -1176,7 +1252,8 @@ impl Builder<'_> {
         if !ops.iter().any(|op| op.kind == OpKind::Implies) {
             return self.disjunction(operands, ops);
         }
-        // Split at `->` (loosest, right-associative), then `||`, then `&&`, then `until`.
+        // Split at `->` (loosest, right-associative), then `||`, then `&&`, then `until`
+        // and `since`.
         let mut segments: Vec<(Formula, usize)> = Vec::new();
         let mut operands = operands.into_iter();
         let mut group: Vec<(Formula, usize)> = operands.next().into_iter().collect();
@@ -1204,8 +1281,8 @@ impl Builder<'_> {
         Ok((acc, h))
     }
 
-    /// Operands joined by `||`, `&&` and `until` (no `->`): `until` chains are folded
-    /// as they come, grouped by `&&`, and those by `||`.
+    /// Operands joined by `||`, `&&`, `until` and `since` (no `->`): `until` and `since`
+    /// chains are folded as they come, grouped by `&&`, and those by `||`.
     fn disjunction(
         &mut self,
         operands: Vec<(Formula, usize)>,
@@ -1215,8 +1292,9 @@ impl Builder<'_> {
         let Some(mut chain) = operands.next() else {
             return Err(Fail(Diagnostic::new("HSTL001", 0..0, "could not read this formula")));
         };
-        // `until` operators folded into `chain` so far.
+        // `until` and `since` operators folded into `chain` so far, and the first one's word.
         let mut untils = 0;
+        let mut first = "until";
         let mut and_parts: Vec<(Formula, usize)> = Vec::new();
         let mut or_parts: Vec<(Formula, usize)> = Vec::new();
         for (op, rhs) in ops.into_iter().zip(operands) {
@@ -1231,7 +1309,11 @@ impl Builder<'_> {
                     untils = 0;
                 }
                 _ => {
-                    chain = self.until(chain, op, rhs, untils)?;
+                    let word = if op.kind == OpKind::Since { "since" } else { "until" };
+                    if untils == 0 {
+                        first = word;
+                    }
+                    chain = self.until(chain, op, rhs, untils, first)?;
                     untils += 1;
                 }
             }
@@ -1241,20 +1323,34 @@ impl Builder<'_> {
         self.nary(or_parts, true)
     }
 
-    /// `acc until rhs`, where `acc` already folds `count` `until`s (a chain is reported
-    /// as HSTL021 at its second `until` and built from the left).
+    /// `acc until rhs` (or `since`), where `acc` already folds `count` `until`s and
+    /// `since`s, the first of them `first` (a chain is reported as HSTL021 at its second
+    /// operator and built from the left).
     fn until(
         &mut self,
         (acc, h): (Formula, usize),
         op: Op,
         (rhs, hr): (Formula, usize),
         count: usize,
+        first: &str,
     ) -> Res<(Formula, usize)> {
+        let since = op.kind == OpKind::Since;
         if count == 1 {
+            let word = if since { "since" } else { "until" };
+            let message = if word == first {
+                format!("`{word}` is not chainable")
+            } else {
+                format!("`{first}` and `{word}` do not chain")
+            };
             self.diagnostics.push(
-                Diagnostic::new("HSTL021", op.range, "`until` is not chainable")
-                    .with_label(acc.range.clone(), "this is already an `until` formula")
-                    .with_help("add parentheses: `(a until b) until c` or `a until (b until c)`"),
+                Diagnostic::new("HSTL021", op.range.clone(), message)
+                    .with_label(acc.range.clone(), {
+                        let article = if first == "until" { "an" } else { "a" };
+                        format!("this is already {article} `{first}` formula")
+                    })
+                    .with_help(format!(
+                        "add parentheses: `(a {first} b) {word} c` or `a {first} (b {word} c)`"
+                    )),
             );
         }
         let h = h.max(hr) + 1;
@@ -1262,13 +1358,13 @@ impl Builder<'_> {
             return Err(self.too_tall(acc.range.start..rhs.range.end));
         }
         let r = acc.range.start..rhs.range.end;
-        Ok((
-            Formula {
-                kind: FormulaKind::Until(Box::new(acc), op.interval, Box::new(rhs)),
-                range: r,
-            },
-            h,
-        ))
+        let (a, b) = (Box::new(acc), Box::new(rhs));
+        let kind = if since {
+            FormulaKind::Since(a, op.interval, b)
+        } else {
+            FormulaKind::Until(a, op.interval, b)
+        };
+        Ok((Formula { kind, range: r }, h))
     }
 
     /// One operand, or an `Or`/`And` node over two or more.
@@ -1444,7 +1540,7 @@ impl Builder<'_> {
 }
 
 /// Words that are keywords of the grammar (`keyword` in `grammar.pest`): never names.
-pub const KEYWORDS: [&str; 20] = [
+pub const KEYWORDS: [&str; 25] = [
     "spec",
     "state",
     "sequences",
@@ -1465,6 +1561,11 @@ pub const KEYWORDS: [&str; 20] = [
     "argmax",
     "eventually",
     "until",
+    "once",
+    "historically",
+    "since",
+    "prev",
+    "next",
 ];
 
 /// A direct parser of `let` items over the lexer's tokens, for speed: it follows the
@@ -1598,10 +1699,14 @@ impl Fast<'_, '_> {
                 "!" if !self.text(k + 1).starts_with('=') => OpKind::Not,
                 "always" if self.word(k) => OpKind::Always,
                 "eventually" if self.word(k) => OpKind::Eventually,
+                "once" if self.word(k) => OpKind::Once,
+                "historically" if self.word(k) => OpKind::Historically,
+                "prev" if self.word(k) => OpKind::Prev,
+                "next" if self.word(k) => OpKind::Next,
                 _ => return k,
             };
             let (interval, j) =
-                if kind == OpKind::Not { (None, k + 1) } else { self.interval(k + 1) };
+                if kind.takes_interval() { self.interval(k + 1) } else { (None, k + 1) };
             pieces.push(Piece::Op(Op { kind, range: self.span(k, j), interval }));
             k = j;
         }
@@ -1614,10 +1719,11 @@ impl Fast<'_, '_> {
             "||" => OpKind::Or,
             "&&" => OpKind::And,
             "until" if self.word(k) => OpKind::Until,
+            "since" if self.word(k) => OpKind::Since,
             _ => return None,
         };
         let (interval, j) =
-            if kind == OpKind::Until { self.interval(k + 1) } else { (None, k + 1) };
+            if kind.takes_interval() { self.interval(k + 1) } else { (None, k + 1) };
         Some((Op { kind, range: self.span(k, j), interval }, j))
     }
 
@@ -1972,7 +2078,7 @@ mod fast_tests {
         assert!(accepted > 50, "only {accepted} fixture lets went through the direct parser");
     }
 
-    const TOKENS: [&str; 40] = [
+    const TOKENS: [&str; 45] = [
         "a",
         "b",
         "v0",
@@ -1982,6 +2088,11 @@ mod fast_tests {
         "always",
         "eventually",
         "until",
+        "once",
+        "historically",
+        "since",
+        "prev",
+        "next",
         "!",
         "(",
         ")",
@@ -2042,7 +2153,15 @@ mod fast_tests {
             prop_oneof![
                 (
                     inner.clone(),
-                    prop::sample::select(vec!["&&", "||", "->", "until", "until[0..3]"]),
+                    prop::sample::select(vec![
+                        "&&",
+                        "||",
+                        "->",
+                        "until",
+                        "until[0..3]",
+                        "since",
+                        "since[1..=4]"
+                    ]),
                     inner.clone()
                 )
                     .prop_map(|(a, op, b)| format!("{a} {op} {b}")),
@@ -2052,7 +2171,13 @@ mod fast_tests {
                         "always",
                         "eventually[0..=5]",
                         "always[2..]",
-                        "!!"
+                        "!!",
+                        "once",
+                        "once[0..=5]",
+                        "historically[2..]",
+                        "prev",
+                        "next",
+                        "prev next !"
                     ]),
                     inner.clone()
                 )
@@ -2111,9 +2236,10 @@ mod fast_tests {
             let tight: String = format!("let L={f};").split(' ').collect::<Vec<_>>().join("");
             agree(&tight);
             // A formula of the language goes through the direct parser, unless it chains
-            // `until` (reported, so left to pest).
+            // `until` or `since` (reported, so left to pest).
             let spaced = format!("let L = {f};");
-            prop_assert!(agree(&spaced) || f.matches("until").count() > 1, "{}", spaced);
+            let chained = f.matches("until").count() + f.matches("since").count() > 1;
+            prop_assert!(agree(&spaced) || chained, "{}", spaced);
         }
     }
 }

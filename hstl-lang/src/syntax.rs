@@ -337,6 +337,16 @@ pub enum FormulaKind {
     Eventually(Option<Interval>, Box<Formula>),
     /// `f until[I] g`.
     Until(Box<Formula>, Option<Interval>, Box<Formula>),
+    /// `once[I] f`: `f` held at some step of the past window.
+    Once(Option<Interval>, Box<Formula>),
+    /// `historically[I] f`: `f` held at every step of the past window.
+    Historically(Option<Interval>, Box<Formula>),
+    /// `f since[I] g`.
+    Since(Box<Formula>, Option<Interval>, Box<Formula>),
+    /// `prev f`: `f` one step back (`+inf` at the first step).
+    Prev(Box<Formula>),
+    /// `next f`: `f` one step ahead (`+inf` at the last step).
+    Next(Box<Formula>),
     /// `f && g && ...` (two or more operands).
     And(Vec<Formula>),
     /// `f || g || ...` (two or more operands).

@@ -81,6 +81,69 @@ fn implication_is_right_associative_and_loosest() {
     assert!(matches!(r.kind, FormulaKind::Implies(..)));
 }
 
+/// The tree of a formula, fully parenthesised, with its leaves as written.
+fn shape(src: &str, f: &Formula) -> String {
+    let iv = |i: &Option<hstl_lang::syntax::Interval>| {
+        i.as_ref().map_or(String::new(), |i| src[i.range.clone()].to_string())
+    };
+    let join = |v: &[Formula], op: &str| {
+        let parts: Vec<String> = v.iter().map(|g| shape(src, g)).collect();
+        format!("({})", parts.join(&format!(" {op} ")))
+    };
+    match &f.kind {
+        FormulaKind::True
+        | FormulaKind::False
+        | FormulaKind::Name(_)
+        | FormulaKind::Compare { .. } => text(src, f).to_string(),
+        FormulaKind::Paren(g) => shape(src, g),
+        FormulaKind::Not(g) => format!("(!{})", shape(src, g)),
+        FormulaKind::Always(i, g) => format!("(always{} {})", iv(i), shape(src, g)),
+        FormulaKind::Eventually(i, g) => format!("(eventually{} {})", iv(i), shape(src, g)),
+        FormulaKind::Once(i, g) => format!("(once{} {})", iv(i), shape(src, g)),
+        FormulaKind::Historically(i, g) => format!("(historically{} {})", iv(i), shape(src, g)),
+        FormulaKind::Prev(g) => format!("(prev {})", shape(src, g)),
+        FormulaKind::Next(g) => format!("(next {})", shape(src, g)),
+        FormulaKind::Until(a, i, b) => {
+            format!("({} until{} {})", shape(src, a), iv(i), shape(src, b))
+        }
+        FormulaKind::Since(a, i, b) => {
+            format!("({} since{} {})", shape(src, a), iv(i), shape(src, b))
+        }
+        FormulaKind::And(v) => join(v, "&&"),
+        FormulaKind::Or(v) => join(v, "||"),
+        FormulaKind::Implies(a, b) => format!("({} -> {})", shape(src, a), shape(src, b)),
+    }
+}
+
+/// The past-time operators' precedence (PAST-TIME.md): `since` as `until`, below `&&`;
+/// `once`, `historically`, `prev` and `next` as the other prefix operators.
+#[test]
+fn past_operators_bind_as_their_future_mirrors() {
+    let cases = [
+        ("prev x > 0 && y > 0", "((prev x > 0) && y > 0)"),
+        ("next !x > 0", "(next (!x > 0))"),
+        ("prev next prev x > 0", "(prev (next (prev x > 0)))"),
+        ("once[0..3] x > 1 since y > 1", "((once[0..3] x > 1) since y > 1)"),
+        ("x > 1 since[2..=5] y > 1", "(x > 1 since[2..=5] y > 1)"),
+        ("a && b since c", "(a && (b since c))"),
+        ("a since b || c", "((a since b) || c)"),
+        ("a since (b until c)", "(a since (b until c))"),
+        ("historically[1..] a -> once a", "((historically[1..] a) -> (once a))"),
+        ("always[0..] (once[0..=10] a && prev b)", "(always[0..] ((once[0..=10] a) && (prev b)))"),
+        ("historically eventually[0..4] a", "(historically (eventually[0..4] a))"),
+    ];
+    let lets = "let a = x > 1; let b = y > 1; let c = x < 1;";
+    for (formula, want) in cases {
+        let (src, f) = let_formula(&format!("{lets} let T = {formula}; task T;"), "T");
+        assert_eq!(shape(&src, &f), want, "{formula}");
+        let checked = check(&src);
+        let errors: Vec<_> = checked.diagnostics.iter().filter(|d| d.is_error()).collect();
+        assert!(errors.is_empty(), "{formula}: {errors:?}");
+        let t = checked.specs[0].lets.iter().find(|l| l.name == "T").expect("T");
+        assert_eq!(t.kind, LetKind::Temporal, "{formula}");
+    }
+}
+
 #[test]
 fn parenthesised_expression_is_a_comparison_and_parenthesised_comparison_a_formula() {
     let (src, f) = let_formula("let A = (x + 1) > 3;", "A");

@@ -34,7 +34,7 @@ fn all_monitors() -> Vec<(&'static str, Monitor)> {
         f0, f1, f2, f3, f4, f5, f6, f7, f8, f9, f10, f11, f12, f13, f14, f15, f16, f17, f18, f19,
         f20, f21, f22, f23, f24, f25, f26, f27, f28, f29, f30, f31, f32, f33, f34, f35, f36, f37,
         f38, f39, f40, f41, f42, f43, f44, f45, f46, f47, f48, f49, f50, f51, f52, f53, f54, f55,
-        f56, f57, f58, f59,
+        f56, f57, f58, f59, f60, f61, f62, f63, f64, f65, f66, f67, f68, f69, f70, f71,
     ];
     m.push(("task", monitor(diff::task::formula, diff::task::signal, diff::task::robustness)));
     m
@@ -113,6 +113,11 @@ fn lower(spec: &CheckedSpec, f: &CFormula) -> Formula {
         CFormulaKind::Always(i, a) => Formula::always(iv(i), b(a)),
         CFormulaKind::Eventually(i, a) => Formula::eventually(iv(i), b(a)),
         CFormulaKind::Until(i, x, y) => Formula::until(iv(i), b(x), b(y)),
+        CFormulaKind::Once(i, a) => Formula::once(iv(i), b(a)),
+        CFormulaKind::Historically(i, a) => Formula::historically(iv(i), b(a)),
+        CFormulaKind::Since(i, x, y) => Formula::since(iv(i), b(x), b(y)),
+        CFormulaKind::Prev(a) => Formula::prev(b(a)),
+        CFormulaKind::Next(a) => Formula::next(b(a)),
         CFormulaKind::Invalid => panic!("the differential spec checks"),
     }
 }

@@ -135,11 +135,13 @@ class STLReward(gymnasium.Wrapper):
 
     The reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
     ``s_0 ..= s_t`` (``s_0`` is the state ``reset`` returns), for the task or the ``let``
-    called ``formula``. hstl's operators look only forward and windows are clipped at the
-    end of the trace, so this is the formula on ``s_t`` alone: for a state formula, such
-    as a region ``let A = ...``, it is the full trace's signal (``hstlc monitor --signal``)
-    at ``t``; a temporal operator sees only the present (``eventually[0..40] A`` gives
-    ``A`` at ``t``). Pick a region as ``formula`` for a dense reward.
+    called ``formula``. The future operators' windows are clipped at the end of the trace,
+    so without a past-time operator this is the formula on ``s_t`` alone: for a state
+    formula, such as a region ``let A = ...``, it is the full trace's signal
+    (``hstlc monitor --signal``) at ``t``; a temporal operator sees only the present
+    (``eventually[0..40] A`` gives ``A`` at ``t``). A past-time operator reads the states
+    before: ``once[0..10] A`` is whether ``A`` held in the last 10 steps. Pick a region as
+    ``formula`` for a dense reward.
 
     ``info`` (of ``reset`` and ``step``) holds the task's own measure, apart from the
     reward: ``task_robustness``, ``rho(task, 0)`` over the trace so far (what

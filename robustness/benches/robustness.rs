@@ -78,9 +78,24 @@ fn benches(c: &mut Criterion) {
         ("F1_w4000", walk::f1(4000)),
         ("F2", walk::f2()),
         ("F3", walk::f3()),
+        // The past-time mirrors: the same kernels on the reversed signal.
+        ("P1_w40", walk::p1(40)),
+        ("P1_w4000", walk::p1(4000)),
+        ("P2", walk::p2()),
+        ("P3", walk::p3()),
     ];
     full_signal(c, &trace, &cases);
-    online(c, &trace, &[("F1_w40", walk::f1(40)), ("F3", walk::f3())]);
+    online(
+        c,
+        &trace,
+        &[
+            ("F1_w40", walk::f1(40)),
+            ("F3", walk::f3()),
+            ("P1_w40", walk::p1(40)),
+            ("P2", walk::p2()),
+            ("P3", walk::p3()),
+        ],
+    );
     step_zero(c, &trace);
     suffix_rewards(c, &mut rng);
 }

@@ -85,3 +85,30 @@ pub fn f3() -> Formula {
         cmp(Expr::var(1), CmpOp::Gt, Expr::constant(10.0)),
     )
 }
+
+/// P1, the past mirror of F1: `historically[0..=w] (x > 3 && x < 9 && y > 10 && y < 14)`.
+pub fn p1(w: usize) -> Formula {
+    let i = Interval { start: 0, end: Bound::Inclusive(w) };
+    Formula::historically(i, region(3.0, 9.0, 10.0, 14.0))
+}
+
+/// P2, the past mirror of F2: every region held within the last 40 steps, at every step so
+/// far: `historically[0..] (once[0..40] A && once[0..40] B && once[0..40] C)`.
+pub fn p2() -> Formula {
+    let once = |f| Formula::once(Interval { start: 0, end: Bound::Exclusive(40) }, f);
+    let body = Formula::and(vec![
+        once(region(3.0, 9.0, 10.0, 14.0)),
+        once(region(1.0, 5.0, 1.0, 5.0)),
+        once(region(9.0, 13.0, 1.0, 7.0)),
+    ]);
+    Formula::historically(Interval::ALL, body)
+}
+
+/// P3, the past mirror of F3: `(x > 5) since[0..=20] (y > 10)`.
+pub fn p3() -> Formula {
+    Formula::since(
+        Interval { start: 0, end: Bound::Inclusive(20) },
+        cmp(Expr::var(0), CmpOp::Gt, Expr::constant(5.0)),
+        cmp(Expr::var(1), CmpOp::Gt, Expr::constant(10.0)),
+    )
+}

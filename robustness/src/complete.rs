@@ -14,11 +14,15 @@
 //! | `always[a..=b] f`, `eventually[a..=b] f` | those of `f`, less `b` |
 //! | `f until[a..=b] g` | the fewest of `f`'s and `g`'s, less `b` |
 //! | `always[a..] f`, `eventually[a..] f`, `f until[a..] g` | as above, less `a` |
+//! | `once[I] f`, `historically[I] f`, `prev f` | those of `f` |
+//! | `f since[I] g` | the fewest of `f`'s and `g`'s |
+//! | `next f` | those of `f`, less one |
 //!
 //! A bounded operator's value at a complete step is the clipped one. An unbounded
 //! operator ranges over its operands' complete prefix, as if the trace ended there: the
 //! persistent task `always[0..] (eventually[0..40] A && ...)` is then the minimum over the
-//! steps whose 40-step windows are whole. Steps past the complete prefix are undetermined.
+//! steps whose 40-step windows are whole. A past-time operator never looks forward, so its
+//! complete prefix is its operands'. Steps past the complete prefix are undetermined.
 
 use crate::formula::Node;
 use crate::kernels::{Kernels, and_into, or_into};
@@ -108,13 +112,36 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
                 v.truncate(node_len(node, v.len()));
                 v
             }
-            Node::Until(iv, a, b) => {
+            Node::Until(iv, a, b) | Node::Since(iv, a, b) => {
                 let (a, b) = (kid(a.index()), kid(b.index()));
                 let m = a.len().min(b.len());
                 let (mut lhs, mut out) = (a[..m].to_vec(), b[..m].to_vec());
-                kernels.until(iv, &mut lhs, &mut out);
+                if matches!(node, Node::Until(..)) {
+                    kernels.until(iv, &mut lhs, &mut out);
+                } else {
+                    kernels.since(iv, &mut lhs, &mut out);
+                }
                 out.truncate(node_len(node, m));
                 out
+            }
+            Node::Once(iv, a) | Node::Historically(iv, a) => {
+                let mut v = kid(a.index()).to_vec();
+                if matches!(node, Node::Once(..)) {
+                    kernels.once(iv, &mut v);
+                } else {
+                    kernels.historically(iv, &mut v);
+                }
+                v
+            }
+            Node::Prev(a) | Node::Next(a) => {
+                let mut v = kid(a.index()).to_vec();
+                if matches!(node, Node::Prev(_)) {
+                    kernels.prev(&mut v);
+                } else {
+                    kernels.next(&mut v);
+                }
+                v.truncate(node_len(node, v.len()));
+                v
             }
             _ => Vec::new(),
         };
@@ -140,6 +167,7 @@ fn node_len(node: &Node, m: usize) -> usize {
             Bound::Unbounded => m.saturating_sub(i.start),
             _ => m.saturating_sub(i.last_offset().unwrap_or(0)),
         },
+        Node::Next(_) => m.saturating_sub(1),
         _ => m,
     }
 }

@@ -87,6 +87,16 @@ pub enum Node {
     Eventually(Interval, NodeId),
     /// `f until[I] g`.
     Until(Interval, NodeId, NodeId),
+    /// `once[I] f`: the maximum over the past window (see [`Interval::past_window`]).
+    Once(Interval, NodeId),
+    /// `historically[I] f`: the minimum over the past window.
+    Historically(Interval, NodeId),
+    /// `f since[I] g`: the time reversal of `until`.
+    Since(Interval, NodeId, NodeId),
+    /// `prev f`: `f` one step back, `+inf` at the first step (`historically[1..=1] f`).
+    Prev(NodeId),
+    /// `next f`: `f` one step ahead, `+inf` at the last step (`always[1..=1] f`).
+    Next(NodeId),
 }
 
 /// A comparison operator. Robustness does not distinguish strict from non-strict.
@@ -305,6 +315,31 @@ impl FormulaBuilder {
         self.f(Node::Until(i, f, g))
     }
 
+    /// `once[i] f`.
+    pub fn once(&mut self, i: Interval, f: NodeId) -> NodeId {
+        self.f(Node::Once(i, f))
+    }
+
+    /// `historically[i] f`.
+    pub fn historically(&mut self, i: Interval, f: NodeId) -> NodeId {
+        self.f(Node::Historically(i, f))
+    }
+
+    /// `f since[i] g`.
+    pub fn since(&mut self, i: Interval, f: NodeId, g: NodeId) -> NodeId {
+        self.f(Node::Since(i, f, g))
+    }
+
+    /// `prev f`.
+    pub fn prev(&mut self, f: NodeId) -> NodeId {
+        self.f(Node::Prev(f))
+    }
+
+    /// `next f`.
+    pub fn next(&mut self, f: NodeId) -> NodeId {
+        self.f(Node::Next(f))
+    }
+
     /// Adds every node of `f`; returns the id of its root.
     pub fn formula(&mut self, f: &Formula) -> NodeId {
         NodeId(self.insert(&f.inner.nodes, f.inner.root))
@@ -380,8 +415,16 @@ impl Node {
                 ([a.0, b.0, 0], 2, &[])
             }
             Node::Cmp { lhs, rhs, .. } => ([lhs.0, rhs.0, 0], 2, &[]),
-            Node::Not(a) | Node::Always(_, a) | Node::Eventually(_, a) => ([a.0, 0, 0], 1, &[]),
-            Node::Implies(a, b) | Node::Until(_, a, b) => ([a.0, b.0, 0], 2, &[]),
+            Node::Not(a)
+            | Node::Always(_, a)
+            | Node::Eventually(_, a)
+            | Node::Once(_, a)
+            | Node::Historically(_, a)
+            | Node::Prev(a)
+            | Node::Next(a) => ([a.0, 0, 0], 1, &[]),
+            Node::Implies(a, b) | Node::Until(_, a, b) | Node::Since(_, a, b) => {
+                ([a.0, b.0, 0], 2, &[])
+            }
             Node::And(v) | Node::Or(v) => ([0; 3], 0, v.as_slice()),
         };
         Children { fixed, n, rest, k: 0 }
@@ -411,9 +454,26 @@ impl Node {
         )
     }
 
-    /// Whether this is `always`, `eventually` or `until`.
+    /// Whether this is a temporal operator: `always`, `eventually`, `until`, or a
+    /// past-time one ([`Node::is_past`]), or `next`.
     pub fn is_temporal(&self) -> bool {
-        matches!(self, Node::Always(..) | Node::Eventually(..) | Node::Until(..))
+        matches!(
+            self,
+            Node::Always(..)
+                | Node::Eventually(..)
+                | Node::Until(..)
+                | Node::Next(_)
+                | Node::Once(..)
+                | Node::Historically(..)
+                | Node::Since(..)
+                | Node::Prev(_)
+        )
+    }
+
+    /// Whether this is a past-time operator (`once`, `historically`, `since`, `prev`): its
+    /// value at `t` reads steps before `t`.
+    pub fn is_past(&self) -> bool {
+        matches!(self, Node::Once(..) | Node::Historically(..) | Node::Since(..) | Node::Prev(_))
     }
 
     /// The node with every operand `k` replaced by `map(k)`.
@@ -458,6 +518,14 @@ impl Node {
                 let a = NodeId(map(a.index()));
                 Node::Until(*i, a, NodeId(map(b.index())))
             }
+            Node::Once(i, a) => Node::Once(*i, NodeId(map(a.index()))),
+            Node::Historically(i, a) => Node::Historically(*i, NodeId(map(a.index()))),
+            Node::Since(i, a, b) => {
+                let a = NodeId(map(a.index()));
+                Node::Since(*i, a, NodeId(map(b.index())))
+            }
+            Node::Prev(a) => Node::Prev(NodeId(map(a.index()))),
+            Node::Next(a) => Node::Next(NodeId(map(a.index()))),
             Node::And(v) => Node::And(v.iter().map(|a| NodeId(map(a.index()))).collect()),
             Node::Or(v) => Node::Or(v.iter().map(|a| NodeId(map(a.index()))).collect()),
         }
@@ -484,6 +552,11 @@ impl Node {
             Node::Always(..) => 16,
             Node::Eventually(..) => 17,
             Node::Until(..) => 18,
+            Node::Once(..) => 19,
+            Node::Historically(..) => 20,
+            Node::Since(..) => 21,
+            Node::Prev(_) => 22,
+            Node::Next(_) => 23,
         }
     }
 
@@ -493,7 +566,12 @@ impl Node {
             Node::Const(c) => (c.to_bits(), None),
             Node::Var(i) => (*i as u64, None),
             Node::Cmp { op, .. } => (*op as u64, None),
-            Node::Always(i, _) | Node::Eventually(i, _) | Node::Until(i, ..) => (0, Some(*i)),
+            Node::Always(i, _)
+            | Node::Eventually(i, _)
+            | Node::Until(i, ..)
+            | Node::Once(i, _)
+            | Node::Historically(i, _)
+            | Node::Since(i, ..) => (0, Some(*i)),
             _ => (0, None),
         }
     }
@@ -577,6 +655,19 @@ impl Interval {
         }
     }
 
+    /// The steps of the past window at step `t`, `{t' : t-b < t' <= t-a}` for `[a..b]`
+    /// (`t-b` included for `[a..=b]`, from step 0 for `[a..]`), clipped at the start of the
+    /// trace. Empty when `t < a`; a bound past `t` reaches back to step 0 (no wrap).
+    pub fn past_window(&self, t: usize) -> std::ops::Range<usize> {
+        let hi = t.saturating_add(1).saturating_sub(self.start);
+        let lo = match self.end {
+            Bound::Unbounded => 0,
+            Bound::Exclusive(b) => t.saturating_add(1).saturating_sub(b),
+            Bound::Inclusive(b) => t.saturating_sub(b),
+        };
+        lo..hi.max(lo)
+    }
+
     /// The steps of the window at step `t` on a trace of `n` steps, clipped to the trace.
     pub fn window(&self, t: usize, n: usize) -> std::ops::Range<usize> {
         let lo = t.saturating_add(self.start).min(n);
@@ -610,7 +701,9 @@ impl Formula {
                 Node::Always(i, _) | Node::Eventually(i, _) | Node::Until(i, ..) => {
                     kids_h().and_then(|h| window_end(i)?.checked_add(h))
                 }
+                Node::Next(_) => kids_h().and_then(|h| h.checked_add(1)),
                 _ if node.is_expr() => Some(0),
+                // Past windows never look forward (`prev`: an upper bound).
                 _ => kids_h(),
             };
             let s = !node.is_temporal() && node.children().all(|k| state[k]);
@@ -787,6 +880,52 @@ impl Formula {
             let (f, g) = (b.formula(&f), b.formula(&g));
             b.until(i, f, g)
         })
+    }
+
+    /// `once[i] f`.
+    pub fn once(i: Interval, f: Formula) -> Formula {
+        Formula::one(|b| {
+            let f = b.formula(&f);
+            b.once(i, f)
+        })
+    }
+
+    /// `historically[i] f`.
+    pub fn historically(i: Interval, f: Formula) -> Formula {
+        Formula::one(|b| {
+            let f = b.formula(&f);
+            b.historically(i, f)
+        })
+    }
+
+    /// `f since[i] g`.
+    pub fn since(i: Interval, f: Formula, g: Formula) -> Formula {
+        Formula::one(|b| {
+            let (f, g) = (b.formula(&f), b.formula(&g));
+            b.since(i, f, g)
+        })
+    }
+
+    /// `prev f`.
+    pub fn prev(f: Formula) -> Formula {
+        Formula::one(|b| {
+            let f = b.formula(&f);
+            b.prev(f)
+        })
+    }
+
+    /// `next f`.
+    pub fn next(f: Formula) -> Formula {
+        Formula::one(|b| {
+            let f = b.formula(&f);
+            b.next(f)
+        })
+    }
+
+    /// Whether some node is a past-time operator: then `rho(f, t)` also reads steps before
+    /// `t`, and a suffix of a trace does not give the signal's values.
+    pub fn has_past(&self) -> bool {
+        self.nodes().iter().any(Node::is_past)
     }
 }
 
@@ -1007,8 +1146,8 @@ enum Piece {
 }
 
 impl Display<'_> {
-    /// Binding strengths of every node: formulas `->` 0, `||` 1, `&&` 2, `until` 3,
-    /// prefix 4, atoms 5; expressions sums 0, products 1, factors 2.
+    /// Binding strengths of every node: formulas `->` 0, `||` 1, `&&` 2, `until` and
+    /// `since` 3, prefix 4, atoms 5; expressions sums 0, products 1, factors 2.
     fn levels(&self) -> Vec<u8> {
         let mut level: Vec<u8> = Vec::with_capacity(self.nodes.len());
         for node in self.nodes {
@@ -1020,8 +1159,14 @@ impl Display<'_> {
                 Node::Or(gs) | Node::And(gs) if gs.len() == 1 => level[gs[0].index()],
                 Node::Or(gs) if !gs.is_empty() => 1,
                 Node::And(gs) if !gs.is_empty() => 2,
-                Node::Until(..) => 3,
-                Node::Not(_) | Node::Always(..) | Node::Eventually(..) => 4,
+                Node::Until(..) | Node::Since(..) => 3,
+                Node::Not(_)
+                | Node::Always(..)
+                | Node::Eventually(..)
+                | Node::Once(..)
+                | Node::Historically(..)
+                | Node::Prev(_)
+                | Node::Next(_) => 4,
                 _ => 5,
             };
             level.push(l);
@@ -1071,18 +1216,31 @@ impl Display<'_> {
                 stack.push(Piece::Formula(id(g), 4));
                 f.write_str("!")
             }
-            Node::Always(i, g) | Node::Eventually(i, g) => {
-                let always = matches!(self.nodes[v as usize], Node::Always(..));
+            node @ (Node::Always(i, g)
+            | Node::Eventually(i, g)
+            | Node::Once(i, g)
+            | Node::Historically(i, g)) => {
                 stack.push(Piece::Formula(id(g), 4));
                 stack.push(Piece::Text(" "));
                 stack.push(Piece::Interval(*i));
-                f.write_str(if always { "always" } else { "eventually" })
+                f.write_str(match node {
+                    Node::Always(..) => "always",
+                    Node::Eventually(..) => "eventually",
+                    Node::Once(..) => "once",
+                    _ => "historically",
+                })
             }
-            Node::Until(i, g, h) => {
+            Node::Prev(g) | Node::Next(g) => {
+                let prev = matches!(self.nodes[v as usize], Node::Prev(_));
+                stack.push(Piece::Formula(id(g), 4));
+                f.write_str(if prev { "prev " } else { "next " })
+            }
+            Node::Until(i, g, h) | Node::Since(i, g, h) => {
+                let since = matches!(self.nodes[v as usize], Node::Since(..));
                 stack.push(Piece::Formula(id(h), 4));
                 stack.push(Piece::Text(" "));
                 stack.push(Piece::Interval(*i));
-                stack.push(Piece::Text(" until"));
+                stack.push(Piece::Text(if since { " since" } else { " until" }));
                 stack.push(Piece::Formula(id(g), 4));
                 Ok(())
             }

@@ -5,7 +5,9 @@
 //! and calls these kernels on whole columns. A monitor generated for one formula can
 //! compute its state subformulas as fused loops over its own state type and hand the
 //! temporal structure to the very same code: [`Kernels::always`], [`Kernels::eventually`]
-//! and [`Kernels::until`] turn an operand signal into the operator's signal in place, and
+//! and [`Kernels::until`] (and the past-time [`Kernels::once`], [`Kernels::historically`],
+//! [`Kernels::since`], [`Kernels::prev`], with [`Kernels::next`]) turn an operand signal
+//! into the operator's signal in place, and
 //! [`pieces`] evaluates a formula with a finite horizon in cache-sized pieces, as the
 //! evaluator does. The values are the evaluator's, bit for bit, NaN policy included (see
 //! [`offline`](crate::offline)).
@@ -103,6 +105,58 @@ impl Kernels {
             }
             out[n - a..].fill(NEG_INF);
         }
+    }
+
+    /// `buf` holds `rho(g, t)` for every step of a trace; it becomes
+    /// `rho(once[interval] g, t)`: the maximum over the past window at `t`, clipped at the
+    /// start of `buf`, `-inf` when empty, NaN samples skipped. It is the time reversal of
+    /// `eventually` (`rev(E(rev(v)))`), so it costs what [`Kernels::eventually`] does,
+    /// whatever the window.
+    pub fn once(&mut self, interval: &Interval, buf: &mut [f64]) {
+        buf.reverse();
+        self.window::<Max>(buf, interval);
+        buf.reverse();
+    }
+
+    /// `buf` holds `rho(g, t)`; it becomes `rho(historically[interval] g, t)`: the minimum
+    /// over the past window, `+inf` when empty, NaN samples skipped (`always`, reversed).
+    pub fn historically(&mut self, interval: &Interval, buf: &mut [f64]) {
+        buf.reverse();
+        self.window::<Min>(buf, interval);
+        buf.reverse();
+    }
+
+    /// `lhs` holds `rho(f, t)` and `out` holds `rho(g, t)`, equally long; `out` becomes
+    /// `rho(f since[interval] g, t)`, the time reversal of `until`. `lhs` is used as
+    /// scratch and left unspecified.
+    ///
+    /// # Panics
+    /// When `lhs` is shorter than `out`.
+    pub fn since(&mut self, interval: &Interval, lhs: &mut [f64], out: &mut [f64]) {
+        let n = out.len();
+        let lhs = &mut lhs[..n];
+        lhs.reverse();
+        out.reverse();
+        self.until(interval, lhs, out);
+        out.reverse();
+    }
+
+    /// `buf` holds `rho(g, t)`; it becomes `rho(prev g, t)`: `rho(g, t - 1)`, and `+inf` at
+    /// step 0 (and for a NaN sample, as `historically[1..=1]` skips it).
+    pub fn prev(&mut self, buf: &mut [f64]) {
+        let n = buf.len();
+        if n == 0 {
+            return;
+        }
+        buf.copy_within(..n - 1, 1);
+        buf[0] = INF;
+        buf.iter_mut().for_each(|v| *v = Min::acc(INF, *v));
+    }
+
+    /// `buf` holds `rho(g, t)`; it becomes `rho(next g, t)`: `rho(g, t + 1)`, and `+inf` at
+    /// the last step (and for a NaN sample, as `always[1..=1]` skips it).
+    pub fn next(&mut self, buf: &mut [f64]) {
+        self.window::<Min>(buf, &Interval { start: 1, end: Bound::Inclusive(1) });
     }
 
     /// `buf[t]` becomes the `L`-fold of `buf` over the window of `i` at `t`, in place.

@@ -4,7 +4,9 @@
 //! language: callers build a [`Formula`] directly, or have the `hstl` facade lower a
 //! checked spec into one. Semantics follow the hstl language reference ("Meaning"):
 //! windows are clipped at the end of the trace, an empty `always` window is `+inf`, an
-//! empty `eventually` or `until` window is `-inf`.
+//! empty `eventually` or `until` window is `-inf`. The past-time operators (`once`,
+//! `historically`, `since`, weak `prev`, and `next`) follow rtamt's discrete-time
+//! semantics, their windows clipped at the start of the trace.
 //!
 //! - [`reference`](mod@reference) follows the semantics table literally; it is the test oracle.
 //! - [`offline`] computes whole signals fast, and the robustness at step 0 from the

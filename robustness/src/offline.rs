@@ -261,10 +261,13 @@ impl Plan {
             if is_leaf(&nodes[v]) {
                 continue;
             }
-            let own = v == root || horizon[v].is_none() || cand[v] == MANY || cand[v] == NONE;
+            // A past-time node reads back to step 0, so it cannot run in pieces: like an
+            // unbounded node it is a group of its own over whole signals.
+            let whole = horizon[v].is_none() || nodes[v].is_past();
+            let own = v == root || whole || cand[v] == MANY || cand[v] == NONE;
             owner[v] = if own { v as u32 } else { cand[v] };
-            // An unbounded node reads whole signals: each operand heads a group.
-            let give = if horizon[v].is_none() { MANY } else { owner[v] };
+            // A node that reads whole signals: each operand heads a group.
+            let give = if whole { MANY } else { owner[v] };
             for c in nodes[v].children() {
                 if !is_leaf(&nodes[c]) {
                     cand[c] = match cand[c] {
@@ -438,7 +441,7 @@ impl Runner {
         for g in &plan.groups {
             let root = g.root;
             let piece = match f.horizons()[root] {
-                Some(h) if !f.states()[root] => piece_len(h),
+                Some(h) if !f.states()[root] && !f.nodes()[root].is_past() => piece_len(h),
                 _ => usize::MAX,
             };
             let out = if n / 2 <= piece {
@@ -638,7 +641,14 @@ impl Runner {
             Node::And(gs) => self.fold_chunk::<Min>(f, s, gs, cols, lo, c0, out),
             Node::Or(gs) => self.fold_chunk::<Max>(f, s, gs, cols, lo, c0, out),
             // Temporal nodes are never state members.
-            Node::Always(..) | Node::Eventually(..) | Node::Until(..) => out.fill(f64::NAN),
+            Node::Always(..)
+            | Node::Eventually(..)
+            | Node::Until(..)
+            | Node::Once(..)
+            | Node::Historically(..)
+            | Node::Since(..)
+            | Node::Prev(_)
+            | Node::Next(_) => out.fill(f64::NAN),
         }
     }
 
@@ -769,6 +779,35 @@ impl Runner {
                 self.put(lhs);
                 out
             }
+            // Past-time operators: the future kernels on the reversed signal (a group of
+            // their own, over the whole trace).
+            Node::Once(i, g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.kernels.once(i, &mut out);
+                out
+            }
+            Node::Historically(i, g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.kernels.historically(i, &mut out);
+                out
+            }
+            Node::Since(i, g, h) => {
+                let mut lhs = self.own(f, v, g.index(), lo, m, last, whole);
+                let mut out = self.own(f, v, h.index(), lo, m, last, whole);
+                self.kernels.since(i, &mut lhs, &mut out);
+                self.put(lhs);
+                out
+            }
+            Node::Prev(g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.kernels.prev(&mut out);
+                out
+            }
+            Node::Next(g) => {
+                let mut out = self.own(f, v, g.index(), lo, m, last, whole);
+                self.kernels.next(&mut out);
+                out
+            }
             // State nodes are state members, computed in chunks.
             _ => {
                 let mut out = self.take(m);
@@ -854,8 +893,16 @@ pub(crate) fn empty_trace_value(f: &Formula) -> f64 {
     for node in f.nodes() {
         let v = |k: usize| vals[k];
         let x = match node {
-            Node::True | Node::Always(..) => INF,
-            Node::False | Node::Eventually(..) | Node::Until(..) => NEG_INF,
+            Node::True
+            | Node::Always(..)
+            | Node::Historically(..)
+            | Node::Prev(_)
+            | Node::Next(_) => INF,
+            Node::False
+            | Node::Eventually(..)
+            | Node::Until(..)
+            | Node::Once(..)
+            | Node::Since(..) => NEG_INF,
             Node::Not(g) => -v(g.index()),
             Node::And(gs) => gs.iter().map(|g| v(g.index())).fold(INF, f64::min),
             Node::Or(gs) => gs.iter().map(|g| v(g.index())).fold(NEG_INF, f64::max),

@@ -2,6 +2,8 @@
 //!
 //! For a formula with a finite horizon `H`, `rho(f, t)` depends on `s_t ..= s_{t+H}` only,
 //! so it is final once state `t + H` has arrived: [`OnlineMonitor::push`] returns it then.
+//! Past-time operators read earlier states too, which their streaming nodes keep (`O(b)`
+//! values for an interval `[a..b]`, a running value for `[a..]`).
 //! Each operator is a streaming node (monotonic deques for `always`/`eventually`, the
 //! offline evaluator's block decomposition run forwards for `until`), so a push costs
 //! amortised `O(1)` per operator and the monitor holds `O(H)` values per operator plus the
@@ -118,15 +120,26 @@ impl OnlineMonitor {
     /// of the trace. The monitor is then ready for a new trace, counting from step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
         let n = self.buffered();
-        let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
         let first = self.first_step;
-        let out = self
-            .eval
-            .signal_of_columns(&self.formula, &cols, n)
-            .iter()
-            .enumerate()
-            .map(|(i, &value)| Verdict { step: first + i, value })
-            .collect();
+        let out = match &mut self.nodes {
+            // The states before the open steps are gone, but a past-time operator reads
+            // them: the streams, which hold what they need of them, end the trace.
+            Some(nodes) if self.formula.has_past() => nodes
+                .finish(&self.formula)
+                .into_iter()
+                .enumerate()
+                .map(|(i, value)| Verdict { step: first + i, value })
+                .collect(),
+            _ => {
+                let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
+                self.eval
+                    .signal_of_columns(&self.formula, &cols, n)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &value)| Verdict { step: first + i, value })
+                    .collect()
+            }
+        };
         self.reset();
         out
     }

@@ -15,18 +15,19 @@ use crate::{Formula, NodeId, Trace};
 
 /// `rho(f, t)` on `trace`. Steps at or past the end of the trace see empty windows.
 ///
-/// Only the steps `t ..= t + H` are computed for a formula of horizon `H`: `rho(f, t)`
-/// reads no other.
+/// Only the steps `t ..= t + H` are computed for a formula of horizon `H` (from step 0
+/// when it has a past-time operator): `rho(f, t)` reads no other.
 pub fn robustness(f: &Formula, trace: &Trace, t: usize) -> f64 {
     let n = trace.len();
     let stop = match f.horizon() {
         Some(h) => t.saturating_add(h).saturating_add(1).min(n.max(t + 1)),
         None => n.max(t + 1),
     };
-    if stop == t + 1 {
+    let from = if f.has_past() { 0 } else { t };
+    if !f.has_past() && stop == t + 1 {
         return at_one_step(f, trace, t);
     }
-    signals(f, trace, t, stop)[f.root().index()][0]
+    signals(f, trace, from, stop)[f.root().index()][t - from]
 }
 
 /// `rho(f, t)` when it reads step `t` alone (a state formula, or a step past the end):
@@ -64,6 +65,11 @@ fn at_one_step(f: &Formula, trace: &Trace, t: usize) -> f64 {
             Node::Until(i, _, h) => window(i)
                 .map(|_| at(h.index()).min(f64::INFINITY))
                 .fold(f64::NEG_INFINITY, f64::max),
+            // Step `t + 1` is not read.
+            Node::Next(_) => f64::INFINITY,
+            // Not reached: a formula with a past-time operator reads from step 0.
+            Node::Historically(..) | Node::Prev(_) => f64::INFINITY,
+            Node::Once(..) | Node::Since(..) => f64::NEG_INFINITY,
         };
         vals.push(x);
     }
@@ -78,7 +84,8 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
 
 /// The signal of every node of `f` at the steps `from .. to` (steps past the trace see
 /// NaN atoms and empty windows); an operator at `u` reads its operands at `u..to`, so the
-/// values are exact where `u + horizon < to` or `to` is at least the trace's length.
+/// values are exact where `u + horizon < to` or `to` is at least the trace's length. A
+/// past-time operator reads `from..=u`: exact when `from` is 0.
 fn signals(f: &Formula, trace: &Trace, from: usize, to: usize) -> Vec<Vec<f64>> {
     let n = trace.len();
     let steps = to.saturating_sub(from);
@@ -87,6 +94,15 @@ fn signals(f: &Formula, trace: &Trace, from: usize, to: usize) -> Vec<Vec<f64>> 
         // `at(k, u)`: node `k` at step `u` (absolute).
         let at = |k: usize, u: usize| sig[k][u - from];
         let window = |i: &crate::Interval, u: usize| i.window(u, n.min(to));
+        // Past windows, cut at `from` (which is 0 when the formula has a past operator);
+        // a step past the trace sees an empty window, as for the future operators.
+        let past = |i: &crate::Interval, u: usize| {
+            if u >= n {
+                return 0..0;
+            }
+            let w = i.past_window(u);
+            w.start.max(from)..w.end.max(from)
+        };
         let values: Vec<f64> = (from..to)
             .map(|u| match node {
                 Node::True => f64::INFINITY,
@@ -123,6 +139,28 @@ fn signals(f: &Formula, trace: &Trace, from: usize, to: usize) -> Vec<Vec<f64>> 
                     .map(|w| {
                         let before = (u..w).map(|v| at(g.index(), v)).fold(f64::INFINITY, f64::min);
                         at(h.index(), w).min(before)
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max),
+                // `next f` is `always[1..=1] f`: `+inf` where step `u + 1` does not exist.
+                Node::Next(g) => (u + 1..(u + 2).min(n.min(to)))
+                    .map(|w| at(g.index(), w))
+                    .fold(f64::INFINITY, f64::min),
+                // `prev f` is `historically[1..=1] f`: `+inf` at step 0.
+                Node::Prev(g) => {
+                    let w = if u >= n { 0..0 } else { u.saturating_sub(1).max(from)..u };
+                    w.map(|w| at(g.index(), w)).fold(f64::INFINITY, f64::min)
+                }
+                Node::Historically(i, g) => {
+                    past(i, u).map(|w| at(g.index(), w)).fold(f64::INFINITY, f64::min)
+                }
+                Node::Once(i, g) => {
+                    past(i, u).map(|w| at(g.index(), w)).fold(f64::NEG_INFINITY, f64::max)
+                }
+                Node::Since(i, g, h) => past(i, u)
+                    .map(|w| {
+                        let after =
+                            (w + 1..=u).map(|v| at(g.index(), v)).fold(f64::INFINITY, f64::min);
+                        at(h.index(), w).min(after)
                     })
                     .fold(f64::NEG_INFINITY, f64::max),
             })

@@ -7,7 +7,9 @@
 //! robustness at step 0 of the suffix from `i` is the segment's `rho(f, i)`, windows
 //! clipped alike. For a persistent task `always[0..] f` with `hor(f) = H`, the suffix from
 //! `i` takes the minimum of `rho(f, u)` over `i <= u <= max(i, m - 1 - H)`: one backward
-//! running minimum gives all of them.
+//! running minimum gives all of them. A task with a past-time operator reads the states
+//! before `t` too, so a suffix is not the segment's tail there: each suffix is then scored
+//! on its own (quadratic in the segment's length).
 
 use crate::formula::{Node, expr_value};
 use crate::offline::{Evaluator, Lattice, Max, Min, Runner, Source};
@@ -56,6 +58,14 @@ impl SegmentScorer {
 
     fn suffix_rewards_of_columns(&mut self, cols: &[&[f64]], m: usize, out: &mut Vec<f64>) {
         out.clear();
+        if self.task.has_past() {
+            for i in 0..m {
+                let tail: Vec<&[f64]> = cols.iter().map(|c| &c[i..m]).collect();
+                let r = self.reward_of_columns(&tail, m - i);
+                out.push(r);
+            }
+            return;
+        }
         match &self.body {
             Some((body, h)) => {
                 let sig = self.eval.signal_of_columns(body, cols, m);
@@ -96,12 +106,15 @@ pub struct TabularScorer {
     tables: Vec<Vec<f64>>,
     /// The horizon of `f` when the task is `always[0..] f`.
     persistent: Option<usize>,
+    /// The task has a past-time operator: suffixes are scored one by one.
+    past: bool,
     runner: Runner,
 }
 
 impl TabularScorer {
     /// A scorer for `task` over `states`, whose row `i` is the state with index `i`.
     pub fn new(task: &Formula, states: &Trace) -> TabularScorer {
+        let past = task.has_past();
         let (plan, persistent) = match reference::persistent_body(task) {
             Some((body, h)) => (task.sub(body), Some(h)),
             None => (task.clone(), None),
@@ -181,6 +194,11 @@ impl TabularScorer {
                 (_, Node::Always(i, g)) => Some(b.always(*i, m(g))),
                 (_, Node::Eventually(i, g)) => Some(b.eventually(*i, m(g))),
                 (_, Node::Until(i, g, h)) => Some(b.until(*i, m(g), m(h))),
+                (_, Node::Once(i, g)) => Some(b.once(*i, m(g))),
+                (_, Node::Historically(i, g)) => Some(b.historically(*i, m(g))),
+                (_, Node::Since(i, g, h)) => Some(b.since(*i, m(g), m(h))),
+                (_, Node::Prev(g)) => Some(b.prev(m(g))),
+                (_, Node::Next(g)) => Some(b.next(m(g))),
                 _ => None,
             };
         }
@@ -195,7 +213,7 @@ impl TabularScorer {
                 by_node[v] = std::mem::take(&mut tables[j]);
             }
         }
-        TabularScorer { plan, tables: by_node, persistent, runner: Runner::tabular() }
+        TabularScorer { plan, tables: by_node, persistent, past, runner: Runner::tabular() }
     }
 
     fn signal(&mut self, seg: &[usize]) -> Vec<f64> {
@@ -234,6 +252,13 @@ impl TabularScorer {
     pub fn suffix_rewards(&mut self, segment: &[usize], out: &mut Vec<f64>) {
         let m = segment.len();
         out.clear();
+        if self.past {
+            for i in 0..m {
+                let r = self.reward(&segment[i..]);
+                out.push(r);
+            }
+            return;
+        }
         let sig = self.signal(segment);
         match self.persistent {
             Some(h) => {

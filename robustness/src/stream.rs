@@ -5,10 +5,15 @@
 //! exactly one value per state once warmed up. Each node keeps its recent values for the
 //! parents that read them later (at most the difference of their horizons), and a window
 //! or until keeps `O(h)` values. Windows use monotonic deques; bounded until uses the
-//! block decomposition of the offline evaluator, run forwards. Values equal the offline
-//! evaluator's (same min/max selections, same NaN policy). Only windows clipped by the end
-//! of the trace are left out: the monitor evaluates those offline at `finish`. The nodes
-//! are walked in order on every push: nothing recurses, and a shared node is computed once.
+//! block decomposition of the offline evaluator, run forwards. Past-time operators look
+//! back, the direction the states arrive in: `once` and `historically` keep a monotonic
+//! deque over their past window (and the last `a` values, not yet in it), `since` a
+//! forward recurrence over blocks of its window's length (the mirror image of until's
+//! decomposition), so each keeps `O(b)` values for an interval `[a..b]`. Values equal the
+//! offline evaluator's (same min/max selections, same NaN policy). Windows clipped by the
+//! end of the trace are computed at [`Stream::finish`] (or, for a formula without past-time
+//! operators, offline by the monitor). The nodes are walked in order on every push: nothing
+//! recurses, and a shared node is computed once.
 
 use crate::formula::{Node, expr_value};
 use crate::offline::{Lattice, Max, Min};
@@ -54,6 +59,55 @@ enum Kind {
     Implies,
     Window(Box<Window>),
     Until(Box<Until>),
+    PastWindow(Box<PastWindow>),
+    Since(Box<Since>),
+}
+
+/// `once` (max) or `historically` (min) over the past window `[t - last, t - a]`, clipped
+/// at step 0 (`prev` is `historically[1..=1]`).
+#[derive(Clone, Debug)]
+struct PastWindow {
+    max: bool,
+    a: usize,
+    /// The farthest offset back; `None` when the window runs back to step 0.
+    last: Option<usize>,
+    /// No step is ever in the window (`[3..3]`).
+    empty: bool,
+    /// Operand values received so far.
+    seen: usize,
+    /// The last `a` operand values, not in any window yet.
+    delay: VecDeque<f64>,
+    /// Monotonic deque of `(step, value)` (bounded window): the front is the extremum.
+    deque: VecDeque<(usize, f64)>,
+    /// The fold of every value that entered (unbounded window).
+    acc: f64,
+}
+
+/// `f since[a..=last] g`: `min(min f over (t - a, t], S(t - a))`, where `S(e)` is
+/// `since[0..=span]` at `e` (`span = last - a`). Cut the steps into blocks of `span + 1`:
+/// the witnesses of `e` are a prefix of its block (a forward recurrence, `p`) and a suffix
+/// of the block before (`q`, computed backwards once that block is complete), the latter
+/// bounded by the minimum of `f` over `e`'s block up to `e` (`pf`).
+#[derive(Clone, Debug)]
+struct Since {
+    a: usize,
+    /// `last - a`; `None` when unbounded (back to step 0).
+    span: Option<usize>,
+    empty: bool,
+    seen: usize,
+    /// The last `a` pairs `(f, g)`, not witnesses yet (NaN read as `+inf`).
+    delay: VecDeque<(f64, f64)>,
+    /// Monotonic min deque over the last `a` values of `f`, with their steps.
+    head: VecDeque<(usize, f64)>,
+    /// Witness steps (`e`) taken so far.
+    witnesses: usize,
+    /// The recurrence over the current block's prefix (or the whole past, unbounded).
+    p: f64,
+    pf: f64,
+    /// The current block's pairs, for `q` once it is complete.
+    block: Vec<(f64, f64)>,
+    /// `q[j]`: since over steps `j ..` of the previous block, to its end.
+    q: Vec<f64>,
 }
 
 /// `always` (min) or `eventually` (max) over `[t + a, t + last]`.
@@ -74,6 +128,7 @@ struct Window {
 /// `f until[a..=last] g`, see `offline::block_until` for the decomposition.
 #[derive(Clone, Debug)]
 struct Until {
+    interval: Interval,
     a: usize,
     last: Option<usize>,
     end: usize,
@@ -119,7 +174,24 @@ impl Stream {
                         seen: 0,
                         deque: VecDeque::new(),
                     })),
+                    Node::Once(i, _) | Node::Historically(i, _) => Kind::PastWindow(Box::new(
+                        PastWindow::new(matches!(node, Node::Once(..)), i),
+                    )),
+                    Node::Prev(_) => Kind::PastWindow(Box::new(PastWindow::new(
+                        false,
+                        &Interval { start: 1, end: Bound::Inclusive(1) },
+                    ))),
+                    Node::Next(_) => Kind::Window(Box::new(Window {
+                        max: false,
+                        a: 1,
+                        last: Some(1),
+                        end: 1,
+                        seen: 0,
+                        deque: VecDeque::new(),
+                    })),
+                    Node::Since(i, ..) => Kind::Since(Box::new(Since::new(i))),
                     Node::Until(i, ..) => Kind::Until(Box::new(Until {
+                        interval: *i,
                         a: i.start,
                         last: last(i),
                         end: end(i),
@@ -231,8 +303,237 @@ impl Stream {
                     _ => None,
                 }
             }
+            Node::Once(_, g) | Node::Historically(_, g) | Node::Prev(g) | Node::Next(g) => {
+                let x = self.at(g.index(), s);
+                match &mut self.nodes[v].kind {
+                    Kind::PastWindow(w) => Some(w.take(x)),
+                    Kind::Window(w) => w.take(x),
+                    _ => None,
+                }
+            }
+            Node::Since(_, g, h) => {
+                let (x, y) = (self.at(g.index(), s), self.at(h.index(), s));
+                match &mut self.nodes[v].kind {
+                    Kind::Since(u) => Some(u.take(x, y)),
+                    _ => None,
+                }
+            }
             _ => None,
         }
+    }
+
+    /// Ends the trace: the root's values at the steps that had none yet, windows clipped
+    /// at the end of the trace. Each node in turn takes its operands' remaining values and
+    /// then gives its own clipped ones, so every node ends with values up to the last step.
+    /// The stream is spent afterwards.
+    pub(crate) fn finish(&mut self, f: &Formula) -> Vec<f64> {
+        let n = self.pushed;
+        let nodes = f.nodes();
+        let h = f.horizon().unwrap_or(0);
+        // The root's steps without a verdict.
+        let first = n.saturating_sub(h);
+        for slot in &mut self.nodes {
+            slot.keep = usize::MAX;
+        }
+        for (v, node) in nodes.iter().enumerate() {
+            if matches!(self.nodes[v].kind, Kind::Skip | Kind::State) {
+                continue;
+            }
+            // Operand steps read so far: one per push from push `lag` on.
+            let lag = self.nodes[v].lag;
+            for s in n.saturating_sub(lag)..n {
+                if let Some(x) = self.temporal(node, v, s) {
+                    self.nodes[v].hist.push_back(x);
+                }
+            }
+            let slot = &mut self.nodes[v];
+            let tail = match &mut slot.kind {
+                Kind::Window(w) => w.finish(n),
+                Kind::Until(u) => u.finish(),
+                _ => Vec::new(),
+            };
+            slot.hist.extend(tail);
+        }
+        let root = &self.nodes[self.root];
+        (first..n)
+            .map(|t| root.hist.get(t.wrapping_sub(root.base)).copied().unwrap_or(f64::NAN))
+            .collect()
+    }
+}
+
+impl PastWindow {
+    fn new(max: bool, i: &Interval) -> PastWindow {
+        PastWindow {
+            max,
+            a: i.start,
+            last: i.last_offset(),
+            empty: i.is_empty(),
+            seen: 0,
+            delay: VecDeque::new(),
+            deque: VecDeque::new(),
+            acc: if max { NEG_INF } else { INF },
+        }
+    }
+
+    /// Takes the operand's value at the next step `t`; returns this node's value at `t`.
+    fn take(&mut self, v: f64) -> f64 {
+        let t = self.seen;
+        self.seen += 1;
+        let id = if self.max { NEG_INF } else { INF };
+        if self.empty {
+            return id;
+        }
+        self.delay.push_back(v);
+        // The value `a` steps back enters the window now.
+        if self.delay.len() > self.a
+            && let Some(x) = self.delay.pop_front()
+        {
+            let k = t - self.a;
+            if self.last.is_none() {
+                self.acc = if self.max { Max::acc(self.acc, x) } else { Min::acc(self.acc, x) };
+            } else if !x.is_nan() {
+                while let Some(&(_, b)) = self.deque.back() {
+                    if (self.max && b <= x) || (!self.max && b >= x) {
+                        self.deque.pop_back();
+                    } else {
+                        break;
+                    }
+                }
+                self.deque.push_back((k, x));
+            }
+        }
+        let Some(last) = self.last else { return self.acc };
+        if t < self.a {
+            return id;
+        }
+        let first = t.saturating_sub(last);
+        while self.deque.front().is_some_and(|&(k, _)| k < first) {
+            self.deque.pop_front();
+        }
+        self.deque.front().map_or(id, |&(_, v)| v)
+    }
+}
+
+impl Since {
+    fn new(i: &Interval) -> Since {
+        Since {
+            a: i.start,
+            span: i.last_offset().map(|l| l.saturating_sub(i.start)),
+            empty: i.is_empty(),
+            seen: 0,
+            delay: VecDeque::new(),
+            head: VecDeque::new(),
+            witnesses: 0,
+            p: NEG_INF,
+            pf: INF,
+            block: Vec::new(),
+            q: Vec::new(),
+        }
+    }
+
+    /// Takes the operands' values at the next step `t`; returns this node's value at `t`.
+    fn take(&mut self, f: f64, g: f64) -> f64 {
+        let t = self.seen;
+        self.seen += 1;
+        if self.empty {
+            return NEG_INF;
+        }
+        // NaN reads as `+inf` on both sides, as the min folds of the reference skip it.
+        let (f, g) = (Min::acc(INF, f), Min::acc(INF, g));
+        // min f over (t - a, t]: the steps after the latest witness.
+        if self.a > 0 {
+            while self.head.back().is_some_and(|&(_, b)| b >= f) {
+                self.head.pop_back();
+            }
+            self.head.push_back((t, f));
+            while self.head.front().is_some_and(|&(k, _)| k.saturating_add(self.a) <= t) {
+                self.head.pop_front();
+            }
+        }
+        self.delay.push_back((f, g));
+        if self.delay.len() <= self.a {
+            return NEG_INF;
+        }
+        let Some((fe, ge)) = self.delay.pop_front() else { return NEG_INF };
+        let head = self.head.front().map_or(INF, |&(_, v)| v);
+        let s = self.witness(fe, ge);
+        Min::acc(head, s)
+    }
+
+    /// `S(e)` for the next witness step `e`, given `f` and `g` at `e`.
+    fn witness(&mut self, f: f64, g: f64) -> f64 {
+        let e = self.witnesses;
+        self.witnesses += 1;
+        let Some(span) = self.span else {
+            // Untimed: out(e) = max(g(e), min(f(e), out(e - 1))).
+            self.p = Max::acc(g, Min::acc(f, self.p));
+            return self.p;
+        };
+        let len = span.saturating_add(1);
+        let j = e % len;
+        if j == 0 {
+            self.p = NEG_INF;
+            self.pf = INF;
+            self.block.clear();
+        }
+        self.p = Max::acc(g, Min::acc(f, self.p));
+        self.pf = Min::acc(self.pf, f);
+        self.block.push((f, g));
+        // Witnesses in the previous block: from `e - span`, its offset `j + 1`.
+        let out = match self.q.get(j + 1) {
+            Some(&q) if e >= len => Max::acc(self.p, Min::acc(self.pf, q)),
+            _ => self.p,
+        };
+        if j + 1 == len {
+            // The block is complete: since over each of its suffixes, backwards.
+            self.q.clear();
+            self.q.resize(len, NEG_INF);
+            let (mut acc, mut sf) = (NEG_INF, INF);
+            for k in (0..len).rev() {
+                let (fk, gk) = self.block[k];
+                acc = Max::acc(acc, Min::acc(gk, sf));
+                self.q[k] = acc;
+                sf = Min::acc(sf, fk);
+            }
+        }
+        out
+    }
+}
+
+impl Window {
+    /// The values at the steps after the last one given, windows clipped at the end of a
+    /// trace of `n` steps, once every operand value has been taken.
+    fn finish(&mut self, n: usize) -> Vec<f64> {
+        let id = if self.max { NEG_INF } else { INF };
+        let first = n.saturating_sub(self.end);
+        (first..n)
+            .map(|t| {
+                if self.last.is_none() {
+                    return id;
+                }
+                let lo = t.saturating_add(self.a);
+                while self.deque.front().is_some_and(|&(k, _)| k < lo) {
+                    self.deque.pop_front();
+                }
+                self.deque.front().map_or(id, |&(_, v)| v)
+            })
+            .collect()
+    }
+}
+
+impl Until {
+    /// The values at the steps after the last one given, windows clipped at the end of the
+    /// trace, once every operand value has been taken: the offline kernel over the values
+    /// still held, which start at the first step without a value.
+    fn finish(&mut self) -> Vec<f64> {
+        if self.last.is_none() {
+            // An empty window keeps no values: `-inf` at every step still open.
+            return vec![NEG_INF; self.seen.min(self.end)];
+        }
+        let mut lhs: Vec<f64> = self.fv.drain(..).collect();
+        let mut out: Vec<f64> = self.gv.drain(..).collect();
+        crate::kernels::Kernels::new().until(&self.interval, &mut lhs, &mut out);
+        out
     }
 }
 

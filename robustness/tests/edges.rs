@@ -47,6 +47,29 @@ const CASES: &[Case] = &[
     // Infinite samples stay exact: `x > 3` with x = inf is inf.
     ("always[0..=1] (x > 3)", &[INF, INF, NEG], &[0.0; 3], &[INF, NEG, NEG]),
     ("!(x > 3) -> y < 1", &[INF, 0.0], &[NEG, 5.0], &[INF, -3.0]),
+    // Past windows are clipped at the start of the trace: empty while `t < a`.
+    ("once[2..=5] (x > 0)", &[1.0, 2.0, 3.0, 4.0], &[0.0; 4], &[NEG, NEG, 1.0, 2.0]),
+    ("once[0..2] (x > 0)", &[1.0, 5.0, 3.0, 2.0], &[0.0; 4], &[1.0, 5.0, 5.0, 3.0]),
+    ("historically[1..] (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[INF, 3.0, 1.0]),
+    ("historically (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[3.0, 1.0, 1.0]),
+    // `prev` and `next` are weak: `+inf` where the step does not exist.
+    ("prev (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[INF, 3.0, 1.0]),
+    ("next (x > 0)", &[3.0, 1.0, 2.0], &[0.0; 3], &[1.0, 2.0, INF]),
+    ("prev (x > 0)", &[-3.0], &[0.0], &[INF]),
+    ("next (x > 0)", &[-3.0], &[0.0], &[INF]),
+    // Since needs its left operand after the witness, not at it.
+    ("(x > 0) since (y > 0)", &[-9.0, 4.0, 5.0], &[2.0, -1.0, -1.0], &[2.0, 2.0, 2.0]),
+    ("(x > 0) since (y > 0)", &[-9.0, 4.0, -5.0], &[2.0, -1.0, -1.0], &[2.0, 2.0, -1.0]),
+    (
+        "(x > 0) since[1..=2] (y > 0)",
+        &[1.0, 5.0, -2.0, 7.0],
+        &[9.0, 0.0, 0.0, 0.0],
+        &[NEG, 5.0, -2.0, 0.0],
+    ),
+    // Bounds up to 2^61 - 2 saturate back to step 0, or leave the window empty.
+    ("once[0..=2305843009213693950] (x > 0)", &[1.0, 3.0, 2.0], &[0.0; 3], &[1.0, 3.0, 3.0]),
+    ("historically[2305843009213693950..] (x > 0)", &[1.0, 3.0], &[0.0; 2], &[INF, INF]),
+    ("(x > 0) since[2305843009213693950..] (y > 0)", &[1.0, 3.0], &[0.0; 2], &[NEG, NEG]),
 ];
 
 #[test]

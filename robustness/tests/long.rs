@@ -42,6 +42,13 @@ fn pieces_join_without_a_seam() {
         "(x > 2) until[3..9] eventually[2..=5] (y < 3)",
         "eventually[5..=700] (x < 1) || !always[1..4] (y >= 2)",
         "always[0..=3] ((x > 5) until[0..=3] (y > 10)) -> eventually[0..=50] (x + y > 20)",
+        // Past-time operators read back to step 0: their groups run whole, inside pieces.
+        "(x > 5) since[0..=20] (y > 10)",
+        "(x > 2) since[3..9] once[2..=5] (y < 3)",
+        "once[0..40] (x < 1) && eventually[0..=30] (y > 12)",
+        "always[0..=10] historically[2..=300] (x > 1 || y > 2)",
+        "prev (x > 3) until[0..=5] next (y < 4)",
+        "historically[0..=3000] (x < 15) && (x > 1) since[0..=50] (y < 2)",
     ];
     let mut ev = Evaluator::new();
     for src in formulas {

@@ -1,5 +1,6 @@
-//! Random formulas with every operator and interval form, on random traces with ±inf and
-//! NaN samples: every evaluator agrees with the reference, and `Display` parses back.
+//! Random formulas with every operator (past-time ones included) and interval form, on
+//! random traces with ±inf and NaN samples: every evaluator agrees with the reference, and
+//! `Display` parses back.
 
 mod common;
 
@@ -81,7 +82,12 @@ fn formula(min_kids: usize) -> impl Strategy<Value = Formula> {
             (interval(), f.clone()).prop_map(|(i, g)| Formula::always(i, g)),
             (interval(), f.clone()).prop_map(|(i, g)| Formula::eventually(i, g)),
             (interval(), f.clone(), f.clone()).prop_map(|(i, g, h)| Formula::until(i, g, h)),
-            (interval(), f).prop_map(|(i, g)| Formula::always(i, g)),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::always(i, g)),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::once(i, g)),
+            (interval(), f.clone()).prop_map(|(i, g)| Formula::historically(i, g)),
+            (interval(), f.clone(), f.clone()).prop_map(|(i, g, h)| Formula::since(i, g, h)),
+            f.clone().prop_map(Formula::prev),
+            f.prop_map(Formula::next),
         ]
     })
 }
@@ -198,6 +204,38 @@ fn complete_at(f: &Formula, id: usize, trace: &Trace) -> (usize, Vec<f64>) {
                 })
                 .collect();
             (own(i, m), v)
+        }
+        Node::Once(i, g) | Node::Historically(i, g) => {
+            let g = sub(g.index());
+            let m = g.len();
+            let min = matches!(node, Node::Historically(..));
+            (m, (0..m).map(|t| fold(&mut i.past_window(t).map(|u| g[u]), min)).collect())
+        }
+        Node::Since(i, g, h) => {
+            let (g, h) = (sub(g.index()), sub(h.index()));
+            let m = g.len().min(h.len());
+            let v = (0..m)
+                .map(|t| {
+                    let mut candidates = i
+                        .past_window(t)
+                        .map(|u| h[u].min(fold(&mut (u + 1..=t).map(|w| g[w]), true)));
+                    fold(&mut candidates, false)
+                })
+                .collect();
+            (m, v)
+        }
+        Node::Prev(g) => {
+            let g = sub(g.index());
+            let v = (0..g.len())
+                .map(|t| if t == 0 { f64::INFINITY } else { f64::INFINITY.min(g[t - 1]) });
+            (g.len(), v.collect())
+        }
+        Node::Next(g) => {
+            let g = sub(g.index());
+            let m = g.len();
+            let v =
+                (0..m).map(|t| if t + 1 < m { f64::INFINITY.min(g[t + 1]) } else { f64::INFINITY });
+            (m.saturating_sub(1), v.collect())
         }
         Node::True => (n, vec![f64::INFINITY; n]),
         Node::False => (n, vec![f64::NEG_INFINITY; n]),

@@ -137,9 +137,13 @@ impl<'a> Gen<'a> {
             CFormulaKind::And(v) | CFormulaKind::Or(v) => {
                 !v.is_empty() && v.iter().all(|g| self.valid(g))
             }
-            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
-                self.valid(a) && self.valid(b)
-            }
+            CFormulaKind::Once(_, a)
+            | CFormulaKind::Historically(_, a)
+            | CFormulaKind::Prev(a)
+            | CFormulaKind::Next(a) => self.valid(a),
+            CFormulaKind::Implies(a, b)
+            | CFormulaKind::Until(_, a, b)
+            | CFormulaKind::Since(_, a, b) => self.valid(a) && self.valid(b),
         }
     }
 
@@ -639,6 +643,12 @@ impl<'a> Gen<'a> {
             CFormulaKind::Until(iv, a, b) => {
                 end(iv)?.checked_add(self.horizon(a)?.max(self.horizon(b)?))
             }
+            // Past windows never look forward.
+            CFormulaKind::Once(_, a) | CFormulaKind::Historically(_, a) | CFormulaKind::Prev(a) => {
+                self.horizon(a)
+            }
+            CFormulaKind::Since(_, a, b) => Some(self.horizon(a)?.max(self.horizon(b)?)),
+            CFormulaKind::Next(a) => self.horizon(a)?.checked_add(1),
         }
     }
 
@@ -659,6 +669,10 @@ impl<'a> Gen<'a> {
                 v.iter().map(|g| self.empty_value(g)).fold(f64::NEG_INFINITY, f64::max)
             }
             CFormulaKind::Implies(a, b) => (-self.empty_value(a)).max(self.empty_value(b)),
+            CFormulaKind::Historically(..) | CFormulaKind::Prev(..) | CFormulaKind::Next(..) => {
+                f64::INFINITY
+            }
+            CFormulaKind::Once(..) | CFormulaKind::Since(..) => f64::NEG_INFINITY,
         }
     }
 
@@ -708,6 +722,29 @@ impl<'a> Gen<'a> {
                 let iv = interval_data(iv, hstl);
                 let (a, b) = (self.formula_data(a, out), self.formula_data(b, out));
                 quote!(__b.until(#iv, #a, #b))
+            }
+            CFormulaKind::Once(iv, a) | CFormulaKind::Historically(iv, a) => {
+                let kind = if matches!(f.kind, CFormulaKind::Once(..)) {
+                    quote!(once)
+                } else {
+                    quote!(historically)
+                };
+                let (iv, a) = (interval_data(iv, hstl), self.formula_data(a, out));
+                quote!(__b.#kind(#iv, #a))
+            }
+            CFormulaKind::Since(iv, a, b) => {
+                let iv = interval_data(iv, hstl);
+                let (a, b) = (self.formula_data(a, out), self.formula_data(b, out));
+                quote!(__b.since(#iv, #a, #b))
+            }
+            CFormulaKind::Prev(a) | CFormulaKind::Next(a) => {
+                let kind = if matches!(f.kind, CFormulaKind::Prev(..)) {
+                    quote!(prev)
+                } else {
+                    quote!(next)
+                };
+                let a = self.formula_data(a, out);
+                quote!(__b.#kind(#a))
             }
         };
         out.push(node)
@@ -1005,6 +1042,34 @@ impl<'a> Gen<'a> {
     }
 }
 
+/// Whether `f` has a past-time operator (not looking through lets, whose signals are
+/// computed over the whole trace). The walk keeps its own stack.
+fn has_past_node(f: &CFormula) -> bool {
+    let mut stack = vec![f];
+    while let Some(f) = stack.pop() {
+        match &f.kind {
+            CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..) => return true,
+            CFormulaKind::Not(a)
+            | CFormulaKind::Always(_, a)
+            | CFormulaKind::Eventually(_, a)
+            | CFormulaKind::Next(a) => stack.push(a),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => stack.extend(v),
+            CFormulaKind::Implies(a, b) | CFormulaKind::Until(_, a, b) => {
+                stack.extend([&**a, &**b])
+            }
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Let(_)
+            | CFormulaKind::Cmp(..)
+            | CFormulaKind::Invalid => {}
+        }
+    }
+    false
+}
+
 /// Code for one formula's signal over `trace` (a `&[State]`), with the kernels `k` in
 /// scope: one `let` statement per operator. State subformulas become one fused expression
 /// per step, mapped over the trace; the temporal structure goes to the offline evaluator's
@@ -1069,7 +1134,10 @@ impl<'g, 'a> Body<'g, 'a> {
             return Sig::Expr(self.map(&[f], None));
         }
         self.uses_kernels = true;
-        match (&f.kind, in_piece, self.g.horizon(f)) {
+        // A past-time operator reads back to step 0: no piece may hold one (a let's
+        // signal is its own, computed over the whole trace).
+        let whole = in_piece || has_past_node(f);
+        match (&f.kind, whole, self.g.horizon(f)) {
             // A let runs its own pieces.
             (CFormulaKind::Let(_), ..) | (_, true, _) | (_, false, None) => {
                 self.operator(f, in_piece)
@@ -1140,14 +1208,42 @@ impl<'g, 'a> Body<'g, 'a> {
                 self.stmts.push(quote!(k.#op(&#iv, &mut #v);));
                 Sig::Var(v)
             }
-            CFormulaKind::Until(iv, a, b) => {
+            CFormulaKind::Until(iv, a, b) | CFormulaKind::Since(iv, a, b) => {
                 let a = self.signal(a, in_piece);
                 let a = self.var(a);
                 let b = self.signal(b, in_piece);
                 let b = self.var(b);
                 let iv = interval_data(iv, hstl);
-                self.stmts.push(quote!(k.until(&#iv, &mut #a, &mut #b);));
+                let op = if matches!(f.kind, CFormulaKind::Until(..)) {
+                    quote!(until)
+                } else {
+                    quote!(since)
+                };
+                self.stmts.push(quote!(k.#op(&#iv, &mut #a, &mut #b);));
                 Sig::Var(b)
+            }
+            CFormulaKind::Once(iv, a) | CFormulaKind::Historically(iv, a) => {
+                let a = self.signal(a, in_piece);
+                let v = self.var(a);
+                let iv = interval_data(iv, hstl);
+                let op = if matches!(f.kind, CFormulaKind::Once(..)) {
+                    quote!(once)
+                } else {
+                    quote!(historically)
+                };
+                self.stmts.push(quote!(k.#op(&#iv, &mut #v);));
+                Sig::Var(v)
+            }
+            CFormulaKind::Prev(a) | CFormulaKind::Next(a) => {
+                let a = self.signal(a, in_piece);
+                let v = self.var(a);
+                let op = if matches!(f.kind, CFormulaKind::Prev(..)) {
+                    quote!(prev)
+                } else {
+                    quote!(next)
+                };
+                self.stmts.push(quote!(k.#op(&mut #v);));
+                Sig::Var(v)
             }
             CFormulaKind::Not(a) => {
                 let a = self.signal(a, in_piece);
@@ -1243,9 +1339,14 @@ impl<'g, 'a> Body<'g, 'a> {
                 quote!((-(#a)).max(#b))
             }
             // Not reached: `point` is only asked for state formulas.
-            CFormulaKind::Always(..) | CFormulaKind::Eventually(..) | CFormulaKind::Until(..) => {
-                quote!(f64::NAN)
-            }
+            CFormulaKind::Always(..)
+            | CFormulaKind::Eventually(..)
+            | CFormulaKind::Until(..)
+            | CFormulaKind::Once(..)
+            | CFormulaKind::Historically(..)
+            | CFormulaKind::Since(..)
+            | CFormulaKind::Prev(..)
+            | CFormulaKind::Next(..) => quote!(f64::NAN),
         }
     }
 

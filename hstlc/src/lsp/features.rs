@@ -251,8 +251,14 @@ fn formula_names(f: &Formula, out: &mut Vec<(Range<usize>, String, bool)>) {
                 FormulaKind::Not(a)
                 | FormulaKind::Always(_, a)
                 | FormulaKind::Eventually(_, a)
+                | FormulaKind::Once(_, a)
+                | FormulaKind::Historically(_, a)
+                | FormulaKind::Prev(a)
+                | FormulaKind::Next(a)
                 | FormulaKind::Paren(a) => stack.push(Node::Formula(a)),
-                FormulaKind::Until(a, _, b) | FormulaKind::Implies(a, b) => {
+                FormulaKind::Until(a, _, b)
+                | FormulaKind::Since(a, _, b)
+                | FormulaKind::Implies(a, b) => {
                     stack.push(Node::Formula(b));
                     stack.push(Node::Formula(a));
                 }
@@ -616,35 +622,71 @@ fn operator_of<'a>(
     let kw_end = |start: usize, kw: &str| start + kw.len();
     let hit = |r: &Range<usize>| r.start <= at && at <= r.end;
     match &f.kind {
-        FormulaKind::Always(iv, g) | FormulaKind::Eventually(iv, g) => {
-            let always = matches!(f.kind, FormulaKind::Always(..));
-            let kw = if always { "always" } else { "eventually" };
+        FormulaKind::Always(iv, g)
+        | FormulaKind::Eventually(iv, g)
+        | FormulaKind::Once(iv, g)
+        | FormulaKind::Historically(iv, g) => {
+            let (kw, meaning, past) = match f.kind {
+                FormulaKind::Always(..) => (
+                    "always",
+                    "the minimum of the operand's robustness over the window (`+inf` if the window is empty): positive when the operand holds at every step of it",
+                    false,
+                ),
+                FormulaKind::Eventually(..) => (
+                    "eventually",
+                    "the maximum of the operand's robustness over the window (`-inf` if the window is empty): positive when the operand holds at some step of it",
+                    false,
+                ),
+                FormulaKind::Once(..) => (
+                    "once",
+                    "the maximum of the operand's robustness over the past window (`-inf` if the window is empty): positive when the operand held at some step of it",
+                    true,
+                ),
+                _ => (
+                    "historically",
+                    "the minimum of the operand's robustness over the past window (`+inf` if the window is empty): positive when the operand held at every step of it",
+                    true,
+                ),
+            };
             let span =
                 f.range.start..iv.as_ref().map_or(kw_end(f.range.start, kw), |i| i.range.end);
             if hit(&span) {
-                let meaning = if always {
-                    "the minimum of the operand's robustness over the window (`+inf` if the window is empty): positive when the operand holds at every step of it"
-                } else {
-                    "the maximum of the operand's robustness over the window (`-inf` if the window is empty): positive when the operand holds at some step of it"
-                };
                 return Some((
                     span,
-                    format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref())),
+                    format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref(), past)),
                 ));
             }
             stack.push(g);
         }
-        FormulaKind::Until(l, iv, r) => {
+        FormulaKind::Prev(g) | FormulaKind::Next(g) => {
+            let prev = matches!(f.kind, FormulaKind::Prev(_));
+            let kw = if prev { "prev" } else { "next" };
+            let span = f.range.start..kw_end(f.range.start, kw);
+            if hit(&span) {
+                let meaning = if prev {
+                    "**prev**: the operand's robustness one step back; `+inf` at the first step of the trace, which has none (so `prev f` holds there). The same as `historically[1..=1] f`."
+                } else {
+                    "**next**: the operand's robustness one step ahead; `+inf` at the last step of the trace, which has none (so `next f` holds there). The same as `always[1..=1] f`."
+                };
+                return Some((span, meaning.to_string()));
+            }
+            stack.push(g);
+        }
+        FormulaKind::Until(l, iv, r) | FormulaKind::Since(l, iv, r) => {
+            let since = matches!(f.kind, FormulaKind::Since(..));
+            let kw = if since { "since" } else { "until" };
             let span = l.range.end..r.range.start;
-            if hit(&span) && text.get(span.clone()).is_some_and(|s| s.contains("until")) {
-                let start = span.start + text[span.clone()].find("until").unwrap_or(0);
-                let end = iv.as_ref().map_or(start + "until".len(), |i| i.range.end);
+            if hit(&span) && text.get(span.clone()).is_some_and(|s| s.contains(kw)) {
+                let start = span.start + text[span.clone()].find(kw).unwrap_or(0);
+                let end = iv.as_ref().map_or(start + kw.len(), |i| i.range.end);
+                let meaning = if since {
+                    "**since**: `f since[I] g` is the maximum, over the steps `t'` of the past window, of the minimum of `g`'s robustness at `t'` and `f`'s robustness at every step after `t'` up to and including now: positive when `g` held at some step of the window and `f` has held ever since."
+                } else {
+                    "**until**: `f until[I] g` is the maximum, over the steps `t'` of the window, of the minimum of `g`'s robustness at `t'` and `f`'s robustness at every step from now up to (not including) `t'`: positive when `g` holds at some step of the window and `f` holds until then."
+                };
                 return Some((
                     start..end,
-                    format!(
-                        "**until**: `f until[I] g` is the maximum, over the steps `t'` of the window, of the minimum of `g`'s robustness at `t'` and `f`'s robustness at every step from now up to (not including) `t'`: positive when `g` holds at some step of the window and `f` holds until then.\n\n{}",
-                        window_words(iv.as_ref())
-                    ),
+                    format!("{meaning}\n\n{}", window_words(iv.as_ref(), since)),
                 ));
             }
             stack.push(r);
@@ -717,35 +759,53 @@ fn operator_of<'a>(
     None
 }
 
-/// A time interval in words.
-fn window_words(iv: Option<&Interval>) -> String {
+/// A time interval in words: a future window (from now on), or a past one (`past`).
+fn window_words(iv: Option<&Interval>, past: bool) -> String {
+    let step = |k: u64| step(k, past);
     let Some(iv) = iv else {
-        return "No interval, so `[0..]`: the window runs from the current step to the end of the trace.".to_string();
+        return if past {
+            "No interval, so `[0..]`: the window runs from the start of the trace to the current step."
+        } else {
+            "No interval, so `[0..]`: the window runs from the current step to the end of the trace."
+        }
+        .to_string();
     };
     let a = iv.start.as_integer();
     let b = iv.end.as_ref().and_then(|e| e.as_integer());
+    let (sign, edge) = if past { ('-', "start") } else { ('+', "end") };
     match (a, b, iv.end.is_some(), iv.inclusive) {
+        (Some(a), _, false, _) if past => {
+            format!(
+                "Interval `[{a}..]`: the window runs from the start of the trace to {}.",
+                step(a)
+            )
+        }
         (Some(a), _, false, _) => {
             format!("Interval `[{a}..]`: the window runs from {} to the end of the trace.", step(a))
         }
         (Some(a), Some(b), true, false) if b > a => format!(
-            "Interval `[{a}..{b}]`: the window is {} to {} ({} steps; step `t+{b}` excluded), clipped at the end of the trace.",
-            step(a),
-            step(b - 1),
+            "Interval `[{a}..{b}]`: the window is {} to {} ({} steps; step `t{sign}{b}` excluded), clipped at the {edge} of the trace.",
+            step(if past { b - 1 } else { a }),
+            step(if past { a } else { b - 1 }),
             b - a
         ),
         (Some(a), Some(b), true, true) if b >= a => format!(
-            "Interval `[{a}..={b}]`: the window is {} to {}, both included ({} steps), clipped at the end of the trace.",
-            step(a),
-            step(b),
+            "Interval `[{a}..={b}]`: the window is {} to {}, both included ({} steps), clipped at the {edge} of the trace.",
+            step(if past { b } else { a }),
+            step(if past { a } else { b }),
             b - a + 1
         ),
         _ => "The interval is empty or not made of integers (see the diagnostic).".to_string(),
     }
 }
 
-fn step(k: u64) -> String {
-    if k == 0 { "the current step `t`".to_string() } else { format!("step `t+{k}`") }
+/// Step `t+k` (or `t-k` in the past) in words.
+fn step(k: u64, past: bool) -> String {
+    match (k, past) {
+        (0, _) => "the current step `t`".to_string(),
+        (_, false) => format!("step `t+{k}`"),
+        (_, true) => format!("step `t-{k}`"),
+    }
 }
 
 /// Where the symbol at `pos` is declared.
@@ -948,6 +1008,103 @@ pub fn format(a: &Analysis) -> Result<Vec<TextEdit>, String> {
                 }
                 None => "cannot format: the file has syntax errors".to_string(),
             })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hover text at the `nth` occurrence of `word` in `text`.
+    fn hover_at(text: &str, word: &str, nth: usize) -> String {
+        let a = Analysis::new(text.to_string(), Encoding::Utf8);
+        let at = text.match_indices(word).nth(nth).map(|(i, _)| i).expect("the word");
+        let pos = a.conv.position(text, at + 1);
+        match hover(&a, pos).map(|h| h.contents) {
+            Some(HoverContents::Markup(m)) => m.value,
+            other => panic!("no hover at `{word}`: {other:?}"),
+        }
+    }
+
+    /// Each past-time operator's hover: its meaning, and its window counted back from now.
+    #[test]
+    fn past_operators_hover_with_their_past_window() {
+        let text = "spec S {
+    state { x: float, y: float }
+    let P = once[2..5] x > 0 || historically[0..=3] y > 0;
+    let Q = x > 0 since[1..] y > 0;
+    let R = prev x > 0 && next y > 0 && historically x > 0;
+    task P && Q && R;
+}
+";
+        let cases: [(&str, usize, &[&str]); 6] = [
+            (
+                "once",
+                0,
+                &[
+                    "**once**",
+                    "maximum",
+                    "past window",
+                    "`t-4` to step `t-2` (3 steps; step `t-5` excluded), clipped at the start",
+                ],
+            ),
+            (
+                "historically",
+                0,
+                &[
+                    "**historically**",
+                    "minimum",
+                    "`t-3` to the current step `t`, both included (4 steps)",
+                ],
+            ),
+            (
+                "since",
+                0,
+                &[
+                    "**since**",
+                    "after `t'`",
+                    "`[1..]`: the window runs from the start of the trace to step `t-1`",
+                ],
+            ),
+            ("prev", 0, &["**prev**", "one step back", "`+inf` at the first step"]),
+            ("next", 0, &["**next**", "one step ahead", "`+inf` at the last step"]),
+            (
+                "historically",
+                1,
+                &[
+                    "No interval, so `[0..]`: the window runs from the start of the trace to the current step",
+                ],
+            ),
+        ];
+        for (word, nth, want) in cases {
+            let got = hover_at(text, word, nth);
+            for w in want {
+                assert!(got.contains(w), "`{word}` #{nth}: {w:?} not in {got:?}");
+            }
+        }
+        // The future operators' windows still count forward.
+        let text = "spec S { state { x: float } task eventually[2..5] x > 0; }";
+        let got = hover_at(text, "eventually", 0);
+        assert!(
+            got.contains(
+                "step `t+2` to step `t+4` (3 steps; step `t+5` excluded), clipped at the end"
+            ),
+            "{got}"
+        );
+    }
+
+    /// Completion offers the past-time keywords with the others.
+    #[test]
+    fn completion_offers_past_operators() {
+        let text = "spec S { state { x: float } task x > 0; }";
+        let a = Analysis::new(text.to_string(), Encoding::Utf8);
+        let labels: Vec<String> = completion(&a, Position { line: 0, character: 30 })
+            .into_iter()
+            .map(|i| i.label)
+            .collect();
+        for k in ["once", "historically", "since", "prev", "next"] {
+            assert!(labels.iter().any(|l| l == k), "{k} missing from {labels:?}");
         }
     }
 }

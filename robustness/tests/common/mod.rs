@@ -43,8 +43,16 @@ pub fn check_all(f: &Formula, trace: &Trace, want: &[f64]) {
     let r0 = ev.robustness(f, trace);
     assert!(same(r0, reference::robustness(f, trace, 0)), "{label}: step 0 gave {r0}");
     for (i, w) in want.iter().enumerate() {
-        let r = ev.robustness(f, &suffix(trace, i));
+        // A past-time operator reads the steps before `i`: a suffix does not give `rho(f, i)`.
+        let r = if f.has_past() {
+            reference::robustness(f, trace, i)
+        } else {
+            ev.robustness(f, &suffix(trace, i))
+        };
         assert!(same(r, *w), "{label}: step 0 of suffix {i} gave {r}, want {w}");
+    }
+    if !trace.is_empty() {
+        assert!(same(r0, want[0]), "{label}: step 0 gave {r0}, want {}", want[0]);
     }
     check_online(f, trace, want, &label);
     check_segments(f, trace, &label);
@@ -213,30 +221,43 @@ impl Parser {
 
     fn until(&mut self) -> Formula {
         let lhs = self.unary();
-        if self.peek_ident("until") {
-            self.pos += 1;
-            let i = self.interval();
-            let rhs = self.unary();
-            Formula::until(i, lhs, rhs)
-        } else {
-            lhs
+        for kw in ["until", "since"] {
+            if self.peek_ident(kw) {
+                self.pos += 1;
+                let i = self.interval();
+                let rhs = self.unary();
+                return if kw == "until" {
+                    Formula::until(i, lhs, rhs)
+                } else {
+                    Formula::since(i, lhs, rhs)
+                };
+            }
         }
+        lhs
     }
 
     fn unary(&mut self) -> Formula {
         if self.eat_sym("!") {
             return Formula::not(self.unary());
         }
-        for kw in ["always", "eventually"] {
+        for kw in ["always", "eventually", "once", "historically"] {
             if self.peek_ident(kw) {
                 self.pos += 1;
                 let i = self.interval();
                 let f = self.unary();
-                return if kw == "always" {
-                    Formula::always(i, f)
-                } else {
-                    Formula::eventually(i, f)
+                return match kw {
+                    "always" => Formula::always(i, f),
+                    "eventually" => Formula::eventually(i, f),
+                    "once" => Formula::once(i, f),
+                    _ => Formula::historically(i, f),
                 };
+            }
+        }
+        for kw in ["prev", "next"] {
+            if self.peek_ident(kw) {
+                self.pos += 1;
+                let f = self.unary();
+                return if kw == "prev" { Formula::prev(f) } else { Formula::next(f) };
             }
         }
         self.atom()
