@@ -270,6 +270,7 @@ class _StudyOut:
         world: World,
         runs: Sequence[Sequence[SeedRun]],
         episodes: Optional[int] = None,
+        optima: Optional[Sequence[Optional[float]]] = None,
     ) -> list[PathLike[str]]: ...
 
 def _train_chunks(

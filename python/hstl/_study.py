@@ -164,9 +164,10 @@ def _study(
             max_retries=max_retries,
             before_batch=before_batch,
         )
-    rows, summary = [], []
+    rows, summary, w_stars = [], [], []
     for spec, (name, _, regions), spec_runs in zip(spec_list, tasks, runs):
         w_star = optima.get(regions) if regions is not None else None
+        w_stars.append(w_star)
         file = _file_of(spec)
         for run in spec_runs:
             w = run["window_rate"]
@@ -187,7 +188,7 @@ def _study(
         figures = _hstl._study_summary(spec_runs, w_star)
         summary.append({"spec": name, "file": file, "optimum": w_star, **figures})
     if folder is not None:
-        folder.write(spec_list, world, runs, episodes)
+        folder.write(spec_list, world, runs, episodes, w_stars)
     return StudyResult(rows, summary)
 
 

@@ -253,8 +253,9 @@ impl _StudyOut {
 
     /// Writes every spec's folder, then `curves.svg` and `curves.csv` beside them. `runs[i]`
     /// holds spec `i`'s dicts from `_study_seeds`; its median seed is trained again for its
-    /// policy and pictures (same seed, same bits). The paths written.
-    #[pyo3(signature = (specs, world, runs, episodes=None))]
+    /// policy and pictures (same seed, same bits); `optima[i]` is spec `i`'s W*, if known,
+    /// for `summary.csv`. The paths written.
+    #[pyo3(signature = (specs, world, runs, episodes=None, optima=None))]
     fn write(
         &mut self,
         py: Python<'_>,
@@ -262,6 +263,7 @@ impl _StudyOut {
         world: &Bound<'_, World>,
         runs: Vec<Vec<Bound<'_, PyAny>>>,
         episodes: Option<usize>,
+        optima: Option<Vec<Option<f64>>>,
     ) -> PyResult<Vec<PathBuf>> {
         let Some(dirs) = self.dirs.take() else {
             return Err(value_error(
@@ -284,10 +286,15 @@ impl _StudyOut {
         let world = world.get();
         let mut written = Vec::new();
         let mut curves = Vec::new();
-        for (((spec, runs), dir), label) in specs.iter().zip(&runs).zip(dirs).zip(&labels) {
+        let mut summary = String::from(facade::SUMMARY_HEADER);
+        for (i, (((spec, runs), dir), label)) in
+            specs.iter().zip(&runs).zip(dirs).zip(&labels).enumerate()
+        {
             let spec = spec.get();
             let (task, checked) = task_of(py, spec, world, episodes, None)?;
             let runs = runs.iter().map(run_of).collect::<PyResult<Vec<_>>>()?;
+            let w_star = optima.as_ref().and_then(|o| o.get(i).copied().flatten());
+            summary.push_str(&facade::summary_line(label, &runs, w_star));
             let files = py
                 .detach(|| {
                     let median = facade::median(&runs);
@@ -314,7 +321,8 @@ impl _StudyOut {
             });
         }
         let seeds = curves.first().map_or(0, |c| c.runs.len());
-        let files = facade::curves_files(&curves, seeds).map_err(|p| problem_error(&p))?;
+        let mut files = facade::curves_files(&curves, seeds).map_err(|p| problem_error(&p))?;
+        files.push(hstl::artifacts::OutFile::text("summary.csv", summary));
         written.extend(hstl_outdir::write_beside(&self.out, &files).map_err(outdir_error)?);
         Ok(written)
     }
