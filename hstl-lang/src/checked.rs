@@ -523,6 +523,31 @@ impl<'a> StateEvaluator<'a> {
     }
 }
 
+impl CFormula {
+    /// The formula's operands, in order (none for an atom or a `let` reference), so that
+    /// a walk over formulas need not name every kind.
+    pub fn operands(&self) -> Vec<&CFormula> {
+        match &self.kind {
+            CFormulaKind::Not(a)
+            | CFormulaKind::Always(_, a)
+            | CFormulaKind::Eventually(_, a)
+            | CFormulaKind::Once(_, a)
+            | CFormulaKind::Historically(_, a)
+            | CFormulaKind::Prev(a)
+            | CFormulaKind::Next(a) => vec![a],
+            CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().collect(),
+            CFormulaKind::Implies(a, b)
+            | CFormulaKind::Until(_, a, b)
+            | CFormulaKind::Since(_, a, b) => vec![a, b],
+            CFormulaKind::True
+            | CFormulaKind::False
+            | CFormulaKind::Let(_)
+            | CFormulaKind::Cmp(..)
+            | CFormulaKind::Invalid => Vec::new(),
+        }
+    }
+}
+
 /// Calls `visit` with every let index that `f` refers to directly.
 pub fn visit_lets(f: &CFormula, visit: &mut dyn FnMut(usize)) {
     match &f.kind {

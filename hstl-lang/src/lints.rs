@@ -308,32 +308,16 @@ pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec
             stack.push(f);
         }
     }
+    // Each comparison once: a `let` is walked once, and a range names one source place.
+    let mut seen = std::collections::HashSet::new();
     while let Some(f) = stack.pop() {
-        match &f.kind {
-            CFormulaKind::Cmp(_, a, b) => {
-                if nan_prone(a, b) && !atoms.iter().any(|(_, _, r)| **r == f.range) {
-                    atoms.push((a, b, &f.range));
-                }
-            }
-            CFormulaKind::Not(g)
-            | CFormulaKind::Always(_, g)
-            | CFormulaKind::Eventually(_, g)
-            | CFormulaKind::Once(_, g)
-            | CFormulaKind::Historically(_, g)
-            | CFormulaKind::Prev(g)
-            | CFormulaKind::Next(g) => stack.push(g),
-            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs.iter()),
-            CFormulaKind::Implies(a, b)
-            | CFormulaKind::Until(_, a, b)
-            | CFormulaKind::Since(_, a, b) => {
-                stack.push(a);
-                stack.push(b);
-            }
-            CFormulaKind::True
-            | CFormulaKind::False
-            | CFormulaKind::Let(_)
-            | CFormulaKind::Invalid => {}
+        if let CFormulaKind::Cmp(_, a, b) = &f.kind
+            && nan_prone(a, b)
+            && seen.insert(f.range.start)
+        {
+            atoms.push((a, b, &f.range));
         }
+        stack.extend(f.operands());
     }
     if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::check::MAX_DOMAIN_WORK {
         return;

@@ -53,38 +53,26 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
             node.children().for_each(|k| last_use[k] = i);
         }
     }
-    // Comparisons read expression values step by step: one forward pass per step.
     let mut signals: Vec<Option<Vec<f64>>> = vec![None; nodes.len()];
-    let cmps: Vec<usize> =
-        (0..nodes.len()).filter(|&i| matches!(nodes[i], Node::Cmp { .. })).collect();
-    if !cmps.is_empty() {
-        let last = cmps[cmps.len() - 1];
-        let mut bufs: Vec<Vec<f64>> = cmps.iter().map(|_| Vec::with_capacity(n)).collect();
-        let (mut row, mut vals) = (Vec::new(), Vec::with_capacity(last + 1));
-        for t in 0..n {
-            trace.row_into(t, &mut row);
-            vals.clear();
-            for node in &nodes[..=last] {
-                let v = crate::formula::expr_value(node, &vals, &row);
-                vals.push(v);
-            }
-            for (buf, &i) in bufs.iter_mut().zip(&cmps) {
-                if let Node::Cmp { lhs, op, rhs } = &nodes[i] {
-                    buf.push(op.robustness(vals[lhs.index()], vals[rhs.index()]));
-                }
-            }
-        }
-        for (buf, &i) in bufs.into_iter().zip(&cmps) {
-            signals[i] = Some(buf);
-        }
-    }
     let mut kernels = Kernels::new();
     for (i, node) in nodes.iter().enumerate() {
-        if node.is_expr() || matches!(node, Node::Cmp { .. }) {
+        if node.is_expr() {
             continue;
         }
         let kid = |k: usize| signals[k].as_deref().unwrap_or(&[]);
         let v = match node {
+            // A comparison's signal is made when it is reached and dropped after its last
+            // reader, so that only the live signals are held, not one per comparison.
+            Node::Cmp { lhs, op, rhs } => {
+                let (lhs, rhs) = (f.expr_at(*lhs), f.expr_at(*rhs));
+                let mut row = Vec::new();
+                (0..n)
+                    .map(|t| {
+                        trace.row_into(t, &mut row);
+                        op.robustness(lhs.eval(&row), rhs.eval(&row))
+                    })
+                    .collect()
+            }
             Node::True => vec![f64::INFINITY; n],
             Node::False => vec![f64::NEG_INFINITY; n],
             Node::Not(a) => kid(a.index()).iter().map(|x| -x).collect(),
