@@ -12,7 +12,7 @@ use std::fmt;
 
 use hstl_lang::{
     Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Domain, Intra, Reward,
-    Terminate,
+    Switch, Terminate,
 };
 use hstl_robustness as rob;
 use hstl_runtime as rt;
@@ -135,6 +135,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
             Reward::Window => rt::RewardKind::Window,
         },
         counterfactual: size(l.counterfactual)?,
+        switch: match l.switch {
+            Switch::Termination => rt::Switch::Termination,
+            Switch::Step => rt::Switch::Step,
+        },
         flat: level(&l.flat),
         options: level(&l.options),
     };

@@ -1282,7 +1282,7 @@ impl Cx<'_> {
     }
 
     fn learn(&mut self, l: &syntax::Learn, preset: Preset, out: &mut CheckedSpec) {
-        const TOP: [&str; 10] = [
+        const TOP: [&str; 11] = [
             "preset",
             "episodes",
             "choices",
@@ -1291,6 +1291,7 @@ impl Cx<'_> {
             "intra",
             "reward",
             "counterfactual",
+            "switch",
             "flat",
             "options",
         ];
@@ -1342,6 +1343,11 @@ impl Cx<'_> {
                 "intra" => match self.word(p, &["paper", "remaining"]).as_deref() {
                     Some("paper") => out.learn.intra = Intra::Paper,
                     Some(_) => out.learn.intra = Intra::Remaining,
+                    None => {}
+                },
+                "switch" => match self.word(p, &["termination", "step"]).as_deref() {
+                    Some("termination") => out.learn.switch = Switch::Termination,
+                    Some(_) => out.learn.switch = Switch::Step,
                     None => {}
                 },
                 "reward" => match self.word(p, &["segment", "window"]).as_deref() {
@@ -2046,8 +2052,12 @@ fn over_states<T: Send>(
     pass: impl Fn(&mut StateEvaluator<'_>, Range<usize>) -> T + Sync,
 ) -> Vec<T> {
     let run = |ks: Range<usize>| pass(&mut StateEvaluator::new(out, roots), ks);
+    // Asking for the core count reads files, so small work never asks.
+    if work < PARALLEL_DOMAIN_WORK || one_thread() {
+        return vec![run(0..n)];
+    }
     let threads = std::thread::available_parallelism().map_or(1, |t| t.get()).min(4);
-    if work < PARALLEL_DOMAIN_WORK || threads < 2 || n < threads || one_thread() {
+    if threads < 2 || n < threads {
         return vec![run(0..n)];
     }
     let chunk = n.div_ceil(threads);

@@ -269,6 +269,15 @@ pub enum Intra {
     Remaining,
 }
 
+/// When a greedy run of the learned policy chooses an option.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Switch {
+    /// When the running option terminates (the paper).
+    Termination,
+    /// At every step: the options policy's pick replaces a different running option.
+    Step,
+}
+
 /// The options-level reward.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Reward {
@@ -322,6 +331,8 @@ pub struct LearnParams {
     pub reward: Reward,
     /// Counterfactual memory values per option execution, 0 = off (0).
     pub counterfactual: u64,
+    /// When a greedy run chooses an option (`termination`).
+    pub switch: Switch,
     /// Flat level (gamma 0.9, alpha 0.2, epsilon 0.8, min_epsilon 0.1, decay 1e-6).
     pub flat: QParams,
     /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
@@ -339,6 +350,7 @@ impl Default for LearnParams {
             intra: Intra::Paper,
             reward: Reward::Segment,
             counterfactual: 0,
+            switch: Switch::Termination,
             flat: QParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 },
             options: QParams {
                 gamma: 0.9,

@@ -441,9 +441,14 @@ impl Splitter<'_, '_> {
     /// Parses the items of `bounds` (token ranges), on several threads when there are
     /// many; each result comes with the item's diagnostics, in the order of `bounds`.
     fn items(&self, bounds: &[(usize, usize)]) -> Vec<ItemResult> {
+        let serial = || bounds.iter().map(|&(a, b)| self.item(a, b)).collect();
+        // Asking for the core count reads files, so small inputs never ask.
+        if !self.parallel || bounds.len() < PARALLEL_ITEMS {
+            return serial();
+        }
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(MAX_THREADS);
-        if !self.parallel || bounds.len() < PARALLEL_ITEMS || threads < 2 {
-            return bounds.iter().map(|&(a, b)| self.item(a, b)).collect();
+        if threads < 2 {
+            return serial();
         }
         let chunk = bounds.len().div_ceil(threads);
         let run = |part: &[(usize, usize)]| -> Vec<ItemResult> {

@@ -10,7 +10,7 @@
 
 use hstl_robustness::{Trace, complete, offline, reference};
 
-use crate::{Agent, Env, Error, Rng, TaskSpec};
+use crate::{Agent, Env, Error, Rng, Switch, TaskSpec};
 
 /// Decides actions step by step: a greedy [`Agent`] or a hand-written controller.
 pub trait Controller {
@@ -272,12 +272,25 @@ impl Controller for AgentController<'_> {
             }
             self.fresh = false;
         }
+        let choice = || agent.options.get(agent.observation(s, &self.tau)).copied();
+        // Interruption: the options policy's pick here replaces a running option of
+        // strictly lower value (on a tie, as where neither was ever tried, it runs on).
+        if agent.switch == Switch::Step
+            && let Some((o, ..)) = self.running
+            && let Some(c) = choice()
+            && c != o
+        {
+            let n = agent.legs.len();
+            let row = agent.options_q.get(agent.observation(s, &self.tau) * n..).unwrap_or(&[]);
+            if let (Some(q_c), Some(q_o)) = (row.get(c), row.get(o))
+                && q_c > q_o
+            {
+                self.running = Some((c, 0, 0));
+            }
+        }
         let (o, leg, _) = match self.running {
             Some(r) => r,
-            None => {
-                let obs = agent.observation(s, &self.tau);
-                *self.running.insert((agent.options.get(obs).copied().unwrap_or(0), 0, 0))
-            }
+            None => *self.running.insert((choice().unwrap_or(0), 0, 0)),
         };
         // An agent that does not fit the state (hand-built, or another environment) takes
         // no valid action, which leaves the state unchanged, instead of panicking.

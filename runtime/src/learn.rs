@@ -246,7 +246,8 @@ impl<'e, E: Env> Learner<'e, E> {
 
     /// The greedy policies of the current Q-tables.
     pub fn agent(&self) -> crate::Agent {
-        crate::Agent::from_q(&self.tables, &self.q, self.spec.learn.max_steps, self.memory())
+        let l = &self.spec.learn;
+        crate::Agent::from_q(&self.tables, &self.q, l.max_steps, self.memory(), l.switch)
     }
 
     /// The learner's per-state tables (crate-internal).

@@ -42,7 +42,7 @@ pub use rand::RngExt;
 pub use serde_json::{Value, json};
 pub use spec::{
     CombinedOption, Intra, LearnParams, LevelParams, PrimitiveOption, Region, RewardKind, Spec,
-    StateVar, TaskSpec, Terminate,
+    StateVar, Switch, TaskSpec, Terminate,
 };
 
 /// The one random generator of the crate: every draw comes from a value of this type.

@@ -25,7 +25,7 @@ use serde_json::{Map, Value};
 use crate::learn::{argmax, best_of};
 use crate::memory::Memory;
 use crate::tables::Tables;
-use crate::{Env, Error, Learner, QTables, TaskSpec};
+use crate::{Env, Error, Learner, QTables, Switch, TaskSpec};
 
 /// Greedy policies over state indices: what a rollout follows.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +44,11 @@ pub struct Agent {
     pub max_steps: usize,
     /// The memory the options policy observes (`memory: B > 0`), or `None`.
     pub memory: Option<Memory>,
+    /// When a run chooses an option: on termination, or at every step.
+    pub switch: Switch,
+    /// With [`Switch::Step`], the options Q-table (`obs * options + o`): a running option
+    /// gives way only to one of strictly greater value. Empty otherwise.
+    pub options_q: Vec<f64>,
 }
 
 /// The `policy.json` document.
@@ -70,6 +75,10 @@ pub struct Policy {
     pub flat_policies: BTreeMap<String, Vec<Entry>>,
     /// Steps after which a leg is cut off.
     pub max_steps: usize,
+    /// When a run chooses an option (`"step"` for [`Switch::Step`]; absent, as in every
+    /// policy of the paper's settings, for [`Switch::Termination`]).
+    #[serde(default, skip_serializing_if = "Switch::is_termination")]
+    pub switch: Switch,
     /// The Q-tables, bit for bit.
     pub q_tables: QTablesDoc,
 }
@@ -145,6 +154,7 @@ impl Agent {
         q: &QTables,
         max_steps: usize,
         memory: Option<&Memory>,
+        switch: Switch,
     ) -> Agent {
         let (n, a) = (tables.legs.len(), tables.actions);
         let values = memory.map_or(1, Memory::values);
@@ -170,6 +180,8 @@ impl Agent {
             terminate: tables.term.clone(),
             max_steps,
             memory: memory.cloned(),
+            switch,
+            options_q: if switch == Switch::Step { q.options.clone() } else { Vec::new() },
         }
     }
 
@@ -269,6 +281,7 @@ impl Policy {
             options_policy,
             flat_policies,
             max_steps: agent.max_steps,
+            switch: agent.switch,
             q_tables,
         }
     }
@@ -361,6 +374,7 @@ impl Policy {
             ("primitives", rebuilt.primitives == self.primitives),
             ("memory", rebuilt.memory == self.memory),
             ("max_steps", rebuilt.max_steps == self.max_steps),
+            ("switch", rebuilt.switch == self.switch),
             ("flat_policies", rebuilt.flat_policies == self.flat_policies),
             ("options_policy", rebuilt.options_policy == self.options_policy),
         ];
@@ -443,7 +457,19 @@ impl Policy {
             }
             terminate.push(t);
         }
-        Ok(Agent { legs, options, flat, terminate, max_steps: self.max_steps, memory })
+        let (max_steps, switch) = (self.max_steps, self.switch);
+        let options_q = match switch {
+            Switch::Step => unhex(&self.q_tables.options, "q_tables.options")?,
+            Switch::Termination => Vec::new(),
+        };
+        if switch == Switch::Step && options_q.len() != options.len() * legs.len() {
+            return err(format!(
+                "q_tables.options holds {} values, not {} (observations times options)",
+                options_q.len(),
+                options.len() * legs.len()
+            ));
+        }
+        Ok(Agent { legs, options, flat, terminate, max_steps, memory, switch, options_q })
     }
 
     /// The memory of the document's `memory` part.

@@ -106,6 +106,8 @@ pub struct LearnParams {
     /// many other memory values it could have started with, drawn at random, as
     /// counterfactual reward machines do.
     pub counterfactual: usize,
+    /// When a greedy run of the policy chooses an option.
+    pub switch: Switch,
     /// The flat (primitive) level; epsilon decays per primitive step.
     pub flat: LevelParams,
     /// The options level; epsilon decays per option choice.
@@ -137,6 +139,27 @@ pub enum Intra {
     Remaining,
 }
 
+/// When a greedy run of the learned policy (evaluation, pictures, `Policy.act`) chooses an
+/// option. Training runs every option to termination either way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Switch {
+    /// When the running option terminates, as in the paper.
+    #[default]
+    Termination,
+    /// At every step: the option the options policy picks in the current state (and memory)
+    /// replaces the running one when they differ, the interruption of Sutton, Precup and
+    /// Singh (1999), which is never worse for exact values.
+    Step,
+}
+
+impl Switch {
+    /// Whether this is the paper's [`Switch::Termination`] (left out of `policy.json`).
+    pub fn is_termination(&self) -> bool {
+        *self == Switch::Termination
+    }
+}
+
 /// How the options level rewards an option execution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RewardKind {
@@ -163,6 +186,7 @@ impl Default for LearnParams {
             intra: Intra::Paper,
             reward: RewardKind::Segment,
             counterfactual: 0,
+            switch: Switch::Termination,
             flat: LevelParams::FLAT,
             options: LevelParams::OPTIONS,
         }

@@ -656,6 +656,8 @@ fn leg_cycles_run_each_primitive_to_termination_in_turn() {
         ],
         max_steps: 3,
         memory: None,
+        switch: hstl_runtime::Switch::Termination,
+        options_q: Vec::new(),
     };
     let mut cycle = LegCycle::new(&agent, vec![0, 1, 2]).unwrap();
     let steps = rollout(&env, &mut cycle, 2, 14, &mut seeded_rng(0));
@@ -667,4 +669,71 @@ fn leg_cycles_run_each_primitive_to_termination_in_turn() {
     assert_eq!(legs, [0, 0, 1, 1, 1, 2, 2, 2, 0, 0, 0, 1, 1, 1]);
     assert!(LegCycle::new(&agent, vec![]).is_err());
     assert!(LegCycle::new(&agent, vec![3]).is_err());
+}
+
+#[test]
+fn switch_step_interrupts_a_leg_only_for_a_strictly_better_option() {
+    use hstl_runtime::Switch;
+    // A deterministic 5 x 1 line: option 0 goes Right and stops at x = 4, option 1 goes
+    // Left and stops at x = 0. The options policy picks 0 at x = 2 (a tie there) and 1 at
+    // x = 3, where option 1 is worth strictly more.
+    let env = GridWorld::new(5, 1, 1.0).unwrap();
+    let mut q = vec![0.0; 10];
+    q[2 * 2..2 * 2 + 2].copy_from_slice(&[1.0, 1.0]);
+    q[3 * 2..3 * 2 + 2].copy_from_slice(&[0.0, 1.0]);
+    let agent = |switch: Switch| hstl_runtime::Agent {
+        legs: vec![vec![0], vec![1]],
+        options: vec![0, 0, 0, 1, 0],
+        flat: vec![vec![3; 5], vec![2; 5]],
+        terminate: vec![(0..5).map(|x| x == 4).collect(), (0..5).map(|x| x == 0).collect()],
+        max_steps: 10,
+        memory: None,
+        switch,
+        options_q: if switch == Switch::Step { q.clone() } else { Vec::new() },
+    };
+    let run = |switch: Switch| {
+        let agent = agent(switch);
+        let steps = rollout(&env, &mut AgentController::new(&agent), 2, 6, &mut seeded_rng(0));
+        let states: Vec<usize> = steps.iter().map(|s| s.state).collect();
+        let options: Vec<usize> = steps.iter().map(|s| s.decision.option).collect();
+        (states, options)
+    };
+    // The paper's runs: option 0 to x = 4, then the options policy's pick there.
+    assert_eq!(run(Switch::Termination), (vec![2, 3, 4, 4, 4, 4], vec![0, 0, 0, 0, 0, 0]));
+    // At x = 3 option 1 takes over; back at x = 2 the tie keeps it running until it
+    // terminates at x = 0, where the options policy picks option 0 again.
+    assert_eq!(run(Switch::Step), (vec![2, 3, 2, 1, 0, 1], vec![0, 1, 1, 1, 0, 0]));
+}
+
+#[test]
+fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
+    let env = GridWorld::default();
+    let mut spec = small_memory();
+    spec.learn.switch = hstl_runtime::Switch::Step;
+    let mut learner = Learner::new(&spec, &env).unwrap();
+    learner.train(&mut seeded_rng(5), |_, _| {});
+    let text = Policy::new(&learner).to_json().unwrap();
+    assert!(text.contains("\n  \"switch\": \"step\",\n"), "{}", &text[..200]);
+    let back = Policy::from_json(&text).unwrap();
+    back.check_against(&spec, &env).unwrap();
+    let agent = back.agent(&env).unwrap();
+    assert_eq!(agent, learner.agent());
+    assert_eq!(agent.options_q.len(), 225 * 729 * 3);
+    // The paper's settings write no `switch`, so their policies stay as they were.
+    let paper = small_memory();
+    let mut plain = Learner::new(&paper, &env).unwrap();
+    plain.train(&mut seeded_rng(5), |_, _| {});
+    let plain_text = Policy::new(&plain).to_json().unwrap();
+    assert!(!plain_text.contains("switch"));
+    assert!(plain.agent().options_q.is_empty());
+    // Training is the same either way: only greedy runs differ.
+    assert_eq!(bits(learner.q()), bits(plain.q()));
+    // A document stripped of its `switch` no longer matches the spec it names.
+    let stripped = Policy::from_json(&text.replace("\n  \"switch\": \"step\",", "")).unwrap();
+    let err = stripped.check_against(&spec, &env).unwrap_err().to_string();
+    assert!(err.contains("`switch`"), "{err}");
+    // An unknown value is refused when the document is read.
+    assert!(
+        Policy::from_json(&text.replace("\"switch\": \"step\"", "\"switch\": \"often\"")).is_err()
+    );
 }

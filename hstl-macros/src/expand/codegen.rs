@@ -994,6 +994,10 @@ impl<'a> Gen<'a> {
             hstl_lang::Intra::Paper => quote!(Paper),
             hstl_lang::Intra::Remaining => quote!(Remaining),
         };
+        let switch = match l.switch {
+            hstl_lang::Switch::Termination => quote!(Termination),
+            hstl_lang::Switch::Step => quote!(Step),
+        };
         let reward = match l.reward {
             hstl_lang::Reward::Segment => quote!(Segment),
             hstl_lang::Reward::Window => quote!(Window),
@@ -1025,6 +1029,7 @@ impl<'a> Gen<'a> {
                             intra: #hstl::runtime::Intra::#intra,
                             reward: #hstl::runtime::RewardKind::#reward,
                             counterfactual: #counterfactual,
+                            switch: #hstl::runtime::Switch::#switch,
                             flat: #flat,
                             options: #opts,
                         },
