@@ -369,12 +369,19 @@ impl Policy {
         if rebuilt.spec != self.spec {
             return err(format!("it names spec `{}`, not `{}`", self.spec, rebuilt.spec));
         }
+        if rebuilt.switch != self.switch {
+            let word = |w: Switch| if w == Switch::Step { "step" } else { "termination" };
+            return err(format!(
+                "its `switch` is `{}`, but the spec it was trained on has `switch: {}`",
+                word(self.switch),
+                word(rebuilt.switch)
+            ));
+        }
         let parts = [
             ("options", rebuilt.options == self.options),
             ("primitives", rebuilt.primitives == self.primitives),
             ("memory", rebuilt.memory == self.memory),
             ("max_steps", rebuilt.max_steps == self.max_steps),
-            ("switch", rebuilt.switch == self.switch),
             ("flat_policies", rebuilt.flat_policies == self.flat_policies),
             ("options_policy", rebuilt.options_policy == self.options_policy),
         ];
