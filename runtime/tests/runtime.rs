@@ -731,7 +731,10 @@ fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
     // A document stripped of its `switch` no longer matches the spec it names.
     let stripped = Policy::from_json(&text.replace("\n  \"switch\": \"step\",", "")).unwrap();
     let err = stripped.check_against(&spec, &env).unwrap_err().to_string();
-    assert_eq!(err, "invalid policy: its `switch` is `termination`, but the spec it was trained on has `switch: step`");
+    assert_eq!(
+        err,
+        "invalid policy: its `switch` is `termination`, but the spec it was trained on has `switch: step`"
+    );
     // An unknown value is refused when the document is read.
     assert!(
         Policy::from_json(&text.replace("\"switch\": \"step\"", "\"switch\": \"often\"")).is_err()
