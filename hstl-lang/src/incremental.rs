@@ -375,7 +375,7 @@ fn push_mid(
 /// it holds no `spec`, and it does not end with a doc comment (which would document the
 /// next item).
 fn stretch_is_closed(mid: &str) -> bool {
-    if mid.bytes().last().is_some_and(|c| !c.is_ascii_whitespace()) {
+    if mid.bytes().last().is_some_and(|c| !crate::parser::is_space(c)) {
         return false;
     }
     let toks = lex(mid);

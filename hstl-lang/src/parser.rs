@@ -107,6 +107,12 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
 /// U+FEFF in UTF-8.
 const BOM: &[u8] = "\u{feff}".as_bytes();
 
+/// White space as the grammar's `WHITESPACE` reads it: space and `\t` to `\r`, so the
+/// vertical tab too (which `u8::is_ascii_whitespace` leaves out).
+pub(crate) fn is_space(c: u8) -> bool {
+    matches!(c, b' ' | b'\t'..=b'\r')
+}
+
 pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagnostic>) -> Vec<Tok> {
     let b = src.as_bytes();
     let mut toks = Vec::new();
@@ -114,7 +120,7 @@ pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagno
     while i < b.len() {
         let c = b[i];
         let start = i;
-        if c.is_ascii_whitespace() {
+        if is_space(c) {
             i += 1;
         } else if b[i..].starts_with(BOM) {
             // The grammar reads a byte order mark as whitespace (editors on Windows write one).

@@ -168,6 +168,17 @@ fn comments_stay_in_place() {
     assert_eq!(comments(&out), comments(src));
 }
 
+#[test]
+fn every_white_space_of_the_grammar_formats_as_a_space() {
+    // The grammar's white space is space, `\t` to `\r` and U+FEFF; the vertical tab once
+    // lexed as a token of its own, so the formatter wrote it out and added a comma after it.
+    let plain = format("spec S {\n    state {\n        x: int in 0..=3,\n    }\n}\n").unwrap();
+    for ws in ["\t", "\n", "\u{b}", "\u{c}", "\r", "\u{feff}"] {
+        let src = format!("spec S {{\n    state {{\n        x: int in 0..=3,{ws}}}\n}}\n");
+        assert_eq!(format(&src).unwrap(), plain, "{ws:?}");
+    }
+}
+
 /// Lines longer than the formatter's width, so that the properties cover wrapping.
 const LONG: &str = "spec Long {\n    state { x: int in 0..=14, y: int in 0..=14 }\n    \
     let Alpha = x > 3 && x < 9 && y > 10 && y < 14 && abs(x - y) < 20 && sqrt(x * x + y * y) > 0.5 && x + y > 1;\n    \
@@ -188,8 +199,10 @@ const FIXTURES: [&str; 8] = [
 ];
 
 /// Pieces to insert: tokens, comments and white space.
-const VOCAB: [&str; 24] = [
+const VOCAB: [&str; 26] = [
     " ",
+    "\u{b}",
+    "\u{c}",
     "\n",
     "\n\n",
     "\t",
