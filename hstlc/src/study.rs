@@ -1,5 +1,5 @@
 //! `hstlc study`: train several specs over many seeds, compare them, and write each one's
-//! pictures. The paper's case study is `scripts/case-study`, which runs this on the four
+//! pictures. The paper's case study is `scripts/case-study`, which runs this on the seven
 //! variants in `examples/specs/`. The figures and the files come from the facade
 //! (`hstl::study`), which the Python package's `hstl.study` calls too; this module prints
 //! and writes them.

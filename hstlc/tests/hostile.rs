@@ -247,7 +247,7 @@ fn the_case_study_script_takes_seeds_and_out() {
         .expect("bash runs");
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("6 specs x 1 seeds"), "{stdout}");
+    assert!(stdout.contains("7 specs x 1 seeds"), "{stdout}");
     for variant in ["surveillance_ot1", "surveillance_memory_tuned"] {
         let seeds = dir.path().join("cs").join(variant).join("seeds.csv");
         let text = std::fs::read_to_string(&seeds).expect("seeds.csv written under --out");
