@@ -132,6 +132,13 @@ impl Plan {
         if cs < body || old_end > close {
             return None;
         }
+        // The closing brace is a token, not the end of a comment that runs to the end of
+        // the file (`spec S { // }` has no closing brace).
+        let comments = &prev.file.comments;
+        let k = comments.partition_point(|c| c.range.end <= close);
+        if comments.get(k).is_some_and(|c| c.range.start <= close) {
+            return None;
+        }
         let pieces = pieces(spec);
         // The closing brace is the spec's own (not the end of an item of a spec that
         // runs to the end of the file).

@@ -165,3 +165,12 @@ fn most_edits_inside_a_body_reparse_only_a_stretch() {
     }
     assert!(partial * 2 > total, "only {partial} of {total} edits took the partial path");
 }
+
+#[test]
+fn a_closing_brace_inside_a_comment_is_not_the_spec_s_end() {
+    // Found by the `check` fuzz target: the body ran into a line comment that ends the
+    // file with `}`, so the spec had no closing brace; deleting a `/` of `//` closes it.
+    for (text, at) in [("spec S{// to }", 7), ("spec S{ let A = x > 1; /* } */ }", 22)] {
+        holds(text, &[(at, 1, None)]);
+    }
+}
