@@ -272,16 +272,16 @@ impl Controller for AgentController<'_> {
             }
             self.fresh = false;
         }
-        let choice = || agent.options.get(agent.observation(s, &self.tau)).copied();
+        let obs = agent.observation(s, &self.tau);
+        let choice = agent.options.get(obs).copied();
         // Interruption: the options policy's pick here replaces a running option of
         // strictly lower value (on a tie, as where neither was ever tried, it runs on).
         if agent.switch == Switch::Step
             && let Some((o, ..)) = self.running
-            && let Some(c) = choice()
+            && let Some(c) = choice
             && c != o
         {
-            let n = agent.legs.len();
-            let row = agent.options_q.get(agent.observation(s, &self.tau) * n..).unwrap_or(&[]);
+            let row = agent.options_q.get(obs * agent.legs.len()..).unwrap_or(&[]);
             if let (Some(q_c), Some(q_o)) = (row.get(c), row.get(o))
                 && q_c > q_o
             {
@@ -290,7 +290,7 @@ impl Controller for AgentController<'_> {
         }
         let (o, leg, _) = match self.running {
             Some(r) => r,
-            None => *self.running.insert((choice().unwrap_or(0), 0, 0)),
+            None => *self.running.insert((choice.unwrap_or(0), 0, 0)),
         };
         // An agent that does not fit the state (hand-built, or another environment) takes
         // no valid action, which leaves the state unchanged, instead of panicking.
