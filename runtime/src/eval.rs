@@ -272,17 +272,15 @@ impl Controller for AgentController<'_> {
             }
             self.fresh = false;
         }
-        let obs = agent.observation(s, &self.tau);
-        let choice = agent.options.get(obs).copied();
         // Interruption: the options policy's pick here replaces a running option of
         // strictly lower value (on a tie, as where neither was ever tried, it runs on).
         if agent.switch == Switch::Step
             && let Some((o, ..)) = self.running
-            && let Some(c) = choice
-            && c != o
         {
+            let obs = agent.observation(s, &self.tau);
             let row = agent.options_q.get(obs * agent.legs.len()..).unwrap_or(&[]);
-            if let (Some(q_c), Some(q_o)) = (row.get(c), row.get(o))
+            if let Some(&c) = agent.options.get(obs)
+                && let (Some(q_c), Some(q_o)) = (row.get(c), row.get(o))
                 && q_c > q_o
             {
                 self.running = Some((c, 0, 0));
@@ -290,7 +288,10 @@ impl Controller for AgentController<'_> {
         }
         let (o, leg, _) = match self.running {
             Some(r) => r,
-            None => *self.running.insert((choice.unwrap_or(0), 0, 0)),
+            None => {
+                let obs = agent.observation(s, &self.tau);
+                *self.running.insert((agent.options.get(obs).copied().unwrap_or(0), 0, 0))
+            }
         };
         // An agent that does not fit the state (hand-built, or another environment) takes
         // no valid action, which leaves the state unchanged, instead of panicking.

@@ -370,11 +370,10 @@ impl Policy {
             return err(format!("it names spec `{}`, not `{}`", self.spec, rebuilt.spec));
         }
         if rebuilt.switch != self.switch {
-            let word = |w: Switch| if w == Switch::Step { "step" } else { "termination" };
             return err(format!(
                 "its `switch` is `{}`, but the spec it was trained on has `switch: {}`",
-                word(self.switch),
-                word(rebuilt.switch)
+                self.switch.word(),
+                rebuilt.switch.word()
             ));
         }
         let parts = [

@@ -158,6 +158,14 @@ impl Switch {
     pub fn is_termination(&self) -> bool {
         *self == Switch::Termination
     }
+
+    /// The word a spec writes for it (`switch: step`), as in `policy.json`.
+    pub fn word(self) -> &'static str {
+        match self {
+            Switch::Termination => "termination",
+            Switch::Step => "step",
+        }
+    }
 }
 
 /// How the options level rewards an option execution.

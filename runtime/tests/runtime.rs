@@ -735,6 +735,10 @@ fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
         err,
         "invalid policy: its `switch` is `termination`, but the spec it was trained on has `switch: step`"
     );
+    // The words of the error are the document's.
+    for w in [hstl_runtime::Switch::Termination, hstl_runtime::Switch::Step] {
+        assert_eq!(serde_json::to_string(&w).unwrap(), format!("\"{}\"", w.word()));
+    }
     // An unknown value is refused when the document is read.
     assert!(
         Policy::from_json(&text.replace("\"switch\": \"step\"", "\"switch\": \"often\"")).is_err()
