@@ -715,6 +715,18 @@ fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
     let text = Policy::new(&learner).to_json().unwrap();
     assert!(text.contains("\n  \"switch\": \"step\",\n"), "{}", &text[..200]);
     let back = Policy::from_json(&text).unwrap();
+    // With memory and `switch` the document has every field, in `Policy::FIELDS`' order
+    // (`to_json_with` refuses extra fields of these names).
+    let fields: Vec<String> = match serde_json::to_value(&back).unwrap() {
+        serde_json::Value::Object(m) => m.keys().cloned().collect(),
+        other => panic!("not an object: {other}"),
+    };
+    let mut sorted = Policy::FIELDS.map(String::from).to_vec();
+    sorted.sort();
+    assert_eq!(fields, sorted);
+    let at: Vec<usize> =
+        Policy::FIELDS.iter().map(|f| text.find(&format!("\n  \"{f}\": ")).unwrap()).collect();
+    assert!(at.is_sorted(), "{at:?}");
     back.check_against(&spec, &env).unwrap();
     let agent = back.agent(&env).unwrap();
     assert_eq!(agent, learner.agent());
