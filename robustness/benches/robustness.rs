@@ -6,7 +6,7 @@
 mod walk;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use hstl_robustness::{Evaluator, Formula, OnlineMonitor, Trace, segment::TabularScorer};
+use hstl_robustness::{Evaluator, Formula, OnlineMonitor, Trace, complete, segment::TabularScorer};
 use std::hint::black_box;
 
 fn full_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
@@ -16,6 +16,17 @@ fn full_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
     let mut ev = Evaluator::new();
     for (name, f) in cases {
         g.bench_function(*name, |b| b.iter(|| black_box(ev.signal(f, black_box(trace))[0])));
+    }
+    g.finish();
+}
+
+/// Over complete windows (`hstlc monitor --complete`, the train and eval reports).
+fn complete_signal(c: &mut Criterion, trace: &Trace, cases: &[(&str, Formula)]) {
+    let mut g = c.benchmark_group("complete");
+    g.throughput(Throughput::Elements(trace.len() as u64));
+    g.sample_size(10);
+    for (name, f) in cases {
+        g.bench_function(*name, |b| b.iter(|| black_box(complete::signal(f, black_box(trace))[0])));
     }
     g.finish();
 }
@@ -85,6 +96,7 @@ fn benches(c: &mut Criterion) {
         ("P3", walk::p3()),
     ];
     full_signal(c, &trace, &cases);
+    complete_signal(c, &trace, &[("F1_w40", walk::f1(40)), ("F2", walk::f2())]);
     online(
         c,
         &trace,

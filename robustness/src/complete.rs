@@ -64,14 +64,9 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
             // A comparison's signal is made when it is reached and dropped after its last
             // reader, so that only the live signals are held, not one per comparison.
             Node::Cmp { lhs, op, rhs } => {
-                let (lhs, rhs) = (f.expr_at(*lhs), f.expr_at(*rhs));
-                let mut row = Vec::new();
-                (0..n)
-                    .map(|t| {
-                        trace.row_into(t, &mut row);
-                        op.robustness(lhs.eval(&row), rhs.eval(&row))
-                    })
-                    .collect()
+                let lhs = f.expr_at(*lhs).eval_trace(trace);
+                let rhs = f.expr_at(*rhs).eval_trace(trace);
+                lhs.iter().zip(&rhs).map(|(&a, &b)| op.robustness(a, b)).collect()
             }
             Node::True => vec![f64::INFINITY; n],
             Node::False => vec![f64::NEG_INFINITY; n],

@@ -1053,6 +1053,45 @@ impl Expr {
         &self.nodes[self.root as usize]
     }
 
+    /// The expression's value at every step of `trace` (what [`Expr::eval`] gives row by
+    /// row), computed node by node over chunks of 512 steps: no allocation per step, and
+    /// memory of one chunk per node, however long the trace.
+    pub fn eval_trace(&self, trace: &crate::Trace) -> Vec<f64> {
+        const CHUNK: usize = 512;
+        let n = trace.len();
+        let mut out = Vec::with_capacity(n);
+        let mut vals: Vec<Vec<f64>> = vec![Vec::with_capacity(CHUNK.min(n)); self.nodes.len()];
+        for lo in (0..n).step_by(CHUNK) {
+            let hi = (lo + CHUNK).min(n);
+            for (i, node) in self.nodes.iter().enumerate() {
+                let (done, rest) = vals.split_at_mut(i);
+                let col = &mut rest[0];
+                col.clear();
+                let v = |e: &ExprId| done[e.index()].iter().copied();
+                let bin = |a: &ExprId, b: &ExprId, g: fn(f64, f64) -> f64| {
+                    v(a).zip(v(b)).map(move |(x, y)| g(x, y))
+                };
+                match node {
+                    Node::Const(c) => col.resize(hi - lo, *c),
+                    Node::Var(j) if *j < trace.vars() => {
+                        col.extend_from_slice(&trace.column(*j)[lo..hi])
+                    }
+                    Node::Neg(e) => col.extend(v(e).map(|x| -x)),
+                    Node::Abs(e) => col.extend(v(e).map(f64::abs)),
+                    Node::Sqrt(e) => col.extend(v(e).map(f64::sqrt)),
+                    Node::Add(a, b) => col.extend(bin(a, b, |x, y| x + y)),
+                    Node::Sub(a, b) => col.extend(bin(a, b, |x, y| x - y)),
+                    Node::Mul(a, b) => col.extend(bin(a, b, |x, y| x * y)),
+                    Node::Div(a, b) => col.extend(bin(a, b, |x, y| x / y)),
+                    // A variable past the trace, as in `eval`; no other node is an expression.
+                    _ => col.resize(hi - lo, f64::NAN),
+                }
+            }
+            out.extend_from_slice(&vals[self.root as usize]);
+        }
+        out
+    }
+
     /// The value of the expression on one sample, `state[i]` being variable `i`.
     ///
     /// A variable index outside `state` reads as NaN; [`Formula::max_var`] lets callers

@@ -287,3 +287,25 @@ fn a_perfect_cycle_keeps_the_persistent_task_over_complete_windows() {
     // Too short a trace leaves step 0 undetermined.
     assert_eq!(complete::robustness(&f, &common::trace_xy(&x[..4], &y[..4])), None);
 }
+
+proptest! {
+    /// An expression over a whole trace (in chunks of 512 steps) is its value row by row,
+    /// bit for bit; a variable the trace lacks is NaN in both.
+    #[test]
+    fn expressions_over_a_trace_agree_with_row_by_row(
+        e in expr(),
+        vars in 1usize..=2,
+        t in trace_up_to(2, true, 1300),
+    ) {
+        let cols: Vec<Vec<f64>> = (0..vars).map(|i| t.column(i).to_vec()).collect();
+        let t = Trace::from_columns(cols).expect("equal lengths");
+        let got = e.eval_trace(&t);
+        prop_assert_eq!(got.len(), t.len());
+        let mut row = Vec::new();
+        for (step, v) in got.iter().enumerate() {
+            t.row_into(step, &mut row);
+            let want = e.eval(&row);
+            prop_assert!(v.to_bits() == want.to_bits(), "step {}: {} against {}", step, v, want);
+        }
+    }
+}
