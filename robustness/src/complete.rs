@@ -64,9 +64,10 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
             // A comparison's signal is made when it is reached and dropped after its last
             // reader, so that only the live signals are held, not one per comparison.
             Node::Cmp { lhs, op, rhs } => {
-                let lhs = f.expr_at(*lhs).eval_trace(trace);
+                let mut v = f.expr_at(*lhs).eval_trace(trace);
                 let rhs = f.expr_at(*rhs).eval_trace(trace);
-                lhs.iter().zip(&rhs).map(|(&a, &b)| op.robustness(a, b)).collect()
+                v.iter_mut().zip(&rhs).for_each(|(a, &b)| *a = op.robustness(*a, b));
+                v
             }
             Node::True => vec![f64::INFINITY; n],
             Node::False => vec![f64::NEG_INFINITY; n],
