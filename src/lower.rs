@@ -11,8 +11,8 @@
 use std::fmt;
 
 use hstl_lang::{
-    Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Domain, Intra, Reward,
-    Switch, Terminate,
+    Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Domain, Intra, Plan,
+    Reward, Switch, Terminate,
 };
 use hstl_robustness as rob;
 use hstl_runtime as rt;
@@ -138,6 +138,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
         switch: match l.switch {
             Switch::Termination => rt::Switch::Termination,
             Switch::Step => rt::Switch::Step,
+        },
+        plan: match l.plan {
+            Plan::Off => rt::Plan::Off,
+            Plan::Model => rt::Plan::Model,
         },
         flat: level(&l.flat),
         options: level(&l.options),

@@ -379,6 +379,7 @@ impl Cx<'_> {
         if let Some(l) = learn {
             self.learn(l, preset, &mut out);
             self.counterfactual_needs(l, &out);
+            self.plan_needs(l, &mut out);
         }
         if preset == Preset::Auto {
             let (fields, set) = filled;
@@ -1282,7 +1283,7 @@ impl Cx<'_> {
     }
 
     fn learn(&mut self, l: &syntax::Learn, preset: Preset, out: &mut CheckedSpec) {
-        const TOP: [&str; 11] = [
+        const TOP: [&str; 12] = [
             "preset",
             "episodes",
             "choices",
@@ -1292,6 +1293,7 @@ impl Cx<'_> {
             "reward",
             "counterfactual",
             "switch",
+            "plan",
             "flat",
             "options",
         ];
@@ -1350,6 +1352,11 @@ impl Cx<'_> {
                     Some(_) => out.learn.switch = Switch::Step,
                     None => {}
                 },
+                "plan" => match self.word(p, &["off", "model"]).as_deref() {
+                    Some("off") => out.learn.plan = Plan::Off,
+                    Some(_) => out.learn.plan = Plan::Model,
+                    None => {}
+                },
                 "reward" => match self.word(p, &["segment", "window"]).as_deref() {
                     Some("segment") => out.learn.reward = Reward::Segment,
                     Some(_) => out.learn.reward = Reward::Window,
@@ -1396,6 +1403,23 @@ impl Cx<'_> {
             )
             .with_help("counterfactual updates replay the memory's counters along each option's run and score it by the window reward: add `memory: 8, reward: window`, or write `learn { preset: auto }` on a persistent task"),
         );
+    }
+
+    /// HSTL072: `plan: model` plans the options level of a persistent task over the
+    /// memory's counters, one option per region: a spec of another shape is refused where
+    /// it writes `plan: model`, and left to Q-learning where only the preset asked for it.
+    fn plan_needs(&mut self, l: &syntax::Learn, out: &mut CheckedSpec) {
+        if out.learn.plan != Plan::Model {
+            return;
+        }
+        let Some(missing) = plan_missing(out, self.src) else { return };
+        match l.params.iter().find(|p| p.name.name == "plan") {
+            Some(p) => self.push(
+                Diagnostic::new("HSTL072", p.range.clone(), format!("`plan: model` needs {missing}"))
+                    .with_help("planning values the options of a persistent task `always[0..] (eventually[0..N] A && ...)` over the memory's counters: write `learn { preset: auto }` with `option A;` per region, or remove `plan: model`"),
+            ),
+            None => out.learn.plan = Plan::Off,
+        }
     }
 
     fn param_name_ok(
@@ -2173,6 +2197,35 @@ fn gen_positions(
         cur.pop();
         used[p] = false;
     }
+}
+
+/// What a spec lacks for `plan: model`, or `None` when it has it all: a persistent task,
+/// `memory`, `reward: window`, an options gamma below 1, and an options set of one option
+/// per region, each a single leg that stops on entering its region (no `avoid`).
+fn plan_missing(out: &CheckedSpec, src: &str) -> Option<&'static str> {
+    let Some(regions) = out.persistent_conjuncts(src) else {
+        return Some("a persistent task `always[0..] (eventually[0..N] A && ...)`");
+    };
+    let l = &out.learn;
+    if l.memory == 0 {
+        return Some("`memory`");
+    }
+    if l.reward != Reward::Window {
+        return Some("`reward: window`");
+    }
+    if l.options.gamma >= 1.0 {
+        return Some("an options gamma below 1");
+    }
+    let enters_a_region = |o: &CombinedOption| -> bool {
+        let [p] = o.sequence.as_slice() else { return false };
+        let Some(p) = out.primitives.get(*p) else { return false };
+        let Terminate::Formula(t) = &p.terminate else { return false };
+        p.avoid.is_none() && regions.iter().any(|r| crate::preset::covers(t, &r.region, src))
+    };
+    if out.options.is_empty() || !out.options.iter().all(enters_a_region) {
+        return Some("options of one leg each that stop on entering a region of the task");
+    }
+    None
 }
 
 #[cfg(test)]

@@ -278,6 +278,15 @@ pub enum Switch {
     Step,
 }
 
+/// How a trained policy's options values are obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plan {
+    /// Q-learned (the paper).
+    Off,
+    /// Planned after training over the memory's counters and a model of the learned legs.
+    Model,
+}
+
 /// The options-level reward.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Reward {
@@ -333,6 +342,8 @@ pub struct LearnParams {
     pub counterfactual: u64,
     /// When a greedy run chooses an option (`termination`).
     pub switch: Switch,
+    /// How the options values are obtained (`off`: Q-learned).
+    pub plan: Plan,
     /// Flat level (gamma 0.9, alpha 0.2, epsilon 0.8, min_epsilon 0.1, decay 1e-6).
     pub flat: QParams,
     /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
@@ -351,6 +362,7 @@ impl Default for LearnParams {
             reward: Reward::Segment,
             counterfactual: 0,
             switch: Switch::Termination,
+            plan: Plan::Off,
             flat: QParams { gamma: 0.9, alpha: 0.2, epsilon: 0.8, min_epsilon: 0.1, decay: 1e-6 },
             options: QParams {
                 gamma: 0.9,

@@ -406,6 +406,23 @@ Fix: add `memory: 8, reward: window` (the task must be persistent), or write \
 `learn { preset: auto }`, which sets all three on a persistent task.",
     },
     CodeInfo {
+        code: "HSTL072",
+        name: "plan-needs-persistent-options",
+        severity: E,
+        summary: "`plan: model` on a spec whose options level cannot be planned",
+        explanation: "`plan: model` computes the options values after training instead of \
+Q-learning them: from the transitions seen in training it estimates how long each option's leg \
+takes from each state and where in its region it arrives, and runs value iteration over the \
+memory's counters, which the task determines exactly. That needs a persistent task \
+`always[0..] (eventually[0..N1] R1 && ...)`, `memory` and `reward: window` (the counters and \
+the reward it plans with), an options gamma below 1, and options of one leg each that stop on \
+entering one of the task's regions, without `avoid`.\n\n\
+Example:\n    task always[0..] eventually[0..40] A;\n    options sequences(A, B);\n    \
+learn { memory: 8, reward: window, plan: model }\n\n\
+Fix: write `option A;` per region and `learn { preset: auto }`, which sets `plan: model` on \
+a persistent task, or remove `plan: model`.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,

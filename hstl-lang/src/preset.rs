@@ -109,6 +109,7 @@ pub fn learn(horizons: Option<&[u64]>, learn: &mut LearnParams) {
             learn.options.gamma = OPTIONS_GAMMA;
             learn.options.alpha = OPTIONS_ALPHA;
             learn.switch = crate::checked::Switch::Step;
+            learn.plan = crate::checked::Plan::Model;
         }
         None => {
             learn.episodes = REACH_EPISODES;
@@ -167,6 +168,9 @@ pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 3]], set_filled
     }
     if l.switch == crate::checked::Switch::Step {
         params.push("switch: step".to_string());
+    }
+    if l.plan == crate::checked::Plan::Model {
+        params.push("plan: model".to_string());
     }
     params.push(format!("flat: {{ alpha: {} }}", l.flat.alpha));
     if l.reward == crate::checked::Reward::Window {

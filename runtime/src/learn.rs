@@ -38,7 +38,8 @@ use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
 use crate::memory::Memory;
-use crate::spec::{Intra, LearnParams, LevelParams, RewardKind};
+use crate::plan::{Model, Planner};
+use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
 
@@ -69,6 +70,11 @@ pub struct Learner<'e, E: Env> {
     states: Vec<E::State>,
     /// The first primitive step from which the flat epsilon is at its floor, if any.
     flat_floor: Option<u64>,
+    /// With `plan: model`: the planner and the transitions seen so far.
+    planning: Option<(Planner, Model)>,
+    /// With `plan: model`, after training: the learned flat and options values, which
+    /// training continues from (the planned ones are in `q`).
+    learned: Option<(Vec<Vec<f64>>, Vec<f64>)>,
 }
 
 /// The learned values, enough to continue training.
@@ -194,6 +200,18 @@ impl<'e, E: Env> Learner<'e, E> {
             RewardKind::Window => Reward::Window,
         };
         let states = (0..tables.states).filter_map(|s| env.state(s)).collect();
+        let planning = match (spec.learn.plan, &memory) {
+            (Plan::Off, _) => None,
+            (Plan::Model, Some(m)) => Some((
+                Planner::new(&tables, m, &spec.learn)?,
+                Model::new(tables.states, tables.actions),
+            )),
+            (Plan::Model, None) => {
+                return Err(Error::Config(
+                    "plan: model needs a persistent task with `memory` and `reward: window`".into(),
+                ));
+            }
+        };
         Ok(Learner {
             env,
             spec: spec.clone(),
@@ -208,6 +226,8 @@ impl<'e, E: Env> Learner<'e, E> {
             gamma_powers: vec![1.0],
             states,
             flat_floor: floor_from(&spec.learn.flat),
+            planning,
+            learned: None,
         })
     }
 
@@ -221,6 +241,7 @@ impl<'e, E: Env> Learner<'e, E> {
             ));
         }
         self.q = q;
+        self.learned = None;
         Ok(self)
     }
 
@@ -271,6 +292,10 @@ impl<'e, E: Env> Learner<'e, E> {
         rng: &mut Rng,
         mut progress: impl FnMut(usize, f64) -> ControlFlow<()>,
     ) -> Trained {
+        if let Some((flat, options)) = self.learned.take() {
+            self.q.flat = flat;
+            self.q.options = options;
+        }
         let episodes = self.spec.learn.episodes;
         let mut curve = Vec::with_capacity(episodes);
         let steps_before = self.q.steps;
@@ -283,7 +308,21 @@ impl<'e, E: Env> Learner<'e, E> {
                 break;
             }
         }
+        self.plan();
         Trained { curve, steps: self.q.steps - steps_before }
+    }
+
+    /// With `plan: model`: the legs and the options values planned from what training has
+    /// seen so far replace the learned ones, which are kept for training to continue from.
+    fn plan(&mut self) {
+        let (Some((planner, model)), Some(memory)) = (&self.planning, &self.memory) else {
+            return;
+        };
+        let gamma = self.spec.learn.options.gamma;
+        let flat = planner.quickest_legs(&self.tables, memory, &self.q.flat, model);
+        let options = planner.options_values(&self.tables, memory, &flat, model, gamma);
+        let flat = std::mem::replace(&mut self.q.flat, flat);
+        self.learned = Some((flat, std::mem::replace(&mut self.q.options, options)));
     }
 
     fn episode(&mut self, rng: &mut Rng, run: &mut Run, rewards: &mut Vec<f64>) -> f64 {
@@ -334,7 +373,18 @@ impl<'e, E: Env> Learner<'e, E> {
     fn run_option(&mut self, o: usize, mut s: usize, rng: &mut Rng, run: &mut Run) {
         let LearnParams { max_steps, flat, .. } = self.spec.learn;
         let Learner {
-            env, tables, memory, q, counters, tau, code, values, states, flat_floor, ..
+            env,
+            tables,
+            memory,
+            q,
+            counters,
+            tau,
+            code,
+            values,
+            states,
+            flat_floor,
+            planning,
+            ..
         } = self;
         let (actions, values) = (tables.actions, *values);
         run.states.clear();
@@ -366,6 +416,9 @@ impl<'e, E: Env> Learner<'e, E> {
                     Some(state) => env.index(&env.step(state, a, rng)),
                     None => s,
                 };
+                if let Some((_, model)) = planning {
+                    model.record(s, a, next);
+                }
                 update_flat(
                     &mut q.flat,
                     &tables.reach,
@@ -1003,5 +1056,82 @@ mod tests {
         spec.primitives[1].init = x(CmpOp::Lt, 2.0);
         let err = Learner::new(&spec, &env).unwrap_err();
         assert!(err.to_string().contains("no option of the set can start"), "{err}");
+    }
+
+    /// The persistent line with `plan: model`, exploring enough to try every move.
+    fn planned_line(episodes: usize) -> TaskSpec {
+        let mut spec = persistent_line();
+        spec.learn.plan = Plan::Model;
+        spec.learn.episodes = episodes;
+        spec.learn.choices = 20;
+        spec.learn.flat = LevelParams { epsilon: 0.5, min_epsilon: 0.5, ..LevelParams::FLAT };
+        spec.learn.options =
+            LevelParams { epsilon: 0.5, min_epsilon: 0.5, gamma: 0.5, ..LevelParams::OPTIONS };
+        spec
+    }
+
+    #[test]
+    fn planning_gives_the_quickest_legs_and_the_options_values_of_the_counters() {
+        // Deterministic: Right (x > 3, x = 4) is 4 - x steps away by action 3 (Right).
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let spec = planned_line(50);
+        let mut learner = Learner::new(&spec, &env).unwrap();
+        learner.train(&mut seeded_rng(3), |_, _| {});
+        let right = &learner.q().flat[0];
+        for x in 0..4 {
+            let row = &right[x * 4..][..4];
+            let steps = (4 - x) as f64;
+            // Up and Down stay, Left moves away (or stays at x = 0).
+            let left = if x == 0 { steps + 1.0 } else { steps + 2.0 };
+            assert_eq!(row, [-(steps + 1.0), -(steps + 1.0), -left, -steps], "x = {x}");
+        }
+        // From x = 0 each leg takes 4 steps and psi(m) = [tau_2 + m < 6 or m = 4] (gamma
+        // 0.5, windows of 6). At arrival the other counter is 4, from where the next leg
+        // earns 1 + 0.125 and then the same again: v = 1.125 + 0.5^4 v, v = 1.2. Memory
+        // B = 2 values tau_2 by the middle of its bucket: 2 in bucket 0, 4 in bucket 1, 6 (expired).
+        let values = 9;
+        let q = &learner.q().options;
+        let want = [(0, 1.875 + 0.0625 * 1.2), (1, 1.2), (2, 0.125 + 0.0625 * 1.2)];
+        for (bucket, v) in want {
+            let got = q[bucket * 2];
+            assert!((got - v).abs() < 1e-4, "bucket {bucket}: {got} against {v}");
+        }
+        assert_eq!(q.len(), 5 * values * 2);
+    }
+
+    #[test]
+    fn planned_training_in_chunks_equals_training_whole() {
+        let env = GridWorld::new(5, 1, 0.8).unwrap();
+        let mut whole = Learner::new(&planned_line(40), &env).unwrap();
+        whole.train(&mut seeded_rng(11), |_, _| {});
+        let mut chunks = Learner::new(&planned_line(20), &env).unwrap();
+        let mut rng = seeded_rng(11);
+        chunks.train(&mut rng, |_, _| {});
+        chunks.train(&mut rng, |_, _| {});
+        assert_eq!(whole.q(), chunks.q());
+        // And the planned tables differ from the learned ones.
+        let mut off = planned_line(40);
+        off.learn.plan = Plan::Off;
+        let mut learned = Learner::new(&off, &env).unwrap();
+        learned.train(&mut seeded_rng(11), |_, _| {});
+        assert_eq!(learned.q().steps, whole.q().steps);
+        assert_ne!(learned.q().options, whole.q().options);
+    }
+
+    #[test]
+    fn plan_refuses_options_it_cannot_plan() {
+        let env = GridWorld::new(5, 1, 1.0).unwrap();
+        let mut spec = planned_line(10);
+        spec.options.push(CombinedOption { name: "RightLeft".into(), sequence: vec![0, 1] });
+        let err = Learner::new(&spec, &env).unwrap_err().to_string();
+        assert!(err.contains("plan: model needs every option to be one leg"), "{err}");
+        let mut spec = planned_line(10);
+        spec.learn.options.gamma = 1.0;
+        let err = Learner::new(&spec, &env).unwrap_err().to_string();
+        assert!(err.contains("options gamma below 1"), "{err}");
+        let mut spec = planned_line(10);
+        spec.learn.memory = 0;
+        let err = Learner::new(&spec, &env).unwrap_err().to_string();
+        assert!(err.contains("plan: model needs a memory"), "{err}");
     }
 }

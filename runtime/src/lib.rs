@@ -9,6 +9,8 @@
 //!   intra-option updates, seeded and bit-for-bit reproducible.
 //! - [`memory`]: the counters and buckets of `memory: B` and the step signal of
 //!   `reward: window` (beyond the paper).
+//! - `plan` (internal): `plan: model`, the options values planned over the memory's
+//!   counters and a model of the learned legs (beyond the paper).
 //! - [`policy`]: greedy policies and the `policy.json` document.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
 //! - [`optimum`]: the exact optimal window rate `W*` of a persistent task on any grid world.
@@ -23,6 +25,7 @@ pub mod eval;
 pub mod learn;
 pub mod memory;
 pub mod optimum;
+mod plan;
 pub mod policy;
 pub mod reach_avoid;
 pub mod spec;
@@ -41,8 +44,8 @@ pub use policy::{Agent, Policy};
 pub use rand::RngExt;
 pub use serde_json::{Value, json};
 pub use spec::{
-    CombinedOption, Intra, LearnParams, LevelParams, PrimitiveOption, Region, RewardKind, Spec,
-    StateVar, Switch, TaskSpec, Terminate,
+    CombinedOption, Intra, LearnParams, LevelParams, Plan, PrimitiveOption, Region, RewardKind,
+    Spec, StateVar, Switch, TaskSpec, Terminate,
 };
 
 /// The one random generator of the crate: every draw comes from a value of this type.

@@ -108,6 +108,10 @@ pub struct LearnParams {
     pub counterfactual: usize,
     /// When a greedy run of the policy chooses an option.
     pub switch: Switch,
+    /// Whether the options values are planned over a model of the legs instead of
+    /// Q-learned (needs a persistent task, `memory`, `reward: window` and one option per
+    /// region).
+    pub plan: Plan,
     /// The flat (primitive) level; epsilon decays per primitive step.
     pub flat: LevelParams,
     /// The options level; epsilon decays per option choice.
@@ -168,6 +172,18 @@ impl Switch {
     }
 }
 
+/// How the options values of a trained policy are obtained.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Plan {
+    /// Q-learned, as in the paper.
+    #[default]
+    Off,
+    /// Planned after training: value iteration over the task's memory counters and a
+    /// model of the learned legs (how long each takes from each state, where it arrives),
+    /// estimated from the transitions seen in training. Training itself is unchanged.
+    Model,
+}
+
 /// How the options level rewards an option execution.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum RewardKind {
@@ -195,6 +211,7 @@ impl Default for LearnParams {
             reward: RewardKind::Segment,
             counterfactual: 0,
             switch: Switch::Termination,
+            plan: Plan::Off,
             flat: LevelParams::FLAT,
             options: LevelParams::OPTIONS,
         }

@@ -998,6 +998,10 @@ impl<'a> Gen<'a> {
             hstl_lang::Switch::Termination => quote!(Termination),
             hstl_lang::Switch::Step => quote!(Step),
         };
+        let plan = match l.plan {
+            hstl_lang::Plan::Off => quote!(Off),
+            hstl_lang::Plan::Model => quote!(Model),
+        };
         let reward = match l.reward {
             hstl_lang::Reward::Segment => quote!(Segment),
             hstl_lang::Reward::Window => quote!(Window),
@@ -1030,6 +1034,7 @@ impl<'a> Gen<'a> {
                             reward: #hstl::runtime::RewardKind::#reward,
                             counterfactual: #counterfactual,
                             switch: #hstl::runtime::Switch::#switch,
+                            plan: #hstl::runtime::Plan::#plan,
                             flat: #flat,
                             options: #opts,
                         },
