@@ -1134,4 +1134,31 @@ mod tests {
         let err = Learner::new(&spec, &env).unwrap_err().to_string();
         assert!(err.contains("plan: model needs a memory"), "{err}");
     }
+
+    #[test]
+    fn plan_refuses_a_world_too_large_to_plan_before_training() {
+        // Two regions of 20,000 cells each, windows of 500 steps: far past the budget.
+        let env = GridWorld::new(400, 100, 1.0).unwrap();
+        let mut spec = planned_line(10);
+        spec.state_vars[0].domain = Some(0..=399);
+        spec.state_vars[1].domain = Some(0..=99);
+        let (r1, r2) = (x(CmpOp::Lt, 200.0), x(CmpOp::Gt, 199.0));
+        let window = Interval { start: 0, end: Bound::Exclusive(500) };
+        spec.task = Formula::always(
+            Interval::ALL,
+            Formula::and(vec![
+                Formula::eventually(window, r1.clone()),
+                Formula::eventually(window, r2.clone()),
+            ]),
+        );
+        for (p, (r, other)) in spec.primitives.iter_mut().zip([(&r2, &r1), (&r1, &r2)]) {
+            p.reach = r.clone();
+            p.terminate = Terminate::Formula(r.clone());
+            p.init = other.clone();
+        }
+        spec.regions = spec.regions_from_task().unwrap();
+        let err = Learner::new(&spec, &env).unwrap_err().to_string();
+        assert!(err.contains("plan: model over 40000 states"), "{err}");
+        assert!(err.contains("`plan: off`"), "{err}");
+    }
 }

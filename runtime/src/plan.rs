@@ -27,6 +27,8 @@ use crate::{Error, LearnParams};
 
 /// At most this many numbers in the planner's tables (durations, arrival cells, values).
 const MAX_PLAN_VALUES: usize = 1 << 26;
+/// At most this many operations in a sweep of value iteration, or in filling the table.
+const MAX_PLAN_WORK: usize = 1 << 31;
 /// Value iteration stops when no value moves by more than this...
 const TOLERANCE: f64 = 1e-5;
 /// ... or after this many sweeps.
@@ -129,6 +131,32 @@ impl Planner {
                  more than {MAX_PLAN_VALUES} planned values; use fewer regions or shorter \
                  windows, or `plan: off`",
                 memory.len()
+            ));
+        }
+        // The work of a value iteration sweep and of filling the options table: every
+        // state a leg starts from, times the cells it may arrive in (at most 1 /
+        // RARE_ARRIVAL of them once the rare ones are dropped), times a grid of counters.
+        let widest = memory
+            .holds
+            .iter()
+            .map(|h| h.iter().filter(|&&x| x).count())
+            .max()
+            .unwrap_or(0)
+            .min((1.0 / RARE_ARRIVAL) as usize);
+        let arrivals = (0..memory.len()).filter_map(grid).max().unwrap_or(usize::MAX);
+        let options = region.len();
+        let work = [
+            cells.checked_mul(options).and_then(|v| v.checked_mul(widest)?.checked_mul(arrivals)),
+            widest
+                .checked_mul(arrivals)
+                .and_then(|v| v.checked_add(memory.values()))
+                .and_then(|v| v.checked_mul(states)?.checked_mul(options)),
+        ];
+        if work.iter().any(|v| v.is_none_or(|v| v > MAX_PLAN_WORK)) {
+            return err(format!(
+                "over {states} states and regions of up to {widest} cells with windows of up \
+                 to {longest} steps needs more than {MAX_PLAN_WORK} operations per sweep; use \
+                 smaller regions, fewer regions or shorter windows, or `plan: off`"
             ));
         }
         Ok(Planner { region, max_duration })
