@@ -41,6 +41,7 @@ impl NameHasher {
 }
 use std::ops::Range;
 
+use crate::budget;
 use crate::checked::*;
 use crate::diagnostic::{self, Diagnostic};
 use crate::parser::parse;
@@ -1828,6 +1829,33 @@ impl Cx<'_> {
             Some(m) => m.present.iter().filter(|&&p| p).count() as u64,
             None => size,
         };
+        if out.learn.plan == Plan::Model
+            && let (Some(conjuncts), Some(task)) = (out.persistent_conjuncts(self.src), &out.task)
+        {
+            let range_of = |f: &CFormula| match f.kind {
+                CFormulaKind::Let(i) => out.lets[i].name_range.clone(),
+                _ => f.range.clone(),
+            };
+            let cells: Vec<u64> = conjuncts
+                .iter()
+                .map(|c| {
+                    let r = range_of(&c.region);
+                    regions.iter().position(|(_, at, _)| *at == r).map_or(0, |i| region_sat[i])
+                })
+                .collect();
+            let horizons: Vec<u64> = conjuncts.iter().map(|c| c.steps).collect();
+            let l = &out.learn;
+            let options = out.options.len() as u64;
+            if let Some(why) =
+                budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps)
+            {
+                self.push(
+                    Diagnostic::new("HSTL033", task.formula.range.clone(), why).with_help(
+                        "use smaller or fewer regions, or shorter windows, or write `plan: off` to Q-learn the options level",
+                    ),
+                );
+            }
+        }
         let world = self.world.filter(|_| mask.is_some());
         for (r, (_, range, name)) in regions.iter().enumerate() {
             if let Some(world) = world

@@ -335,7 +335,10 @@ Fix: widen `terminate`, or leave it out: the option then stops where its region 
         explanation: "`memory: B` gives the options level one observation per state and memory \
 value, (B + 1)^k memory values for k regions; `policy.json` holds an entry for each. At most \
 2,097,152 observations (states times memory values) are allowed. Memory and `reward: window` \
-also keep a table entry per step of each window: windows of at most 1,000,000 steps.\n\n\
+also keep a table entry per step of each window: windows of at most 1,000,000 steps. \
+`plan: model` plans over the exact counters of every region and each leg's durations from \
+every state: at most 67,108,864 planned values and 2,147,483,648 operations per sweep, \
+counted from the states, the regions' sizes and the windows.\n\n\
 Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 million\n\n\
 Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
     },

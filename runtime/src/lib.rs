@@ -9,7 +9,7 @@
 //!   intra-option updates, seeded and bit-for-bit reproducible.
 //! - [`memory`]: the counters and buckets of `memory: B` and the step signal of
 //!   `reward: window` (beyond the paper).
-//! - `plan` (internal): `plan: model`, the options values planned over the memory's
+//! - [`plan`]: `plan: model`, the options values planned over the memory's
 //!   counters and a model of the learned legs (beyond the paper).
 //! - [`policy`]: greedy policies and the `policy.json` document.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
@@ -25,7 +25,7 @@ pub mod eval;
 pub mod learn;
 pub mod memory;
 pub mod optimum;
-mod plan;
+pub mod plan;
 pub mod policy;
 pub mod reach_avoid;
 pub mod spec;
