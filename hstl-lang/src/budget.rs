@@ -164,3 +164,28 @@ pub fn plan_exceeded(
     }
     None
 }
+
+/// The work the preset allows `plan: model` (a fraction of a second): about 30 sweeps of
+/// value iteration and one fill of the options table, counted as [`plan_time`] does.
+pub const PRESET_PLAN_WORK: u64 = 1 << 28;
+
+/// The operations `plan: model` takes, roughly: 30 sweeps of value iteration and the fill
+/// of the options table, saturating (the sizes as for [`plan_exceeded`]).
+pub fn plan_time(states: u64, cells: &[u64], horizons: &[u64], options: u64, buckets: u64) -> u64 {
+    let total = cells.iter().fold(0u64, |a, &c| a.saturating_add(c));
+    let widest = cells.iter().copied().max().unwrap_or(0).min(PLAN_ARRIVALS);
+    let grid = |skip: usize| -> u64 {
+        (0..horizons.len())
+            .filter(|&j| j != skip)
+            .fold(1u64, |acc, j| acc.saturating_mul(horizons[j].saturating_add(1)))
+    };
+    let arrivals = (0..horizons.len()).map(grid).max().unwrap_or(u64::MAX);
+    let values = buckets.saturating_add(1).saturating_pow(horizons.len() as u32);
+    let sweep = total.saturating_mul(options).saturating_mul(widest).saturating_mul(arrivals);
+    let fill = arrivals
+        .saturating_mul(widest)
+        .saturating_add(values)
+        .saturating_mul(states)
+        .saturating_mul(options);
+    sweep.saturating_mul(30).saturating_add(fill)
+}

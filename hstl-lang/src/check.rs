@@ -383,8 +383,8 @@ impl Cx<'_> {
             self.plan_needs(l, &mut out);
         }
         if preset == Preset::Auto {
-            let (fields, set) = filled;
-            out.preset_expansion = Some(crate::preset::expansion(&out, self.src, &fields, set));
+            let (fields, set) = &filled;
+            out.preset_expansion = Some(crate::preset::expansion(&out, self.src, fields, *set));
         }
         self.safety_unseen(&out);
         self.persistent_needs(learn, &out);
@@ -418,7 +418,16 @@ impl Cx<'_> {
             _ => None,
         };
         if self.error_count() == 0 {
-            self.finite_domain(&out, options_item, spec, mask.as_ref());
+            let plan_written =
+                learn.is_some_and(|l| l.params.iter().any(|p| p.name.name == "plan"));
+            let too_large =
+                self.finite_domain(&out, options_item, spec, mask.as_ref(), plan_written);
+            if too_large {
+                // Only the preset asked for the plan: it Q-learns the options level instead.
+                out.learn.plan = Plan::Off;
+                let (fields, set) = &filled;
+                out.preset_expansion = Some(crate::preset::expansion(&out, self.src, fields, *set));
+            }
         }
         out
     }
@@ -1680,10 +1689,11 @@ impl Cx<'_> {
         item: Option<&syntax::OptionsItem>,
         spec: &syntax::Spec,
         mask: Option<&DomainMask>,
-    ) {
-        let Some(size) = out.domain_size() else { return };
+        plan_written: bool,
+    ) -> bool {
+        let Some(size) = out.domain_size() else { return false };
         if out.state_vars.is_empty() {
-            return;
+            return false;
         }
         if size > MAX_DOMAIN_STATES {
             let r =
@@ -1699,7 +1709,7 @@ impl Cx<'_> {
                 )
                 .with_help("shrink the `int` ranges to get the region and option checks"),
             );
-            return;
+            return false;
         }
         // Regions: lets an option reaches, and the Rj of a persistent task.
         let mut regions: Vec<(CFormula, Range<usize>, String)> = Vec::new();
@@ -1756,7 +1766,7 @@ impl Cx<'_> {
                 )
                 .with_help("shrink the `int` ranges, or shorten the chains of lets the regions use"),
             );
-            return;
+            return false;
         }
         let n = size as usize;
         let states = |k: usize| -> Vec<f64> {
@@ -1829,6 +1839,7 @@ impl Cx<'_> {
             Some(m) => m.present.iter().filter(|&&p| p).count() as u64,
             None => size,
         };
+        let mut plan_too_large = false;
         if out.learn.plan == Plan::Model
             && let (Some(conjuncts), Some(task)) = (out.persistent_conjuncts(self.src), &out.task)
         {
@@ -1846,9 +1857,14 @@ impl Cx<'_> {
             let horizons: Vec<u64> = conjuncts.iter().map(|c| c.steps).collect();
             let l = &out.learn;
             let options = out.options.len() as u64;
-            if let Some(why) =
-                budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps)
-            {
+            let exceeded =
+                budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps);
+            if !plan_written {
+                // The preset plans only what takes a fraction of a second.
+                plan_too_large = exceeded.is_some()
+                    || budget::plan_time(size, &cells, &horizons, options, l.memory)
+                        > budget::PRESET_PLAN_WORK;
+            } else if let Some(why) = exceeded {
                 self.push(
                     Diagnostic::new("HSTL033", task.formula.range.clone(), why).with_help(
                         "use smaller or fewer regions, or shorter windows, or write `plan: off` to Q-learn the options level",
@@ -1911,7 +1927,7 @@ impl Cx<'_> {
             }
         }
         if out.options.is_empty() {
-            return;
+            return plan_too_large;
         }
         // Pass 2: termination sets.
         // With them, per primitive, the termination states outside its avoided region.
@@ -2039,6 +2055,7 @@ impl Cx<'_> {
                 }
             }
         }
+        plan_too_large
     }
 }
 
