@@ -3,7 +3,8 @@
 //! An editor sends the whole text after every keystroke. [`reparse`] takes the previous
 //! [`Parsed`] (moved in, nothing is copied), finds the changed bytes, and re-parses only
 //! the items of one spec body around them (one more item on each side, so that item
-//! boundaries that depend on the next token stay right). The items before are kept as
+//! boundaries that depend on the next token stay right; more before it when the edit
+//! touches the first token of that item). The items before are kept as
 //! they are; the items after are kept with their byte ranges shifted. The result is
 //! exactly what [`parse`] gives for the new text (same tree, same diagnostics, up to
 //! their order); [`crate::check_parsed`] then checks it without parsing again.
@@ -148,7 +149,14 @@ impl Plan {
         // Keep the pieces before the change but the last of them; the items after it but
         // the first.
         let before = pieces.iter().take_while(|p| p.0.end <= cs).count();
-        let keep_before = before.saturating_sub(1);
+        let mut keep_before = before.saturating_sub(1);
+        // A kept piece ends where it does because of the token after it (an item
+        // keyword, a doc comment, `}`), the first of the stretch: the edit must leave that
+        // token whole (deleting the space in `let let` makes it `letlet`, no keyword, and
+        // the piece before runs on), else the stretch starts one piece earlier.
+        while keep_before > 0 && !first_token_untouched(old, pieces[keep_before - 1].0.end, cs) {
+            keep_before -= 1;
+        }
         let first_after = pieces.iter().position(|p| p.0.start >= old_end).unwrap_or(pieces.len());
         let keep_after = (first_after + 1).min(pieces.len());
         let mid_start = if keep_before > 0 { pieces[keep_before - 1].0.end } else { body };
@@ -374,6 +382,13 @@ fn push_mid(
         sh(&mut b.range, delta);
         broken.push(b);
     }
+}
+
+/// Whether the first token (or comment) of `src[from..]` ends before `cs`, with at least
+/// one byte before `cs` after it, so that an edit at `cs` cannot change it.
+fn first_token_untouched(src: &str, from: usize, cs: usize) -> bool {
+    let Some(head) = src.get(from..cs) else { return false };
+    lex(head).first().is_some_and(|t| t.end < head.len())
 }
 
 /// Whether a stretch of a spec body, parsed on its own, splits into the same items as

@@ -174,3 +174,17 @@ fn a_closing_brace_inside_a_comment_is_not_the_spec_s_end() {
         holds(text, &[(at, 1, None)]);
     }
 }
+
+#[test]
+fn an_edit_that_joins_an_item_keyword_to_the_next_word() {
+    // Found by the `check` fuzz target (two workers, the same day): an unbalanced item
+    // ended only because the next token was an item keyword standing alone (`let`,
+    // `option`); deleting the space after it made `letlet`, no keyword, so the item before
+    // runs on. The re-parse had kept that item as it was.
+    for (text, at) in [
+        ("spec S {\n t( ee  ( { x: int }\n    let let x > = s3;\n    task A;\n}\n", 37),
+        ("spec S {\n    let A = y < `option let B = x;\n    task A;\n}\n", 32),
+    ] {
+        holds(text, &[(at, 1, None)]);
+    }
+}
