@@ -223,8 +223,17 @@ impl Plan {
             w.items.retain(|i| i.range().start < inner.end);
             w.broken.retain(|b| b.range.start < inner.end);
         }
+        // The last piece of the stretch must end inside it, before the token of the kept
+        // piece after it (a `state` item broken by a line comment that the edit extends
+        // runs on over a next piece that starts with no keyword), so that the kept piece
+        // starts where it did.
+        let inside = |w: &Spec| {
+            w.items.iter().all(|i| i.range().end <= inner.end)
+                && w.broken.iter().all(|b| b.range.end <= inner.end)
+        };
         let ok = wrapped.file.specs.len() == 1
             && wrapped.file.specs[0].range.end == text.len()
+            && inside(&wrapped.file.specs[0])
             && wrapped.diagnostics.iter().all(|d| {
                 inner.start <= d.range.start
                     && d.range.end <= inner.end

@@ -188,3 +188,14 @@ fn an_edit_that_joins_an_item_keyword_to_the_next_word() {
         holds(text, &[(at, 1, None)]);
     }
 }
+
+#[test]
+fn a_piece_that_runs_on_into_the_next() {
+    // Found by the `check` fuzz target (the second round, on the fix above): deleting the
+    // line break after a line comment puts the next item into the comment, so the broken
+    // `state` before it runs on over `tas = y;`, which starts with no keyword; the re-parse
+    // had kept `tas = y;` as a piece of its own, overlapping.
+    let text = "spec S {\n    state le // c\n    let A = x > 3;\n    tas = y;\n}\n";
+    let at = text.find("// c").unwrap() + 4;
+    holds(text, &[(at, 1, None)]);
+}
