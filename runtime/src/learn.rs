@@ -319,8 +319,9 @@ impl<'e, E: Env> Learner<'e, E> {
             return;
         };
         let gamma = self.spec.learn.options.gamma;
-        let flat = planner.quickest_legs(&self.tables, memory, &self.q.flat, model);
-        let options = planner.options_values(&self.tables, memory, &flat, model, gamma);
+        let moves = model.moves();
+        let flat = planner.quickest_legs(&self.tables, memory, &self.q.flat, &moves);
+        let options = planner.options_values(&self.tables, memory, &flat, &moves, gamma);
         let flat = std::mem::replace(&mut self.q.flat, flat);
         self.learned = Some((flat, std::mem::replace(&mut self.q.options, options)));
     }

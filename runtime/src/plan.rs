@@ -69,11 +69,16 @@ impl Model {
         }
     }
 
-    /// The estimated distribution of the state after `a` in `s` (empty if never tried).
-    fn distribution(&self, s: usize, a: usize) -> Vec<(usize, f64)> {
-        let row = &self.next[s * self.actions + a];
-        let total: f64 = row.iter().map(|&(_, c)| f64::from(c)).sum();
-        row.iter().map(|&(n, c)| (n, f64::from(c) / total)).collect()
+    /// `moves[s * actions + a]`: the estimated distribution of the state after `a` in `s`
+    /// (empty if never tried), which both of the planner's steps read.
+    pub fn moves(&self) -> Vec<Vec<(usize, f64)>> {
+        self.next
+            .iter()
+            .map(|row| {
+                let total: f64 = row.iter().map(|&(_, c)| f64::from(c)).sum();
+                row.iter().map(|&(n, c)| (n, f64::from(c) / total)).collect()
+            })
+            .collect()
     }
 }
 
@@ -208,15 +213,13 @@ impl Planner {
         tables: &Tables,
         memory: &Memory,
         flat: &[Vec<f64>],
-        model: &Model,
+        moves: &[Vec<(usize, f64)>],
     ) -> Vec<Vec<f64>> {
         let (states, actions) = (tables.states, tables.actions);
-        let moves: Vec<Vec<(usize, f64)>> =
-            (0..states * actions).map(|i| model.distribution(i / actions, i % actions)).collect();
         let mut out = flat.to_vec();
         for (o, legs) in tables.legs.iter().enumerate() {
             let inside = &memory.holds[self.region[o]];
-            let (live, steps) = quickest(inside, &moves, actions);
+            let (live, steps) = quickest(inside, moves, actions);
             let table = &mut out[legs[0]];
             for s in (0..states).filter(|&s| live[s]) {
                 for a in 0..actions {
@@ -235,11 +238,11 @@ impl Planner {
         tables: &Tables,
         memory: &Memory,
         flat: &[Vec<f64>],
-        model: &Model,
+        moves: &[Vec<(usize, f64)>],
         gamma: f64,
     ) -> Vec<f64> {
         let legs: Vec<Leg> = (0..tables.legs.len())
-            .map(|o| Leg::new(tables, memory, flat, model, self, o))
+            .map(|o| Leg::new(tables, memory, flat, moves, self, o))
             .collect();
         let grids = Grids::new(memory);
         let values = iterate(tables, memory, &legs, &grids, gamma);
@@ -335,15 +338,15 @@ impl Leg {
         tables: &Tables,
         memory: &Memory,
         flat: &[Vec<f64>],
-        model: &Model,
+        moves: &[Vec<(usize, f64)>],
         plan: &Planner,
         o: usize,
     ) -> Leg {
         let (states, actions, p) = (tables.states, tables.actions, tables.legs[o][0]);
         let region = plan.region[o];
         let inside = &memory.holds[region];
-        let moves: Vec<Vec<(usize, f64)>> = (0..states)
-            .map(|s| model.distribution(s, argmax(&flat[p][s * actions..][..actions])))
+        let moves: Vec<&[(usize, f64)]> = (0..states)
+            .map(|s| moves[s * actions + argmax(&flat[p][s * actions..][..actions])].as_slice())
             .collect();
         let d_max = plan.max_duration;
         // Durations, backwards in d: arriving in one step, or stepping outside the region
@@ -352,7 +355,7 @@ impl Leg {
         for d in 1..=d_max {
             for s in 0..states {
                 let mut p = 0.0;
-                for &(n, w) in &moves[s] {
+                for &(n, w) in moves[s] {
                     if inside[n] {
                         if d == 1 {
                             p += w;
@@ -403,7 +406,7 @@ impl Leg {
             for s in 0..states {
                 let row = &mut next[s * k..][..k];
                 row.fill(0.0);
-                for &(n, w) in &moves[s] {
+                for &(n, w) in moves[s] {
                     if inside[n] {
                         row[slot[n]] += w;
                     } else {
