@@ -1784,8 +1784,13 @@ impl Cx<'_> {
         // Pass 1: region counts and the maximum robustness of each reach. States are
         // independent: large domains are split into contiguous chunks run on several
         // threads, merged in state order (the same counts, maxima and sets).
+        // The preset's choice to plan is made on the map without its walls, so that the
+        // macro (which sees no world) and the CLI (which does) choose alike.
+        let preset_plans = out.learn.plan == Plan::Model && !plan_written;
+        let count_walls = preset_plans && mask.is_some();
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut region_sat = vec![0u64; regions.len()];
+            let mut region_walls = vec![0u64; regions.len()];
             let mut region_reachable = vec![0u64; regions.len()];
             let mut reach_max = vec![f64::NEG_INFINITY; np];
             let mut init_set = vec![Vec::with_capacity(ks.len()); np];
@@ -1793,6 +1798,13 @@ impl Cx<'_> {
                 if !present(k) {
                     // A wall: no state, so in no set.
                     init_set.iter_mut().for_each(|set| set.push(false));
+                    if count_walls {
+                        let s = states(k);
+                        ev.load(&s);
+                        for (r, (f, _, _)) in regions.iter().enumerate() {
+                            region_walls[r] += u64::from(ev.robustness(f, &s) > 0.0);
+                        }
+                    }
                     continue;
                 }
                 let s = states(k);
@@ -1812,14 +1824,18 @@ impl Cx<'_> {
                     init_set[p].push(ev.robustness(&prim.init, &s) > 0.0);
                 }
             }
-            (region_sat, region_reachable, reach_max, init_set)
+            (region_sat, region_walls, region_reachable, reach_max, init_set)
         });
         let mut region_sat = vec![0u64; regions.len()];
+        let mut region_walls = vec![0u64; regions.len()];
         let mut region_reachable = vec![0u64; regions.len()];
         let mut reach_max = vec![f64::NEG_INFINITY; np];
         let mut init_set: Vec<Vec<bool>> = vec![Vec::with_capacity(n); np];
-        for (sat, reachable, max, init) in chunks {
+        for (sat, walls, reachable, max, init) in chunks {
             for (total, c) in region_sat.iter_mut().zip(sat) {
+                *total += c;
+            }
+            for (total, c) in region_walls.iter_mut().zip(walls) {
                 *total += c;
             }
             for (total, c) in region_reachable.iter_mut().zip(reachable) {
@@ -1835,6 +1851,7 @@ impl Cx<'_> {
                 set.extend(part);
             }
         }
+        let size_without_walls = size;
         let size = match mask {
             Some(m) => m.present.iter().filter(|&&p| p).count() as u64,
             None => size,
@@ -1847,24 +1864,38 @@ impl Cx<'_> {
                 CFormulaKind::Let(i) => out.lets[i].name_range.clone(),
                 _ => f.range.clone(),
             };
-            let cells: Vec<u64> = conjuncts
-                .iter()
-                .map(|c| {
-                    let r = range_of(&c.region);
-                    regions.iter().position(|(_, at, _)| *at == r).map_or(0, |i| region_sat[i])
-                })
-                .collect();
+            let cells_of = |walls: bool| -> Vec<u64> {
+                conjuncts
+                    .iter()
+                    .map(|c| {
+                        let r = range_of(&c.region);
+                        regions
+                            .iter()
+                            .position(|(_, at, _)| *at == r)
+                            .map_or(0, |i| region_sat[i] + if walls { region_walls[i] } else { 0 })
+                    })
+                    .collect()
+            };
             let horizons: Vec<u64> = conjuncts.iter().map(|c| c.steps).collect();
             let l = &out.learn;
             let options = out.options.len() as u64;
-            let exceeded =
-                budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps);
-            if !plan_written {
-                // The preset plans only what takes a fraction of a second.
-                plan_too_large = exceeded.is_some()
-                    || budget::plan_time(size, &cells, &horizons, options, l.memory)
-                        > budget::PRESET_PLAN_WORK;
-            } else if let Some(why) = exceeded {
+            if preset_plans {
+                // The preset plans only what takes a fraction of a second. The sizes grow
+                // with the walls counted in, so what it plans fits the map with them too.
+                let (size, cells) = (size_without_walls, cells_of(true));
+                plan_too_large =
+                    budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps)
+                        .is_some()
+                        || budget::plan_time(size, &cells, &horizons, options, l.memory)
+                            > budget::PRESET_PLAN_WORK;
+            } else if let Some(why) = budget::plan_exceeded(
+                size,
+                &cells_of(false),
+                &horizons,
+                options,
+                l.memory,
+                l.max_steps,
+            ) {
                 self.push(
                     Diagnostic::new("HSTL033", task.formula.range.clone(), why).with_help(
                         "use smaller or fewer regions, or shorter windows, or write `plan: off` to Q-learn the options level",

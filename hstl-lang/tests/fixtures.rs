@@ -130,6 +130,22 @@ fn every_code_has_an_entry_and_a_fixture() {
     }
 }
 
+/// The learner a spec asks for is the same from the macro (no map) and the CLI (a map):
+/// `preset: auto` decides whether to plan on the map without its walls.
+#[test]
+fn the_preset_chooses_alike_with_and_without_the_map() {
+    let mut with_maps = 0;
+    for (name, src) in fixtures("valid").into_iter().filter(|(_, s)| world_of(s).is_some()) {
+        let (in_world, alone) = (check(&src), hstl_lang::check(&src));
+        for (a, b) in in_world.specs.iter().zip(&alone.specs) {
+            assert_eq!(a.learn.plan, b.learn.plan, "{name}: `plan` differs with the map");
+            assert_eq!(a.preset_expansion, b.preset_expansion, "{name}");
+        }
+        with_maps += 1;
+    }
+    assert!(with_maps > 0, "no valid fixture draws a map");
+}
+
 #[test]
 fn valid_fixtures_check_without_errors() {
     for (name, src) in fixtures("valid") {
