@@ -1691,9 +1691,12 @@ impl Cx<'_> {
         mask: Option<&DomainMask>,
         plan_written: bool,
     ) -> bool {
-        let Some(size) = out.domain_size() else { return false };
+        // Where the domain is not counted, the preset cannot know that planning fits: it
+        // Q-learns (a `plan: model` written out is left to the runtime's own limits).
+        let preset_plans = out.learn.plan == Plan::Model && !plan_written;
+        let Some(size) = out.domain_size() else { return preset_plans };
         if out.state_vars.is_empty() {
-            return false;
+            return preset_plans;
         }
         if size > MAX_DOMAIN_STATES {
             let r =
@@ -1709,7 +1712,7 @@ impl Cx<'_> {
                 )
                 .with_help("shrink the `int` ranges to get the region and option checks"),
             );
-            return false;
+            return preset_plans;
         }
         // Regions: lets an option reaches, and the Rj of a persistent task.
         let mut regions: Vec<(CFormula, Range<usize>, String)> = Vec::new();
@@ -1766,7 +1769,7 @@ impl Cx<'_> {
                 )
                 .with_help("shrink the `int` ranges, or shorten the chains of lets the regions use"),
             );
-            return false;
+            return preset_plans;
         }
         let n = size as usize;
         let states = |k: usize| -> Vec<f64> {
@@ -1786,7 +1789,6 @@ impl Cx<'_> {
         // threads, merged in state order (the same counts, maxima and sets).
         // The preset's choice to plan is made on the map without its walls, so that the
         // macro (which sees no world) and the CLI (which does) choose alike.
-        let preset_plans = out.learn.plan == Plan::Model && !plan_written;
         let count_walls = preset_plans && mask.is_some();
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut region_sat = vec![0u64; regions.len()];

@@ -81,3 +81,24 @@ fn many_unknown_names_among_many_lets_still_suggest_first() {
     // The first reported ones get their suggestion: Z0 is one letter off L0 and M0.
     assert_eq!(diagnostics[0].help.as_deref(), Some("did you mean `L0`?"));
 }
+
+/// A domain too costly to enumerate is not counted, so `preset: auto` cannot know that
+/// planning fits in its budget: it Q-learns rather than leave `train` to refuse the plan.
+#[test]
+fn the_preset_q_learns_where_the_domain_is_not_counted() {
+    let mut src = String::from("spec Big {\n    state { x: int in 0..=399, y: int in 0..=499 }\n");
+    src.push_str("    let L0 = x > 3;\n");
+    for k in 1..120 {
+        src.push_str(&format!("    let L{k} = L{} && y > 3;\n", k - 1));
+    }
+    src.push_str(
+        "    let A = L119 && x < 300;\n    task always[0..] eventually[0..40] A;\n    option A;\n    learn { preset: auto }\n}\n",
+    );
+    let checked = check(&src);
+    assert!(checked.diagnostics.iter().any(|d| d.code == "HSTL022"), "the domain is counted");
+    assert!(checked.diagnostics.iter().all(|d| d.severity != Severity::Error));
+    let spec = &checked.specs[0];
+    assert_eq!(spec.learn.plan, hstl_lang::Plan::Off);
+    let expansion = spec.preset_expansion.as_deref().unwrap_or_default();
+    assert!(expansion.contains("learn {") && !expansion.contains("plan: model"), "{expansion}");
+}
