@@ -130,20 +130,23 @@ fn every_code_has_an_entry_and_a_fixture() {
     }
 }
 
-/// The learner a spec asks for is the same from the macro (no map) and the CLI (a map):
-/// `preset: auto` decides whether to plan on the map without its walls.
+/// A map adds diagnostics and nothing else: the checked spec, and so the learner, is the
+/// same from the macro (no map) and the CLI (a map). `preset: auto` decides whether to plan
+/// on the map without its walls.
 #[test]
-fn the_preset_chooses_alike_with_and_without_the_map() {
+fn a_map_changes_only_the_diagnostics() {
     let mut with_maps = 0;
-    for (name, src) in fixtures("valid").into_iter().filter(|(_, s)| world_of(s).is_some()) {
+    let all = fixtures("valid").into_iter().chain(fixtures("invalid"));
+    for (name, src) in all.filter(|(_, s)| world_of(s).is_some()) {
         let (in_world, alone) = (check(&src), hstl_lang::check(&src));
+        assert_eq!(in_world.specs.len(), alone.specs.len(), "{name}");
         for (a, b) in in_world.specs.iter().zip(&alone.specs) {
             assert_eq!(a.learn.plan, b.learn.plan, "{name}: `plan` differs with the map");
-            assert_eq!(a.preset_expansion, b.preset_expansion, "{name}");
+            assert_eq!(a, b, "{name}: the checked spec differs with the map");
         }
         with_maps += 1;
     }
-    assert!(with_maps > 0, "no valid fixture draws a map");
+    assert!(with_maps > 0, "no fixture draws a map");
 }
 
 #[test]
