@@ -1786,9 +1786,9 @@ impl Cx<'_> {
         };
         // Pass 1: region counts and the maximum robustness of each reach. States are
         // independent: large domains are split into contiguous chunks run on several
-        // threads, merged in state order (the same counts, maxima and sets).
-        // The preset's choice to plan is made on the map without its walls, so that the
-        // macro (which sees no world) and the CLI (which does) choose alike.
+        // threads, merged in state order (the same counts, maxima and sets). The preset's
+        // choice to plan is made on the map without its walls, so that the macro (which
+        // sees no world) and the CLI (which does) choose alike.
         let count_walls = preset_plans && mask.is_some();
         let chunks = over_states(out, &roots, n, work, |ev, ks| {
             let mut region_sat = vec![0u64; regions.len()];
@@ -1866,38 +1866,28 @@ impl Cx<'_> {
                 CFormulaKind::Let(i) => out.lets[i].name_range.clone(),
                 _ => f.range.clone(),
             };
-            let cells_of = |walls: bool| -> Vec<u64> {
-                conjuncts
-                    .iter()
-                    .map(|c| {
-                        let r = range_of(&c.region);
-                        regions
-                            .iter()
-                            .position(|(_, at, _)| *at == r)
-                            .map_or(0, |i| region_sat[i] + if walls { region_walls[i] } else { 0 })
-                    })
-                    .collect()
-            };
+            // Region cells under walls are counted only for the preset (zero otherwise).
+            let cells: Vec<u64> = conjuncts
+                .iter()
+                .map(|c| {
+                    let r = range_of(&c.region);
+                    let at = regions.iter().position(|(_, at, _)| *at == r);
+                    at.map_or(0, |i| region_sat[i] + region_walls[i])
+                })
+                .collect();
+            let states = if preset_plans { size_without_walls } else { size };
             let horizons: Vec<u64> = conjuncts.iter().map(|c| c.steps).collect();
             let l = &out.learn;
             let options = out.options.len() as u64;
+            let exceeded =
+                budget::plan_exceeded(states, &cells, &horizons, options, l.memory, l.max_steps);
             if preset_plans {
                 // The preset plans only what takes a fraction of a second. The sizes grow
                 // with the walls counted in, so what it plans fits the map with them too.
-                let (size, cells) = (size_without_walls, cells_of(true));
-                plan_too_large =
-                    budget::plan_exceeded(size, &cells, &horizons, options, l.memory, l.max_steps)
-                        .is_some()
-                        || budget::plan_time(size, &cells, &horizons, options, l.memory)
-                            > budget::PRESET_PLAN_WORK;
-            } else if let Some(why) = budget::plan_exceeded(
-                size,
-                &cells_of(false),
-                &horizons,
-                options,
-                l.memory,
-                l.max_steps,
-            ) {
+                plan_too_large = exceeded.is_some()
+                    || budget::plan_time(states, &cells, &horizons, options, l.memory)
+                        > budget::PRESET_PLAN_WORK;
+            } else if let Some(why) = exceeded {
                 self.push(
                     Diagnostic::new("HSTL033", task.formula.range.clone(), why).with_help(
                         "use smaller or fewer regions, or shorter windows, or write `plan: off` to Q-learn the options level",
