@@ -90,7 +90,7 @@ pub fn load_in_world(
 }
 
 /// The spec named `wanted` (or the only one) of a checked text without errors.
-fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loaded, LoadError> {
+pub fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loaded, LoadError> {
     if checked.has_errors() {
         return Err(LoadError::Invalid(checked.diagnostics));
     }

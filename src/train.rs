@@ -55,6 +55,20 @@ pub fn trainable(spec: &CheckedSpec, source: &str, file: &str) -> Result<TaskSpe
             "add an option per region, such as `option A;` for `let A = ...;`".to_string(),
         ));
     }
+    if hstl_lang::lints::task_is_constant(spec) {
+        let task = spec.task.as_ref().map_or(spec.name_range.start, |t| t.formula.range.start);
+        return Err(Problem::new(
+            format!(
+                "{}: HSTL104: spec `{}` has a task that refers to no state variable: its \
+                 robustness is the same on every run, so there is nothing to learn",
+                at(task),
+                spec.name
+            ),
+            "write the task over the state, such as `task always[0..] eventually[0..40] A;` \
+             (`hstlc explain HSTL104`)"
+                .to_string(),
+        ));
+    }
     if let Some(v) = spec.state_vars.iter().find(|v| !matches!(v.domain, Domain::Int { .. })) {
         return Err(Problem::new(
             format!(

@@ -1,39 +1,51 @@
 //! Every spec in docs/LANGUAGE.md, README.md, examples/specs and examples/suite checks
 //! without errors, as `hstlc check` would report them (warnings allowed, exit status 0):
-//! against the world its doc comment names (`--world NAME|FILE.toml`, or the suite's
-//! ``World: `NAME|FILE.toml` ``), or the default `paper`.
+//! each spec against the world it names (`world "...";`, a path relative to its file), or
+//! alone when it names none.
 
+use std::collections::HashMap;
 use std::path::Path;
 
+use hstl::lang::{Checked, SpecWorld, WorldFacts};
 use hstl::world::GridWorld;
 
-/// The world a spec's text names with `--world`, as `hstlc` resolves it (paths are relative
-/// to the package root).
-fn world_of(src: &str) -> (GridWorld, String) {
-    let named = src.split("--world").nth(1).or_else(|| src.split("World: ").nth(1));
-    let Some(arg) = named.and_then(|rest| rest.split_whitespace().next()) else {
-        return (GridWorld::default(), "world `paper`".into());
-    };
-    let arg = arg.trim_start_matches('`').trim_end_matches(['`', ')', '.', ',']);
-    if let Some(world) = GridWorld::builtin(arg) {
-        return (world, format!("world `{arg}`"));
+/// Checks `src` as `hstlc check` does: every `world` item read relative to `base`. A world
+/// that cannot be read fails the test.
+fn check(name: &str, src: &str, base: &Path) -> Checked {
+    let parsed = hstl::lang::parse(src);
+    let mut worlds: HashMap<String, WorldFacts> = HashMap::new();
+    for spec in &parsed.file.specs {
+        let Some(item) = hstl::lang::world_item(spec) else { continue };
+        let world = GridWorld::builtin(&item.name).unwrap_or_else(|| {
+            let path = base.join(&item.name);
+            let text = std::fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("{name}: world {}: {e}", path.display()));
+            GridWorld::from_toml(&text, "world")
+                .unwrap_or_else(|e| panic!("{name}: world {}: {e}", path.display()))
+        });
+        let label = hstl::world::label(&world, None);
+        worlds.insert(item.name.clone(), hstl::world::facts(&world, &label));
     }
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(arg);
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{arg}: {e}"));
-    let world = GridWorld::from_toml(&text, "world").unwrap_or_else(|e| panic!("{arg}: {e}"));
-    let label = format!("world `{}` ({arg})", world.world_name());
-    (world, label)
+    hstl::lang::check_parsed_with_worlds(src, parsed, &|spec| match hstl::lang::world_item(spec)
+        .and_then(|w| worlds.get(&w.name))
+    {
+        Some(facts) => SpecWorld::Facts(facts),
+        None => SpecWorld::Alone,
+    })
 }
 
-fn assert_checks(name: &str, src: &str) {
-    let (world, label) = world_of(src);
-    let checked = hstl::world::check(src, &world, &label);
+fn assert_checks(name: &str, src: &str, base: &Path) {
+    let checked = check(name, src, base);
     assert!(
         !checked.has_errors(),
         "{name} has errors:\n{}",
         hstl::lang::render_plain(src, name, &checked.diagnostics)
     );
     assert!(!checked.specs.is_empty(), "{name} holds no spec");
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// The ```` ```hstl ```` blocks of a Markdown file under the package root.
@@ -65,7 +77,7 @@ fn every_spec_in_the_language_document_and_the_readme_checks() {
         let specs: Vec<&String> = blocks.iter().filter(|b| b.contains("spec ")).collect();
         assert!(!specs.is_empty(), "{doc}: no spec blocks");
         for (i, block) in specs.iter().enumerate() {
-            assert_checks(&format!("{doc} spec block {}", i + 1), block);
+            assert_checks(&format!("{doc} spec block {}", i + 1), block, root());
         }
     }
 }
@@ -80,9 +92,8 @@ fn every_suite_task_checks_cleanly_against_its_world() {
         let path = entry.expect("entry").path();
         if path.extension().is_some_and(|e| e == "hstl") {
             let src = std::fs::read_to_string(&path).expect("readable");
-            let (world, label) = world_of(&src);
-            assert!(src.contains("World: "), "{} names no world", path.display());
-            let checked = hstl::world::check(&src, &world, &label);
+            assert!(src.contains("world \""), "{} names no world", path.display());
+            let checked = check(&path.display().to_string(), &src, &dir);
             assert!(
                 checked.diagnostics.is_empty(),
                 "{}:\n{}",
@@ -107,7 +118,7 @@ fn every_example_spec_checks() {
         let path = entry.expect("entry").path();
         if path.extension().is_some_and(|e| e == "hstl") {
             let src = std::fs::read_to_string(&path).expect("readable");
-            assert_checks(&path.display().to_string(), &src);
+            assert_checks(&path.display().to_string(), &src, &dir);
             n += 1;
         }
     }

@@ -46,7 +46,7 @@ use crate::checked::*;
 use crate::diagnostic::{self, Diagnostic};
 use crate::parser::parse;
 use crate::syntax::{self, FieldValue, Formula, FormulaKind, Item, OptionsKind, ParamValue};
-use crate::world::{DomainMask, WorldFacts};
+use crate::world::{DomainMask, SpecWorld, WorldFacts, WorldProblem};
 
 /// At most this many diagnostics are reported per file.
 pub const MAX_DIAGNOSTICS: usize = 200;
@@ -96,14 +96,14 @@ pub fn check(src: &str) -> Checked {
 /// `src` (an editor that re-parses only what changed, see [`crate::incremental`], builds
 /// it without parsing the whole text). Never fails and never panics.
 pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
-    check_parsed_in(src, parsed, None)
+    check_parsed_in(src, parsed, &|_| SpecWorld::Alone)
 }
 
-/// [`check_parsed`], with each spec that has options also checked against `world`.
-pub(crate) fn check_parsed_in(
+/// [`check_parsed`], with each spec checked against the world `world_of` gives for it.
+pub(crate) fn check_parsed_in<'w>(
     src: &str,
     parsed: crate::parser::Parsed,
-    world: Option<&WorldFacts>,
+    world_of: &dyn Fn(&syntax::Spec) -> SpecWorld<'w>,
 ) -> Checked {
     let mut diags = parsed.diagnostics;
     let mut specs = Vec::new();
@@ -126,9 +126,15 @@ pub(crate) fn check_parsed_in(
         } else {
             seen.insert(spec.name.name.clone(), spec.name.range.clone());
         }
+        let (world, world_problem) = match world_of(spec) {
+            SpecWorld::Alone => (None, None),
+            SpecWorld::Facts(facts) => (Some(facts), None),
+            SpecWorld::Unavailable(problem) => (None, Some(problem)),
+        };
         let mut cx = Cx {
             src,
             world,
+            world_problem,
             diags: Vec::new(),
             names: HashMap::default(),
             let_refs: Vec::new(),
@@ -157,8 +163,10 @@ enum NameRef {
 /// Per-spec checking state.
 struct Cx<'s> {
     src: &'s str,
-    /// The world the specs with options are checked against, if any.
+    /// The world the spec is checked against, if any.
     world: Option<&'s WorldFacts>,
+    /// Why the world the spec names could not be had, if so.
+    world_problem: Option<&'s WorldProblem>,
     diags: Vec<Diagnostic>,
     names: HashMap<String, (NameRef, Range<usize>), BuildHasherDefault<NameHasher>>,
     /// Let references found while resolving the current formula: (let index, range).
@@ -309,6 +317,7 @@ impl Cx<'_> {
             options: Vec::new(),
             learn: LearnParams::default(),
             preset_expansion: None,
+            world: None,
         };
         // Once-only items.
         let mut firsts: HashMap<&'static str, Range<usize>> = HashMap::new();
@@ -323,6 +332,7 @@ impl Cx<'_> {
                 Item::Task(_) => Some("task"),
                 Item::Options(_) => Some("options"),
                 Item::Learn(_) => Some("learn"),
+                Item::World(_) => Some("world"),
                 _ => None,
             };
             if let Some(kw) = once {
@@ -349,6 +359,9 @@ impl Cx<'_> {
                 Item::Option(o) => option_decls.push(o),
                 Item::Options(o) => options_item = Some(o),
                 Item::Learn(l) => learn = Some(l),
+                Item::World(w) => {
+                    out.world = Some(WorldRef { name: w.name.clone(), range: w.name_range.clone() })
+                }
             }
         }
         self.lets(&lets, &mut out);
@@ -408,8 +421,18 @@ impl Cx<'_> {
                 }
             }
         }
+        // The world's diagnostics come beside the spec's own, never instead of them: the
+        // spec's checks below run as they would without a world.
+        let spec_errors = self.error_count();
+        if let (Some(problem), Some(item)) = (self.world_problem, &out.world) {
+            self.push(
+                Diagnostic::new("HSTL034", item.range.clone(), problem.message.clone())
+                    .with_help(problem.help.clone()),
+            );
+        }
+        let state_broken = spec.broken.iter().any(|b| b.keyword.as_deref() == Some("state"));
         let mask = match self.world {
-            Some(world) if self.error_count() == 0 && !out.primitives.is_empty() => {
+            Some(world) if !out.primitives.is_empty() && !state_broken => {
                 let mut found = Vec::new();
                 let mask = world.fit(&out, &mut |d| found.push(d));
                 self.diags.append(&mut found);
@@ -417,7 +440,7 @@ impl Cx<'_> {
             }
             _ => None,
         };
-        if self.error_count() == 0 {
+        if spec_errors == 0 {
             let plan_written =
                 learn.is_some_and(|l| l.params.iter().any(|p| p.name.name == "plan"));
             let too_large =

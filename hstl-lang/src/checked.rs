@@ -405,6 +405,17 @@ pub struct CheckedSpec {
     /// options set and the `learn` values), for `hstlc check` and the editor's hover;
     /// `None` for the paper's preset.
     pub preset_expansion: Option<String>,
+    /// The world the spec names with `world "...";`, if any.
+    pub world: Option<WorldRef>,
+}
+
+/// The world a spec names: `world "four-rooms";` or `world "maps/yard.toml";`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldRef {
+    /// A built-in world's name, or a world file's path relative to the spec file.
+    pub name: String,
+    /// Byte range of the string, quotes included.
+    pub range: Range<usize>,
 }
 
 /// One conjunct `eventually[0..N] R` of a persistent task.

@@ -343,17 +343,32 @@ Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 mil
 Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
     },
     CodeInfo {
-        code: "HSTL050",
-        name: "constant-formula",
+        code: "HSTL034",
+        name: "world-unavailable",
         severity: E,
-        summary: "a task or an option's `reach` that refers to no state variable",
-        explanation: "Robustness measures how far the state is from flipping a formula. A \
-task, or the `reach` formula of a primitive option, that refers to no state variable \
-(directly or through the lets it uses) has the same robustness at every step: `inf` for \
-`true`, `-inf` for `false`, a constant for `3 > 2`. There is nothing to monitor, and \
-training would have no reward to learn from (an infinite one at that).\n\n\
-Example:\n    let A = true;\n    task always[0..] eventually[0..40] A;\n    option A;\n\n\
-Fix: write the formula over the state, such as `let A = x > 3 && y < 5;`.",
+        summary: "the world a spec names cannot be found or read",
+        explanation: "`world \"NAME_OR_PATH\";` names the world a spec is written for: a \
+built-in world (`paper`, `four-rooms`) or a world file, whose path is relative to the spec \
+file. This one is no built-in name, and the file it names is missing, unreadable or \
+malformed (the message says which, with the world file's line and column). `hstlc check`, \
+`train` and `study` and the editor check the spec against the world it names; `--world` \
+overrides it.\n\n\
+Example:\n    world \"maps/yrad.toml\";   // the file is maps/yard.toml\n\n\
+Fix: correct the name or the path (relative to the spec file), or fix the world file.",
+    },
+    CodeInfo {
+        code: "HSTL050",
+        name: "constant-reach",
+        severity: E,
+        summary: "an option's `reach` that refers to no state variable",
+        explanation: "Robustness measures how far the state is from flipping a formula. The \
+`reach` formula of a primitive option that refers to no state variable (directly or through \
+the lets it uses) has the same robustness in every state: `inf` for `true`, `-inf` for \
+`false`, a constant for `3 > 2`. The option's reward is then the same everywhere, and there \
+is nothing for it to learn (an infinite reward at that). A task that refers to no state \
+variable is only a warning (HSTL104): it can be monitored.\n\n\
+Example:\n    let A = true;\n    option A;\n\n\
+Fix: reach a region of the state, such as `let A = x > 3;`.",
     },
     CodeInfo {
         code: "HSTL051",
@@ -456,6 +471,20 @@ Fix: correct the bounds (on an integer grid `3 < x < 4` is empty).",
 what a region is), so reaching it needs no learning.\n\n\
 Example:\n    state { x: int in 0..=14 }\n    let A = x >= 0;\n\n\
 Fix: tighten the formula.",
+    },
+    CodeInfo {
+        code: "HSTL104",
+        name: "constant-task",
+        severity: W,
+        summary: "a task that refers to no state variable",
+        explanation: "A task that refers to no state variable (directly or through the lets it \
+uses) has the same robustness at every step: `always[1..6] (1 >= 2)` is -1 on every trace, \
+`true` is `inf`. It is valid STL, and `hstlc monitor` computes it as rtamt does, but it is \
+probably not what was meant, and there is nothing to learn from it: `hstlc train` (and \
+`hstl.train`) refuse such a task.\n\n\
+Example:\n    task always[1..6] (1 >= 2);\n\n\
+Fix: write the task over the state, such as `task always[0..] eventually[0..40] A;` with \
+`let A = x > 3;`.",
     },
     CodeInfo {
         code: "HSTL131",

@@ -87,6 +87,8 @@ pub(crate) fn lex(src: &str) -> Vec<Tok> {
                 TokKind::Number => Kind::Number,
                 TokKind::Punct => Kind::Punct,
                 TokKind::Doc => Kind::Doc,
+                // A string is one word as far as the space around it goes.
+                TokKind::Str => Kind::Word,
                 TokKind::Other => Kind::Other,
             };
             Tok { kind, start: t.start, end: t.end }
@@ -175,7 +177,7 @@ impl Plan {
                         }
                         continue;
                     }
-                    Item::Let(_) | Item::Task(_) => continue,
+                    Item::Let(_) | Item::Task(_) | Item::World(_) => continue,
                 };
                 for start in entries {
                     plan.node(toks, first_at(start), 2, false);

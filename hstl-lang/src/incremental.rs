@@ -199,7 +199,9 @@ impl Plan {
             fates.push(fate);
         }
         let mid = new.get(mid_start..mid_end_new)?;
-        if !stretch_is_closed(mid) {
+        // A string runs to its closing quote or the line's end, which may lie in a kept
+        // piece; strings are rare (a `world` item), so a stretch with one parses whole.
+        if !stretch_is_closed(mid) || mid.contains('"') {
             return None;
         }
         // A syntax error names the token after it, which for the last item of the
@@ -536,6 +538,11 @@ fn shift_item(item: &mut Item, d: isize) {
         Item::Learn(l) => {
             l.params.iter_mut().for_each(|p| shift_param(p, d));
             sh(&mut l.range, d);
+        }
+        Item::World(w) => {
+            shift_doc(&mut w.doc, d);
+            sh(&mut w.name_range, d);
+            sh(&mut w.range, d);
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Checks that keep a spec from failing later, in `train` or in files it names, or from
-//! meaning something else than it seems: `HSTL050` (a task or reach formula that refers
-//! to no state variable), `HSTL051` (a name longer than [`MAX_NAME_CHARS`]) and `HSTL150`
+//! meaning something else than it seems: `HSTL050` (a reach formula that refers to no
+//! state variable), `HSTL104` (a task that refers to none), `HSTL051` (a name longer than [`MAX_NAME_CHARS`]) and `HSTL150`
 //! (`<=` or `>=` against a whole number on an `int` variable), and `HSTL060` (an expression
 //! that is NaN on a state of the declared `int` domain).
 
@@ -46,22 +46,36 @@ pub(crate) fn long_names(spec: &syntax::Spec, out: &mut Vec<Diagnostic>) {
     }
 }
 
-/// `HSTL050` for a task, or a primitive option's `reach`, that refers to no state
-/// variable, directly or through lets: its robustness is the same at every step (`inf` for
-/// `true`), so there is nothing to monitor, and no reward to learn from.
-pub(crate) fn constant_formulas(spec: &CheckedSpec, out: &mut Vec<Diagnostic>) {
-    // Whether each let refers to the state, in an order where a let's lets come first;
-    // lets left out of the order (cycles, reported already) count as referring to it.
+/// Whether the spec's task refers to no state variable, directly or through lets: its
+/// robustness is the same at every step, so training has nothing to learn from it
+/// (`HSTL104`, which `train` refuses).
+pub fn task_is_constant(spec: &CheckedSpec) -> bool {
+    let reads_state = lets_reading_state(spec);
+    spec.task.as_ref().is_some_and(|t| !refers_to_state(&t.formula, &reads_state))
+}
+
+/// Per let: whether it refers to the state, directly or through lets. Lets left out of the
+/// dependency order (cycles, reported already) count as referring to it.
+fn lets_reading_state(spec: &CheckedSpec) -> Vec<bool> {
     let mut reads_state = vec![true; spec.lets.len()];
     for &i in &spec.let_order {
         reads_state[i] = refers_to_state(&spec.lets[i].formula, &reads_state);
     }
+    reads_state
+}
+
+/// `HSTL104` (a warning) for a task that refers to no state variable, and `HSTL050` (an
+/// error) for a primitive option's `reach` that does not: the task's robustness is the same
+/// at every step (`inf` for `true`), which can be monitored but not learnt from, and the
+/// option's reward is the same in every state.
+pub(crate) fn constant_formulas(spec: &CheckedSpec, out: &mut Vec<Diagnostic>) {
+    let reads_state = lets_reading_state(spec);
     if let Some(task) = &spec.task
         && !refers_to_state(&task.formula, &reads_state)
     {
         out.push(
             Diagnostic::new(
-                "HSTL050",
+                "HSTL104",
                 task.formula.range.clone(),
                 "the task refers to no state variable: its robustness is the same at every step",
             )

@@ -43,6 +43,8 @@ pub(crate) enum TokKind {
     Number,
     Punct,
     Doc,
+    /// A string literal, quotes included (closed or not: an open one ends at the line's end).
+    Str,
     Other,
 }
 
@@ -87,9 +89,15 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
         })
         .map(|c| c.range.clone())
         .collect();
+    let open_strings = diagnostics
+        .iter()
+        .filter(|d| d.message == UNTERMINATED_STRING)
+        .map(|d| d.range.start)
+        .collect();
     let mut p = Splitter {
         src,
         deep_comments,
+        open_strings,
         toks: &toks,
         ends: &ends,
         i: 0,
@@ -103,6 +111,25 @@ fn parse_with(src: &str, parallel: bool) -> Parsed {
     }
     Parsed { file: File { specs, comments }, diagnostics }
 }
+
+/// The value of a string literal as the grammar reads it (quotes included): `\"` and `\\`
+/// resolved.
+fn unescape(lit: &str) -> String {
+    let inner = lit.strip_prefix('"').and_then(|s| s.strip_suffix('"')).unwrap_or(lit);
+    let mut out = String::with_capacity(inner.len());
+    let mut chars = inner.chars();
+    while let Some(c) = chars.next() {
+        if c == '\\' {
+            out.extend(chars.next());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The lexer's message for a string without its closing quote.
+const UNTERMINATED_STRING: &str = "unterminated string";
 
 /// U+FEFF in UTF-8.
 const BOM: &[u8] = "\u{feff}".as_bytes();
@@ -169,6 +196,28 @@ pub(crate) fn lex(src: &str, comments: &mut Vec<Comment>, diags: &mut Vec<Diagno
                 ));
             }
             comments.push(Comment { kind: CommentKind::Block, range: start..i });
+        } else if c == b'"' {
+            i += 1;
+            let mut closed = false;
+            while i < b.len() && b[i] != b'\n' && b[i] != b'\r' {
+                match b[i] {
+                    b'"' => {
+                        i += 1;
+                        closed = true;
+                        break;
+                    }
+                    // An escape is two bytes; only `\"` and `\\` are valid, which pest decides.
+                    b'\\' if i + 1 < b.len() && matches!(b[i + 1], b'"' | b'\\') => i += 2,
+                    _ => i += 1,
+                }
+            }
+            if !closed {
+                diags.push(
+                    Diagnostic::new("HSTL001", start..start + 1, UNTERMINATED_STRING)
+                        .with_help("close the string with `\"` on the same line"),
+                );
+            }
+            toks.push(Tok { kind: TokKind::Str, start, end: i });
         } else if c.is_ascii_alphabetic() || c == b'_' {
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
                 i += 1;
@@ -218,6 +267,8 @@ const ITEM_KEYWORDS: [&str; 6] = ["let", "task", "option", "state", "learn", "sp
 struct Splitter<'a, 'd> {
     src: &'a str,
     deep_comments: Vec<Range<usize>>,
+    /// Where each unterminated string starts, in source order (already reported).
+    open_strings: Vec<usize>,
     toks: &'a [Tok],
     ends: &'a [usize],
     i: usize,
@@ -378,6 +429,8 @@ impl Splitter<'_, '_> {
             if seen_non_doc && k > a {
                 let starts_item = (t.kind == TokKind::Word && ITEM_KEYWORDS.contains(&s))
                     || (s == "options" && brace_depth == 0)
+                    || (s == "world"
+                        && self.toks.get(k + 1).is_some_and(|n| n.kind == TokKind::Str))
                     || (t.kind == TokKind::Doc && depth == 0);
                 if starts_item {
                     break;
@@ -444,6 +497,12 @@ impl Splitter<'_, '_> {
         self.deep_comments.get(k).is_some_and(|c| c.start < range.end)
     }
 
+    /// Whether a string that the lexer found unterminated (and reported) lies inside `range`.
+    fn has_open_string(&self, range: &Range<usize>) -> bool {
+        let k = self.open_strings.partition_point(|&s| s < range.start);
+        self.open_strings.get(k).is_some_and(|&s| s < range.end)
+    }
+
     /// Parses the items of `bounds` (token ranges), on several threads when there are
     /// many; each result comes with the item's diagnostics, in the order of `bounds`.
     fn items(&self, bounds: &[(usize, usize)]) -> Vec<ItemResult> {
@@ -492,7 +551,7 @@ impl Splitter<'_, '_> {
 
     fn item_into(&self, a: usize, b: usize, diagnostics: &mut Vec<Diagnostic>) -> Option<Item> {
         let range = self.toks[a].start..self.toks[b - 1].end;
-        if self.has_deep_comment(&range) {
+        if self.has_deep_comment(&range) || self.has_open_string(&range) {
             return None;
         }
         // Bracket nesting is checked before pest so that deep input cannot exhaust the stack.
@@ -774,7 +833,12 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         | Rule::task_item
         | Rule::option_item
         | Rule::options_item
-        | Rule::learn_item => "an item (`state`, `let`, `task`, `option`, `options` or `learn`)",
+        | Rule::learn_item
+        | Rule::world_item => {
+            "an item (`state`, `let`, `task`, `option`, `options`, `learn` or `world`)"
+        }
+        Rule::string => "a string such as `\"four-rooms\"`",
+        Rule::k_world => "`world`",
         Rule::func => "`abs` or `sqrt`",
         Rule::call => "a function call",
         Rule::k_spec => "`spec`",
@@ -1055,6 +1119,14 @@ impl Builder<'_> {
                     .map(|c| self.param(c))
                     .collect::<Res<Vec<_>>>()?;
                 Item::Learn(Learn { params, range })
+            }
+            Rule::world_item => {
+                let Some(lit) = rest.iter().find(|c| c.as_rule() == Rule::string) else {
+                    return Err(self.internal(range));
+                };
+                let name_range = self.range(lit);
+                let name = unescape(lit.as_str());
+                Item::World(WorldItem { doc, name, name_range, range })
             }
             _ => return Err(self.internal(range)),
         })

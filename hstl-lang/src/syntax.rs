@@ -119,6 +119,8 @@ pub enum Item {
     Options(OptionsItem),
     /// `learn { ... }`.
     Learn(Learn),
+    /// `world "NAME_OR_PATH";`.
+    World(WorldItem),
 }
 
 impl Item {
@@ -131,8 +133,23 @@ impl Item {
             Item::Option(i) => i.range.clone(),
             Item::Options(i) => i.range.clone(),
             Item::Learn(i) => i.range.clone(),
+            Item::World(i) => i.range.clone(),
         }
     }
+}
+
+/// `world "four-rooms";` or `world "maps/yard.toml";`: the world the spec is written for,
+/// a built-in world's name or a world file's path relative to the spec file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldItem {
+    /// Doc comment.
+    pub doc: Option<Doc>,
+    /// The string's value: its text between the quotes, escapes (`\"`, `\\`) resolved.
+    pub name: String,
+    /// Byte range of the string, quotes included.
+    pub name_range: Range<usize>,
+    /// Byte range of the item (docs included).
+    pub range: Range<usize>,
 }
 
 /// `state { var, ... }`.

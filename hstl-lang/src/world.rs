@@ -1,20 +1,29 @@
 //! Checking a spec against the grid world it is trained in.
 //!
-//! The front end knows nothing of the runtime: the facade describes a world as plain data
-//! ([`WorldFacts`]) and [`check_in_world`] runs every check of [`crate::check()`] plus
-//! these, on each spec that has options (a spec without options is never trained):
+//! A spec names its world with an item `world "NAME_OR_PATH";` (a built-in world's name, or
+//! a world file's path relative to the spec file). The front end reads no file: the caller
+//! (the CLI, the language server, Python) finds the world each spec names, or the one a
+//! command line imposes, and passes it as plain data ([`SpecWorld`], [`WorldFacts`]) to
+//! [`check_parsed_with_worlds`]. A spec checked [`SpecWorld::Alone`] gets no world facts and
+//! no world diagnostics: a custom Rust or gymnasium environment is a world no check can see.
+//!
+//! Against a world, every check of [`crate::check()`] runs, plus these, on each spec that
+//! has options (a spec without options is never trained):
 //! - `HSTL030`: the state variables must be `x: int in 0..=W-1` and `y: int in 0..=H-1`;
 //! - `HSTL031`: a region an option reaches has no free cell (an error; a region only the
 //!   task names stays the warning `HSTL102`);
 //! - `HSTL032`: an option's termination set has no free cell;
 //! - `HSTL131`: no start can reach a region (walls cut it off).
 //!
-//! With a world, the finite-domain checks (`HSTL018`, `HSTL020`, `HSTL102`, `HSTL103`)
-//! range over the free cells only: walls are not states.
+//! and `HSTL034` at the `world` item when the world it names cannot be had. A world never
+//! hides another diagnostic: the spec's own checks report the same with or without it.
+//! With a world the state fits, the finite-domain checks (`HSTL018`, `HSTL020`, `HSTL102`,
+//! `HSTL103`) range over the free cells only: walls are not states.
 
 use crate::check::{Checked, check_parsed_in};
 use crate::checked::{CheckedSpec, Domain, VarType};
 use crate::diagnostic::Diagnostic;
+use crate::syntax::{Item, Spec, WorldItem};
 use crate::{Parsed, parse};
 
 /// What the checks know of a grid world.
@@ -32,16 +41,57 @@ pub struct WorldFacts {
     pub reachable: Vec<bool>,
 }
 
+/// Why the world a spec names could not be had: an unknown name, a missing or malformed
+/// world file. Reported as `HSTL034` at the spec's `world` item.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WorldProblem {
+    /// What is wrong (for a malformed file, its `FILE:LINE:COL` first), without a trailing
+    /// period.
+    pub message: String,
+    /// How to fix it.
+    pub help: String,
+}
+
+/// What one spec is checked against.
+#[derive(Clone, Copy, Debug)]
+pub enum SpecWorld<'w> {
+    /// No world: the spec is checked alone.
+    Alone,
+    /// A world whose facts are known.
+    Facts(&'w WorldFacts),
+    /// The world the spec names, which could not be had.
+    Unavailable(&'w WorldProblem),
+}
+
 /// Parses and checks `src` as [`crate::check()`] does, and checks each spec with options
-/// against `world`. Never fails and never panics.
+/// against `world`, whatever world the spec names (a command line's `--world`). Never fails
+/// and never panics.
 pub fn check_in_world(src: &str, world: &WorldFacts) -> Checked {
-    check_parsed_in(src, parse(src), Some(world))
+    check_parsed_in(src, parse(src), &|_| SpecWorld::Facts(world))
 }
 
 /// [`check_in_world`] on a text that is already parsed (see [`crate::check_parsed`]): what
 /// an editor that re-parses only what changed calls.
 pub fn check_parsed_in_world(src: &str, parsed: Parsed, world: &WorldFacts) -> Checked {
-    check_parsed_in(src, parsed, Some(world))
+    check_parsed_in(src, parsed, &|_| SpecWorld::Facts(world))
+}
+
+/// Checks a parsed text with each spec against the world `world_of` gives for it (usually
+/// the one its [`world_item`] names, found by the caller). Never fails and never panics.
+pub fn check_parsed_with_worlds<'w>(
+    src: &str,
+    parsed: Parsed,
+    world_of: &dyn Fn(&Spec) -> SpecWorld<'w>,
+) -> Checked {
+    check_parsed_in(src, parsed, world_of)
+}
+
+/// The spec's `world` item (the first, if it has several: the others are reported).
+pub fn world_item(spec: &Spec) -> Option<&WorldItem> {
+    spec.items.iter().find_map(|i| match i {
+        Item::World(w) => Some(w),
+        _ => None,
+    })
 }
 
 /// Per state of a spec's declared domain (in the order the finite-domain checks number

@@ -7,17 +7,73 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use hstl_lang::{
-    CFormula, CFormulaKind, Checked, CheckedSpec, Domain, Terminate, WorldFacts, codes,
-    render_plain,
+    CFormula, CFormulaKind, Checked, CheckedSpec, Domain, SpecWorld, Terminate, WorldFacts,
+    WorldProblem, codes, render_plain,
 };
 
 /// Checks a fixture: against the grid world its leading `// world:` comment draws (one
-/// `// ` line per row, top first, `.` free, `#` wall, `S` start), or on its own.
+/// `// ` line per row, top first, `.` free, `#` wall, `S` start), or as a shell that reads
+/// no file would: a spec naming a `.toml` world finds it missing (`HSTL034`), one naming
+/// anything else is checked alone.
 fn check(src: &str) -> Checked {
     match world_of(src) {
         Some(world) => hstl_lang::check_in_world(src, &world),
-        None => hstl_lang::check(src),
+        None => {
+            let missing = WorldProblem {
+                message: "cannot read `maps/yrad.toml`: no such file or directory".into(),
+                help: "check the path of the world file (relative to the spec file)".into(),
+            };
+            let parsed = hstl_lang::parse(src);
+            hstl_lang::check_parsed_with_worlds(src, parsed, &|spec| match hstl_lang::world_item(
+                spec,
+            ) {
+                Some(w) if w.name.ends_with(".toml") => SpecWorld::Unavailable(&missing),
+                _ => SpecWorld::Alone,
+            })
+        }
     }
+}
+
+/// An open `width` x `height` grid, every cell a start.
+fn open_world(width: usize, height: usize) -> WorldFacts {
+    let cells = width * height;
+    WorldFacts {
+        label: format!("world `open{width}x{height}`"),
+        width,
+        height,
+        free: vec![true; cells],
+        reachable: vec![true; cells],
+    }
+}
+
+/// The codes that only a world gives.
+const WORLD_CODES: [&str; 5] = ["HSTL030", "HSTL031", "HSTL032", "HSTL034", "HSTL131"];
+
+/// No check hides another: a world that does not fit (or fits with no walls) changes no
+/// diagnostic of the spec's own, only adds its own codes.
+#[test]
+fn a_world_adds_to_the_diagnostics_and_hides_none() {
+    let own = |c: &Checked| -> Vec<(String, std::ops::Range<usize>, String)> {
+        c.diagnostics
+            .iter()
+            .filter(|d| !WORLD_CODES.contains(&d.code) && d.code != "HSTL024")
+            .map(|d| (d.code.to_string(), d.range.clone(), d.message.clone()))
+            .collect()
+    };
+    let mut mismatched = 0;
+    for (name, src) in fixtures("invalid").into_iter().chain(fixtures("valid")) {
+        if world_of(&src).is_some() {
+            continue;
+        }
+        let alone = hstl_lang::check(&src);
+        for world in [open_world(15, 15), open_world(13, 13), open_world(3, 1)] {
+            let with = hstl_lang::check_in_world(&src, &world);
+            assert_eq!(own(&alone), own(&with), "{name} against {}", world.label);
+            mismatched += usize::from(with.diagnostics.iter().any(|d| d.code == "HSTL030"));
+        }
+    }
+    // The property is exercised on specs the world does not fit, not only on ones it does.
+    assert!(mismatched > 20, "only {mismatched} mismatches");
 }
 
 fn world_of(src: &str) -> Option<WorldFacts> {
@@ -178,6 +234,9 @@ fn text(src: &str, f: &CFormula) -> String {
 /// A readable summary of a checked spec for snapshots.
 fn summarise(out: &mut String, spec: &CheckedSpec, src: &str) {
     let _ = writeln!(out, "spec {} (doc: {:?})", spec.name, spec.doc);
+    if let Some(w) = &spec.world {
+        let _ = writeln!(out, "  world {:?} at {}", w.name, &src[w.range.clone()]);
+    }
     for v in &spec.state_vars {
         let dom = match v.domain {
             Domain::Unbounded => "unbounded".to_string(),

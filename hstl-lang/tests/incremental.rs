@@ -9,7 +9,7 @@ use hstl_lang::{Diagnostic, Parsed, check, check_parsed, parse};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed};
 
-const FIXTURES: [&str; 10] = [
+const FIXTURES: [&str; 12] = [
     "spec A { state { x: int in 0..=3 } let P = x > 1; task always P; }\n\n// between\n\
      /// Second.\nspec B {\n    state { y: float }\n    let Q = y < 2;\n    task eventually[0..5] Q;\n}\n",
     include_str!("fixtures/valid/case_study_ot1.hstl"),
@@ -21,9 +21,11 @@ const FIXTURES: [&str; 10] = [
     include_str!("fixtures/invalid/HSTL001_missing_semicolon.hstl"),
     include_str!("fixtures/invalid/HSTL021_until_chain.hstl"),
     include_str!("fixtures/invalid/HSTL003_duplicate_let.hstl"),
+    include_str!("fixtures/valid/world_item.hstl"),
+    include_str!("fixtures/invalid/HSTL001_unterminated_string.hstl"),
 ];
 
-const VOCAB: [&str; 30] = [
+const VOCAB: [&str; 33] = [
     " ",
     "\n",
     "// c\n",
@@ -54,6 +56,9 @@ const VOCAB: [&str; 30] = [
     "\n    let Y = (x + 1) > 2;",
     "learn { episodes: 3 }\n",
     "=",
+    "\"",
+    "\\",
+    "world \"a // b\";\n",
 ];
 
 fn sorted(mut d: Vec<Diagnostic>) -> Vec<Diagnostic> {

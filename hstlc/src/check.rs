@@ -8,7 +8,7 @@ use hstl::lang::{Diagnostic, Severity};
 
 use crate::cli_error::CliError;
 use crate::output::out;
-use crate::world_arg::{LoadedWorld, WORLD_HELP};
+use crate::world_arg::{LoadedWorld, check_source, override_note};
 use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc check`.
@@ -23,10 +23,18 @@ pub struct CheckArgs {
     /// The name to report for standard input.
     #[arg(long, value_name = "NAME", default_value = "<stdin>")]
     pub stdin_filename: String,
-    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
-    /// The grid world the specs with options are checked against.
-    pub world: String,
+    #[arg(long, value_name = "NAME|FILE.toml", long_help = CHECK_WORLD_HELP)]
+    /// The grid world the specs with options are checked against, instead of the ones they
+    /// name.
+    pub world: Option<String>,
 }
+
+/// The `--world` help text of `check`.
+const CHECK_WORLD_HELP: &str = "The grid world to check the specs with options against, \
+instead of the world each names with `world \"...\";`: a built-in name (`paper`, the paper's \
+15 x 15 open grid with slip 0.3, or `four-rooms`) or a world file (`FILE.toml`, see README \
+\"Worlds\"). Without it, a spec is checked against the world it names, or alone when it names \
+none";
 
 /// How `check` prints diagnostics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -54,18 +62,22 @@ pub struct Checked {
 /// Runs `hstlc check`.
 pub fn run(args: &CheckArgs) -> CmdResult {
     // Read every input first: an unreadable file stops the run before anything prints.
-    let world = LoadedWorld::load(&args.world)?;
+    let imposed = args.world.as_deref().map(LoadedWorld::load).transpose()?;
     let inputs = args
         .files
         .iter()
-        .map(|path| read_input(path, &args.stdin_filename))
+        .map(|path| read_input(path, &args.stdin_filename).map(|(n, s)| (path, n, s)))
         .collect::<Result<Vec<_>, _>>()?;
     let mut notes = String::new();
     let checked: Vec<Checked> = inputs
         .into_iter()
-        .map(|(name, source)| {
-            let result = hstl::world::check(&source, &world.world, &world.label);
+        .map(|(path, name, source)| {
+            let path = (path != Path::new("-")).then_some(path.as_path());
+            let (result, worlds) = check_source(&source, path, imposed.as_ref());
             for spec in &result.specs {
+                if let (Some(named), Some(imposed)) = (&spec.world, &imposed) {
+                    notes.extend(override_note(&name, &spec.name, &named.name, &worlds, imposed));
+                }
                 if let Some(e) = &spec.preset_expansion {
                     notes.push_str(&preset_note(&name, &spec.name, e));
                 }

@@ -40,6 +40,7 @@ mod server;
 #[cfg(test)]
 mod tests;
 pub mod transport;
+mod worlds;
 
 pub use server::MAX_DOCUMENT_BYTES;
 pub use transport::MAX_MESSAGE_BYTES;

@@ -5,11 +5,11 @@
 //! 141 when the reader of standard output stopped reading (see [`output`]).
 
 mod check;
-mod cli_error;
+use hstlc::cli_error;
 mod eval;
 mod explain;
 mod fmt;
-mod input;
+use hstlc::input;
 mod monitor;
 mod output;
 mod render;
@@ -17,7 +17,7 @@ mod spec_file;
 mod study;
 use hstlc::trace_csv;
 mod train;
-mod world_arg;
+use hstlc::world_arg;
 
 use std::process::ExitCode;
 

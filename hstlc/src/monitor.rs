@@ -104,7 +104,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             Some("give one `--trace` (a file or `-` for a pipe) with `--online`".to_string()),
         ));
     }
-    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), None)? else {
+    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref())? else {
         return Ok(Status::Errors);
     };
     let (spec, name) = (&loaded.spec, &loaded.file);

@@ -11,7 +11,7 @@ use crate::check::{Checked, read_input};
 use crate::cli_error::CliError;
 use crate::output::err;
 use crate::render;
-use crate::world_arg::LoadedWorld;
+use crate::world_arg::{LoadedWorld, check_source, override_note};
 
 /// A spec that checked without errors.
 pub struct LoadedSpec {
@@ -32,20 +32,71 @@ impl LoadedSpec {
     }
 }
 
-/// Reads and checks `path` (against `world`, for the commands that train) and picks the
-/// spec named `wanted` (or the only one). A file with
-/// errors has its diagnostics printed to standard error, as `check` renders them, and gives
-/// `Ok(None)`: the caller exits with status 1.
-pub fn load(
+/// Reads and checks `path` alone (no world: what `monitor` runs) and picks the spec named
+/// `wanted` (or the only one). A file with errors has its diagnostics printed to standard
+/// error, as `check` renders them, and gives `Ok(None)`: the caller exits with status 1.
+pub fn load(path: &Path, wanted: Option<&str>) -> Result<Option<LoadedSpec>, CliError> {
+    let (file, source) = read_input(path, "<stdin>")?;
+    let loaded = hstl::load::load(&source, wanted);
+    picked(file, source, loaded)
+}
+
+/// Reads `path` for the commands that train: picks the spec named `wanted` (or the only
+/// one) and its world, `flag` (`--world`) when given, else the world the spec names, else
+/// `paper`; checks the spec against that world, and says on standard error which world it
+/// is when that is not the one the spec names. Errors as [`load`].
+pub fn load_trainable(
     path: &Path,
     wanted: Option<&str>,
-    world: Option<&LoadedWorld>,
-) -> Result<Option<LoadedSpec>, CliError> {
+    flag: Option<&str>,
+) -> Result<Option<(LoadedSpec, LoadedWorld)>, CliError> {
+    let imposed = flag.map(LoadedWorld::load).transpose()?;
     let (file, source) = read_input(path, "<stdin>")?;
-    let loaded = match world {
-        Some(w) => hstl::load::load_in_world(&source, wanted, &w.world, &w.label),
-        None => hstl::load::load(&source, wanted),
+    let on_disk = (path != Path::new("-")).then_some(path);
+    let (checked, worlds) = check_source(&source, on_disk, imposed.as_ref());
+    let Some(loaded) = picked(file, source, hstl::load::pick(checked, wanted))? else {
+        return Ok(None);
     };
+    let named = loaded.spec.world.as_ref().map(|w| w.name.clone());
+    match (imposed, named) {
+        (Some(imposed), named) => {
+            if let Some(named) = named
+                && let Some(note) =
+                    override_note(&loaded.file, &loaded.spec.name, &named, &worlds, &imposed)
+            {
+                err!("{note}");
+            }
+            Ok(Some((loaded, imposed)))
+        }
+        (None, Some(named)) => match worlds.get(&named) {
+            Some(Ok(world)) => Ok(Some((loaded, world.clone()))),
+            // Checked above: a world that cannot be had is an error (HSTL034).
+            _ => {
+                Err(CliError::new(format!("{}: world `{named}` cannot be read", loaded.file), None))
+            }
+        },
+        (None, None) => {
+            // A spec that names no world trains in `paper`, checked against it first.
+            let paper = LoadedWorld::load("paper")?;
+            err!(
+                "note: {}: spec `{}` names no world (`world \"NAME\";`): training in {}\n",
+                loaded.file,
+                loaded.spec.name,
+                paper.label
+            );
+            let (checked, _) = check_source(&loaded.source, on_disk, Some(&paper));
+            let loaded = picked(loaded.file, loaded.source, hstl::load::pick(checked, wanted))?;
+            Ok(loaded.map(|l| (l, paper)))
+        }
+    }
+}
+
+/// The spec `load` picked, or its errors printed.
+fn picked(
+    file: String,
+    source: String,
+    loaded: Result<hstl::load::Loaded, LoadError>,
+) -> Result<Option<LoadedSpec>, CliError> {
     match loaded {
         Ok(loaded) => Ok(Some(LoadedSpec { file, source, spec: loaded.spec })),
         Err(LoadError::Invalid(diagnostics)) => {

@@ -38,9 +38,10 @@ pub struct StudyArgs {
     /// Skip the optimum W* (value iteration takes a few seconds per region set).
     #[arg(long)]
     pub no_optimum: bool,
-    /// The grid world to train in.
-    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
-    pub world: String,
+    /// The grid world to train every spec in, instead of the ones they name (default:
+    /// `paper` for a spec that names none).
+    #[arg(long, value_name = "NAME|FILE.toml", long_help = WORLD_HELP)]
+    pub world: Option<String>,
     /// Worker threads (default: every core; at most 256).
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=256))]
     pub threads: Option<usize>,
@@ -58,10 +59,10 @@ const KEEP_BUDGET: usize = 256 << 20;
 /// Runs `hstlc study`.
 pub fn run(args: &StudyArgs) -> CmdResult {
     // Check every spec against the world before the long part starts.
-    let world = LoadedWorld::load(&args.world)?;
     let mut loaded = Vec::new();
+    let mut worlds: Vec<LoadedWorld> = Vec::new();
     for path in &args.specs {
-        let Some(l) = spec_file::load(path, None, Some(&world))? else {
+        let Some((l, world)) = spec_file::load_trainable(path, None, args.world.as_deref())? else {
             return Ok(Status::Errors);
         };
         let mut spec = l.trainable()?;
@@ -69,6 +70,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             spec.learn.episodes = e;
         }
         loaded.push((path.clone(), l, spec));
+        worlds.push(world);
     }
     // Each spec's folder, taken before the long part: a folder another run holds is
     // refused at once, and two specs of one name get folders of their own.
@@ -76,34 +78,37 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         .iter()
         .map(|d| OutDir::lock(d, Writer::CLI))
         .collect::<Result<Vec<_>, _>>()?;
-    let env = &world.world;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
         .max(1);
-    outln!(
-        "study: {} specs x {} seeds on {}, {threads} threads",
-        loaded.len(),
-        args.seeds,
-        world.words()
-    )?;
+    let one_world = worlds.windows(2).all(|w| w[0].world == w[1].world);
+    let on = match worlds.first() {
+        Some(w) if one_world => w.words(),
+        _ => "the worlds they name".to_string(),
+    };
+    outln!("study: {} specs x {} seeds on {on}, {threads} threads", loaded.len(), args.seeds)?;
     let seeds: Vec<u64> = (0..args.seeds).collect();
-    let mut optima: Vec<(Vec<Region>, f64)> = Vec::new();
+    let mut optima: Vec<(Vec<Region>, GridWorld, f64)> = Vec::new();
     let mut baseline: Option<(String, f64, hstl::runtime::RewardKind)> = None;
     let labels = facade::labels(&args.specs);
     // Every spec's (and variant's) curves, for the figure of all of them.
     let mut all_curves: Vec<CurveSet> = Vec::new();
     let mut summary = String::from(facade::SUMMARY_HEADER);
-    for (((_, l, spec), label), out) in loaded.iter().zip(&labels).zip(outs) {
+    for ((((_, l, spec), label), out), world) in loaded.iter().zip(&labels).zip(outs).zip(&worlds) {
+        let env = &world.world;
         let budget = AtomicUsize::new(KEEP_BUDGET);
         let keep = Keep { source: &l.source, budget: &budget };
         let (results, kept) = run_seeds(spec, env, &seeds, threads, l, Some(&keep))?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
             None
         } else {
-            Some(optimum(&mut optima, spec, env)?)
+            Some(optimum(&mut optima, spec, world)?)
         };
         outln!()?;
+        if !one_world {
+            outln!("{label}: on {}", world.words())?;
+        }
         outln!(
             "{label}: `{}`, {} options, intra: {}, {} seeds x {} episodes x {} choices",
             spec.name,
@@ -204,11 +209,12 @@ fn run_seeds(
 
 /// W* for the spec's regions, solved once per distinct region set.
 fn optimum(
-    cache: &mut Vec<(Vec<Region>, f64)>,
+    cache: &mut Vec<(Vec<Region>, GridWorld, f64)>,
     spec: &TaskSpec,
-    env: &GridWorld,
+    world: &LoadedWorld,
 ) -> Result<f64, CliError> {
-    if let Some((_, w)) = cache.iter().find(|(r, _)| *r == spec.regions) {
+    let env = &world.world;
+    if let Some((_, _, w)) = cache.iter().find(|(r, e, _)| *r == spec.regions && e == env) {
         return Ok(*w);
     }
     let start = Instant::now();
@@ -223,7 +229,7 @@ fn optimum(
         start.elapsed().as_secs_f64(),
         if o.converged { "" } else { ", not converged" }
     )?;
-    cache.push((spec.regions.clone(), o.gain));
+    cache.push((spec.regions.clone(), env.clone(), o.gain));
     Ok(o.gain)
 }
 

@@ -10,7 +10,7 @@ use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
 
 use crate::cli_error::CliError;
 use crate::output::outln;
-use crate::world_arg::{LoadedWorld, WORLD_HELP};
+use crate::world_arg::WORLD_HELP;
 use crate::{CmdResult, Status, spec_file};
 use hstl::artifacts::{self, OutFile};
 use hstl_outdir::{OutDir, Writer};
@@ -21,9 +21,9 @@ pub struct TrainArgs {
     /// The spec file (`-` reads standard input).
     #[arg(value_name = "SPEC")]
     pub spec: PathBuf,
-    /// The grid world to train in.
-    #[arg(long, value_name = "NAME|FILE.toml", default_value = "paper", long_help = WORLD_HELP)]
-    pub world: String,
+    /// The grid world to train in, instead of the one the spec names (default: `paper`).
+    #[arg(long, value_name = "NAME|FILE.toml", long_help = WORLD_HELP)]
+    pub world: Option<String>,
     /// The seed of the one random generator every draw comes from.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -55,8 +55,9 @@ pub struct Outcome {
 
 /// Runs `hstlc train`.
 pub fn run(args: &TrainArgs) -> CmdResult {
-    let world = LoadedWorld::load(&args.world)?;
-    let Some(loaded) = spec_file::load(&args.spec, args.spec_name.as_deref(), Some(&world))? else {
+    let loaded =
+        spec_file::load_trainable(&args.spec, args.spec_name.as_deref(), args.world.as_deref())?;
+    let Some((loaded, world)) = loaded else {
         return Ok(Status::Errors);
     };
     let mut spec = loaded.trainable()?;

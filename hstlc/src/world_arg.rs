@@ -1,13 +1,17 @@
 //! `--world NAME|FILE.toml`: a built-in world by name, or a world file.
 
-use std::path::Path;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 
+use hstl::lang::syntax::Spec;
+use hstl::lang::{Parsed, SpecWorld, WorldFacts, WorldProblem};
 use hstl::world::GridWorld;
 
 use crate::cli_error::CliError;
 use crate::input;
 
 /// A world and how messages name it.
+#[derive(Clone)]
 pub struct LoadedWorld {
     /// The world.
     pub world: GridWorld,
@@ -26,25 +30,33 @@ impl LoadedWorld {
     /// The world `arg` names: a built-in name, or a path to a world file. Errors name the
     /// file, line and column.
     pub fn load(arg: &str) -> Result<LoadedWorld, CliError> {
+        LoadedWorld::named(arg, None).map_err(|e| match e {
+            CliError::Read { .. } => CliError::new(e.to_string(), Some(hstl::world::read_help())),
+            other => other,
+        })
+    }
+
+    /// The world a spec's `world "ARG";` item names: a built-in name, or a world file's
+    /// path relative to `base` (the spec file's folder; `None`: the current folder). A file
+    /// that cannot be read is `CliError::Read`, without help ([`item_help`] gives one).
+    pub fn named(arg: &str, base: Option<&Path>) -> Result<LoadedWorld, CliError> {
         if let Some(world) = GridWorld::builtin(arg) {
             let label = hstl::world::label(&world, None);
             return Ok(LoadedWorld { world, label, file: None });
         }
-        let path = Path::new(arg);
+        let path: PathBuf = match base {
+            Some(base) if Path::new(arg).is_relative() => base.join(arg),
+            _ => PathBuf::from(arg),
+        };
+        let path = path.as_path();
         if !hstl::world::looks_like_file(arg) && !path.exists() {
             let unknown = hstl::world::unknown(arg);
             return Err(CliError::new(unknown.message, unknown.help));
         }
+        // A file that cannot be read stays `CliError::Read`, so each caller says how to fix
+        // it (too large or not UTF-8 say so already).
         let input::Input { name: file, text, .. } =
-            input::read_text(path, "<stdin>", hstl::lang::MAX_SOURCE_BYTES, "world file").map_err(
-                |e| match e {
-                    // Too large or not UTF-8 say how to fix it already.
-                    CliError::Read { .. } => {
-                        CliError::new(e.to_string(), Some(hstl::world::read_help()))
-                    }
-                    other => other,
-                },
-            )?;
+            input::read_text(path, "<stdin>", hstl::lang::MAX_SOURCE_BYTES, "world file")?;
         let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
         let world = hstl::world::from_file(&text, &file, &stem)
             .map_err(|p| CliError::new(p.message, p.help))?;
@@ -73,4 +85,112 @@ pub fn world_words(world: &GridWorld, file: Option<&str>) -> String {
     let from = file.map_or(String::new(), |f| format!("{f}; "));
     let name = world.world_name();
     format!("world `{name}` ({from}{} x {}{walls}, slip {slip})", world.width(), world.height())
+}
+
+/// Where a spec's world comes from when it is checked.
+pub enum WorldChoice<'a> {
+    /// `--world`: every spec with options is checked against this world, whatever it names.
+    Override(&'a LoadedWorld),
+    /// Each spec's own `world` item, its path relative to this folder (the spec file's;
+    /// `None`: the current folder, for standard input). A spec without one is checked alone.
+    FromSpecs(Option<&'a Path>),
+}
+
+/// The worlds the specs of one text name, each read once, as the checks see them.
+pub struct SpecWorlds {
+    named: HashMap<String, Result<(LoadedWorld, WorldFacts), WorldProblem>>,
+    imposed: Option<WorldFacts>,
+}
+
+impl SpecWorlds {
+    /// Reads the world each spec of `parsed` names, relative to `base`; with `imposed`
+    /// (`--world`), the specs are checked against that one instead.
+    pub fn resolve(
+        parsed: &Parsed,
+        base: Option<&Path>,
+        imposed: Option<&LoadedWorld>,
+    ) -> SpecWorlds {
+        let mut named = HashMap::new();
+        for spec in &parsed.file.specs {
+            if let Some(item) = hstl::lang::world_item(spec)
+                && !named.contains_key(&item.name)
+            {
+                let loaded = LoadedWorld::named(&item.name, base)
+                    .map(|w| {
+                        let facts = hstl::world::facts(&w.world, &w.label);
+                        (w, facts)
+                    })
+                    .map_err(|e| WorldProblem { message: e.to_string(), help: item_help(&e) });
+                named.insert(item.name.clone(), loaded);
+            }
+        }
+        let imposed = imposed.map(|w| hstl::world::facts(&w.world, &w.label));
+        SpecWorlds { named, imposed }
+    }
+
+    /// What `spec` is checked against.
+    pub fn lookup(&self, spec: &Spec) -> SpecWorld<'_> {
+        if let Some(facts) = &self.imposed {
+            return SpecWorld::Facts(facts);
+        }
+        match hstl::lang::world_item(spec).and_then(|item| self.named.get(&item.name)) {
+            Some(Ok((_, facts))) => SpecWorld::Facts(facts),
+            Some(Err(problem)) => SpecWorld::Unavailable(problem),
+            None => SpecWorld::Alone,
+        }
+    }
+
+    /// The world that a `world "NAME";` item names, read, or why it could not be.
+    pub fn get(&self, name: &str) -> Option<Result<&LoadedWorld, &WorldProblem>> {
+        self.named.get(name).map(|r| r.as_ref().map(|(w, _)| w))
+    }
+}
+
+/// Checks `source` (the file `path`; `None` for standard input) with each spec against its
+/// world: the one it names, or `imposed` (`--world`).
+pub fn check_source(
+    source: &str,
+    path: Option<&Path>,
+    imposed: Option<&LoadedWorld>,
+) -> (hstl::lang::Checked, SpecWorlds) {
+    let parsed = hstl::lang::parse(source);
+    let worlds = SpecWorlds::resolve(&parsed, spec_folder(path), imposed);
+    let checked = hstl::lang::check_parsed_with_worlds(source, parsed, &|spec| worlds.lookup(spec));
+    (checked, worlds)
+}
+
+/// The folder a spec file's `world` paths are relative to: the file's own (`None`: the
+/// current folder).
+pub fn spec_folder(path: Option<&Path>) -> Option<&Path> {
+    path.and_then(Path::parent).filter(|p| !p.as_os_str().is_empty())
+}
+
+/// The note printed when `--world` replaces a different world that a spec names.
+pub fn override_note(
+    file: &str,
+    spec: &str,
+    named: &str,
+    worlds: &SpecWorlds,
+    imposed: &LoadedWorld,
+) -> Option<String> {
+    let same = matches!(worlds.get(named), Some(Ok(w)) if w.world == imposed.world);
+    (!same).then(|| {
+        format!(
+            "note: {file}: spec `{spec}` names world `{named}`; `--world` checks it against {} instead\n",
+            imposed.label
+        )
+    })
+}
+
+/// How to fix a `world` item whose world cannot be had: the world file's own help for a
+/// malformed one, else where its path starts from.
+pub fn item_help(e: &CliError) -> String {
+    match e {
+        CliError::Other { help: Some(help), .. } => help.clone(),
+        _ => format!(
+            "a world file's path is relative to the spec file's folder; or name a built-in \
+             world ({})",
+            hstl::world::BUILTIN.map(|b| format!("`{b}`")).join(", ")
+        ),
+    }
 }

@@ -159,7 +159,17 @@ const CASES: &[Case] = &[
     // worlds: the spec against the map (world file errors are in `world_file_errors`)
     case("check_world_mismatch", &["check", "--world", "four-rooms", "surveillance.hstl"]),
     case("check_world_file", &["check", "--world", "worlds/nook.toml", "nook.hstl"]),
-    case("check_world_mismatch_default_paper", &["check", "nook.hstl"]),
+    // a spec that names no world is checked alone (a custom environment's spec)
+    case("check_no_world_alone", &["check", "nook.hstl"]),
+    // a spec names its world: a file relative to the spec, `--world` overrides it with a note
+    case("check_named_world_file", &["check", "nook_named.hstl"]),
+    case("check_named_world_override", &["check", "--world", "paper", "nook_named.hstl"]),
+    case("check_named_world_mismatch_and_more", &["check", "nook_wrong_world.hstl"]),
+    case("check_named_world_missing", &["check", "--format", "concise", "nook_missing_world.hstl"]),
+    // a task with a constant robustness: a warning; monitor computes it; train refuses it
+    case("check_constant_task", &["check", "--format", "concise", "constant.hstl"]),
+    case("monitor_constant_task", &["monitor", "constant.hstl", "--trace", "trace.csv"]),
+    case("train_constant_task", &["train", "constant.hstl", "--out", "unused"]),
     case("train_zero_episodes", &["train", "small.hstl", "--episodes", "0", "--out", "unused"]),
     case("train_spec_errors", &["train", "errors.hstl", "--out", "unused"]),
     case("eval_not_a_policy", &["eval", "not_a_policy.json"]),

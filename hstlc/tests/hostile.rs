@@ -40,6 +40,7 @@ fn write(dir: &Path, name: &str, text: impl AsRef<[u8]>) {
 }
 
 const SMALL: &str = "spec Small {
+    world \"paper\";
     state { x: int in 0..=14, y: int in 0..=14 }
     let A = x < 3 && y < 3;
     let B = x > 11 && y > 11;
@@ -143,9 +144,9 @@ fn byte_order_marks_line_ends_and_early_errors() {
     // With CR-only line ends the diagnostics name the right line.
     write(dir.path(), "cr_error.hstl", SMALL.replace('\n', "\r").replace("x < 3", "q < 3"));
     let run = hstlc_in(dir.path(), &["check", "--format", "concise", "cr_error.hstl"], b"");
-    assert!(run.stdout.starts_with("cr_error.hstl:3:13: HSTL002"), "{}", run.stdout);
+    assert!(run.stdout.starts_with("cr_error.hstl:4:13: HSTL002"), "{}", run.stdout);
     let run = hstlc_in(dir.path(), &["check", "cr_error.hstl"], b"");
-    assert!(run.stdout.contains("[cr_error.hstl:3:13]"), "{}", run.stdout);
+    assert!(run.stdout.contains("[cr_error.hstl:4:13]"), "{}", run.stdout);
     // CSV errors too, after a lone-CR line end.
     write(dir.path(), "cr.csv", "x,y\r1,1\r2,oops\r");
     let run = hstlc_in(dir.path(), &["monitor", "bom.hstl", "--trace", "cr.csv"], b"");
@@ -160,16 +161,22 @@ fn byte_order_marks_line_ends_and_early_errors() {
         "{}",
         run.stderr
     );
-    // `task true;` and a 300-character option name: `check` says so, `train` does not start.
+    // A task with nothing to learn: a warning, and `train` refuses it with the code.
+    let constant = SMALL
+        .replace("task always[0..] (eventually[0..40] A && eventually[0..40] B);", "task true;");
+    write(dir.path(), "early.hstl", &constant);
+    let run = hstlc_in(dir.path(), &["check", "--format", "concise", "early.hstl"], b"");
+    assert_eq!(run.status, Some(0));
+    assert!(run.stdout.contains("HSTL104"), "{}", run.stdout);
+    let run = hstlc_in(dir.path(), &["train", "early.hstl", "--out", "early"], b"");
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(run.stderr.contains("HSTL104"), "{}", run.stderr);
+    assert!(!dir.path().join("early").exists());
+    // An option that reaches a constant and a 300-character option name: `check` says so,
+    // `train` does not start.
     let long = format!("O{}", "o".repeat(299));
     for (spec, code) in [
-        (
-            SMALL.replace(
-                "task always[0..] (eventually[0..40] A && eventually[0..40] B);",
-                "task true;",
-            ),
-            "HSTL050",
-        ),
+        (SMALL.replace("option A;", "let K = true; option K;"), "HSTL050"),
         (SMALL.replace("option B;", &format!("let {long} = x > 5; option {long};")), "HSTL051"),
     ] {
         write(dir.path(), "early.hstl", &spec);

@@ -13,7 +13,7 @@ from typing import Any, Callable, Iterable, List, Mapping, Optional, Sequence, U
 
 from . import _hstl
 from ._hstl import Spec, World
-from ._train import _count_of, _seed_of
+from ._train import _count_of, _seed_of, world_of
 
 #: What a Ray task costs beside its training, as a share of one seed's training. Measured
 #: (BENCHMARKS.md, "Sweeps on Ray"): on a local cluster an empty task takes about 1 ms and
@@ -45,7 +45,7 @@ class StudyResult(list):
 def study(
     specs: Union[Spec, str, "os.PathLike[str]", Sequence[Union[Spec, str, "os.PathLike[str]"]]],
     seeds: Union[int, Iterable[int]] = 20,
-    world: Union[World, str, "os.PathLike[str]"] = "paper",
+    world: Union[World, str, "os.PathLike[str]", None] = None,
     backend: str = "local",
     address: Optional[str] = None,
     out: Optional[Union[str, "os.PathLike[str]"]] = None,
@@ -70,7 +70,8 @@ def study(
     against ``world`` first (``hstl.SpecError`` with the diagnostics of ``hstlc check
     --world``), before anything trains. ``seeds``: a count (seeds 0, 1, ... N-1, as
     ``hstlc study --seeds N``) or the seeds themselves. ``world``: a ``hstl.World``, a
-    built-in name or a world file. ``episodes`` overrides each spec's ``learn {
+    built-in name or a world file; by default the world the specs name (``paper`` when they
+    name none; specs that name different worlds are studied apart). ``episodes`` overrides each spec's ``learn {
     episodes }``; ``optimum=False`` skips W* (value iteration, a few seconds per set of
     regions).
 
@@ -136,7 +137,7 @@ def _study(
     if batch is not None:
         batch = _whole(batch, "batch", 1, 100_000)
     max_retries = _whole(max_retries, "max_retries", 0, 1000)
-    world = world if isinstance(world, World) else World._resolve(os.fspath(world))
+    world = _one_world(spec_list, world)
     # Every spec checked against the world here, before anything trains or is sent away.
     tasks = [_hstl._study_task(spec, world, episodes) for spec in spec_list]
     paths = [_path_of(spec) for spec in spec_list]
@@ -339,3 +340,19 @@ def _on_ray(
     finally:
         if started:
             ray.shutdown()
+
+
+def _one_world(spec_list: List[Spec], world: Any) -> World:
+    """The world a study trains in: ``world`` when given, else the one every spec names (or
+    ``paper`` when none names one); specs that name different worlds are studied apart."""
+    if world is not None:
+        return world if isinstance(world, World) else World._resolve(os.fspath(world))
+    worlds = [world_of(spec, None) for spec in spec_list]
+    first = worlds[0] if worlds else World.builtin("paper")
+    if any(w != first for w in worlds[1:]):
+        names = sorted({w.name for w in worlds})
+        raise ValueError(
+            f"the specs name different worlds ({', '.join(names)}): study each world's specs "
+            "apart, or train them all in one with world="
+        )
+    return first

@@ -14,7 +14,7 @@ _MAX_SEED = 2**64 - 1
 
 def train(
     spec: Union[Spec, str, "os.PathLike[str]"],
-    world: Union[World, str, "os.PathLike[str]"] = "paper",
+    world: Union[World, str, "os.PathLike[str]", None] = None,
     seed: int = 0,
     episodes: Optional[int] = None,
     progress: Optional[bool] = None,
@@ -25,10 +25,12 @@ def train(
     """Trains ``spec`` with the hierarchical learner and returns the ``hstl.Policy``.
 
     ``spec`` is a ``hstl.Spec`` or a spec file's path; ``world`` a ``hstl.World``, a
-    built-in world's name (``"paper"``, the default, or ``"four-rooms"``) or a world file's
-    path. The spec is checked against the world first (raising ``hstl.SpecError`` with the
-    diagnostics of ``hstlc check --world``), and the policy's ``policy.json`` is byte for
-    byte what ``hstlc train SPEC --world WORLD --seed SEED --episodes EPISODES`` writes.
+    built-in world's name (``"paper"`` or ``"four-rooms"``) or a world file's path. By
+    default the world is the one the spec names (``world "...";``, a path relative to the
+    spec file), or ``"paper"`` when it names none; ``world=`` overrides it. The spec is
+    checked against the world first (raising ``hstl.SpecError`` with the diagnostics of
+    ``hstlc check --world``), and the policy's ``policy.json`` is byte for byte what
+    ``hstlc train SPEC --world WORLD --seed SEED --episodes EPISODES`` writes.
     ``episodes`` overrides the spec's ``learn { episodes }`` (1 to ``MAX_EPISODES``); every
     random draw comes from one generator seeded with ``seed`` (0 to 2**64 - 1), so the
     same seed gives the same Q-tables, bit for bit.
@@ -55,15 +57,31 @@ def train(
         if env is None:
             if valuation is not None:
                 raise TypeError("`valuation` goes with `env=`; a world gives its own (x, y)")
-            world = world if isinstance(world, World) else World._resolve(os.fspath(world))
+            world = world_of(spec, world)
             return _hstl._train_world(spec, world, seed, episodes, bar.callback)
         if valuation is None:
             raise TypeError(
                 "train(env=...) needs valuation=, a function from an observation to the spec's state variables"
             )
-        if not (isinstance(world, str) and world == "paper"):
+        if world is not None:
             raise TypeError("pass either world= or env=, not both")
         return _hstl._train_env(spec, env, valuation, seed, *_spaces(env), episodes, bar.callback)
+
+
+def world_of(spec: Spec, world: Union[World, str, "os.PathLike[str]", None]) -> World:
+    """The world to train ``spec`` in: ``world`` when given, else the one the spec names (a
+    path relative to its file), else ``paper``."""
+    if world is not None:
+        return world if isinstance(world, World) else World._resolve(os.fspath(world))
+    named = spec.world
+    if named is None:
+        return World.builtin("paper")
+    try:
+        return World.builtin(named)
+    except ValueError:
+        pass
+    folder = "" if spec.filename.startswith("<") else os.path.dirname(spec.filename)
+    return World._resolve(os.path.join(folder, named))
 
 
 def _spaces(env: Any) -> tuple[str, int, int, int, int]:

@@ -33,7 +33,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Union
 
 from . import _hstl
 from ._hstl import Spec, World
-from ._train import _seed_of
+from ._train import _seed_of, world_of
 
 #: The ``learn`` values a config may set.
 LEARN_KEYS = tuple(_hstl.LEARN_KEYS)
@@ -62,7 +62,8 @@ def trainable(config: Mapping[str, Any]) -> None:
     """A Ray Tune function trainable for one spec.
 
     ``config`` holds ``spec`` (a ``hstl.Spec`` or a spec file's path), and may hold
-    ``world`` (a ``hstl.World``, a built-in name or a world file; default ``"paper"``),
+    ``world`` (a ``hstl.World``, a built-in name or a world file; default: the one the spec
+    names, else ``"paper"``),
     ``seed`` (default 0), ``chunk`` (episodes between reports, default ``DEFAULT_CHUNK``),
     ``optimum`` (W*, to report ``ratio``; see ``trainable_for``) and any of
     ``LEARN_KEYS``. Each report holds ``episodes`` (trained so far), ``reward`` (per
@@ -78,8 +79,7 @@ def trainable(config: Mapping[str, Any]) -> None:
         )
     spec = config["spec"]
     spec = spec if isinstance(spec, Spec) else Spec.load(os.fspath(spec))
-    world = config.get("world", "paper")
-    world = world if isinstance(world, World) else World._resolve(os.fspath(world))
+    world = world_of(spec, config.get("world"))
     seed = _seed_of(config.get("seed", 0))
     chunk = config.get("chunk", DEFAULT_CHUNK)
     if isinstance(chunk, (bool, float)) or not hasattr(chunk, "__index__") or int(chunk) < 1:
@@ -103,7 +103,7 @@ def trainable(config: Mapping[str, Any]) -> None:
 
 def trainable_for(
     spec: Union[Spec, str, "os.PathLike[str]"],
-    world: Union[World, str, "os.PathLike[str]"] = "paper",
+    world: Union[World, str, "os.PathLike[str]", None] = None,
     *,
     seed: int = 0,
     chunk: int = DEFAULT_CHUNK,
@@ -117,7 +117,7 @@ def trainable_for(
     so that every trial reports ``ratio`` = W/W*.
     """
     spec = spec if isinstance(spec, Spec) else Spec.load(os.fspath(spec))
-    world = world if isinstance(world, World) else World._resolve(os.fspath(world))
+    world = world_of(spec, world)
     _hstl._study_task(spec, world, None)
     w_star = _hstl._study_optimum(spec, world) if optimum else None
     bound = {"spec": spec, "world": world, "seed": seed, "chunk": chunk, "optimum": w_star}

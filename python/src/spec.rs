@@ -198,6 +198,13 @@ impl Spec {
         &self.filename
     }
 
+    /// The world the spec names with `world "...";` (a built-in name, or a world file's
+    /// path relative to the spec file), or None.
+    #[getter]
+    fn world(&self) -> Option<&str> {
+        self.spec.world.as_ref().map(|w| w.name.as_str())
+    }
+
     /// The source text it was checked from.
     #[getter]
     fn source(&self) -> &str {

@@ -38,10 +38,21 @@ pub fn spec_module(
         _ => TokenStream::new(),
     };
     let spec_impl = if complete { g.spec_impl(src) } else { TokenStream::new() };
+    let world = match &spec.world {
+        Some(w) => {
+            let name = &w.name;
+            quote!(::core::option::Option::Some(#name))
+        }
+        None => quote!(::core::option::Option::None),
+    };
     quote! {
         #doc
         #[allow(dead_code)]
         pub mod #module {
+            /// The world the spec names with `world "...";` (a built-in world's name, or a
+            /// world file's path relative to the spec), if any: the macro reads no file, so
+            /// the spec is checked alone.
+            pub const WORLD: ::core::option::Option<&'static str> = #world;
             #state
             #primitives
             #options
@@ -559,7 +570,10 @@ impl<'a> Gen<'a> {
                     #data
                 }
 
-                /// Robustness at every step of the trace.
+                /// Robustness at every step of the trace. States are taken as given: a NaN
+                /// field, or an expression that computes NaN, is skipped by the mins and
+                /// maxes (the NaN policy of `hstl::robustness::offline`); refuse such a trace
+                /// first with `hstl::robustness::nan` where it can occur.
                 pub fn signal(trace: &[#state]) -> ::std::vec::Vec<f64> {
                     signal_with(trace, &mut #kernels::new())
                 }
@@ -567,7 +581,7 @@ impl<'a> Gen<'a> {
                 #signal_with
 
                 /// Robustness of the trace: at step 0 (what the reference evaluator gives
-                /// for an empty trace when it is empty).
+                /// for an empty trace when it is empty). NaN as for [`signal`].
                 pub fn robustness(trace: &[#state]) -> f64 {
                     #robustness
                 }

@@ -4,6 +4,7 @@
 use std::cell::OnceCell;
 use std::collections::HashSet;
 use std::ops::Range;
+use std::path::Path;
 
 use hstl::lang::check::MAX_DOMAIN_STATES;
 use hstl::lang::syntax::{
@@ -18,6 +19,7 @@ use lsp_types::{
 };
 
 use super::convert::{Converter, Encoding};
+use super::worlds::{DocWorlds, WorldCache};
 
 /// What a name refers to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -57,12 +59,6 @@ pub struct Leftovers {
     _parts: Box<dyn std::any::Any>,
 }
 
-/// The default world of `hstlc check`, as the checks see it.
-fn paper() -> &'static hstl::lang::WorldFacts {
-    static PAPER: std::sync::OnceLock<hstl::lang::WorldFacts> = std::sync::OnceLock::new();
-    PAPER.get_or_init(|| hstl::world::facts(&hstl::world::GridWorld::default(), "world `paper`"))
-}
-
 /// Everything the server knows about one version of a document.
 pub struct Analysis {
     /// The text.
@@ -77,13 +73,20 @@ pub struct Analysis {
     occurrences: OnceCell<Vec<Occurrence>>,
     /// Position conversion for this text.
     pub conv: Converter,
+    /// The worlds the specs name, as they were checked against.
+    pub worlds: DocWorlds,
 }
 
 impl Analysis {
     /// Checks `text` and indexes its names.
-    pub fn new(text: String, enc: Encoding) -> Self {
+    pub fn new(
+        text: String,
+        enc: Encoding,
+        worlds: &mut WorldCache,
+        folder: Option<&Path>,
+    ) -> Self {
         let parsed = hstl::lang::parse(&text);
-        Self::from_parsed(text, parsed, enc)
+        Self::from_parsed(text, parsed, enc, worlds, folder)
     }
 
     /// The analysis of a new version of the text of `prev`: only the items around the
@@ -91,12 +94,18 @@ impl Analysis {
     ///
     /// Also returns what is left of `prev` (the old text and checked specs), so that the
     /// caller can free it after answering rather than before.
-    pub fn update(prev: Analysis, text: String, enc: Encoding) -> (Self, Leftovers) {
+    pub fn update(
+        prev: Analysis,
+        text: String,
+        enc: Encoding,
+        worlds: &mut WorldCache,
+        folder: Option<&Path>,
+    ) -> (Self, Leftovers) {
         let Analysis { text: old, checked, parse_diagnostics, occurrences, .. } = prev;
         let hstl::lang::Checked { file, specs, diagnostics } = checked;
         let prev = hstl::lang::Parsed { file, diagnostics: parse_diagnostics };
         let (parsed, _) = hstl::lang::incremental::reparse(prev, &old, &text);
-        let next = Self::from_parsed(text, parsed, enc);
+        let next = Self::from_parsed(text, parsed, enc, worlds, folder);
         (next, Leftovers { _parts: Box::new((old, specs, diagnostics, occurrences)) })
     }
 
@@ -105,12 +114,20 @@ impl Analysis {
         Leftovers { _parts: Box::new(self) }
     }
 
-    fn from_parsed(text: String, parsed: hstl::lang::Parsed, enc: Encoding) -> Self {
+    fn from_parsed(
+        text: String,
+        parsed: hstl::lang::Parsed,
+        enc: Encoding,
+        cache: &mut WorldCache,
+        folder: Option<&Path>,
+    ) -> Self {
         let parse_diagnostics = parsed.diagnostics.clone();
-        // The same diagnostics as `hstlc check`, whose default world is `paper`.
-        let checked = hstl::lang::check_parsed_in_world(&text, parsed, paper());
+        // The same diagnostics as `hstlc check`: each spec against the world it names.
+        let worlds = cache.resolve(&parsed, folder);
+        let checked =
+            hstl::lang::check_parsed_with_worlds(&text, parsed, &|spec| worlds.lookup(spec));
         let conv = Converter::new(&text, enc);
-        Analysis { text, checked, parse_diagnostics, occurrences: OnceCell::new(), conv }
+        Analysis { text, checked, parse_diagnostics, occurrences: OnceCell::new(), conv, worlds }
     }
 
     /// Every name occurrence, sorted by start.
@@ -220,7 +237,7 @@ fn index_spec(spec_i: usize, spec: &Spec, out: &mut Vec<Occurrence>) {
                     push(id.range.clone(), SymKind::Option, &id.name, false);
                 }
             }
-            Item::Learn(_) => {}
+            Item::Learn(_) | Item::World(_) => {}
         }
     }
     for (range, name, formula) in names {
@@ -325,7 +342,7 @@ pub fn hover(a: &Analysis, pos: Position) -> Option<Hover> {
     let option = a.occurrences_at(offset).find(|o| o.symbol.kind == SymKind::Option);
     let (range, text) = match option.or_else(|| a.symbol_at(offset)) {
         Some(o) => (o.range.clone(), symbol_hover(a, &o.symbol)?),
-        None => match preset_hover(a, offset) {
+        None => match preset_hover(a, offset).or_else(|| world_hover(a, offset)) {
             Some(found) => found,
             None => operator_hover(a, offset)?,
         },
@@ -334,6 +351,29 @@ pub fn hover(a: &Analysis, pos: Position) -> Option<Hover> {
         contents: HoverContents::Markup(MarkupContent { kind: MarkupKind::Markdown, value: text }),
         range: Some(a.conv.range(&a.text, &range)),
     })
+}
+
+/// The `world` item whose string holds `offset`, quotes included.
+fn world_at(a: &Analysis, offset: usize) -> Option<&syntax::WorldItem> {
+    a.checked.file.specs.iter().flat_map(|s| &s.items).find_map(|i| match i {
+        Item::World(w) if w.name_range.start <= offset && offset <= w.name_range.end => Some(w),
+        _ => None,
+    })
+}
+
+/// On a `world` item's string: the world it names (its size and slip), or why it cannot be
+/// had.
+fn world_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)> {
+    let item = world_at(a, offset)?;
+    let resolved = a.worlds.get(&item.name)?;
+    let text = match resolved.world.as_ref() {
+        Ok((_, words)) => format!(
+            "**{words}**: the world this spec is written for; `hstlc check`, `train` and \
+             `study` use it (`--world` overrides it)"
+        ),
+        Err(problem) => format!("**world unavailable**: {}", problem.message),
+    };
+    Some((item.name_range.clone(), text))
 }
 
 /// On `preset` in a `learn` item (its name or its value): what the preset sets, and for
@@ -808,12 +848,23 @@ fn step(k: u64, past: bool) -> String {
     }
 }
 
-/// Where the symbol at `pos` is declared.
-pub fn definition(a: &Analysis, pos: Position) -> Option<lsp_types::Range> {
+/// Where a go-to-definition leads.
+pub enum Target {
+    /// A range of the same document.
+    Here(lsp_types::Range),
+    /// The start of another file (a world file).
+    File(std::path::PathBuf),
+}
+
+/// Where the symbol at `pos` is declared; on a `world` item's string, the world file.
+pub fn definition(a: &Analysis, pos: Position) -> Option<Target> {
     let offset = a.conv.offset(&a.text, pos);
+    if let Some(item) = world_at(a, offset) {
+        return a.worlds.get(&item.name)?.path.clone().map(Target::File);
+    }
     let o = a.symbol_at(offset)?;
     let d = a.declaration(&o.symbol)?;
-    Some(a.conv.range(&a.text, &d.range))
+    Some(Target::Here(a.conv.range(&a.text, &d.range)))
 }
 
 /// Every occurrence of the symbol at `pos`.
@@ -913,6 +964,14 @@ pub fn symbols(a: &Analysis) -> Vec<DocumentSymbol> {
                         None,
                     ));
                 }
+                Item::World(w) => children.push(sym(
+                    "world".into(),
+                    Some(w.name.clone()),
+                    SymbolKind::FILE,
+                    &w.range,
+                    &w.name_range,
+                    None,
+                )),
             }
         }
         out.push(sym(
@@ -932,12 +991,17 @@ pub fn symbols(a: &Analysis) -> Vec<DocumentSymbol> {
 const FIELD_WORDS: [&str; 3] = ["reach", "init", "terminate"];
 
 /// Keywords, then the names of the spec the cursor is in (variables, lets, options;
-/// also those declared by items that do not parse yet).
+/// also those declared by items that do not parse yet). Inside the string of a `world`
+/// item: the built-in worlds and the world files beside the document.
 pub fn completion(a: &Analysis, pos: Position) -> Vec<CompletionItem> {
     let offset = a.conv.offset(&a.text, pos);
+    if in_world_string(&a.text, offset) {
+        return world_completion(a);
+    }
     let mut items: Vec<CompletionItem> = hstl::lang::KEYWORDS
         .iter()
         .chain(FIELD_WORDS.iter())
+        .chain(["world"].iter())
         .map(|k| CompletionItem {
             label: (*k).to_string(),
             kind: Some(CompletionItemKind::KEYWORD),
@@ -985,6 +1049,49 @@ pub fn completion(a: &Analysis, pos: Position) -> Vec<CompletionItem> {
     items
 }
 
+/// Whether `offset` is inside an open `world "...` string: the line before it reads
+/// `world`, a quote, and no other quote.
+fn in_world_string(text: &str, offset: usize) -> bool {
+    let Some(before) = text.get(..offset) else { return false };
+    let line = &before[before.rfind(['\n', '\r']).map_or(0, |i| i + 1)..];
+    let Some(quote) = line.find('"') else { return false };
+    line[..quote].trim_end().ends_with("world") && !line[quote + 1..].contains('"')
+}
+
+/// The most world files offered from the document's folder.
+const MAX_WORLD_FILES: usize = 200;
+
+/// The built-in worlds, then the `.toml` files in the document's folder.
+fn world_completion(a: &Analysis) -> Vec<CompletionItem> {
+    let mut items: Vec<CompletionItem> = hstl::world::BUILTIN
+        .iter()
+        .map(|name| CompletionItem {
+            label: (*name).to_string(),
+            kind: Some(CompletionItemKind::CONSTANT),
+            detail: Some("built-in world".into()),
+            ..CompletionItem::default()
+        })
+        .collect();
+    let Some(folder) = a.worlds.folder() else { return items };
+    let Ok(entries) = std::fs::read_dir(folder) else { return items };
+    let mut files: Vec<String> = entries
+        .filter_map(Result::ok)
+        .take(10 * MAX_WORLD_FILES)
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    files.sort();
+    files.truncate(MAX_WORLD_FILES);
+    items.extend(files.into_iter().map(|name| CompletionItem {
+        label: name,
+        kind: Some(CompletionItemKind::FILE),
+        detail: Some("world file beside the spec".into()),
+        ..CompletionItem::default()
+    }));
+    items
+}
+
 /// The edits that give the canonical layout (none when it is already canonical), or why
 /// the text cannot be formatted.
 pub fn format(a: &Analysis) -> Result<Vec<TextEdit>, String> {
@@ -1018,7 +1125,7 @@ mod tests {
 
     /// The hover text at the `nth` occurrence of `word` in `text`.
     fn hover_at(text: &str, word: &str, nth: usize) -> String {
-        let a = Analysis::new(text.to_string(), Encoding::Utf8);
+        let a = Analysis::new(text.to_string(), Encoding::Utf8, &mut WorldCache::default(), None);
         let at = text.match_indices(word).nth(nth).map(|(i, _)| i).expect("the word");
         let pos = a.conv.position(text, at + 1);
         match hover(&a, pos).map(|h| h.contents) {
@@ -1098,7 +1205,7 @@ mod tests {
     #[test]
     fn completion_offers_past_operators() {
         let text = "spec S { state { x: float } task x > 0; }";
-        let a = Analysis::new(text.to_string(), Encoding::Utf8);
+        let a = Analysis::new(text.to_string(), Encoding::Utf8, &mut WorldCache::default(), None);
         let labels: Vec<String> = completion(&a, Position { line: 0, character: 30 })
             .into_iter()
             .map(|i| i.label)

@@ -10,11 +10,12 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Display;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
 
 use lsp_server::ErrorCode;
 use lsp_types::notification::{
-    DidChangeTextDocument, DidCloseTextDocument, DidOpenTextDocument, Notification as _,
-    PublishDiagnostics,
+    DidChangeTextDocument, DidChangeWatchedFiles, DidCloseTextDocument, DidOpenTextDocument,
+    Notification as _, PublishDiagnostics,
 };
 use lsp_types::request::{
     Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, References,
@@ -32,6 +33,7 @@ use super::convert::Encoding;
 use super::features::{self, Analysis, Leftovers};
 use super::queue::{Outgoing, Sink};
 use super::transport::{Id, Incoming};
+use super::worlds::{WorldCache, path_uri, uri_path};
 
 /// Largest document analysed (4 MiB): a larger one is kept open, but gets no
 /// diagnostics or answers, and the client is told once why.
@@ -125,6 +127,8 @@ pub struct Server {
     next_stale: u64,
     /// What is left of replaced analyses, dropped once the diagnostics are queued.
     trash: Vec<Leftovers>,
+    /// The world files documents name, read once each.
+    worlds: WorldCache,
     log: Log,
 }
 
@@ -140,6 +144,7 @@ impl Server {
             stale: BTreeMap::new(),
             next_stale: 0,
             trash: Vec::new(),
+            worlds: WorldCache::default(),
             log,
         }
     }
@@ -303,8 +308,12 @@ impl Server {
                 let pos = p.text_document_position_params;
                 let doc = self.document(&pos.text_document.uri, out)?;
                 let uri = pos.text_document.uri.clone();
-                let location = features::definition(doc, pos.position)
-                    .map(|range| lsp_types::Location { uri, range });
+                let location = match features::definition(doc, pos.position) {
+                    Some(features::Target::Here(range)) => Some(lsp_types::Location { uri, range }),
+                    Some(features::Target::File(path)) => path_uri(&path)
+                        .map(|uri| lsp_types::Location { uri, range: lsp_types::Range::default() }),
+                    None => None,
+                };
                 reply(id, &location)
             }
             References::METHOD => {
@@ -387,6 +396,24 @@ impl Server {
                 }
                 self.store(p.text_document.uri, p.text_document.version, change.text);
             }
+            DidChangeWatchedFiles::METHOD => {
+                // A world file may have changed: documents that read one are checked again.
+                let reread: Vec<Uri> = self
+                    .documents
+                    .iter()
+                    .filter(|(_, d)| {
+                        d.pending.is_none()
+                            && matches!(&d.state, State::Analysed(a) if a.worlds.has_files())
+                    })
+                    .map(|(u, _)| u.clone())
+                    .collect();
+                for uri in reread {
+                    let Some(doc) = self.documents.get(&uri) else { continue };
+                    let State::Analysed(a) = &doc.state else { continue };
+                    let (version, text) = (doc.version, a.text.clone());
+                    self.store(uri, version, text);
+                }
+            }
             DidCloseTextDocument::METHOD => {
                 let p: lsp_types::DidCloseTextDocumentParams =
                     serde_json::from_value(params).map_err(|e| e.to_string())?;
@@ -449,13 +476,16 @@ impl Server {
             State::TooLarge(text.len())
         } else {
             let trash = &mut self.trash;
+            let worlds = &mut self.worlds;
+            let path = uri_path(uri);
+            let folder = path.as_deref().and_then(Path::parent);
             let analysed = catch_unwind(AssertUnwindSafe(|| match prev {
                 State::Analysed(prev) => {
-                    let (next, leftovers) = Analysis::update(*prev, text, encoding);
+                    let (next, leftovers) = Analysis::update(*prev, text, encoding, worlds, folder);
                     trash.push(leftovers);
                     next
                 }
-                _ => Analysis::new(text, encoding),
+                _ => Analysis::new(text, encoding, worlds, folder),
             }));
             match analysed {
                 Ok(a) => State::Analysed(Box::new(a)),

@@ -57,6 +57,8 @@ struct Client {
     server: Option<JoinHandle<std::io::Result<super::Ending>>>,
     next_id: i32,
     notifications: Vec<Notification>,
+    /// The document the client edits.
+    uri: String,
 }
 
 impl Client {
@@ -80,6 +82,7 @@ impl Client {
             server: Some(handle),
             next_id: 0,
             notifications: vec![],
+            uri: URI.to_string(),
         };
         let init = c.request("initialize", json!({ "capabilities": capabilities }));
         let result = init.result.expect("initialize succeeds");
@@ -131,14 +134,14 @@ impl Client {
             self.notifications.remove(0)
         };
         assert_eq!(n.method, "textDocument/publishDiagnostics");
-        assert_eq!(n.params["uri"], URI);
+        assert_eq!(n.params["uri"], self.uri.as_str());
         n.params["diagnostics"].as_array().cloned().unwrap_or_default()
     }
 
     fn open(&mut self, text: &str) -> Vec<Value> {
         self.notify(
             "textDocument/didOpen",
-            json!({ "textDocument": { "uri": URI, "languageId": "hstl", "version": 1, "text": text } }),
+            json!({ "textDocument": { "uri": self.uri, "languageId": "hstl", "version": 1, "text": text } }),
         );
         self.diagnostics()
     }
@@ -146,7 +149,7 @@ impl Client {
     fn change(&mut self, version: i32, text: &str) -> Vec<Value> {
         self.notify(
             "textDocument/didChange",
-            json!({ "textDocument": { "uri": URI, "version": version }, "contentChanges": [{ "text": text }] }),
+            json!({ "textDocument": { "uri": self.uri, "version": version }, "contentChanges": [{ "text": text }] }),
         );
         self.diagnostics()
     }
@@ -154,7 +157,7 @@ impl Client {
     fn at(&mut self, method: &str, line: u32, character: u32) -> Reply {
         self.request(
             method,
-            json!({ "textDocument": { "uri": URI }, "position": { "line": line, "character": character }, "context": { "includeDeclaration": true } }),
+            json!({ "textDocument": { "uri": self.uri }, "position": { "line": line, "character": character }, "context": { "includeDeclaration": true } }),
         )
     }
 
@@ -370,8 +373,7 @@ fn diagnostics_match_check_on_every_invalid_fixture() {
         let text = std::fs::read_to_string(&path).unwrap();
         version += 1;
         let got = c.change(version, &text);
-        let want = hstl::world::check(&text, &hstl::world::GridWorld::default(), "world `paper`")
-            .diagnostics;
+        let want = crate::world_arg::check_source(&text, None, None).0.diagnostics;
         assert_eq!(got.len(), want.len(), "{}", path.display());
         for (g, w) in got.iter().zip(&want) {
             assert_eq!(g["code"], w.code, "{}", path.display());
@@ -730,4 +732,56 @@ fn idle_analysis_skips_closed_documents_and_keeps_the_order_of_changes() {
             "textDocument/publishDiagnostics d 1",
         ]
     );
+}
+
+/// A spec names its world: the editor reads it relative to the document, underlines a
+/// missing one at the item, hovers and goes to the world file, completes names inside the
+/// string, and reads the file again when it changes.
+#[test]
+fn the_world_a_spec_names() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let world = dir.path().join("nook.toml");
+    std::fs::write(&world, "map = \"\"\"\n.....\n.....\n.....\n.....\n\"\"\"\n").expect("world");
+    let spec = "spec Nook {
+    world \"nook.toml\";
+    state { x: int in 0..=4, y: int in 0..=3 }
+    let Corner = x > 2 && y > 1;
+    task always[0..] eventually[0..20] Corner;
+    option Corner;
+}
+";
+    let (mut c, _) = Client::start(json!({}));
+    c.uri = super::worlds::path_uri(&dir.path().join("spec.hstl")).expect("uri").to_string();
+    // The world fits: no diagnostics (against `paper` the state would not fit).
+    assert_eq!(c.open(spec), Vec::<Value>::new());
+    // Hover on the string names the world; go to definition opens its file.
+    let (line, col) = pos_of(spec, "nook.toml", 0, 2);
+    let hover = c.at("textDocument/hover", line, col).result.expect("hover");
+    let text = hover["contents"]["value"].as_str().unwrap_or_default().to_string();
+    assert!(text.contains("world `nook`") && text.contains("5 x 4"), "{text}");
+    let target = c.at("textDocument/definition", line, col).result.expect("definition");
+    let want = super::worlds::path_uri(&world).expect("uri").to_string();
+    assert_eq!(target["uri"], want.as_str());
+    // Inside the string: the built-in worlds and the world files beside the spec.
+    let params =
+        json!({ "textDocument": { "uri": c.uri }, "position": { "line": line, "character": col } });
+    let items = c.request("textDocument/completion", params).result.expect("completion");
+    let labels: Vec<&str> =
+        items.as_array().unwrap().iter().filter_map(|i| i["label"].as_str()).collect();
+    assert_eq!(labels, ["paper", "four-rooms", "nook.toml"]);
+    // The world file shrinks: the spec no longer fits, once the editor says files changed.
+    std::fs::write(&world, "map = \"\"\"\n...\n...\n\"\"\"\n").expect("world");
+    c.notify("workspace/didChangeWatchedFiles", json!({ "changes": [] }));
+    let diags = c.diagnostics();
+    assert!(diags.iter().any(|d| d["code"] == "HSTL030"), "{diags:#?}");
+    // A missing world: HSTL034 at the item, beside the spec's own diagnostics.
+    let missing =
+        spec.replace("nook.toml", "nowhere.toml").replace("option Corner;", "option Cornr;");
+    let diags = c.change(3, &missing);
+    let codes: Vec<&str> = diags.iter().filter_map(|d| d["code"].as_str()).collect();
+    assert!(codes.contains(&"HSTL034") && codes.contains(&"HSTL010"), "{codes:?}");
+    let at = diags.iter().find(|d| d["code"] == "HSTL034").expect("HSTL034");
+    let (line, col) = pos_of(&missing, "\"nowhere.toml\"", 0, 0);
+    assert_eq!(at["range"]["start"], json!({ "line": line, "character": col }));
+    c.shutdown();
 }
