@@ -541,10 +541,19 @@ impl Cx<'_> {
     }
 
     fn int_bound(&mut self, n: &syntax::NumberLit, what: &str) -> Option<i64> {
-        match n.as_integer().and_then(|v| i64::try_from(v).ok()) {
-            Some(v) if v < i64::MAX / 4 => Some(v),
+        // A domain bound may be negative (`-5..=5`); an interval's never is (the grammar).
+        let (negative, magnitude) = match n.text.strip_prefix('-') {
+            Some(digits) if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) => {
+                (true, digits.parse::<u64>().ok())
+            }
+            _ => (false, n.as_integer()),
+        };
+        let value = magnitude.and_then(|v| i64::try_from(v).ok()).filter(|&v| v < i64::MAX / 4);
+        match value.map(|v| if negative { -v } else { v }) {
+            Some(v) => Some(v),
             _ => {
-                let whole = n.as_integer().is_some() || n.text.bytes().all(|b| b.is_ascii_digit());
+                let digits = n.text.strip_prefix('-').unwrap_or(&n.text);
+                let whole = !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit());
                 let msg = if whole {
                     format!("{what} bound `{}` is too large", n.text)
                 } else {
@@ -1160,22 +1169,46 @@ impl Cx<'_> {
                 range: o.range.clone(),
             });
         }
-        // HSTL014: options need a finite state space.
+        // HSTL014: options need a bounded state space (tables or tilings cover it).
         if let Some(first) = decls.first() {
             for v in &out.state_vars {
-                if !matches!(v.domain, Domain::Int { .. }) {
-                    let ty = if v.ty == syntax::VarType::Int { "int" } else { "float" };
+                if v.domain == Domain::Unbounded {
+                    let (ty, example) = match v.ty {
+                        syntax::VarType::Int => ("int", "int in 0..=N"),
+                        syntax::VarType::Float => ("float", "float in LO..=HI"),
+                    };
                     self.push(
                         Diagnostic::new(
                             "HSTL014",
                             v.name_range.clone(),
-                            format!("state variable `{}` has no finite `int` range", v.name),
+                            format!("state variable `{}` has no bounds", v.name),
                         )
                         .with_label(first.name.range.clone(), "options are declared here")
                         .with_help(format!(
-                            "options need a finite state space: declare `{}: int in 0..=N` (it is `{ty}`{})",
-                            v.name,
-                            if ty == "int" { " without a range" } else { "" }
+                            "options need a bounded state space: declare `{}: {example}` (it is `{ty}` without a range)",
+                            v.name
+                        )),
+                    );
+                }
+            }
+            // HSTL025: the most robust state of a region is found by enumerating the domain.
+            if let Some(v) =
+                out.state_vars.iter().find(|v| matches!(v.domain, Domain::Float { .. }))
+            {
+                for p in out.primitives.iter().filter(|p| p.terminate == Terminate::Argmax) {
+                    self.push(
+                        Diagnostic::new(
+                            "HSTL025",
+                            p.name_range.clone(),
+                            format!(
+                                "option `{}` stops where its region is most robust (`terminate: argmax`, the default), which needs a finite domain, but `{}` is a `float`",
+                                p.name, v.name
+                            ),
+                        )
+                        .with_help(format!(
+                            "stop on entering the region: `option {} {{ terminate: {} }}`, or `learn {{ preset: auto }}`, which does so",
+                            p.name,
+                            self.src.get(p.reach.range.clone()).unwrap_or("REGION")
                         )),
                     );
                 }

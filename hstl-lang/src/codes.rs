@@ -177,12 +177,13 @@ Fix: rename a primitive option (or the `let` it reaches) or drop one entry.",
         code: "HSTL014",
         name: "infinite-domain",
         severity: E,
-        summary: "a state variable without a finite `int` range while options are declared",
-        explanation: "Options are learned with tables over every state, so every state variable \
-must be `int` with a range when the spec declares an option.\n\n\
+        summary: "a state variable without bounds while options are declared",
+        explanation: "Options are learned over the whole state space: with tables over every \
+state of an `int` domain, or with tilings over the box of a `float` one (`learner: tiles`). \
+Either needs bounds, so every state variable has a range when the spec declares an option.\n\n\
 Example:\n    state { x: float, y: int }\n    option A;\n\n\
-Fix: declare `x: int in 0..=14`, or remove the options (a spec without options is still a \
-monitor).",
+Fix: bound it, `x: float in 0..=14` or `y: int in 0..=14` (a world's extent or size), or \
+remove the options (a spec without options is still a monitor).",
     },
     CodeInfo {
         code: "HSTL015",
@@ -291,6 +292,19 @@ Fix: list the sequences you need with `options { ... }`.",
         explanation: "At most 200 diagnostics are reported per file; this one says how many more \
 there were (it is an error when some of those were errors).\n\n\
 Fix: fix the reported ones and check again.",
+    },
+    CodeInfo {
+        code: "HSTL025",
+        name: "argmax-needs-finite-domain",
+        severity: E,
+        summary: "`terminate: argmax` over a `float` state",
+        explanation: "An option without `terminate` (or with `terminate: argmax`, the paper's \
+rule) stops in the states where its region's robustness is largest. Those states are found by \
+enumerating the domain, which a `float` variable does not allow; on a continuous state the \
+most robust point is usually a single point the robot never hits exactly.\n\n\
+Example:\n    state { x: float in 0..=14, y: float in 0..=14 }\n    let A = x > 12 && y > 12;\n    option A;\n\n\
+Fix: stop on entering the region, `option A { terminate: A }`, or write `learn { preset: \
+auto }`, which gives every option that form.",
     },
     CodeInfo {
         code: "HSTL030",

@@ -1006,6 +1006,12 @@ impl Builder<'_> {
         NumberLit { value: text.parse().unwrap_or(f64::NAN), text, range: self.range(p) }
     }
 
+    /// `-` and a number (white space between them dropped from the text).
+    fn neg_number(&self, p: &Pair<'_, Rule>) -> NumberLit {
+        let text: String = p.as_str().split_whitespace().collect();
+        NumberLit { value: text.parse().unwrap_or(f64::NAN), text, range: self.range(p) }
+    }
+
     fn too_tall(&self, range: Range<usize>) -> Fail {
         Fail(
             Diagnostic::new(
@@ -1158,6 +1164,7 @@ impl Builder<'_> {
                     for x in c.into_inner() {
                         match x.as_rule() {
                             Rule::number => nums.push(self.number(&x)),
+                            Rule::neg_number => nums.push(self.neg_number(&x)),
                             Rule::range_op => inclusive = x.as_str() == "..=",
                             _ => {}
                         }
@@ -1209,12 +1216,7 @@ impl Builder<'_> {
                     let Some(v) = c.into_inner().next() else { continue };
                     value = Some(match v.as_rule() {
                         Rule::number => ParamValue::Number(self.number(&v)),
-                        Rule::neg_number => {
-                            let r = self.range(&v);
-                            let text: String = v.as_str().split_whitespace().collect();
-                            let value = text.parse().unwrap_or(f64::NAN);
-                            ParamValue::Number(NumberLit { value, text, range: r })
-                        }
+                        Rule::neg_number => ParamValue::Number(self.neg_number(&v)),
                         Rule::ident => ParamValue::Word(ident(&v, self.offset)),
                         _ => {
                             let r = self.range(&v);

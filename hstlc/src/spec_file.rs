@@ -78,6 +78,10 @@ pub fn load_trainable(
         (None, None) => {
             // A spec that names no world trains in `paper`, checked against it first.
             let paper = LoadedWorld::load("paper")?;
+            if loaded.spec.primitives.is_empty() {
+                // Nothing to train: `trainable` says so, without a word on worlds.
+                return Ok(Some((loaded, paper)));
+            }
             err!(
                 "note: {}: spec `{}` names no world (`world \"NAME\";`): training in {}\n",
                 loaded.file,
