@@ -39,9 +39,10 @@ pub fn normal_pair(rng: &mut Rng) -> [f64; 2] {
     }
 }
 
-/// ln 2 split so that `k * LN2_HI` is exact for every exponent `k` of a double.
-const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-1;
-const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+/// ln 2 split so that `k * LN2_HI` is exact for every exponent `k` of a double (its low 32
+/// bits are zero): 6.93147180369123816490e-01 and 1.90821492927058770002e-10.
+const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
 
 /// The natural logarithm of a positive finite `x`, within a few units in the last place,
 /// from basic operations only. `x = 2^k * m` with `m` in `(sqrt(2)/2, sqrt(2)]`, and

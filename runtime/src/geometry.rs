@@ -364,8 +364,8 @@ mod tests {
         fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
             let mut out = Vec::new();
             let mut borrow = 0i64;
-            for i in 0..a.len() {
-                let mut d = i64::from(a[i]) - i64::from(*b.get(i).unwrap_or(&0)) - borrow;
+            for (i, &ai) in a.iter().enumerate() {
+                let mut d = i64::from(ai) - i64::from(*b.get(i).unwrap_or(&0)) - borrow;
                 borrow = i64::from(d < 0);
                 if d < 0 {
                     d += 1 << 32;

@@ -247,9 +247,8 @@ impl PlaneWorld {
 
     pub(crate) fn build(name: &str, mut config: PlaneConfig) -> Result<PlaneWorld, ConfigError> {
         let err = |field, message: String, help| Err(ConfigError { field, message, help });
-        let axes: [(&str, [f64; 2], fn(Option<usize>) -> Field); 2] =
-            [("x", config.x, Field::X), ("y", config.y, Field::Y)];
-        for (axis, [lo, hi], field) in axes {
+        for (axis, [lo, hi]) in [("x", config.x), ("y", config.y)] {
+            let field = |i| if axis == "x" { Field::X(i) } else { Field::Y(i) };
             if let Some(i) = [lo, hi].iter().position(|v| !v.is_finite()) {
                 let message =
                     format!("{axis} = {}: the extent's bounds must be finite", list(&[lo, hi]));

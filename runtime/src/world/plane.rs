@@ -7,7 +7,7 @@ use std::ops::Range;
 use serde::Deserialize;
 use serde::de::{self, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use toml::Spanned;
-use toml::de::DeTable;
+use toml::de::{DeTable, DeValue};
 
 use super::{WorldError, world_name};
 use crate::plane::{
@@ -50,7 +50,7 @@ enum Raw {
     List(Vec<Spanned<Raw>>, usize),
     /// The entries kept and how many there were.
     Table(Vec<(Spanned<String>, Spanned<Raw>)>, usize),
-    /// A boolean or a date.
+    /// A boolean (dates are refused before, see [`refuse_dates`]).
     Other(&'static str),
 }
 
@@ -130,11 +130,6 @@ impl<'de> Visitor<'de> for RawVisitor {
         let mut entries = Vec::new();
         let mut count = 0usize;
         while let Some(key) = map.next_key::<Spanned<String>>()? {
-            // toml hands a date over as a table with this one key.
-            if count == 0 && key.get_ref() == "$__toml_private_datetime" {
-                map.next_value::<IgnoredAny>()?;
-                return Ok(Raw::Other("a date"));
-            }
             if count < MAX_ITEMS {
                 entries.push((key, map.next_value::<Spanned<Raw>>()?));
             } else {
@@ -150,26 +145,29 @@ fn error(message: impl Into<String>, span: Range<usize>, help: &str) -> WorldErr
     WorldError::new(message, Some(span), help)
 }
 
+/// Where a list of numbers is: the list, and each number.
+type Located = (Range<usize>, Vec<Range<usize>>);
+
 /// The spans a range error can point at.
 #[derive(Default)]
 struct Spans {
-    x: Option<(Range<usize>, Vec<Range<usize>>)>,
-    y: Option<(Range<usize>, Vec<Range<usize>>)>,
+    x: Option<Located>,
+    y: Option<Located>,
     step: Range<usize>,
     headings: Range<usize>,
     slip: Option<Range<usize>>,
     noise: Option<Range<usize>>,
     obstacles: Option<Range<usize>>,
     /// Per obstacle: its list of numbers and each number.
-    obstacle: Vec<(Range<usize>, Vec<Range<usize>>)>,
-    start: Option<(Range<usize>, Vec<Range<usize>>)>,
+    obstacle: Vec<Located>,
+    start: Option<Located>,
     /// The `kind` value: what a missing key points at.
     kind: Range<usize>,
 }
 
 impl Spans {
     fn of(&self, field: Field) -> Range<usize> {
-        let pick = |whole: &Option<(Range<usize>, Vec<Range<usize>>)>, i: Option<usize>| {
+        let pick = |whole: &Option<Located>, i: Option<usize>| {
             whole.as_ref().map(|(all, each)| i.and_then(|i| each.get(i)).unwrap_or(all).clone())
         };
         let span = match field {
@@ -197,7 +195,7 @@ fn numbers(
     n: usize,
     desc: &str,
     help: &str,
-) -> Result<(Vec<f64>, (Range<usize>, Vec<Range<usize>>)), WorldError> {
+) -> Result<(Vec<f64>, Located), WorldError> {
     let Raw::List(items, count) = value.get_ref() else {
         let message = format!("{key} must be {desc}, not {}", value.get_ref().what());
         return Err(error(message, value.span(), help));
@@ -242,6 +240,7 @@ pub(super) fn parse(
     table: Spanned<DeTable<'_>>,
     default_name: &str,
 ) -> Result<PlaneWorld, WorldError> {
+    refuse_dates(table.get_ref())?;
     let file = PlaneFile::deserialize(toml::de::Deserializer::from(table)).map_err(|e| {
         let message = e.message().trim_end_matches(['\n', '.']).replace('\n', "; ");
         WorldError::new(message, e.span(), KEYS_HELP)
@@ -344,11 +343,31 @@ pub(super) fn parse(
         .map_err(|ConfigError { field, message, help }| error(message, spans.of(field), help))
 }
 
+/// Refuses the first date in the table: no plane world value is one, and toml hands dates
+/// to a spanned value in a form that cannot be worded.
+fn refuse_dates(table: &DeTable<'_>) -> Result<(), WorldError> {
+    // An explicit stack: nesting depth is the file's, not bounded by us.
+    let mut stack: Vec<&Spanned<DeValue<'_>>> = table.values().collect();
+    while let Some(value) = stack.pop() {
+        match value.get_ref() {
+            DeValue::Datetime(_) => {
+                return Err(error(
+                    "a date is not a value of a plane world",
+                    value.span(),
+                    "write numbers, lists of numbers and obstacle tables; see `kind = \"plane\"` in the docs",
+                ));
+            }
+            DeValue::Array(items) => stack.extend(items.iter()),
+            DeValue::Table(t) => stack.extend(t.values()),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// One obstacle, `{ circle = [cx, cy, r] }` or `{ rect = [x0, y0, x1, y1] }`, with the
 /// spans of its list and numbers.
-fn obstacle(
-    item: &Spanned<Raw>,
-) -> Result<(Obstacle, (Range<usize>, Vec<Range<usize>>)), WorldError> {
+fn obstacle(item: &Spanned<Raw>) -> Result<(Obstacle, Located), WorldError> {
     let Raw::Table(entries, count) = item.get_ref() else {
         let message = format!(
             "an obstacle must be a table such as `{{ circle = [cx, cy, r] }}`, not {}",
