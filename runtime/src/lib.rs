@@ -3,8 +3,12 @@
 //!
 //! - [`spec`]: the plain data a checked spec lowers into ([`TaskSpec`]) and the [`Spec`]
 //!   trait generated code implements.
-//! - [`env`](mod@env): the [`Env`] trait (gymnasium conventions) and the [`GridWorld`]: the
-//!   paper's open grid or a map with walls.
+//! - [`env`](mod@env): the [`World`] trait (gymnasium conventions: reset, step, valuation)
+//!   and its finite refinement [`Env`] (numbered states, for the Q-tables).
+//! - [`grid`]: the [`GridWorld`]: the paper's open grid or a map with walls.
+//! - [`plane`]: the [`PlaneWorld`]: a point robot in a bounded plane with obstacles.
+//! - [`mountain_car`]: gymnasium's MountainCar-v0 as a [`World`].
+//! - [`draw`]: the draws of the continuous worlds, reproducible on every platform.
 //! - [`learn`]: Algorithm 1: flat Q-learning per primitive option, options Q-learning with
 //!   intra-option updates, seeded and bit-for-bit reproducible.
 //! - [`memory`]: the counters and buckets of `memory: B` and the step signal of
@@ -15,30 +19,38 @@
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
 //! - [`optimum`]: the exact optimal window rate `W*` of a persistent task on any grid world.
 //! - [`reach_avoid`]: the exact optimal probability of a reach-avoid task.
-//! - [`world`]: world files (TOML maps with walls and start cells) and the built-in worlds.
+//! - [`world`]: world files (TOML: grid maps with walls and start cells, and plane worlds)
+//!   and the built-in worlds.
 //!
 //! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
 
+pub mod draw;
 pub mod env;
 mod error;
 pub mod eval;
+mod geometry;
+pub mod grid;
 pub mod learn;
 pub mod memory;
+pub mod mountain_car;
 pub mod optimum;
 pub mod plan;
+pub mod plane;
 pub mod policy;
 pub mod reach_avoid;
 pub mod spec;
 mod tables;
 pub mod world;
 
-pub use env::{Cell, Env, GridWorld, Tile};
+pub use env::{Cell, Env, GridWorld, Tile, World};
 pub use error::Error;
 pub use hstl_robustness as robustness;
 pub use learn::{Learner, QTables, Trained};
 pub use memory::Memory;
+pub use mountain_car::{CarState, MountainCar};
+pub use plane::{Obstacle, PlaneConfig, PlaneWorld, Point};
 pub use policy::{Agent, Policy};
-/// What an [`Env`] implementation needs from `rand` and `serde_json`, re-exported so that it
+/// What a [`World`] or [`Env`] implementation needs from `rand` and `serde_json`, re-exported so that it
 /// needs neither in its own `Cargo.toml`: the draws of the one generator ([`Rng`]) and the
 /// parameters' JSON ([`Value`], [`json!`]).
 pub use rand::RngExt;

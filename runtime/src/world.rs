@@ -1,4 +1,5 @@
-//! World files: a grid world as TOML, and the worlds built in by name.
+//! World files: grid worlds (TOML maps) and plane worlds (`kind = "plane"`), and the
+//! worlds built in by name.
 //!
 //! **Contract** (DESIGN.md, "world files"):
 //!
@@ -29,16 +30,47 @@
 //! assert!(!world.is_free(2, 0) && world.is_free(2, 1));
 //! # Ok::<(), hstl_runtime::world::WorldError>(())
 //! ```
+//!
+//! **Contract** (DESIGN.md, "plane worlds"): a file with `kind = "plane"` is a
+//! [`PlaneWorld`]; `kind = "grid"` (or no `kind`) is the map above, read exactly as
+//! before. The keys of a plane world: `name` (optional), `kind`, `x` and `y` (the extent,
+//! `[lo, hi]` with `lo < hi`, finite), `step` (positive, finite), `headings` (3 to 64),
+//! `slip` (in `[0, 1]`, default 0), `noise` (`>= 0`, finite, default 0), `obstacles`
+//! (optional, at most [`MAX_OBSTACLES`]: `{ circle = [cx, cy, r] }` with `r > 0`, or
+//! `{ rect = [x0, y0, x1, y1] }` with `x0 < x1` and `y0 < y1`) and `start` (optional,
+//! `[x0, y0, x1, y1]`, clipped to the extent; it needs a free part). Numbers may be
+//! written as integers. Every error points at the key or value it is about, and unknown
+//! keys are refused.
+//!
+//! ```
+//! use hstl_runtime::world::AnyWorld;
+//! use hstl_runtime::World;
+//!
+//! let text = "kind = \"plane\"\nx = [0, 20]\ny = [0, 10]\nstep = 0.5\nheadings = 8\n\
+//!             obstacles = [{ circle = [10, 5, 1.5] }]\nstart = [0, 0, 2, 2]\n";
+//! let AnyWorld::Plane(world) = AnyWorld::from_toml(text, "yard")? else { panic!() };
+//! assert_eq!(world.name(), "yard");
+//! assert_eq!(world.actions(), ["E", "NE", "N", "NW", "W", "SW", "S", "SE"]);
+//! # Ok::<(), hstl_runtime::world::WorldError>(())
+//! ```
+
+mod plane;
 
 use std::fmt;
 use std::ops::Range;
 
 use serde::Deserialize;
+use serde_json::Value;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
 
-use crate::GridWorld;
 use crate::env::{MAX_GRID_CELLS, Tile};
+use crate::plane::PlaneWorld;
+pub use crate::plane::{MAX_OBSTACLES, PLANE_BUILTIN};
+use crate::{Error, GridWorld, World};
 
-/// The names of the built-in worlds, for [`builtin`].
+/// The names of the built-in grid worlds, for [`builtin`]; [`PLANE_BUILTIN`] names the
+/// plane ones, and [`AnyWorld::builtin`] takes both.
 pub const BUILTIN: [&str; 2] = ["paper", "four-rooms"];
 
 /// The slip of a world file that does not set one.
@@ -55,13 +87,13 @@ pub struct WorldError {
     pub help: String,
 }
 
-/// The keys of a world file.
+/// The keys of a grid world file.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct WorldFile {
-    name: Option<toml::Spanned<String>>,
-    slip: Option<toml::Spanned<f64>>,
-    map: toml::Spanned<String>,
+    name: Option<Spanned<String>>,
+    slip: Option<Spanned<f64>>,
+    map: Spanned<String>,
 }
 
 const MAP_HELP: &str = "write the map with `.` for a free cell, `#` for a wall and `S` for a \
@@ -82,19 +114,99 @@ impl WorldError {
 }
 
 impl GridWorld {
-    /// The world in a world file's text. `default_name` names it when the file has no
-    /// `name` (the CLI passes the file name without its extension).
+    /// The grid world in a world file's text. `default_name` names it when the file has no
+    /// `name` (the CLI passes the file name without its extension). A plane world file is
+    /// an error here: [`AnyWorld::from_toml`] reads both kinds.
     pub fn from_toml(text: &str, default_name: &str) -> Result<GridWorld, WorldError> {
         parse(text, default_name)
     }
 
-    /// A built-in world by name (see [`BUILTIN`]).
+    /// A built-in grid world by name (see [`BUILTIN`]).
     pub fn builtin(name: &str) -> Option<GridWorld> {
         builtin(name)
     }
 }
 
-/// A built-in world by name: `paper` (the paper's 15 x 15 open grid, slip 0.3) or
+impl PlaneWorld {
+    /// The plane world in a world file's text (`kind = "plane"`). `default_name` names it
+    /// when the file has no `name`. A grid world file is an error here.
+    pub fn from_toml(text: &str, default_name: &str) -> Result<PlaneWorld, WorldError> {
+        let (table, kind) = document(text)?;
+        match kind {
+            Some((Kind::Plane, _)) => plane::parse(text, table, default_name),
+            _ => Err(WorldError::new(
+                "this is a grid world; only a plane world can be used here",
+                kind.map(|(_, span)| span),
+                "give a plane world file, one with `kind = \"plane\"`",
+            )),
+        }
+    }
+}
+
+/// A world of either kind a world file describes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyWorld {
+    /// A grid world: a map of cells (`kind = "grid"`, the default).
+    Grid(GridWorld),
+    /// A plane world: a bounded plane (`kind = "plane"`).
+    Plane(PlaneWorld),
+}
+
+impl AnyWorld {
+    /// The world in a world file's text, of the kind its `kind` says. `default_name` names
+    /// it when the file has no `name`.
+    pub fn from_toml(text: &str, default_name: &str) -> Result<AnyWorld, WorldError> {
+        let (mut table, kind) = document(text)?;
+        match kind {
+            Some((Kind::Plane, _)) => plane::parse(text, table, default_name).map(AnyWorld::Plane),
+            _ => {
+                table.get_mut().remove("kind");
+                parse_grid(text, table, default_name).map(AnyWorld::Grid)
+            }
+        }
+    }
+
+    /// A built-in world by name: a grid ([`BUILTIN`]) or a plane ([`PLANE_BUILTIN`]).
+    pub fn builtin(name: &str) -> Option<AnyWorld> {
+        builtin(name).map(AnyWorld::Grid).or_else(|| PlaneWorld::builtin(name).map(AnyWorld::Plane))
+    }
+
+    /// The world from `policy.json`'s `env`: its name and the `params` that
+    /// [`World::params`] wrote. `"kind": "plane"` is a plane world; no `kind` (or
+    /// `"grid"`) a grid world, also one written before worlds existed.
+    pub fn from_params(name: &str, params: &Value) -> Result<AnyWorld, Error> {
+        match params.get("kind") {
+            None => GridWorld::from_params(name, params).map(AnyWorld::Grid),
+            Some(Value::String(k)) if k == "grid" => {
+                GridWorld::from_params(name, params).map(AnyWorld::Grid)
+            }
+            Some(Value::String(k)) if k == "plane" => {
+                PlaneWorld::from_params(name, params).map(AnyWorld::Plane)
+            }
+            Some(_) => {
+                Err(Error::Env("the world's `kind` is neither \"grid\" nor \"plane\"".into()))
+            }
+        }
+    }
+
+    /// The world's name.
+    pub fn name(&self) -> &str {
+        match self {
+            AnyWorld::Grid(w) => World::name(w),
+            AnyWorld::Plane(w) => w.name(),
+        }
+    }
+
+    /// The world's parameters, as `policy.json` keeps them (see [`World::params`]).
+    pub fn params(&self) -> Value {
+        match self {
+            AnyWorld::Grid(w) => World::params(w),
+            AnyWorld::Plane(w) => w.params(),
+        }
+    }
+}
+
+/// A built-in grid world by name: `paper` (the paper's 15 x 15 open grid, slip 0.3) or
 /// `four-rooms` (13 x 13 with outer walls, four rooms joined by one-cell doorways).
 pub fn builtin(name: &str) -> Option<GridWorld> {
     let text = match name {
@@ -118,30 +230,119 @@ pub(crate) fn paper() -> GridWorld {
 /// The four-rooms world, as DESIGN.md draws it.
 const FOUR_ROOMS: &str = include_str!("worlds/four-rooms.toml");
 
-/// Parses a world file (see the module docs).
+/// Parses a grid world file (see the module docs). A plane world file (`kind = "plane"`)
+/// is an error here: read it with [`AnyWorld::from_toml`].
 pub fn parse(text: &str, default_name: &str) -> Result<GridWorld, WorldError> {
-    let file: WorldFile = toml::from_str(text).map_err(|e| {
+    let (mut table, kind) = document(text)?;
+    if let Some((Kind::Plane, span)) = kind {
+        return Err(WorldError::new(
+            "this is a plane world (`kind = \"plane\"`); only a grid world can be used here",
+            Some(span),
+            "give a grid world file (one with a `map`), or use a program that runs plane worlds",
+        ));
+    }
+    // `kind = "grid"` says what no `kind` says; the grid's keys are read as before.
+    table.get_mut().remove("kind");
+    parse_grid(text, table, default_name)
+}
+
+/// What a world file's `kind` says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Grid,
+    Plane,
+}
+
+/// The file's TOML table, and its `kind` with the span of its value if it has one.
+type Document<'t> = (Spanned<DeTable<'t>>, Option<(Kind, Range<usize>)>);
+
+/// Parses the TOML and reads `kind`.
+fn document(text: &str) -> Result<Document<'_>, WorldError> {
+    let table = DeTable::parse(text).map_err(|e| {
+        let message = e.message().trim_end_matches(['\n', '.']).replace('\n', "; ");
+        WorldError::new(message, e.span(), TOML_HELP)
+    })?;
+    let kind = match table.get_ref().get("kind") {
+        None => None,
+        Some(value) => {
+            let span = value.span();
+            let kind = match value.get_ref().as_str() {
+                Some("grid") => Kind::Grid,
+                Some("plane") => Kind::Plane,
+                Some(other) => {
+                    return Err(WorldError::new(
+                        format!("unknown world kind `{}`", other.escape_default()),
+                        Some(span),
+                        KIND_HELP,
+                    ));
+                }
+                None => {
+                    return Err(WorldError::new(
+                        format!("kind must be a string, not {}", describe(value.get_ref())),
+                        Some(span),
+                        KIND_HELP,
+                    ));
+                }
+            };
+            Some((kind, span))
+        }
+    };
+    Ok((table, kind))
+}
+
+const TOML_HELP: &str =
+    "a world file is TOML: `name = \"...\"`, `slip = 0.3`, `map = \"\"\"...\"\"\"`";
+const KIND_HELP: &str =
+    "a world's `kind` is \"grid\" (a map, the default) or \"plane\" (a bounded plane)";
+const NAME_HELP: &str = "give a short name such as `name = \"office\"`, or leave it out";
+
+/// What kind of TOML value `v` is, for messages.
+fn describe(v: &DeValue<'_>) -> &'static str {
+    match v {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) | DeValue::Float(_) => "a number",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a date",
+        DeValue::Array(_) => "a list",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+/// The world's name: the file's `name` (1 to 200 characters) or `default_name`.
+fn world_name(
+    name: Option<(&str, Range<usize>)>,
+    default_name: &str,
+) -> Result<String, WorldError> {
+    match name {
+        Some((n, span)) if n.trim().is_empty() || n.len() > 200 => Err(WorldError::new(
+            "the world's name must hold 1 to 200 characters",
+            Some(span),
+            NAME_HELP,
+        )),
+        Some((n, _)) => Ok(n.to_string()),
+        None => Ok(default_name.to_string()),
+    }
+}
+
+/// Reads a grid world from the file's table (without `kind`).
+fn parse_grid(
+    text: &str,
+    table: Spanned<DeTable<'_>>,
+    default_name: &str,
+) -> Result<GridWorld, WorldError> {
+    let file = WorldFile::deserialize(toml::de::Deserializer::from(table)).map_err(|e| {
         let message = e.message().trim_end_matches(['\n', '.']).replace('\n', "; ");
         let help = if message.contains("unknown field") {
             "a world file has only the keys `name`, `slip` and `map`"
         } else if message.contains("missing field") {
             "add the map, such as `map = \"\"\"` then one line per row and `\"\"\"`"
         } else {
-            "a world file is TOML: `name = \"...\"`, `slip = 0.3`, `map = \"\"\"...\"\"\"`"
+            TOML_HELP
         };
         WorldError::new(message, e.span(), help)
     })?;
-    let name = match &file.name {
-        Some(n) if n.get_ref().trim().is_empty() || n.get_ref().len() > 200 => {
-            return Err(WorldError::new(
-                "the world's name must hold 1 to 200 characters",
-                Some(n.span()),
-                "give a short name such as `name = \"office\"`, or leave it out",
-            ));
-        }
-        Some(n) => n.get_ref().clone(),
-        None => default_name.to_string(),
-    };
+    let name =
+        world_name(file.name.as_ref().map(|n| (n.get_ref().as_str(), n.span())), default_name)?;
     let slip = match &file.slip {
         Some(s) if !(0.0..=1.0).contains(s.get_ref()) => {
             return Err(WorldError::new(
