@@ -47,7 +47,9 @@ pub trait World {
 ///
 /// It declares the [`World`] methods itself, and every `Env` is a `World` through a
 /// blanket implementation, so that an environment written before the split (one `impl
-/// Env` block) still compiles unchanged. Do not implement both traits for one type.
+/// Env` block) still compiles unchanged; a type implements one of the two, never both.
+/// With both traits imported, call a shared method on a concrete type as `Env::step(..)`
+/// or `World::step(..)`: the method name alone is ambiguous there.
 pub trait Env {
     /// A state of the environment.
     type State: Clone + fmt::Debug + PartialEq;

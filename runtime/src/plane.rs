@@ -92,9 +92,11 @@ impl Obstacle {
         }
     }
 
-    /// Whether the closed segment from `p` to `q` touches the obstacle: decided exactly for
-    /// these doubles (a segment that grazes a corner or the circle touches it), see
-    /// the `geometry` notes in the module docs. `p == q` is the point.
+    /// Whether the closed segment from `p` to `q` touches the obstacle, decided exactly for
+    /// these doubles: a segment that grazes a corner or runs along an edge touches it,
+    /// whatever the rounding. `p == q` is the point. Exact while the products of
+    /// coordinate differences neither overflow nor underflow (numbers between about
+    /// 1e-140 and 1e140, or zero); past that, a doubtful case counts as touching.
     pub fn touches_segment(&self, p: Point, q: Point) -> bool {
         match *self {
             Obstacle::Circle { cx, cy, r } => {

@@ -133,7 +133,7 @@ impl PlaneWorld {
     pub fn from_toml(text: &str, default_name: &str) -> Result<PlaneWorld, WorldError> {
         let (table, kind) = document(text)?;
         match kind {
-            Some((Kind::Plane, _)) => plane::parse(text, table, default_name),
+            Some((Kind::Plane, _)) => plane::parse(table, default_name),
             _ => Err(WorldError::new(
                 "this is a grid world; only a plane world can be used here",
                 kind.map(|(_, span)| span),
@@ -158,7 +158,7 @@ impl AnyWorld {
     pub fn from_toml(text: &str, default_name: &str) -> Result<AnyWorld, WorldError> {
         let (mut table, kind) = document(text)?;
         match kind {
-            Some((Kind::Plane, _)) => plane::parse(text, table, default_name).map(AnyWorld::Plane),
+            Some((Kind::Plane, _)) => plane::parse(table, default_name).map(AnyWorld::Plane),
             _ => {
                 table.get_mut().remove("kind");
                 parse_grid(text, table, default_name).map(AnyWorld::Grid)

@@ -236,7 +236,6 @@ fn number(key: &str, value: &Spanned<Raw>, help: &str) -> Result<f64, WorldError
 
 /// Reads a plane world from the file's table (`kind = "plane"`).
 pub(super) fn parse(
-    _text: &str,
     table: Spanned<DeTable<'_>>,
     default_name: &str,
 ) -> Result<PlaneWorld, WorldError> {
