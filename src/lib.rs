@@ -26,6 +26,7 @@
 //! ```
 
 pub mod artifacts;
+pub mod continuous;
 pub mod evaluate;
 pub mod load;
 pub mod lower;

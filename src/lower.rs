@@ -145,6 +145,10 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
         },
         flat: level(&l.flat),
         options: level(&l.options),
+        tiles: match &l.tiles {
+            Some(_) => Some(tiles(spec).ok_or_else(invalid)?),
+            None => None,
+        },
     };
     Ok(rt::TaskSpec {
         name: spec.name.clone(),
@@ -155,6 +159,13 @@ pub fn task_spec(spec: &CheckedSpec, src: &str) -> Result<rt::TaskSpec, LowerErr
         learn,
         regions,
     })
+}
+
+/// The spec's tile coding as the runtime's data ([`CheckedSpec::tile_box`]).
+pub fn tiles(spec: &CheckedSpec) -> Option<rt::TileParams> {
+    let b = spec.tile_box()?;
+    let bins = b.bins.iter().map(|&n| usize::try_from(n).ok()).collect::<Option<Vec<_>>>()?;
+    Some(rt::TileParams { tilings: usize::try_from(b.tilings).ok()?, bins, lo: b.lo, hi: b.hi })
 }
 
 /// The task's formula.

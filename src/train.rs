@@ -69,7 +69,12 @@ pub fn trainable(spec: &CheckedSpec, source: &str, file: &str) -> Result<TaskSpe
                 .to_string(),
         ));
     }
-    if let Some(v) = spec.state_vars.iter().find(|v| !matches!(v.domain, Domain::Int { .. })) {
+    let tiled = spec.learn.tiles.is_some();
+    // Tables need an `int` range; tilings any bounded domain.
+    let learnable = |v: &&hstl_lang::StateVarInfo| {
+        matches!(v.domain, Domain::Int { .. }) || tiled && v.domain != Domain::Unbounded
+    };
+    if let Some(v) = spec.state_vars.iter().find(|v| !learnable(v)) {
         return Err(Problem::new(
             format!(
                 "{}: state variable `{}` needs an `int` range for training",

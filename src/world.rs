@@ -15,13 +15,15 @@
 //! assert_eq!(checked.diagnostics[0].code, "HSTL030"); // four-rooms is 13 x 13
 //! ```
 
-use hstl_lang::{Checked, LineIndex, WorldFacts};
+use hstl_lang::{BoxFacts, Checked, LineIndex, SpecWorld, WorldFacts};
 use hstl_runtime::Env;
 
 use crate::Problem;
 
 pub use hstl_runtime::GridWorld;
-pub use hstl_runtime::world::{BUILTIN, DEFAULT_SLIP, WorldError};
+pub use hstl_runtime::world::{
+    AnyWorld, BUILTIN, CAR_BUILTIN, DEFAULT_SLIP, PLANE_BUILTIN, WorldError,
+};
 
 /// What the front end's checks need to know of `world`; `label` names it in messages,
 /// such as ``world `office` (office.toml)``.
@@ -42,6 +44,115 @@ pub fn facts(world: &GridWorld, label: &str) -> WorldFacts {
 /// [`hstl_lang::world`]). Never fails and never panics.
 pub fn check(src: &str, world: &GridWorld, label: &str) -> Checked {
     hstl_lang::check_in_world(src, &facts(world, label))
+}
+
+/// What the checks know of a world of any kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Facts {
+    /// A grid world's cells.
+    Grid(WorldFacts),
+    /// A continuous world's state variables and ranges.
+    Box(BoxFacts),
+}
+
+impl Facts {
+    /// What a spec is checked against in this world.
+    pub fn spec_world(&self) -> SpecWorld<'_> {
+        match self {
+            Facts::Grid(f) => SpecWorld::Facts(f),
+            Facts::Box(f) => SpecWorld::Box(f),
+        }
+    }
+}
+
+/// What the front end's checks need to know of a world of any kind (see [`facts`]).
+pub fn any_facts(world: &AnyWorld, label: &str) -> Facts {
+    match world {
+        AnyWorld::Grid(g) => Facts::Grid(facts(g, label)),
+        AnyWorld::Plane(p) => {
+            let ([x0, x1], [y0, y1]) = p.extent();
+            let vars = vec![("x".to_string(), x0, x1), ("y".to_string(), y0, y1)];
+            Facts::Box(BoxFacts { label: label.to_string(), vars })
+        }
+        AnyWorld::MountainCar(_) => {
+            use hstl_runtime::MountainCar as C;
+            let vars = vec![
+                ("x".to_string(), C::MIN_POSITION, C::MAX_POSITION),
+                ("v".to_string(), -C::MAX_SPEED, C::MAX_SPEED),
+            ];
+            Facts::Box(BoxFacts { label: label.to_string(), vars })
+        }
+    }
+}
+
+/// [`label`] for a world of any kind.
+pub fn any_label(world: &AnyWorld, file: Option<&str>) -> String {
+    match file {
+        Some(file) => format!("world `{}` ({file})", world.name()),
+        None => format!("world `{}`", world.name()),
+    }
+}
+
+/// [`from_file`] for a world file of any kind (`kind = "plane"` or a grid).
+pub fn any_from_file(text: &str, file: &str, stem: &str) -> Result<AnyWorld, Problem> {
+    AnyWorld::from_toml(text, stem).map_err(|e| {
+        let at = e.span.as_ref().map_or(String::new(), |span| {
+            let p = LineIndex::new(text).position(text, span.start);
+            format!("{}:{}: ", p.line, p.column)
+        });
+        Problem::new(format!("{file}:{at}{}", e.message), e.help.clone())
+    })
+}
+
+/// A world's kind, size and dynamics in words, for summaries: ``world `four-rooms` (13 x
+/// 13, 65 walls, slip 0.3)``, ``world `yard` (yard.toml; plane 20 x 10, step 0.5, 8
+/// headings, slip 0.1, noise 0.05, 2 obstacles)``, with the file it was read from.
+pub fn words(world: &AnyWorld, file: Option<&str>) -> String {
+    let from = file.map_or(String::new(), |f| format!("{f}; "));
+    let name = world.name();
+    // Nine decimals: a `policy.json` written before worlds stores p, and 1 - 0.7 is not 0.3.
+    let round = |v: f64| (v * 1e9).round() / 1e9;
+    match world {
+        AnyWorld::Grid(g) => {
+            let cells = g.width() * g.height();
+            let walls = match cells - Env::num_states(g) {
+                0 => String::new(),
+                1 => ", 1 wall".into(),
+                n => format!(", {n} walls"),
+            };
+            format!(
+                "world `{name}` ({from}{} x {}{walls}, slip {})",
+                g.width(),
+                g.height(),
+                round(g.slip())
+            )
+        }
+        AnyWorld::Plane(p) => {
+            let ([x0, x1], [y0, y1]) = p.extent();
+            let obstacles = match p.obstacles().len() {
+                0 => String::new(),
+                1 => ", 1 obstacle".into(),
+                n => format!(", {n} obstacles"),
+            };
+            format!(
+                "world `{name}` ({from}plane {} x {}, step {}, {} headings, slip {}, noise {}{obstacles})",
+                round(x1 - x0),
+                round(y1 - y0),
+                p.step_length(),
+                p.headings(),
+                round(p.slip()),
+                p.noise()
+            )
+        }
+        AnyWorld::MountainCar(_) => {
+            format!("world `{name}` ({from}gymnasium's MountainCar-v0 dynamics, no goal)")
+        }
+    }
+}
+
+/// The built-in names of every kind, quoted and listed.
+pub fn builtin_list() -> String {
+    AnyWorld::builtin_names().iter().map(|b| format!("`{b}`")).collect::<Vec<_>>().join(", ")
 }
 
 /// How messages name a world: ``world `paper` `` for a built-in one, ``world `office`
@@ -90,5 +201,5 @@ pub fn from_file(text: &str, file: &str, stem: &str) -> Result<GridWorld, Proble
 
 /// The built-in worlds' names, quoted and listed.
 fn builtin_names() -> String {
-    BUILTIN.map(|b| format!("`{b}`")).join(", ")
+    builtin_list()
 }

@@ -46,7 +46,7 @@ use crate::checked::*;
 use crate::diagnostic::{self, Diagnostic};
 use crate::parser::parse;
 use crate::syntax::{self, FieldValue, Formula, FormulaKind, Item, OptionsKind, ParamValue};
-use crate::world::{DomainMask, SpecWorld, WorldFacts, WorldProblem};
+use crate::world::{BoxFacts, DomainMask, SpecWorld, WorldFacts, WorldProblem};
 
 /// At most this many diagnostics are reported per file.
 pub const MAX_DIAGNOSTICS: usize = 200;
@@ -63,6 +63,12 @@ pub const MAX_COUNTERFACTUAL: u64 = 1000;
 
 /// The fields an option may have.
 const OPTION_FIELDS: [&str; 4] = ["reach", "init", "terminate", "avoid"];
+
+/// At most this many tilings in `learn { tiles: { tilings } }`.
+pub const MAX_TILINGS: u64 = 64;
+
+/// At most this many tiles along a variable in `learn { tiles: { bins } }`.
+pub const MAX_TILE_BINS: u64 = 1024;
 
 /// The expanded options set may hold at most this many options.
 pub const MAX_OPTIONS: u64 = 10_000;
@@ -126,15 +132,18 @@ pub(crate) fn check_parsed_in<'w>(
         } else {
             seen.insert(spec.name.name.clone(), spec.name.range.clone());
         }
-        let (world, world_problem) = match world_of(spec) {
-            SpecWorld::Alone => (None, None),
-            SpecWorld::Facts(facts) => (Some(facts), None),
-            SpecWorld::Unavailable(problem) => (None, Some(problem)),
-        };
+        let (mut world, mut world_problem, mut box_world) = (None, None, None);
+        match world_of(spec) {
+            SpecWorld::Alone => {}
+            SpecWorld::Facts(facts) => world = Some(facts),
+            SpecWorld::Box(facts) => box_world = Some(facts),
+            SpecWorld::Unavailable(problem) => world_problem = Some(problem),
+        }
         let mut cx = Cx {
             src,
             world,
             world_problem,
+            box_world,
             diags: Vec::new(),
             names: HashMap::default(),
             let_refs: Vec::new(),
@@ -167,6 +176,8 @@ struct Cx<'s> {
     world: Option<&'s WorldFacts>,
     /// Why the world the spec names could not be had, if so.
     world_problem: Option<&'s WorldProblem>,
+    /// The continuous world the spec is checked against, if any.
+    box_world: Option<&'s BoxFacts>,
     diags: Vec<Diagnostic>,
     names: HashMap<String, (NameRef, Range<usize>), BuildHasherDefault<NameHasher>>,
     /// Let references found while resolving the current formula: (let index, range).
@@ -395,6 +406,10 @@ impl Cx<'_> {
             self.counterfactual_needs(l, &out);
             self.plan_needs(l, &mut out);
         }
+        // A float state is learned with tilings, whatever the preset.
+        if out.is_continuous() && !out.primitives.is_empty() && out.learn.tiles.is_none() {
+            out.learn.tiles = Some(Tiles::default());
+        }
         if preset == Preset::Auto {
             let (fields, set) = &filled;
             out.preset_expansion = Some(crate::preset::expansion(&out, self.src, fields, *set));
@@ -431,6 +446,14 @@ impl Cx<'_> {
             );
         }
         let state_broken = spec.broken.iter().any(|b| b.keyword.as_deref() == Some("state"));
+        if let Some(b) = self.box_world
+            && !out.primitives.is_empty()
+            && !state_broken
+        {
+            let mut found = Vec::new();
+            b.fit(&out, &mut |d| found.push(d));
+            self.diags.append(&mut found);
+        }
         let mask = match self.world {
             Some(world) if !out.primitives.is_empty() && !state_broken => {
                 let mut found = Vec::new();
@@ -1349,7 +1372,7 @@ impl Cx<'_> {
     }
 
     fn learn(&mut self, l: &syntax::Learn, preset: Preset, out: &mut CheckedSpec) {
-        const TOP: [&str; 12] = [
+        const TOP: [&str; 13] = [
             "preset",
             "episodes",
             "choices",
@@ -1362,13 +1385,14 @@ impl Cx<'_> {
             "plan",
             "flat",
             "options",
+            "tiles",
         ];
         if preset == Preset::Auto {
             // The preset first: every value written beside it overrides it.
             let horizons: Option<Vec<u64>> =
                 out.persistent_conjuncts(self.src).map(|cs| cs.iter().map(|c| c.steps).collect());
             out.learn.preset = Preset::Auto;
-            crate::preset::learn(horizons.as_deref(), &mut out.learn);
+            crate::preset::learn(horizons.as_deref(), out.is_continuous(), &mut out.learn);
         }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();
         for p in &l.params {
@@ -1440,6 +1464,12 @@ impl Cx<'_> {
                         );
                         continue;
                     };
+                    if key == "tiles" {
+                        let mut t = out.learn.tiles.unwrap_or_default();
+                        self.tiles(ps, &mut t);
+                        out.learn.tiles = Some(t);
+                        continue;
+                    }
                     let mut q = if key == "flat" { out.learn.flat } else { out.learn.options };
                     self.qparams(ps, key, &mut q);
                     if key == "flat" { out.learn.flat = q } else { out.learn.options = q }
@@ -1581,6 +1611,43 @@ impl Cx<'_> {
                 };
                 self.push(d);
                 None
+            }
+        }
+    }
+
+    /// `tiles: { tilings: N, bins: N }`.
+    fn tiles(&mut self, ps: &[syntax::Param], t: &mut Tiles) {
+        const KNOWN: [&str; 2] = ["tilings", "bins"];
+        let mut seen: HashMap<String, Range<usize>> = HashMap::new();
+        for p in ps {
+            if !self.param_name_ok(p, &KNOWN, &mut seen) {
+                continue;
+            }
+            let (key, max) = if p.name.name == "tilings" {
+                ("tilings", MAX_TILINGS)
+            } else {
+                ("bins", MAX_TILE_BINS)
+            };
+            let Some(v) = self.whole(p, 1) else { continue };
+            if v > max {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL016",
+                        value_range(&p.value),
+                        format!("`tiles.{key}` must be at most {max}, found {v}"),
+                    )
+                    .with_help(if key == "tilings" {
+                        "8 tilings are the usual choice".to_string()
+                    } else {
+                        "tiles about one world step wide are the usual choice".to_string()
+                    }),
+                );
+                continue;
+            }
+            if key == "tilings" {
+                t.tilings = v;
+            } else {
+                t.bins = Some(v);
             }
         }
     }

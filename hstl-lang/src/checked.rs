@@ -348,6 +348,41 @@ pub struct LearnParams {
     pub flat: QParams,
     /// Options level (gamma 0.9, alpha 0.5, epsilon 0.8, min_epsilon 0.1, decay 1e-4).
     pub options: QParams,
+    /// The tile coding of a continuous state (`tiles: { ... }`); `None`: tables. A spec
+    /// with options over a `float` state always has one.
+    pub tiles: Option<Tiles>,
+}
+
+/// `learn { tiles: { tilings: 8, bins: 14 } }`: the approximate learner's tile coding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tiles {
+    /// Offset tilings (8).
+    pub tilings: u64,
+    /// Tiles along every state variable; `None`: from the world (a tile about one step
+    /// wide on a plane world), else 10.
+    pub bins: Option<u64>,
+}
+
+/// A [`Tiles`] laid over the spec's domain box: what the approximate learner codes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TileBox {
+    /// Offset tilings.
+    pub tilings: u64,
+    /// Tiles along each state variable, in declaration order.
+    pub bins: Vec<u64>,
+    /// Each variable's lower bound.
+    pub lo: Vec<f64>,
+    /// Each variable's upper bound.
+    pub hi: Vec<f64>,
+}
+
+/// Tiles along a `float` variable when neither the spec nor the world says how many.
+pub const DEFAULT_BINS: u64 = 10;
+
+impl Default for Tiles {
+    fn default() -> Tiles {
+        Tiles { tilings: 8, bins: None }
+    }
 }
 
 impl Default for LearnParams {
@@ -371,6 +406,7 @@ impl Default for LearnParams {
                 min_epsilon: 0.1,
                 decay: 1e-4,
             },
+            tiles: None,
         }
     }
 }
@@ -432,6 +468,33 @@ pub struct PersistentConjunct {
 }
 
 impl CheckedSpec {
+    /// The spec's tile coding over its domain box: `bins` tiles along every variable when
+    /// given; else one tile per value of an `int` variable (at most 64) and
+    /// [`DEFAULT_BINS`] along a `float` one (training narrows that to the world's step).
+    /// `None` without `tiles` or with an unbounded variable.
+    pub fn tile_box(&self) -> Option<TileBox> {
+        let t = self.learn.tiles?;
+        let mut b =
+            TileBox { tilings: t.tilings, bins: Vec::new(), lo: Vec::new(), hi: Vec::new() };
+        for v in &self.state_vars {
+            let (lo, hi, n) = match v.domain {
+                Domain::Int { lo, hi } => (lo as f64, hi as f64, (hi - lo).clamp(1, 64) as u64),
+                Domain::Float { lo, hi, .. } => (lo, hi, DEFAULT_BINS),
+                Domain::Unbounded => return None,
+            };
+            b.lo.push(lo);
+            b.hi.push(hi);
+            b.bins.push(t.bins.unwrap_or(n));
+        }
+        Some(b)
+    }
+
+    /// Whether some state variable is a `float`: the state is continuous, and options over
+    /// it are learned with tilings.
+    pub fn is_continuous(&self) -> bool {
+        self.state_vars.iter().any(|v| v.ty == VarType::Float)
+    }
+
     /// For a task `always[0..] (eventually[0..N1] R1 && ... && eventually[0..Nk] Rk)` with
     /// state formulas Rj, the conjuncts in order; `None` for any other task.
     pub fn persistent_conjuncts(&self, src: &str) -> Option<Vec<PersistentConjunct>> {

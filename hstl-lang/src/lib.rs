@@ -77,6 +77,6 @@ pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Location, Position};
 pub use render::{FileDiagnostics, render_concise, render_plain};
 pub use world::{
-    SpecWorld, WorldFacts, WorldProblem, check_in_world, check_parsed_in_world,
+    BoxFacts, SpecWorld, WorldFacts, WorldProblem, check_in_world, check_parsed_in_world,
     check_parsed_with_worlds, world_item,
 };

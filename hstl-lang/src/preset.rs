@@ -20,6 +20,13 @@ pub const OPTIONS_GAMMA: f64 = 0.98;
 /// of samples (2400 episodes kept 0.935, 4800 0.941), but the paper's 1200 episodes keep
 /// every suite task near 1 s of training.
 pub const OPTIONS_ALPHA: f64 = 0.1;
+/// The flat discount of the preset on a continuous state: a leg there takes many small
+/// steps (MountainCar swings back and forth for about a hundred), which the paper's 0.9
+/// discounts to nothing; with 0.99 the MountainCar patrol keeps 0.96 of its windows, with
+/// 0.9 under 0.1.
+pub const CONTINUOUS_FLAT_GAMMA: f64 = 0.99;
+/// The flat step size of the preset on a continuous state, shared by the active tiles.
+pub const CONTINUOUS_FLAT_ALPHA: f64 = 0.1;
 /// Episodes of the preset for a task that is not persistent: a reach task is decided in
 /// its first legs, so many short episodes from random starts learn the approach, where the
 /// paper's long ones spend their choices at the goal (the suite's reach-avoid tasks: 0.94
@@ -99,9 +106,17 @@ pub fn memory_buckets(horizons: &[u64]) -> u64 {
 }
 
 /// The `learn` values the preset sets for a spec whose task has the persistent form with
-/// deadlines `horizons` (`None` for another form), before any value written beside it.
-pub fn learn(horizons: Option<&[u64]>, learn: &mut LearnParams) {
-    learn.flat.alpha = FLAT_ALPHA;
+/// deadlines `horizons` (`None` for another form), before any value written beside it. On a
+/// `continuous` state the options level is Q-learned over tilings (`plan: model` plans over
+/// the finite states of a grid) and the legs learn with [`CONTINUOUS_FLAT_GAMMA`] and
+/// [`CONTINUOUS_FLAT_ALPHA`].
+pub fn learn(horizons: Option<&[u64]>, continuous: bool, learn: &mut LearnParams) {
+    if continuous {
+        learn.flat.gamma = CONTINUOUS_FLAT_GAMMA;
+        learn.flat.alpha = CONTINUOUS_FLAT_ALPHA;
+    } else {
+        learn.flat.alpha = FLAT_ALPHA;
+    }
     match horizons {
         Some(h) => {
             learn.memory = memory_buckets(h);
@@ -109,7 +124,9 @@ pub fn learn(horizons: Option<&[u64]>, learn: &mut LearnParams) {
             learn.options.gamma = OPTIONS_GAMMA;
             learn.options.alpha = OPTIONS_ALPHA;
             learn.switch = crate::checked::Switch::Step;
-            learn.plan = crate::checked::Plan::Model;
+            if !continuous {
+                learn.plan = crate::checked::Plan::Model;
+            }
         }
         None => {
             learn.episodes = REACH_EPISODES;
@@ -172,10 +189,18 @@ pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 3]], set_filled
     if l.plan == crate::checked::Plan::Model {
         params.push("plan: model".to_string());
     }
-    params.push(format!("flat: {{ alpha: {} }}", l.flat.alpha));
+    if spec.is_continuous() {
+        params.push(format!("flat: {{ gamma: {}, alpha: {} }}", l.flat.gamma, l.flat.alpha));
+    } else {
+        params.push(format!("flat: {{ alpha: {} }}", l.flat.alpha));
+    }
     if l.reward == crate::checked::Reward::Window {
         params
             .push(format!("options: {{ gamma: {}, alpha: {} }}", l.options.gamma, l.options.alpha));
+    }
+    if let Some(t) = &l.tiles {
+        let bins = t.bins.map_or(String::new(), |b| format!(", bins: {b}"));
+        params.push(format!("tiles: {{ tilings: {}{bins} }}", t.tilings));
     }
     lines.push(format!("learn {{ {} }}", params.join(", ")));
     lines.join("\n")

@@ -52,13 +52,25 @@ pub struct WorldProblem {
     pub help: String,
 }
 
+/// What the checks know of a continuous world (a plane, mountain-car): its state
+/// variables and their ranges.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoxFacts {
+    /// How messages name the world, such as ``world `yard` (yard.toml)``.
+    pub label: String,
+    /// Each state variable: its name and its range `[lo, hi]`, in the world's order.
+    pub vars: Vec<(String, f64, f64)>,
+}
+
 /// What one spec is checked against.
 #[derive(Clone, Copy, Debug)]
 pub enum SpecWorld<'w> {
     /// No world: the spec is checked alone.
     Alone,
-    /// A world whose facts are known.
+    /// A grid world whose facts are known.
     Facts(&'w WorldFacts),
+    /// A continuous world whose state variables are known.
+    Box(&'w BoxFacts),
     /// The world the spec names, which could not be had.
     Unavailable(&'w WorldProblem),
 }
@@ -202,5 +214,69 @@ impl WorldFacts {
             reachable.push(cell.is_some_and(|c| self.reachable.get(c).copied().unwrap_or(false)));
         }
         Some(DomainMask { present, reachable })
+    }
+}
+
+impl BoxFacts {
+    /// The state block a spec needs for this world.
+    fn declaration(&self) -> String {
+        let vars: Vec<String> =
+            self.vars.iter().map(|(n, lo, hi)| format!("{n}: float in {lo}..={hi}")).collect();
+        format!("`{}`", vars.join(", "))
+    }
+
+    /// `HSTL030` for each state variable of `spec` that is not the world's, with its range.
+    pub(crate) fn fit(&self, spec: &CheckedSpec, push: &mut impl FnMut(Diagnostic)) {
+        let help = format!("declare the state as {} to match {}", self.declaration(), self.label);
+        for v in &spec.state_vars {
+            let Some((_, lo, hi)) = self.vars.iter().find(|w| w.0 == v.name) else {
+                let names: Vec<&str> = self.vars.iter().map(|w| w.0.as_str()).collect();
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        v.name_range.start..v.range.end,
+                        format!(
+                            "state variable `{}` is not a variable of {}, whose state is {}",
+                            v.name,
+                            self.label,
+                            names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+                        ),
+                    )
+                    .with_help(help.clone()),
+                );
+                continue;
+            };
+            let right = v.ty == VarType::Float
+                && matches!(v.domain, Domain::Float { lo: a, hi: b, inclusive: true } if a == *lo && b == *hi);
+            if !right {
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        v.name_range.start..v.range.end,
+                        format!(
+                            "state variable `{}` must be `float in {lo}..={hi}`: the range of {}",
+                            v.name, self.label
+                        ),
+                    )
+                    .with_help(help.clone()),
+                );
+            }
+        }
+        for (name, _, _) in &self.vars {
+            if !spec.state_vars.iter().any(|v| &v.name == name) {
+                let at = spec
+                    .state_vars
+                    .first()
+                    .map_or(spec.name_range.clone(), |v| v.name_range.start..v.range.end);
+                push(
+                    Diagnostic::new(
+                        "HSTL030",
+                        at,
+                        format!("the state has no variable `{name}`, which {} needs", self.label),
+                    )
+                    .with_help(help.clone()),
+                );
+            }
+        }
     }
 }

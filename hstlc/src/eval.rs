@@ -34,7 +34,14 @@ pub struct EvalArgs {
     /// Skip the optimum W* (value iteration takes a few seconds).
     #[arg(long)]
     pub no_optimum: bool,
+    /// Also write each greedy run as `DIR/run_K.csv` (`t,VAR...,action,option`, one row per
+    /// step and one more for the final state), at most the first 1,000 runs.
+    #[arg(long, value_name = "DIR")]
+    pub runs: Option<PathBuf>,
 }
+
+/// At most this many runs are written by `--runs`.
+pub const MAX_RUN_FILES: usize = 1000;
 
 /// A count flag from 1 to `max`.
 fn count(max: usize) -> clap::builder::RangedU64ValueParser<usize> {
@@ -57,6 +64,11 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     runs.check_budget(flag)?;
     let input::Input { name, text, .. } =
         input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
+    if let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text)
+        && hstl::continuous::is_learned_function(&doc)
+    {
+        return run_continuous(args, &name, &doc, runs);
+    }
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
     runs.check_burn_in(spec, flag)?;
@@ -135,6 +147,77 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                 report.rate / optimum.gain
             )?;
         }
+    }
+    Ok(Status::Clean)
+}
+
+/// `hstlc eval` of a learned function (a continuous world): the window rate of a
+/// persistent task or the satisfaction rate of another, with no exact optimum to divide by;
+/// `--runs` writes the greedy runs as data.
+fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Runs) -> CmdResult {
+    use hstl::continuous as c;
+    let replay = c::replay(doc).map_err(|p| p.in_file(name))?;
+    let spec = &replay.spec;
+    runs.check_burn_in(spec, flag)?;
+    // Decide what can be written before anything is printed.
+    let out = args
+        .runs
+        .as_ref()
+        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
+        .transpose()?;
+    outln!(
+        "policy of `{}` on {}: {} options, tiles {}, {} greedy runs of {} steps (seed {})",
+        spec.name,
+        hstl::world::words(&replay.world, None),
+        spec.options.len(),
+        crate::train::tiles_words(&replay.agent.model),
+        args.starts,
+        args.steps,
+        args.seed
+    )?;
+    match c::evaluate(&replay, runs)? {
+        c::Evaluation::Window(w) => {
+            let Stats { min: lo, max: hi, .. } = Stats::of(&w.per_run);
+            outln!(
+                "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
+                w.rate,
+                args.burn_in,
+                spec.regions
+                    .iter()
+                    .map(|r| format!("{} within {}", r.name, r.horizon))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )?;
+            let Stats { mean, min: lo, max: hi, .. } = Stats::of(&w.robustness);
+            outln!(
+                "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
+            )?;
+            outln!("  no exact optimum on a continuous world: W/W* is not defined here")?;
+        }
+        c::Evaluation::Satisfaction { rate } => {
+            outln!(
+                "  satisfied in {rate:.4} of {} runs of {} steps (no exact optimum on a continuous world: P/P* is not defined here)",
+                args.starts,
+                args.steps
+            )?;
+        }
+    }
+    if let Some(out) = out {
+        let n = args.starts.min(MAX_RUN_FILES);
+        let files: Vec<hstl::artifacts::OutFile> =
+            c::greedy_runs(&replay, n, args.steps, args.seed)
+                .iter()
+                .enumerate()
+                .map(|(k, run)| {
+                    hstl::artifacts::OutFile::text(
+                        format!("run_{}.csv", k + 1),
+                        c::run_csv(&replay, run),
+                    )
+                })
+                .collect();
+        let dir = out.path().to_path_buf();
+        out.write(&files)?;
+        outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", dir.display())?;
     }
     Ok(Status::Clean)
 }

@@ -76,8 +76,10 @@ pub fn load_trainable(
             }
         },
         (None, None) => {
-            // A spec that names no world trains in `paper`, checked against it first.
-            let paper = LoadedWorld::load("paper")?;
+            // A spec that names no world trains in `paper` (a `float` one in `paper-plane`,
+            // the same world as a plane), checked against it first.
+            let default = if loaded.spec.is_continuous() { "paper-plane" } else { "paper" };
+            let paper = LoadedWorld::load(default)?;
             if loaded.spec.primitives.is_empty() {
                 // Nothing to train: `trainable` says so, without a word on worlds.
                 return Ok(Some((loaded, paper)));

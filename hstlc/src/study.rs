@@ -12,6 +12,7 @@ use clap::Args;
 use hstl::artifacts::OutFile;
 use hstl::runtime::{GridWorld, Intra, Region, TaskSpec};
 use hstl::study::{self as facade, CurveSet, Keep, Kept, SeedRun, Stats, StudiedSpec};
+use hstl::world::AnyWorld;
 use hstl_outdir::{OutDir, Writer};
 
 use crate::cli_error::CliError;
@@ -96,14 +97,23 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     let mut all_curves: Vec<CurveSet> = Vec::new();
     let mut summary = String::from(facade::SUMMARY_HEADER);
     for ((((_, l, spec), label), out), world) in loaded.iter().zip(&labels).zip(outs).zip(&worlds) {
-        let env = &world.world;
+        let env = match &world.world {
+            AnyWorld::Grid(g) => g,
+            continuous => {
+                let (line, curves) =
+                    continuous_spec(spec, l, label, continuous, &seeds, threads, out)?;
+                summary.push_str(&line);
+                all_curves.push(curves);
+                continue;
+            }
+        };
         let budget = AtomicUsize::new(KEEP_BUDGET);
         let keep = Keep { source: &l.source, budget: &budget };
         let (results, kept) = run_seeds(spec, env, &seeds, threads, l, Some(&keep))?;
         let w_star = if args.no_optimum || spec.regions.is_empty() {
             None
         } else {
-            Some(optimum(&mut optima, spec, world)?)
+            Some(optimum(&mut optima, spec, env)?)
         };
         outln!()?;
         if !one_world {
@@ -192,6 +202,149 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     Ok(Status::Clean)
 }
 
+/// One spec of a study on a continuous world: each seed trained with the approximate
+/// learner and its greedy policy measured (the window rate W of a persistent task, the
+/// satisfaction rate P of another; no exact optimum exists to divide by), the table
+/// printed, the median seed's `policy.json` and curve written. Returns its `summary.csv`
+/// line (the measure's own mean and minimum, the optimum empty) and its curves.
+fn continuous_spec(
+    spec: &TaskSpec,
+    l: &spec_file::LoadedSpec,
+    label: &str,
+    world: &AnyWorld,
+    seeds: &[u64],
+    threads: usize,
+    out: OutDir,
+) -> Result<(String, CurveSet), CliError> {
+    use hstl::continuous as c;
+    let mut spec = spec.clone();
+    c::fit_tiles(&mut spec, &l.spec, world);
+    let one = |seed: u64| -> Result<SeedResult, CliError> {
+        let start = Instant::now();
+        let trained = c::train(&spec, world, seed, |_, _| {}).map_err(|e| {
+            let p = hstl::train::cannot_train(&l.file, &spec.name, &e);
+            CliError::new(p.message, p.help)
+        })?;
+        let secs = start.elapsed().as_secs_f64();
+        let rate = match c::after_training(&spec, world, &trained.agent, seed)? {
+            c::Evaluation::Window(w) => w.rate,
+            c::Evaluation::Satisfaction { rate } => rate,
+        };
+        Ok(SeedResult { rate, secs, steps: trained.steps, curve: trained.curve })
+    };
+    let next = AtomicUsize::new(0);
+    let results: Vec<Result<(usize, SeedResult), CliError>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads.min(seeds.len()).max(1))
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(&seed) = seeds.get(i) else { break };
+                        mine.push(one(seed).map(|r| (i, r)));
+                    }
+                    mine
+                })
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    });
+    let mut runs: Vec<(usize, SeedResult)> = results.into_iter().collect::<Result<_, _>>()?;
+    if runs.len() != seeds.len() {
+        return Err(CliError::new("a training thread stopped before its seeds were done", None));
+    }
+    runs.sort_by_key(|r| r.0);
+    let persistent = !spec.regions.is_empty();
+    let measure = if persistent { "W" } else { "P" };
+    let rates: Vec<f64> = runs.iter().map(|r| r.1.rate).collect();
+    let secs: Vec<f64> = runs.iter().map(|r| r.1.secs).collect();
+    let speed: Vec<f64> =
+        runs.iter().map(|r| r.1.steps as f64 / r.1.secs.max(1e-9) / 1e6).collect();
+    let rewards: Vec<f64> =
+        runs.iter().map(|r| facade::tail_mean(&r.1.curve, facade::TAIL)).collect();
+    outln!()?;
+    outln!(
+        "{label}: `{}` on a continuous world, {} options, {} seeds x {} episodes x {} choices, tiles {}",
+        spec.name,
+        spec.options.len(),
+        seeds.len(),
+        spec.learn.episodes,
+        spec.learn.choices,
+        spec.learn.tiles.as_ref().map_or(String::new(), |t| format!(
+            "{} tilings of {}",
+            t.tilings,
+            t.bins.iter().map(usize::to_string).collect::<Vec<_>>().join(" x ")
+        ))
+    )?;
+    let row = |name: &str, s: Stats, digits: usize| {
+        let Stats { mean: m, sd, min: lo, max: hi } = s;
+        outln!("  {name:<34} {m:>9.digits$} {sd:>9.digits$} {lo:>9.digits$} {hi:>9.digits$}")
+    };
+    outln!("  {:<34} {:>9} {:>9} {:>9} {:>9}", "", "mean", "sd", "min", "max")?;
+    row("training time (s)", Stats::of(&secs), 3)?;
+    row("primitive steps/s (millions)", Stats::of(&speed), 2)?;
+    row("reward per episode (last 100)", Stats::of(&rewards), 2)?;
+    let name = if persistent { "window rate W" } else { "satisfaction rate P" };
+    row(name, Stats::of(&rates), 3)?;
+    outln!("  no exact optimum on a continuous world: {measure} is not divided by one")?;
+    // The median seed by the measure; its policy is trained again (same seed, same bits).
+    let mut order: Vec<usize> = (0..runs.len()).collect();
+    order.sort_by(|&a, &b| rates[a].total_cmp(&rates[b]).then(a.cmp(&b)));
+    let median = order.get(runs.len().saturating_sub(1) / 2).copied().unwrap_or(0);
+    let seed = seeds.get(median).copied().unwrap_or(0);
+    let trained =
+        c::train(&spec, world, seed, |_, _| {}).map_err(|e| CliError::new(e.to_string(), None))?;
+    let policy = c::policy_json(&spec, world, &trained.agent, &l.source, seed)
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    let seeds_csv: String = std::iter::once(format!("seed,{measure},reward,train_secs\n"))
+        .chain(runs.iter().map(|(i, r)| {
+            format!(
+                "{},{},{},{}\n",
+                seeds[*i],
+                r.rate,
+                facade::tail_mean(&r.curve, facade::TAIL),
+                r.secs
+            )
+        }))
+        .collect();
+    let files = vec![
+        OutFile::text("policy.json", policy),
+        OutFile::text("curve.csv", hstl::artifacts::curve_csv(&trained.curve)),
+        OutFile::text("seeds.csv", seeds_csv),
+    ];
+    let dir = out.path().to_path_buf();
+    out.write(&files)?;
+    outln!(
+        "  policy.json: seed {seed}, the median of {} seeds by {measure} ({:.3})",
+        runs.len(),
+        rates[median]
+    )?;
+    outln!("  wrote {}", dir.display())?;
+    let s = Stats::of(&rates);
+    let line = format!(
+        "{},{measure},,{},{},{}\n",
+        facade::csv_field(label),
+        s.mean,
+        s.min,
+        Stats::of(&secs).mean
+    );
+    let curves = CurveSet {
+        label: label.to_string(),
+        kind: spec.learn.reward,
+        runs: runs.into_iter().map(|(i, r)| (seeds[i], r.curve)).collect(),
+    };
+    Ok((line, curves))
+}
+
+/// What one seed of a continuous study measured.
+struct SeedResult {
+    /// W or P.
+    rate: f64,
+    secs: f64,
+    steps: u64,
+    curve: Vec<f64>,
+}
+
 /// Trains `spec` for `seeds` on `threads` workers, timed by this process's clock.
 fn run_seeds(
     spec: &TaskSpec,
@@ -211,9 +364,8 @@ fn run_seeds(
 fn optimum(
     cache: &mut Vec<(Vec<Region>, GridWorld, f64)>,
     spec: &TaskSpec,
-    world: &LoadedWorld,
+    env: &GridWorld,
 ) -> Result<f64, CliError> {
-    let env = &world.world;
     if let Some((_, _, w)) = cache.iter().find(|(r, e, _)| *r == spec.regions && e == env) {
         return Ok(*w);
     }

@@ -7,6 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use hstl::runtime::eval::WindowConfig;
 use hstl::runtime::{GridWorld, Policy, TaskSpec, seeded_rng};
+use hstl::world::AnyWorld;
 
 use crate::cli_error::CliError;
 use crate::output::outln;
@@ -64,7 +65,10 @@ pub fn run(args: &TrainArgs) -> CmdResult {
     if let Some(e) = args.episodes {
         spec.learn.episodes = e;
     }
-    let env = &world.world;
+    let env = match &world.world {
+        AnyWorld::Grid(g) => g,
+        continuous => return run_continuous(args, &loaded, spec, continuous, &world),
+    };
     // Before the long part: a folder another run holds is refused at once.
     let out = OutDir::lock(&args.out, Writer::CLI)?;
     let bar = progress_bar(spec.learn.episodes as u64);
@@ -135,6 +139,95 @@ pub fn run(args: &TrainArgs) -> CmdResult {
         outln!("  {why}")?;
     }
     Ok(Status::Clean)
+}
+
+/// `hstlc train` on a continuous world: the approximate learner, its `policy.json`, the
+/// learning curve, and the greedy policy's window or satisfaction rate.
+fn run_continuous(
+    args: &TrainArgs,
+    loaded: &spec_file::LoadedSpec,
+    mut spec: TaskSpec,
+    world: &AnyWorld,
+    loaded_world: &crate::world_arg::LoadedWorld,
+) -> CmdResult {
+    use hstl::continuous as c;
+    c::fit_tiles(&mut spec, &loaded.spec, world);
+    let out = OutDir::lock(&args.out, Writer::CLI)?;
+    let bar = progress_bar(spec.learn.episodes as u64);
+    let start = Instant::now();
+    let trained = c::train(&spec, world, args.seed, |episode, reward| {
+        bar.set_position(episode as u64 + 1);
+        bar.set_message(format!("reward {reward:.1}"));
+    })
+    .map_err(|e| {
+        let p = hstl::train::cannot_train(&loaded.file, &spec.name, &e);
+        CliError::new(p.message, p.help)
+    })?;
+    let secs = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let policy = c::policy_json(&spec, world, &trained.agent, &loaded.source, args.seed)
+        .map_err(|e| CliError::new(e.to_string(), None))?;
+    let subject = artifacts::subject(&loaded.file, args.spec_name.as_deref());
+    let mut files = vec![
+        OutFile::text("policy.json", policy),
+        OutFile::text("curve.csv", artifacts::curve_csv(&trained.curve)),
+    ];
+    files.extend(artifacts::plane_pictures(
+        &spec,
+        world,
+        &loaded.spec,
+        &trained.agent,
+        &subject,
+        args.seed,
+    )?);
+    files.push(artifacts::curve_picture(
+        &format!("{subject}: learning curve\nseed {}", args.seed),
+        std::slice::from_ref(&trained.curve),
+    )?);
+    let evaluation = c::after_training(&spec, world, &trained.agent, args.seed)?;
+    let written = out.write(&files)?;
+    outln!(
+        "trained `{}` on {} (seed {}): {} episodes, {} steps in {:.2} s ({:.1}M steps/s), tiles {}",
+        spec.name,
+        loaded_world.words(),
+        args.seed,
+        trained.curve.len(),
+        trained.steps,
+        secs,
+        trained.steps as f64 / secs.max(1e-9) / 1e6,
+        tiles_words(&trained.agent.model)
+    )?;
+    outln!(
+        "  reward per episode: {:.2} (mean of the last {} episodes)",
+        tail_mean(&trained.curve, 100),
+        trained.curve.len().min(100)
+    )?;
+    match evaluation {
+        c::Evaluation::Window(w) => outln!(
+            "  window rate {:.3} over {} greedy runs of {} steps (no exact optimum on a continuous world)",
+            w.rate,
+            WindowConfig::default().starts,
+            WindowConfig::default().steps
+        )?,
+        c::Evaluation::Satisfaction { rate } => outln!(
+            "  satisfied in {rate:.3} of 1000 greedy runs of {} steps (no exact optimum on a continuous world)",
+            c::task_steps(&spec)
+        )?,
+    }
+    outln!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files))?;
+    Ok(Status::Clean)
+}
+
+/// ``8 tilings of 14 x 14`` (and the options level's).
+pub fn tiles_words(m: &hstl::runtime::approx::Model) -> String {
+    let dims = |b: Vec<usize>| b.iter().map(usize::to_string).collect::<Vec<_>>().join(" x ");
+    format!(
+        "{} tilings of {} (options level: {} of {})",
+        m.flat_coder.tilings(),
+        dims(m.flat_coder.bins()),
+        m.options_coder.tilings(),
+        dims(m.options_coder.bins())
+    )
 }
 
 /// `--episodes`: 1 to the limit a spec's `learn { episodes }` has.

@@ -4,8 +4,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use hstl::lang::syntax::Spec;
-use hstl::lang::{Parsed, SpecWorld, WorldFacts, WorldProblem};
-use hstl::world::GridWorld;
+use hstl::lang::{Parsed, SpecWorld, WorldProblem};
+use hstl::world::{AnyWorld, Facts, GridWorld};
 
 use crate::cli_error::CliError;
 use crate::input;
@@ -13,8 +13,8 @@ use crate::input;
 /// A world and how messages name it.
 #[derive(Clone)]
 pub struct LoadedWorld {
-    /// The world.
-    pub world: GridWorld,
+    /// The world: a grid, a plane or `mountain-car`.
+    pub world: AnyWorld,
     /// ``world `four-rooms` `` or ``world `office` (maps/office.toml)``.
     pub label: String,
     /// The world file, for one read from a file.
@@ -40,8 +40,8 @@ impl LoadedWorld {
     /// path relative to `base` (the spec file's folder; `None`: the current folder). A file
     /// that cannot be read is `CliError::Read`, without help ([`item_help`] gives one).
     pub fn named(arg: &str, base: Option<&Path>) -> Result<LoadedWorld, CliError> {
-        if let Some(world) = GridWorld::builtin(arg) {
-            let label = hstl::world::label(&world, None);
+        if let Some(world) = AnyWorld::builtin(arg) {
+            let label = hstl::world::any_label(&world, None);
             return Ok(LoadedWorld { world, label, file: None });
         }
         let path: PathBuf = match base {
@@ -58,33 +58,22 @@ impl LoadedWorld {
         let input::Input { name: file, text, .. } =
             input::read_text(path, "<stdin>", hstl::lang::MAX_SOURCE_BYTES, "world file")?;
         let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
-        let world = hstl::world::from_file(&text, &file, &stem)
+        let world = hstl::world::any_from_file(&text, &file, &stem)
             .map_err(|p| CliError::new(p.message, p.help))?;
-        let label = hstl::world::label(&world, Some(&file));
+        let label = hstl::world::any_label(&world, Some(&file));
         Ok(LoadedWorld { world, label, file: Some(file) })
     }
 
     /// The world's name, size and slip, for summaries.
     pub fn words(&self) -> String {
-        world_words(&self.world, self.file.as_deref())
+        hstl::world::words(&self.world, self.file.as_deref())
     }
 }
 
 /// ``world `four-rooms` (13 x 13, 65 walls, slip 0.3)``, with the file it was read from
-/// before the size.
+/// before the size (see [`hstl::world::words`]).
 pub fn world_words(world: &GridWorld, file: Option<&str>) -> String {
-    let cells = world.width() * world.height();
-    let walls = cells - hstl::runtime::Env::num_states(world);
-    let walls = match walls {
-        0 => String::new(),
-        1 => ", 1 wall".into(),
-        n => format!(", {n} walls"),
-    };
-    // Nine decimals: a `policy.json` written before worlds stores p, and 1 - 0.7 is not 0.3.
-    let slip = (world.slip() * 1e9).round() / 1e9;
-    let from = file.map_or(String::new(), |f| format!("{f}; "));
-    let name = world.world_name();
-    format!("world `{name}` ({from}{} x {}{walls}, slip {slip})", world.width(), world.height())
+    hstl::world::words(&AnyWorld::Grid(world.clone()), file)
 }
 
 /// Where a spec's world comes from when it is checked.
@@ -98,8 +87,8 @@ pub enum WorldChoice<'a> {
 
 /// The worlds the specs of one text name, each read once, as the checks see them.
 pub struct SpecWorlds {
-    named: HashMap<String, Result<(LoadedWorld, WorldFacts), WorldProblem>>,
-    imposed: Option<WorldFacts>,
+    named: HashMap<String, Result<(LoadedWorld, Facts), WorldProblem>>,
+    imposed: Option<Facts>,
 }
 
 impl SpecWorlds {
@@ -117,24 +106,24 @@ impl SpecWorlds {
             {
                 let loaded = LoadedWorld::named(&item.name, base)
                     .map(|w| {
-                        let facts = hstl::world::facts(&w.world, &w.label);
+                        let facts = hstl::world::any_facts(&w.world, &w.label);
                         (w, facts)
                     })
                     .map_err(|e| WorldProblem { message: e.to_string(), help: item_help(&e) });
                 named.insert(item.name.clone(), loaded);
             }
         }
-        let imposed = imposed.map(|w| hstl::world::facts(&w.world, &w.label));
+        let imposed = imposed.map(|w| hstl::world::any_facts(&w.world, &w.label));
         SpecWorlds { named, imposed }
     }
 
     /// What `spec` is checked against.
     pub fn lookup(&self, spec: &Spec) -> SpecWorld<'_> {
         if let Some(facts) = &self.imposed {
-            return SpecWorld::Facts(facts);
+            return facts.spec_world();
         }
         match hstl::lang::world_item(spec).and_then(|item| self.named.get(&item.name)) {
-            Some(Ok((_, facts))) => SpecWorld::Facts(facts),
+            Some(Ok((_, facts))) => facts.spec_world(),
             Some(Err(problem)) => SpecWorld::Unavailable(problem),
             None => SpecWorld::Alone,
         }
@@ -190,7 +179,7 @@ pub fn item_help(e: &CliError) -> String {
         _ => format!(
             "a world file's path is relative to the spec file's folder; or name a built-in \
              world ({})",
-            hstl::world::BUILTIN.map(|b| format!("`{b}`")).join(", ")
+            hstl::world::builtin_list()
         ),
     }
 }

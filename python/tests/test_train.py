@@ -167,7 +167,7 @@ def test_a_spec_with_errors_raises_hstlc_checks_diagnostics(hstlc, monkeypatch):
     assert run_cli(hstlc, "train", "float_state.hstl", "--out", "unused").returncode == 1
     with pytest.raises(hstl.SpecError) as e:
         hstl.train("float_state.hstl")
-    assert str(e.value) == concise.stdout.rstrip("\n") and e.value.diagnostics[0].code == "HSTL014"
+    assert str(e.value) == concise.stdout.rstrip("\n") and e.value.diagnostics[0].code == "HSTL025"
 
 
 def test_bad_arguments_raise():

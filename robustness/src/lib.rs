@@ -28,10 +28,12 @@ pub mod offline;
 pub mod online;
 pub mod reference;
 pub mod segment;
+pub mod state;
 mod stream;
 pub mod trace;
 
 pub use formula::{Bound, CmpOp, Expr, ExprId, Formula, FormulaBuilder, Interval, Node, NodeId};
 pub use offline::Evaluator;
 pub use online::{OnlineMonitor, Verdict};
+pub use state::StateEval;
 pub use trace::{Trace, TraceError};

@@ -656,7 +656,7 @@ fn end(i: &Interval) -> usize {
 
 /// `rho` of state node `node` on one state, given the values of earlier nodes on it, as
 /// the reference evaluator computes it.
-fn state_value(node: &Node, vals: &[f64], row: &[f64]) -> f64 {
+pub(crate) fn state_value(node: &Node, vals: &[f64], row: &[f64]) -> f64 {
     let v = |k: &crate::NodeId| vals[k.index()];
     match node {
         Node::True => INF,

@@ -24,6 +24,7 @@
 //!
 //! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
 
+pub mod approx;
 pub mod draw;
 pub mod env;
 mod error;
@@ -57,7 +58,7 @@ pub use rand::RngExt;
 pub use serde_json::{Value, json};
 pub use spec::{
     CombinedOption, Intra, LearnParams, LevelParams, Plan, PrimitiveOption, Region, RewardKind,
-    Spec, StateVar, Switch, TaskSpec, Terminate,
+    Spec, StateVar, Switch, TaskSpec, Terminate, TileParams,
 };
 
 /// The one random generator of the crate: every draw comes from a value of this type.

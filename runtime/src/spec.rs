@@ -116,6 +116,23 @@ pub struct LearnParams {
     pub flat: LevelParams,
     /// The options level; epsilon decays per option choice.
     pub options: LevelParams,
+    /// The tile coding of the approximate learner ([`crate::approx`]); `None`: the
+    /// tabular learner.
+    pub tiles: Option<TileParams>,
+}
+
+/// The tile coding of a continuous state (see [`crate::approx::tiles`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TileParams {
+    /// Offset tilings of the flat levels (8); the options level has half as many, each
+    /// tile twice as wide.
+    pub tilings: usize,
+    /// Tiles along each state variable, in the spec's order.
+    pub bins: Vec<usize>,
+    /// Each state variable's lower bound (the domain's).
+    pub lo: Vec<f64>,
+    /// Each state variable's upper bound.
+    pub hi: Vec<f64>,
 }
 
 /// Q-learning parameters of one level.
@@ -214,6 +231,7 @@ impl Default for LearnParams {
             plan: Plan::Off,
             flat: LevelParams::FLAT,
             options: LevelParams::OPTIONS,
+            tiles: None,
         }
     }
 }
@@ -266,8 +284,18 @@ impl TaskSpec {
         if self.state_vars.is_empty() {
             return err("the spec has no state variable".into());
         }
+        if let Some(t) = &self.learn.tiles {
+            let n = self.state_vars.len();
+            if t.bins.len() != n || t.lo.len() != n || t.hi.len() != n {
+                return err(format!(
+                    "the tiling has bounds for other than the {n} state variables"
+                ));
+            }
+        }
         for v in &self.state_vars {
             match &v.domain {
+                // The approximate learner covers a continuous variable with its tiling.
+                None if self.learn.tiles.is_some() => {}
                 None => return err(format!("state variable {} has no finite int range", v.name)),
                 Some(d) if d.is_empty() => {
                     return err(format!(

@@ -67,7 +67,7 @@ use toml::de::{DeTable, DeValue};
 use crate::env::{MAX_GRID_CELLS, Tile};
 use crate::plane::PlaneWorld;
 pub use crate::plane::{MAX_OBSTACLES, PLANE_BUILTIN};
-use crate::{Error, GridWorld, World};
+use crate::{Error, GridWorld, MountainCar, World};
 
 /// The names of the built-in grid worlds, for [`builtin`]; [`PLANE_BUILTIN`] names the
 /// plane ones, and [`AnyWorld::builtin`] takes both.
@@ -150,7 +150,12 @@ pub enum AnyWorld {
     Grid(GridWorld),
     /// A plane world: a bounded plane (`kind = "plane"`).
     Plane(PlaneWorld),
+    /// Gymnasium's MountainCar-v0 dynamics, built in as `mountain-car`.
+    MountainCar(MountainCar),
 }
+
+/// The names of the built-in continuous worlds that are no plane: `mountain-car`.
+pub const CAR_BUILTIN: [&str; 1] = ["mountain-car"];
 
 impl AnyWorld {
     /// The world in a world file's text, of the kind its `kind` says. `default_name` names
@@ -168,7 +173,21 @@ impl AnyWorld {
 
     /// A built-in world by name: a grid ([`BUILTIN`]) or a plane ([`PLANE_BUILTIN`]).
     pub fn builtin(name: &str) -> Option<AnyWorld> {
+        if CAR_BUILTIN.contains(&name) {
+            return Some(AnyWorld::MountainCar(MountainCar));
+        }
         builtin(name).map(AnyWorld::Grid).or_else(|| PlaneWorld::builtin(name).map(AnyWorld::Plane))
+    }
+
+    /// Every built-in world's name: grids, planes, then the others.
+    pub fn builtin_names() -> Vec<&'static str> {
+        BUILTIN.iter().chain(&PLANE_BUILTIN).chain(&CAR_BUILTIN).copied().collect()
+    }
+
+    /// Whether the world's state is continuous (a plane, mountain-car): the approximate
+    /// learner trains in it.
+    pub fn is_continuous(&self) -> bool {
+        !matches!(self, AnyWorld::Grid(_))
     }
 
     /// The world from `policy.json`'s `env`: its name and the `params` that
@@ -183,6 +202,9 @@ impl AnyWorld {
             Some(Value::String(k)) if k == "plane" => {
                 PlaneWorld::from_params(name, params).map(AnyWorld::Plane)
             }
+            Some(Value::String(k)) if k == "mountain-car" => {
+                MountainCar::from_params(params).map(AnyWorld::MountainCar)
+            }
             Some(_) => {
                 Err(Error::Env("the world's `kind` is neither \"grid\" nor \"plane\"".into()))
             }
@@ -194,6 +216,7 @@ impl AnyWorld {
         match self {
             AnyWorld::Grid(w) => World::name(w),
             AnyWorld::Plane(w) => w.name(),
+            AnyWorld::MountainCar(w) => w.name(),
         }
     }
 
@@ -202,6 +225,7 @@ impl AnyWorld {
         match self {
             AnyWorld::Grid(w) => World::params(w),
             AnyWorld::Plane(w) => w.params(),
+            AnyWorld::MountainCar(w) => w.params(),
         }
     }
 }

@@ -41,6 +41,7 @@ fn check_any(text: &str) {
             }
         }
         Ok(AnyWorld::Grid(_)) => {}
+        Ok(AnyWorld::MountainCar(_)) => panic!("a world file made mountain-car: {text}"),
         Err(e) => check_error(text, &e),
     }
 }

@@ -1020,6 +1020,20 @@ impl<'a> Gen<'a> {
             hstl_lang::Reward::Segment => quote!(Segment),
             hstl_lang::Reward::Window => quote!(Window),
         };
+        let tiles = match self.spec.tile_box() {
+            Some(b) => {
+                let tilings = b.tilings as usize;
+                let bins = b.bins.iter().map(|&n| n as usize);
+                let (lo, hi) = (&b.lo, &b.hi);
+                quote!(::core::option::Option::Some(#hstl::runtime::TileParams {
+                    tilings: #tilings,
+                    bins: ::std::vec![#(#bins),*],
+                    lo: ::std::vec![#(#lo),*],
+                    hi: ::std::vec![#(#hi),*],
+                }))
+            }
+            None => quote!(::core::option::Option::None),
+        };
         let doc =
             format!(" The spec `{name}` for the runtime: train it with `hstl::runtime::Learner`.");
         quote! {
@@ -1051,6 +1065,7 @@ impl<'a> Gen<'a> {
                             plan: #hstl::runtime::Plan::#plan,
                             flat: #flat,
                             options: #opts,
+                            tiles: #tiles,
                         },
                         regions: ::std::vec![#(#regions),*],
                     }

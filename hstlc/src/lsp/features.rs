@@ -1063,10 +1063,10 @@ const MAX_WORLD_FILES: usize = 200;
 
 /// The built-in worlds, then the `.toml` files in the document's folder.
 fn world_completion(a: &Analysis) -> Vec<CompletionItem> {
-    let mut items: Vec<CompletionItem> = hstl::world::BUILTIN
-        .iter()
+    let mut items: Vec<CompletionItem> = hstl::world::AnyWorld::builtin_names()
+        .into_iter()
         .map(|name| CompletionItem {
-            label: (*name).to_string(),
+            label: name.to_string(),
             kind: Some(CompletionItemKind::CONSTANT),
             detail: Some("built-in world".into()),
             ..CompletionItem::default()

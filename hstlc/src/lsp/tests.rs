@@ -768,7 +768,7 @@ fn the_world_a_spec_names() {
     let items = c.request("textDocument/completion", params).result.expect("completion");
     let labels: Vec<&str> =
         items.as_array().unwrap().iter().filter_map(|i| i["label"].as_str()).collect();
-    assert_eq!(labels, ["paper", "four-rooms", "nook.toml"]);
+    assert_eq!(labels, ["paper", "four-rooms", "paper-plane", "mountain-car", "nook.toml"]);
     // The world file shrinks: the spec no longer fits, once the editor says files changed.
     std::fs::write(&world, "map = \"\"\"\n...\n...\n\"\"\"\n").expect("world");
     c.notify("workspace/didChangeWatchedFiles", json!({ "changes": [] }));

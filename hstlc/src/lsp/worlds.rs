@@ -12,7 +12,8 @@ use std::sync::Arc;
 use std::time::SystemTime;
 
 use hstl::lang::syntax::Spec;
-use hstl::lang::{Parsed, SpecWorld, WorldFacts, WorldProblem};
+use hstl::lang::{Parsed, SpecWorld, WorldProblem};
+use hstl::world::Facts;
 use lsp_types::Uri;
 
 use crate::world_arg::{LoadedWorld, item_help};
@@ -27,7 +28,7 @@ pub struct Resolved {
     pub path: Option<PathBuf>,
     /// The world's facts and words (``world `yard` (yard.toml; 20 x 10, slip 0.1)``), or why
     /// it could not be had.
-    pub world: Arc<Result<(WorldFacts, String), WorldProblem>>,
+    pub world: Arc<Result<(Facts, String), WorldProblem>>,
 }
 
 /// The worlds of one analysis, by the text of each `world` item.
@@ -43,7 +44,7 @@ impl DocWorlds {
     pub fn lookup(&self, spec: &Spec) -> SpecWorld<'_> {
         let Some(item) = hstl::lang::world_item(spec) else { return SpecWorld::Alone };
         match self.by_name.get(&item.name).map(|r| r.world.as_ref()) {
-            Some(Ok((facts, _))) => SpecWorld::Facts(facts),
+            Some(Ok((facts, _))) => facts.spec_world(),
             Some(Err(problem)) => SpecWorld::Unavailable(problem),
             None => SpecWorld::Alone,
         }
@@ -87,7 +88,7 @@ impl WorldCache {
     }
 
     fn one(&mut self, name: &str, folder: Option<&Path>) -> Resolved {
-        if hstl::world::GridWorld::builtin(name).is_some() {
+        if hstl::world::AnyWorld::builtin(name).is_some() {
             return Resolved { path: None, world: Arc::new(load(name, None)) };
         }
         let path = match folder {
@@ -124,10 +125,10 @@ impl WorldCache {
 }
 
 /// Reads the world `name` names as `hstlc check` does.
-fn load(name: &str, folder: Option<&Path>) -> Result<(WorldFacts, String), WorldProblem> {
+fn load(name: &str, folder: Option<&Path>) -> Result<(Facts, String), WorldProblem> {
     let world = LoadedWorld::named(name, folder)
         .map_err(|e| WorldProblem { message: e.to_string(), help: item_help(&e) })?;
-    Ok((hstl::world::facts(&world.world, &world.label), world.words()))
+    Ok((hstl::world::any_facts(&world.world, &world.label), world.words()))
 }
 
 /// The file a `file:` URI names, or `None` for another scheme.

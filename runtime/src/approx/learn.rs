@@ -1,0 +1,667 @@
+//! Algorithm 1 with linear function approximation: the tabular learner's updates
+//! ([`crate::learn`]) with every Q-value a sum of tile weights.
+//!
+//! **Flat level.** Primitive `p` has one weight vector per action over the state's tiles:
+//! `Q_p(s, a) = sum_t w_p[a][phi_t(s)]`. Every primitive step `s -a-> s'`, whichever
+//! option runs, updates every primitive (off-policy, semi-gradient Q-learning): reward
+//! `rho(reach_p, s')`, target `r + gamma max_a' Q_p(s', a')`, each active weight moved by
+//! `alpha / tilings` times the error. A leg with `avoid: R` earns `min(rho(reach),
+//! rho(!R))` outside `R` and, on entering, a penalty worse than any reward outside (the
+//! worst over a lattice of the box, less one, earned forever), without bootstrapping.
+//!
+//! **Options level.** `Q(obs, o) = sum_t v_o[code][psi_t(s)]`, `psi` a coarser tiling of the
+//! state and `code` the memory's buckets of a persistent task (its counters, exact, are
+//! what keeps a long window Markov; the buckets are what the policy tells apart), so that
+//! the options level never grows with the window's length. An option run from `s_0` to
+//! `s_k` updates every suffix `s_j .. s_k` (intra-option, `j = 0` first) toward its own
+//! reward plus `gamma^(k-j) max_{o' available at s_k} Q(obs_k, o')`, all bootstrapping from
+//! the values before this execution's updates, as the tabular learner does.
+//!
+//! Exploration, episodes, `max_steps`, `reward: window` and `switch: step` (in the greedy
+//! agent) are the tabular learner's. Nothing here names a state index or a table: states
+//! are the world's own values, seen through [`World::valuation`].
+
+use std::ops::ControlFlow;
+
+use hstl_robustness::segment::SegmentScorer;
+use hstl_robustness::{Formula, StateEval, Trace};
+use rand::RngExt;
+
+use super::tiles::TileCoder;
+use crate::spec::{LevelParams, RewardKind, Terminate, TileParams};
+use crate::{Error, Rng, TaskSpec, World};
+
+/// At most this many weights in all (flat and options), 8 bytes each.
+pub const MAX_WEIGHTS: usize = 1 << 25;
+
+/// Lattice points per variable when the worst reward of a leg with `avoid` is looked for.
+const LATTICE: usize = 33;
+
+/// The learned weights, enough to act greedily and to continue training.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Weights {
+    /// `flat[p][a * F + f]`: primitive `p`'s weight of feature `f` for action `a`.
+    pub flat: Vec<Vec<f64>>,
+    /// `options[(code * n_options + o) * G + g]`: option `o`'s weight of options feature
+    /// `g` under memory code `code`.
+    pub options: Vec<f64>,
+    /// Primitive steps taken so far (drives the flat epsilon).
+    pub steps: u64,
+    /// Option choices made so far (drives the options epsilon).
+    pub choices: u64,
+}
+
+/// What the learner and the greedy agent share: the spec's formulas, the codings and the
+/// memory's dynamics, all over the world's values.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The spec's state variables' names, in valuation order.
+    pub vars: Vec<String>,
+    /// Actions of the world.
+    pub actions: usize,
+    /// The flat levels' coding.
+    pub flat_coder: TileCoder,
+    /// The options level's coding.
+    pub options_coder: TileCoder,
+    reach: Vec<Formula>,
+    init: Vec<Formula>,
+    terminate: Vec<Formula>,
+    avoid: Vec<Option<(Formula, f64)>>,
+    /// `legs[o]`: the primitives option `o` runs.
+    pub legs: Vec<Vec<usize>>,
+    /// The persistent task's regions and windows (empty for another task).
+    regions: Vec<(Formula, usize)>,
+    /// Memory buckets `B` (0: the options level sees no memory).
+    pub buckets: usize,
+    /// Memory codes `(B + 1)^k` (1 without memory).
+    pub values: usize,
+    /// Steps after which a leg is cut off.
+    pub max_steps: usize,
+}
+
+impl Model {
+    /// The model of `spec` in `world`. Fails for a spec the approximate learner cannot
+    /// run (no `tiles` settings, `terminate: argmax`, a world whose variables are not the
+    /// spec's) or one too large for [`MAX_WEIGHTS`].
+    pub fn new<W: World>(spec: &TaskSpec, world: &W) -> Result<Model, Error> {
+        let Some(tiles) = &spec.learn.tiles else {
+            return Err(Error::Config("the approximate learner needs `tiles` settings".into()));
+        };
+        let vars: Vec<String> = spec.state_vars.iter().map(|v| v.name.clone()).collect();
+        if world.state_vars() != vars {
+            return Err(Error::Spec(format!(
+                "the spec's state variables ({}) are not the world's ({})",
+                vars.join(", "),
+                world.state_vars().join(", ")
+            )));
+        }
+        let actions = world.actions().len();
+        if actions == 0 {
+            return Err(Error::Env(format!("environment {} has no action", world.name())));
+        }
+        let flat_coder = coder(tiles, 1, tiles.tilings)?;
+        let options_coder = coder(tiles, 2, tiles.tilings.div_ceil(2))?;
+        let mut reach = Vec::new();
+        let mut init = Vec::new();
+        let mut terminate = Vec::new();
+        for p in &spec.primitives {
+            let stop = match &p.terminate {
+                Terminate::Formula(f) => f.clone(),
+                Terminate::Argmax => {
+                    return Err(Error::Spec(format!(
+                        "option {} stops where its region is most robust (argmax), which needs a \
+                         finite state space; give it `terminate: REGION`",
+                        p.name
+                    )));
+                }
+            };
+            reach.push(p.reach.clone());
+            init.push(p.init.clone());
+            terminate.push(stop);
+        }
+        let gamma = spec.learn.flat.gamma;
+        let forever = if gamma < 1.0 { 1.0 / (1.0 - gamma) } else { spec.learn.max_steps as f64 };
+        let avoid = spec
+            .primitives
+            .iter()
+            .map(|p| {
+                p.avoid.as_ref().map(|r| {
+                    let worst = worst_outside(&p.reach, r, tiles);
+                    (r.clone(), (worst - 1.0) * forever)
+                })
+            })
+            .collect();
+        let persistent = spec.learn.memory > 0 || spec.learn.reward == RewardKind::Window;
+        let regions: Vec<(Formula, usize)> = if persistent {
+            spec.regions.iter().map(|r| (r.formula.clone(), r.horizon.max(1))).collect()
+        } else {
+            Vec::new()
+        };
+        if persistent && regions.is_empty() {
+            return Err(Error::Spec(
+                "memory and `reward: window` need a persistent task with regions".into(),
+            ));
+        }
+        let buckets = spec.learn.memory;
+        let values = if buckets == 0 {
+            Some(1)
+        } else {
+            u32::try_from(regions.len()).ok().and_then(|k| (buckets + 1).checked_pow(k))
+        };
+        let legs: Vec<Vec<usize>> = spec.options.iter().map(|o| o.sequence.clone()).collect();
+        let total = values.and_then(|v| {
+            let flat = flat_coder.len().checked_mul(actions)?.checked_mul(reach.len())?;
+            let options = options_coder.len().checked_mul(legs.len())?.checked_mul(v)?;
+            flat.checked_add(options)
+        });
+        let (Some(values), Some(total)) = (values, total) else {
+            return Err(Error::Config("the weights would not fit in memory".into()));
+        };
+        if total > MAX_WEIGHTS {
+            return Err(Error::Config(format!(
+                "{total} weights are more than the {MAX_WEIGHTS} allowed; use fewer tiles, \
+                 tilings or memory buckets"
+            )));
+        }
+        Ok(Model {
+            vars,
+            actions,
+            flat_coder,
+            options_coder,
+            reach,
+            init,
+            terminate,
+            avoid,
+            legs,
+            regions,
+            buckets,
+            values,
+            max_steps: spec.learn.max_steps,
+        })
+    }
+
+    /// Zeroed weights of this model's shape.
+    pub fn zero_weights(&self) -> Weights {
+        let flat = vec![vec![0.0; self.flat_coder.len() * self.actions]; self.reach.len()];
+        let options = vec![0.0; self.values * self.legs.len() * self.options_coder.len()];
+        Weights { flat, options, steps: 0, choices: 0 }
+    }
+
+    /// Whether `weights` has this model's shape.
+    pub fn fits(&self, weights: &Weights) -> bool {
+        let zero = self.zero_weights();
+        weights.flat.len() == zero.flat.len()
+            && weights.flat.iter().all(|w| w.len() == zero.flat[0].len())
+            && weights.options.len() == zero.options.len()
+    }
+
+    /// The options whose first leg may start at the valuation `x` (every option when none
+    /// may: a continuous state has no place to refuse).
+    pub fn available(&self, eval: &mut StateEval, x: &[f64], out: &mut Vec<usize>) {
+        out.clear();
+        for (o, legs) in self.legs.iter().enumerate() {
+            if eval.value(&self.init[legs[0]], x) > 0.0 {
+                out.push(o);
+            }
+        }
+        if out.is_empty() {
+            out.extend(0..self.legs.len());
+        }
+    }
+
+    /// Whether primitive `p` stops at `x`: its termination formula holds, or it entered its
+    /// avoided region.
+    pub fn stops(&self, eval: &mut StateEval, p: usize, x: &[f64]) -> bool {
+        eval.value(&self.terminate[p], x) > 0.0
+            || self.avoid[p].as_ref().is_some_and(|(r, _)| eval.value(r, x) >= 0.0)
+    }
+
+    /// The window of each region of a persistent task, in conjunct order.
+    pub fn horizons(&self) -> impl Iterator<Item = usize> + '_ {
+        self.regions.iter().map(|(_, n)| *n)
+    }
+
+    /// Whether the task is persistent (its memory's counters run).
+    pub fn is_persistent(&self) -> bool {
+        !self.regions.is_empty()
+    }
+
+    /// The counters at the start of an episode in `x`: 0 for a region that holds there,
+    /// else the window (expired).
+    pub fn start_counters(&self, eval: &mut StateEval, x: &[f64], tau: &mut Vec<usize>) {
+        tau.clear();
+        for (r, n) in &self.regions {
+            tau.push(if eval.value(r, x) > 0.0 { 0 } else { *n });
+        }
+    }
+
+    /// Moves the counters on to `x`; returns `psi` (every window kept).
+    pub fn step_counters(&self, eval: &mut StateEval, x: &[f64], tau: &mut [usize]) -> bool {
+        let mut kept = true;
+        for ((r, n), t) in self.regions.iter().zip(tau.iter_mut()) {
+            *t = if eval.value(r, x) > 0.0 { 0 } else { (*t + 1).min(*n) };
+            kept &= *t < *n;
+        }
+        kept
+    }
+
+    /// The memory code of the counters (0 without buckets).
+    pub fn code(&self, tau: &[usize]) -> usize {
+        if self.buckets == 0 {
+            return 0;
+        }
+        let b = self.buckets;
+        tau.iter().zip(&self.regions).fold(0, |code, (&t, (_, n))| {
+            let bucket = if t >= *n { b } else { t * b / n };
+            code * (b + 1) + bucket
+        })
+    }
+
+    /// `Q_p(x, a)` for every action, from the features `f` of `x`, into `out`.
+    fn flat_values(&self, w: &[f64], f: &[usize], out: &mut [f64]) {
+        let n = self.flat_coder.len();
+        for (a, q) in out.iter_mut().enumerate() {
+            let row = &w[a * n..][..n];
+            *q = f.iter().map(|&i| row[i]).sum();
+        }
+    }
+
+    /// The greedy action of primitive `p` at the features `f`; the lowest index among ties.
+    pub fn greedy_action(
+        &self,
+        weights: &Weights,
+        p: usize,
+        f: &[usize],
+        scratch: &mut Vec<f64>,
+    ) -> usize {
+        scratch.resize(self.actions, 0.0);
+        self.flat_values(&weights.flat[p], f, scratch);
+        crate::learn::argmax(scratch)
+    }
+
+    /// `Q(obs, o)` under memory code `code`, from the options features `g`.
+    pub fn option_value(&self, weights: &Weights, code: usize, o: usize, g: &[usize]) -> f64 {
+        let n = self.options_coder.len();
+        let row = &weights.options[(code * self.legs.len() + o) * n..][..n];
+        g.iter().map(|&i| row[i]).sum()
+    }
+
+    /// The available option with the largest value; the first among ties.
+    pub fn best_option(
+        &self,
+        weights: &Weights,
+        code: usize,
+        g: &[usize],
+        available: &[usize],
+    ) -> usize {
+        let mut best = available[0];
+        let mut top = self.option_value(weights, code, best, g);
+        for &o in &available[1..] {
+            let v = self.option_value(weights, code, o, g);
+            if v > top || top.is_nan() && !v.is_nan() {
+                (best, top) = (o, v);
+            }
+        }
+        best
+    }
+}
+
+/// The coding of `tiles` with every variable's tile count divided by `coarser` (at least 1).
+fn coder(tiles: &TileParams, coarser: usize, tilings: usize) -> Result<TileCoder, Error> {
+    let bins: Vec<usize> = tiles.bins.iter().map(|b| (b / coarser).max(1)).collect();
+    TileCoder::new(&tiles.lo, &tiles.hi, &bins, tilings).map_err(Error::Config)
+}
+
+/// The worst flat reward outside `avoid` of a leg reaching `reach`: the least
+/// `min(rho(reach), -rho(avoid))` over a lattice of the box where `avoid` does not hold
+/// (`LATTICE` points per variable, at most 4,096 in all), or 0 when that is larger.
+fn worst_outside(reach: &Formula, avoid: &Formula, tiles: &TileParams) -> f64 {
+    let dims = tiles.lo.len();
+    let per = (1..=LATTICE).rev().find(|&n| n.checked_pow(dims as u32).is_some_and(|t| t <= 4096));
+    let per = per.unwrap_or(1).max(2);
+    let total = per.saturating_pow(dims as u32).min(4096);
+    let mut eval = StateEval::new();
+    let mut x = vec![0.0; dims];
+    let mut worst = 0.0f64;
+    for mut k in 0..total {
+        for (d, v) in x.iter_mut().enumerate() {
+            let i = k % per;
+            k /= per;
+            *v = tiles.lo[d] + (tiles.hi[d] - tiles.lo[d]) * i as f64 / (per - 1) as f64;
+        }
+        let a = eval.value(avoid, &x);
+        if a < 0.0 {
+            let r = eval.value(reach, &x).min(-a);
+            if r.is_finite() {
+                worst = worst.min(r);
+            }
+        }
+    }
+    worst
+}
+
+/// The result of [`ApproxLearner::train`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trained {
+    /// The learning curve: per episode, the sum of the rewards of its options.
+    pub curve: Vec<f64>,
+    /// Primitive steps taken in this call.
+    pub steps: u64,
+}
+
+/// Trains one spec in one world with linear function approximation.
+#[derive(Clone, Debug)]
+pub struct ApproxLearner<'w, W: World> {
+    world: &'w W,
+    spec: TaskSpec,
+    model: Model,
+    weights: Weights,
+    scorer: Option<SegmentScorer>,
+    eval: StateEval,
+    gamma_powers: Vec<f64>,
+}
+
+/// One option execution: the valuations, features and memory along it.
+#[derive(Clone, Debug)]
+struct Run<S> {
+    /// The world's states `s_0 .. s_k`.
+    states: Vec<S>,
+    /// Valuations, `vars` values per position.
+    values: Vec<f64>,
+    /// Options features, `tilings` per position.
+    options_features: Vec<usize>,
+    /// The memory code at each position.
+    codes: Vec<usize>,
+    /// `psi` at each position (empty for a task without counters).
+    psi: Vec<bool>,
+}
+
+impl<'w, W: World> ApproxLearner<'w, W> {
+    /// A learner with zeroed weights (see [`Model::new`] for what fails).
+    pub fn new(spec: &TaskSpec, world: &'w W) -> Result<ApproxLearner<'w, W>, Error> {
+        spec.validate()?;
+        let model = Model::new(spec, world)?;
+        let weights = model.zero_weights();
+        let scorer = match spec.learn.reward {
+            RewardKind::Segment => Some(SegmentScorer::new(&spec.task)),
+            RewardKind::Window => None,
+        };
+        Ok(ApproxLearner {
+            world,
+            spec: spec.clone(),
+            model,
+            weights,
+            scorer,
+            eval: StateEval::new(),
+            gamma_powers: vec![1.0],
+        })
+    }
+
+    /// Continues from earlier weights (for instance from a loaded `policy.json`).
+    pub fn with_weights(mut self, weights: Weights) -> Result<ApproxLearner<'w, W>, Error> {
+        if !self.model.fits(&weights) {
+            return Err(Error::Config(
+                "the weights do not have the shape of this spec and world".into(),
+            ));
+        }
+        self.weights = weights;
+        Ok(self)
+    }
+
+    /// The learned weights.
+    pub fn weights(&self) -> &Weights {
+        &self.weights
+    }
+
+    /// The model the weights are read with.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The spec being learned.
+    pub fn spec(&self) -> &TaskSpec {
+        &self.spec
+    }
+
+    /// Runs `learn.episodes` episodes, calling `progress(episode, reward)` after each.
+    pub fn train(&mut self, rng: &mut Rng, mut progress: impl FnMut(usize, f64)) -> Trained {
+        self.train_until(rng, |e, r| {
+            progress(e, r);
+            ControlFlow::Continue(())
+        })
+    }
+
+    /// [`ApproxLearner::train`], stopped after the episode for which `progress` breaks.
+    pub fn train_until(
+        &mut self,
+        rng: &mut Rng,
+        mut progress: impl FnMut(usize, f64) -> ControlFlow<()>,
+    ) -> Trained {
+        let before = self.weights.steps;
+        let mut curve = Vec::with_capacity(self.spec.learn.episodes);
+        let mut run = Run::default();
+        let mut scratch = Scratch::default();
+        for episode in 0..self.spec.learn.episodes {
+            let reward = self.episode(rng, &mut run, &mut scratch);
+            curve.push(reward);
+            if progress(episode, reward).is_break() {
+                break;
+            }
+        }
+        Trained { curve, steps: self.weights.steps - before }
+    }
+
+    fn episode(&mut self, rng: &mut Rng, run: &mut Run<W::State>, s: &mut Scratch) -> f64 {
+        let mut state = self.world.reset(rng);
+        self.world.valuation(&state, &mut s.x);
+        self.model.start_counters(&mut self.eval, &s.x, &mut s.tau);
+        let mut total = 0.0;
+        for _ in 0..self.spec.learn.choices {
+            let o = self.choose_option(rng, s);
+            self.run_option(o, &state, rng, run, s);
+            self.suffix_rewards(run, &mut s.rewards);
+            total += s.rewards[0];
+            self.update_options(o, run, s);
+            state = run.states.last().cloned().unwrap_or(state);
+            let vars = self.model.vars.len();
+            s.x.clear();
+            s.x.extend_from_slice(&run.values[run.values.len() - vars..]);
+        }
+        total
+    }
+
+    fn choose_option(&mut self, rng: &mut Rng, s: &mut Scratch) -> usize {
+        let eps = self.spec.learn.options.epsilon_at(self.weights.choices);
+        self.weights.choices += 1;
+        self.model.available(&mut self.eval, &s.x, &mut s.available);
+        if rng.random::<f64>() < eps {
+            return s.available[rng.random_range(0..s.available.len())];
+        }
+        self.model.options_coder.features(&s.x, &mut s.g);
+        let code = self.model.code(&s.tau);
+        self.model.best_option(&self.weights, code, &s.g, &s.available)
+    }
+
+    fn run_option(
+        &mut self,
+        o: usize,
+        start: &W::State,
+        rng: &mut Rng,
+        run: &mut Run<W::State>,
+        s: &mut Scratch,
+    ) {
+        let flat = self.spec.learn.flat;
+        let model = &self.model;
+        let vars = model.vars.len();
+        run.states.clear();
+        run.values.clear();
+        run.options_features.clear();
+        run.codes.clear();
+        run.psi.clear();
+        let mut state = start.clone();
+        run.states.push(state.clone());
+        run.values.extend_from_slice(&s.x);
+        model.options_coder.features(&s.x, &mut s.g);
+        run.options_features.extend_from_slice(&s.g);
+        run.codes.push(model.code(&s.tau));
+        if model.is_persistent() {
+            run.psi.push(s.tau.iter().zip(&model.regions).all(|(t, (_, n))| t < n));
+        }
+        model.flat_coder.features(&s.x, &mut s.f);
+        for &p in &model.legs[o] {
+            for _ in 0..model.max_steps {
+                let eps = flat.epsilon_at(self.weights.steps);
+                self.weights.steps += 1;
+                let a = if rng.random::<f64>() < eps {
+                    rng.random_range(0..model.actions)
+                } else {
+                    model.greedy_action(&self.weights, p, &s.f, &mut s.q)
+                };
+                let next = self.world.step(&state, a, rng);
+                self.world.valuation(&next, &mut s.x_next);
+                model.flat_coder.features(&s.x_next, &mut s.f_next);
+                update_flat(model, &mut self.weights.flat, &mut self.eval, flat, a, s);
+                if model.is_persistent() {
+                    let kept = model.step_counters(&mut self.eval, &s.x_next, &mut s.tau);
+                    run.psi.push(kept);
+                }
+                run.states.push(next.clone());
+                run.values.extend_from_slice(&s.x_next);
+                model.options_coder.features(&s.x_next, &mut s.g);
+                run.options_features.extend_from_slice(&s.g);
+                run.codes.push(model.code(&s.tau));
+                state = next;
+                std::mem::swap(&mut s.f, &mut s.f_next);
+                std::mem::swap(&mut s.x, &mut s.x_next);
+                if model.stops(&mut self.eval, p, &s.x) {
+                    break;
+                }
+            }
+        }
+        debug_assert_eq!(run.values.len(), run.states.len() * vars);
+    }
+
+    /// `out[j]`: the reward of the suffix of `run` from position `j`.
+    fn suffix_rewards(&mut self, run: &Run<W::State>, out: &mut Vec<f64>) {
+        let k = run.states.len() - 1;
+        match &mut self.scorer {
+            Some(scorer) => {
+                let vars = self.model.vars.len();
+                let columns = (0..vars)
+                    .map(|d| run.values.iter().skip(d).step_by(vars).copied().collect())
+                    .collect();
+                match Trace::from_columns(columns) {
+                    Ok(trace) => scorer.suffix_rewards(&trace, out),
+                    Err(_) => {
+                        out.clear();
+                        out.resize(k + 1, 0.0);
+                    }
+                }
+            }
+            None => {
+                let gamma = self.spec.learn.options.gamma;
+                out.clear();
+                out.resize(k + 1, 0.0);
+                for j in (0..k).rev() {
+                    out[j] = f64::from(u8::from(run.psi[j + 1])) + gamma * out[j + 1];
+                }
+            }
+        }
+    }
+
+    fn update_options(&mut self, o: usize, run: &Run<W::State>, s: &mut Scratch) {
+        let params = self.spec.learn.options;
+        let model = &self.model;
+        let t = model.options_coder.tilings();
+        let k = run.states.len() - 1;
+        let vars = model.vars.len();
+        let end_g = &run.options_features[k * t..][..t];
+        model.available(&mut self.eval, &run.values[k * vars..][..vars], &mut s.available);
+        let best = s
+            .available
+            .iter()
+            .map(|&b| model.option_value(&self.weights, run.codes[k], b, end_g))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if self.gamma_powers.len() <= k {
+            let last = self.gamma_powers.len();
+            self.gamma_powers.extend((last..=k).map(|i| params.gamma.powi(i as i32)));
+        }
+        let n = model.options_coder.len();
+        let step = params.alpha / t as f64;
+        for j in 0..k {
+            let g = &run.options_features[j * t..][..t];
+            let target = s.rewards[j] + self.gamma_powers[k - j] * best;
+            let base = (run.codes[j] * model.legs.len() + o) * n;
+            let q: f64 = g.iter().map(|&i| self.weights.options[base + i]).sum();
+            let delta = step * (target - q);
+            for &i in g {
+                self.weights.options[base + i] += delta;
+            }
+        }
+    }
+}
+
+impl<S> Default for Run<S> {
+    fn default() -> Self {
+        Run {
+            states: Vec::new(),
+            values: Vec::new(),
+            options_features: Vec::new(),
+            codes: Vec::new(),
+            psi: Vec::new(),
+        }
+    }
+}
+
+/// Buffers reused across steps.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    x: Vec<f64>,
+    x_next: Vec<f64>,
+    f: Vec<usize>,
+    f_next: Vec<usize>,
+    g: Vec<usize>,
+    q: Vec<f64>,
+    tau: Vec<usize>,
+    available: Vec<usize>,
+    rewards: Vec<f64>,
+}
+
+/// The flat update of every primitive after the step `x -a-> x_next` (features `f`,
+/// `f_next` in `s`).
+fn update_flat(
+    model: &Model,
+    flat_weights: &mut [Vec<f64>],
+    eval: &mut StateEval,
+    params: LevelParams,
+    a: usize,
+    s: &mut Scratch,
+) {
+    let n = model.flat_coder.len();
+    let step = params.alpha / model.flat_coder.tilings() as f64;
+    s.q.resize(model.actions, 0.0);
+    for (p, w) in flat_weights.iter_mut().enumerate() {
+        let mut reward = eval.value(&model.reach[p], &s.x_next);
+        let mut ends = false;
+        if let Some((r, penalty)) = &model.avoid[p] {
+            let inside = eval.value(r, &s.x_next);
+            if inside >= 0.0 {
+                (reward, ends) = (*penalty, true);
+            } else {
+                reward = reward.min(-inside);
+            }
+        }
+        let best = if ends {
+            0.0
+        } else {
+            model.flat_values(w, &s.f_next, &mut s.q);
+            s.q.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        };
+        let row = &mut w[a * n..][..n];
+        let q: f64 = s.f.iter().map(|&i| row[i]).sum();
+        let delta = step * (reward + params.gamma * best - q);
+        for &i in &s.f {
+            row[i] += delta;
+        }
+    }
+}

@@ -1,0 +1,473 @@
+//! Specs on continuous worlds (plane worlds, `mountain-car`): training with the approximate
+//! learner ([`hstl_runtime::approx`]), its `policy.json` (the tiling and the weights), and
+//! replaying one: what `hstlc train`, `eval` and `study` do on such a world, shared with the
+//! Python package.
+//!
+//! **`policy.json` of a learned function.** Beside the contract's `spec`, `env`,
+//! `state_vars`, `actions` and `options` (and `spec_source`, `seed`), it holds:
+//! - `"learner": "tiles"`;
+//! - `"tiles"`: `{"tilings", "bins", "lo", "hi", "options_tilings", "options_bins"}`, the
+//!   flat levels' tiling of the state's box and the options level's coarser one;
+//! - `"memory"`: `{"regions", "horizons", "buckets"}` for a persistent task;
+//! - `"weights"`: `{"flat": {PRIMITIVE: [[INDEX, BITS], ...]}, "options": [[INDEX, BITS],
+//!   ...], "flat_len", "options_len"}`, the non-zero weights only (flat index `a * F + f`
+//!   for action `a` and feature `f`; options index `(code * n_options + o) * G + g`), each
+//!   value the 16 hex digits of its `f64` bits, as `q_tables` holds Q-values;
+//! - `"steps"`, `"choices"`: how far training went.
+//!
+//! A replay lowers the spec from `spec_source` again, lays the tiling over the world again
+//! and refuses a document whose tiling, shapes, indices or values do not fit them.
+
+use std::ops::ControlFlow;
+
+use hstl_lang::CheckedSpec;
+use hstl_runtime::approx::{ApproxAgent, ApproxLearner, Weights, WindowSummary};
+use hstl_runtime::world::AnyWorld;
+use hstl_runtime::{Error, TaskSpec, seeded_rng};
+use serde_json::{Value, json};
+
+use crate::Problem;
+use crate::evaluate::Runs;
+use crate::train::EVAL_SEED;
+
+/// The most tiles along a variable that a world's step sets (a tile about one step wide).
+pub const MAX_STEP_BINS: usize = 64;
+
+/// Tiles along each variable of `mountain-car` when the spec sets none.
+pub const CAR_BINS: usize = 12;
+
+/// Runs `$body` with `$w` bound to the continuous world inside `$world` (an error for a
+/// grid).
+macro_rules! with_world {
+    ($world:expr, $w:ident => $body:expr) => {
+        match $world {
+            AnyWorld::Plane($w) => $body,
+            AnyWorld::MountainCar($w) => $body,
+            AnyWorld::Grid(_) => Err(grid_error()),
+        }
+    };
+}
+
+fn grid_error() -> Error {
+    Error::Config("a grid world is learned with tables, not tilings".into())
+}
+
+/// Lays the spec's tiling over `world`: where the spec sets no `bins`, a plane's tile is
+/// about one step wide (at most [`MAX_STEP_BINS`] along a variable) and `mountain-car`'s
+/// variables get [`CAR_BINS`] each.
+pub fn fit_tiles(spec: &mut TaskSpec, checked: &CheckedSpec, world: &AnyWorld) {
+    let (Some(t), Some(declared)) = (spec.learn.tiles.as_mut(), checked.learn.tiles) else {
+        return;
+    };
+    if declared.bins.is_some() {
+        return;
+    }
+    for (d, bins) in t.bins.iter_mut().enumerate() {
+        match world {
+            AnyWorld::Plane(p) => {
+                let width = t.hi[d] - t.lo[d];
+                let n = (width / p.step_length()).round();
+                *bins = if n.is_finite() { (n as usize).clamp(2, MAX_STEP_BINS) } else { *bins };
+            }
+            AnyWorld::MountainCar(_) => *bins = CAR_BINS,
+            AnyWorld::Grid(_) => {}
+        }
+    }
+}
+
+/// A trained learned function and what training measured.
+#[derive(Clone, Debug)]
+pub struct Trained {
+    /// The greedy agent (its model and weights).
+    pub agent: ApproxAgent,
+    /// The summed option rewards of each episode.
+    pub curve: Vec<f64>,
+    /// Primitive steps taken.
+    pub steps: u64,
+}
+
+/// Trains `spec` (its tiling fitted, see [`fit_tiles`]) in the continuous `world` from
+/// `seed`; `progress` sees each episode and its reward and may stop training.
+pub fn train_until(
+    spec: &TaskSpec,
+    world: &AnyWorld,
+    seed: u64,
+    progress: impl FnMut(usize, f64) -> ControlFlow<()>,
+) -> Result<Trained, Error> {
+    with_world!(world, w => {
+        let mut learner = ApproxLearner::new(spec, w)?;
+        let trained = learner.train_until(&mut seeded_rng(seed), progress);
+        let agent = ApproxAgent::new(spec, w, learner.weights().clone())?;
+        Ok(Trained { agent, curve: trained.curve, steps: trained.steps })
+    })
+}
+
+/// [`train_until`] without stopping.
+pub fn train(
+    spec: &TaskSpec,
+    world: &AnyWorld,
+    seed: u64,
+    mut progress: impl FnMut(usize, f64),
+) -> Result<Trained, Error> {
+    train_until(spec, world, seed, |e, r| {
+        progress(e, r);
+        ControlFlow::Continue(())
+    })
+}
+
+/// `policy.json` of a learned function (see the module docs).
+pub fn policy_json(
+    spec: &TaskSpec,
+    world: &AnyWorld,
+    agent: &ApproxAgent,
+    source: &str,
+    seed: u64,
+) -> Result<String, Error> {
+    let m = &agent.model;
+    let w = &agent.weights;
+    let actions: Vec<String> = with_world!(world, wd => Ok(hstl_runtime::World::actions(wd)))?;
+    let sparse = |v: &[f64]| -> Vec<Value> {
+        // Each weight as the 16 hex digits of its bits, as `q_tables` holds Q-values, so
+        // that the document loads back to the same bits (`-0.0` included).
+        v.iter()
+            .enumerate()
+            .filter(|(_, x)| x.to_bits() != 0)
+            .map(|(i, x)| json!([i, format!("{:016x}", x.to_bits())]))
+            .collect()
+    };
+    let flat: serde_json::Map<String, Value> = spec
+        .primitives
+        .iter()
+        .zip(&w.flat)
+        .map(|(p, v)| (p.name.clone(), Value::Array(sparse(v))))
+        .collect();
+    let options: Vec<Value> = spec
+        .options
+        .iter()
+        .map(|o| {
+            let seq: Vec<&str> =
+                o.sequence.iter().map(|&p| spec.primitives[p].name.as_str()).collect();
+            json!({"name": o.name, "sequence": seq})
+        })
+        .collect();
+    let mut doc = json!({
+        "spec": spec.name,
+        "env": {"name": world.name(), "params": world.params()},
+        "state_vars": m.vars,
+        "actions": actions,
+        "options": options,
+        "learner": "tiles",
+        "tiles": {
+            "tilings": m.flat_coder.tilings(),
+            "bins": m.flat_coder.bins(),
+            "lo": m.flat_coder.lo(),
+            "hi": m.flat_coder.hi(),
+            "options_tilings": m.options_coder.tilings(),
+            "options_bins": m.options_coder.bins(),
+        },
+        "weights": {
+            "flat_len": w.flat.first().map_or(0, Vec::len),
+            "options_len": w.options.len(),
+            "flat": flat,
+            "options": sparse(&w.options),
+        },
+        "steps": w.steps,
+        "choices": w.choices,
+        "spec_source": source,
+        "seed": seed,
+    });
+    if m.is_persistent() {
+        let regions: Vec<&str> = spec.regions.iter().map(|r| r.name.as_str()).collect();
+        let horizons: Vec<usize> = m.horizons().collect();
+        doc["memory"] = json!({"regions": regions, "horizons": horizons, "buckets": m.buckets});
+    }
+    if spec.learn.switch == hstl_runtime::Switch::Step {
+        doc["switch"] = json!("step");
+    }
+    serde_json::to_string_pretty(&doc).map_err(|e| Error::Config(e.to_string()))
+}
+
+/// Whether a `policy.json` (already parsed) holds a learned function.
+pub fn is_learned_function(doc: &Value) -> bool {
+    doc.get("learner").and_then(Value::as_str) == Some("tiles")
+}
+
+/// A `policy.json` of a learned function, checked whole against its spec and world.
+#[derive(Clone, Debug)]
+pub struct Replay {
+    /// The spec it was trained on, lowered again from `spec_source`, its tiling fitted.
+    pub spec: TaskSpec,
+    /// The world it was trained in.
+    pub world: AnyWorld,
+    /// The greedy agent the document describes.
+    pub agent: ApproxAgent,
+    /// The spec file's text.
+    pub source: String,
+    /// The seed it was trained from, when recorded.
+    pub seed: Option<u64>,
+}
+
+/// Reads a learned-function `policy.json` (see the module docs); messages are worded as
+/// `hstlc eval` prints them, after `FILE: `.
+pub fn replay(doc: &Value) -> Result<Replay, Problem> {
+    let retrain = || "train the policy again with `hstlc train`".to_string();
+    let edited =
+        || "the file was edited or damaged: train the policy again with `hstlc train`".to_string();
+    let field = |name: &str| {
+        doc.get(name).ok_or_else(|| Problem::new(format!("it has no `{name}` entry"), edited()))
+    };
+    let source = field("spec_source")?
+        .as_str()
+        .ok_or_else(|| Problem::new("its `spec_source` is not a string", edited()))?
+        .to_string();
+    let name = field("spec")?
+        .as_str()
+        .ok_or_else(|| Problem::new("its `spec` is not a string", edited()))?;
+    let seed = match doc.get("seed") {
+        None => None,
+        Some(v) => Some(
+            v.as_u64().ok_or_else(|| Problem::new("its `seed` is not a whole number", edited()))?,
+        ),
+    };
+    let env = field("env")?;
+    let world_name = env.get("name").and_then(Value::as_str).unwrap_or("");
+    let params = env.get("params").cloned().unwrap_or(Value::Null);
+    let world = AnyWorld::from_params(world_name, &params)
+        .map_err(|e| Problem::new(format!("its world: {e}"), edited()))?;
+    if !world.is_continuous() {
+        return Err(Problem::new(
+            "its world is a grid, which a learned function is not trained in",
+            edited(),
+        ));
+    }
+    let checked = hstl_lang::check(&source);
+    let picked = checked
+        .specs
+        .iter()
+        .find(|s| s.name == name)
+        .filter(|_| !checked.has_errors())
+        .ok_or_else(|| {
+            Problem::new(
+                format!("its `spec_source` does not hold a valid spec `{name}`"),
+                retrain(),
+            )
+        })?;
+    let mut spec = crate::lower::task_spec(picked, &source)
+        .map_err(|e| Problem::new(e.to_string(), retrain()))?;
+    fit_tiles(&mut spec, picked, &world);
+    // The document's tiling must be the one the spec and the world give.
+    let agent0 =
+        with_world!(&world, w => zero_of(&spec, w).and_then(|z| ApproxAgent::new(&spec, w, z)))
+            .map_err(|e| {
+                Problem::new(format!("it does not fit its spec and world: {e}"), retrain())
+            })?;
+    let m = &agent0.model;
+    let tiles = field("tiles")?;
+    let same = tiles.get("tilings").and_then(Value::as_u64) == Some(m.flat_coder.tilings() as u64)
+        && tiles.get("bins") == Some(&json!(m.flat_coder.bins()))
+        && tiles.get("lo") == Some(&json!(m.flat_coder.lo()))
+        && tiles.get("hi") == Some(&json!(m.flat_coder.hi()))
+        && tiles.get("options_tilings").and_then(Value::as_u64)
+            == Some(m.options_coder.tilings() as u64)
+        && tiles.get("options_bins") == Some(&json!(m.options_coder.bins()));
+    if !same {
+        return Err(Problem::new(
+            "its `tiles` are not the tiling its spec and world give",
+            edited(),
+        ));
+    }
+    let weights_doc = field("weights")?;
+    let mut weights = agent0.weights.clone();
+    let flat_len = weights.flat.first().map_or(0, Vec::len);
+    if weights_doc.get("flat_len").and_then(Value::as_u64) != Some(flat_len as u64)
+        || weights_doc.get("options_len").and_then(Value::as_u64)
+            != Some(weights.options.len() as u64)
+    {
+        return Err(Problem::new(
+            "its weights do not have the shape of its spec and world",
+            edited(),
+        ));
+    }
+    let flat = weights_doc
+        .get("flat")
+        .and_then(Value::as_object)
+        .ok_or_else(|| Problem::new("its `weights.flat` is not an object", edited()))?;
+    if flat.len() != spec.primitives.len() {
+        return Err(Problem::new(
+            "its `weights.flat` does not name every primitive option once",
+            edited(),
+        ));
+    }
+    for (p, prim) in spec.primitives.iter().enumerate() {
+        let entries = flat.get(&prim.name).ok_or_else(|| {
+            Problem::new(
+                format!("its `weights.flat` has no entry for option `{}`", prim.name),
+                edited(),
+            )
+        })?;
+        fill(&mut weights.flat[p], entries, &format!("weights.flat.{}", prim.name))
+            .map_err(|m| Problem::new(m, edited()))?;
+    }
+    let options = weights_doc
+        .get("options")
+        .ok_or_else(|| Problem::new("it has no `weights.options`", edited()))?;
+    fill(&mut weights.options, options, "weights.options")
+        .map_err(|m| Problem::new(m, edited()))?;
+    weights.steps = doc.get("steps").and_then(Value::as_u64).unwrap_or(0);
+    weights.choices = doc.get("choices").and_then(Value::as_u64).unwrap_or(0);
+    let agent = ApproxAgent { weights, ..agent0 };
+    Ok(Replay { spec, world, agent, source, seed })
+}
+
+/// Zeroed weights of `spec`'s model in `w`.
+fn zero_of<W: hstl_runtime::World>(spec: &TaskSpec, w: &W) -> Result<Weights, Error> {
+    Ok(hstl_runtime::approx::Model::new(spec, w)?.zero_weights())
+}
+
+/// Fills `into` from sparse `[[index, "hex bits"], ...]` entries: every index in range and
+/// given once, every value finite.
+fn fill(into: &mut [f64], entries: &Value, what: &str) -> Result<(), String> {
+    let list = entries.as_array().ok_or_else(|| format!("its `{what}` is not a list"))?;
+    if list.len() > into.len() {
+        return Err(format!("its `{what}` has more entries than weights"));
+    }
+    let mut seen = vec![false; into.len()];
+    for e in list {
+        let pair = e.as_array().filter(|p| p.len() == 2);
+        let bits = |v: &Value| {
+            let h =
+                v.as_str().filter(|h| h.len() == 16 && h.bytes().all(|b| b.is_ascii_hexdigit()))?;
+            u64::from_str_radix(h, 16).ok().map(f64::from_bits)
+        };
+        let (Some(i), Some(v)) = (
+            pair.and_then(|p| p[0].as_u64()).and_then(|i| usize::try_from(i).ok()),
+            pair.and_then(|p| bits(&p[1])),
+        ) else {
+            return Err(format!("an entry of its `{what}` is not `[INDEX, \"16 hex digits\"]`"));
+        };
+        if i >= into.len() || seen[i] {
+            return Err(format!("its `{what}` has index {i} out of range or twice"));
+        }
+        if !v.is_finite() {
+            return Err(format!("its `{what}` has a value that is not a finite number"));
+        }
+        seen[i] = true;
+        into[i] = v;
+    }
+    Ok(())
+}
+
+/// What an evaluation of a learned function measured.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Evaluation {
+    /// A persistent task: the window rate.
+    Window(WindowSummary),
+    /// Another task: the share of runs that satisfy it.
+    Satisfaction {
+        /// The share of runs whose trace satisfies the task.
+        rate: f64,
+    },
+}
+
+/// Runs the greedy agent from `runs.starts` random starts (one generator seeded with
+/// `runs.seed`) and measures the window rate of a persistent task, or the share of runs
+/// that satisfy another.
+pub fn evaluate(replay: &Replay, runs: Runs) -> Result<Evaluation, Problem> {
+    let Replay { spec, world, agent, .. } = replay;
+    let mut rng = seeded_rng(runs.seed);
+    let result: Result<Evaluation, Error> = with_world!(world, w => {
+        if agent.model.is_persistent() {
+            agent
+                .window_rate(w, spec, runs.starts, runs.steps, runs.burn_in, &mut rng)
+                .map(Evaluation::Window)
+        } else {
+            Ok(Evaluation::Satisfaction { rate: agent.satisfaction(w, spec, runs.starts, runs.steps, &mut rng) })
+        }
+    });
+    result.map_err(|e| Problem::new(e.to_string(), None))
+}
+
+/// The evaluation `hstlc train` prints after training from `seed` (its own generator).
+pub fn after_training(
+    spec: &TaskSpec,
+    world: &AnyWorld,
+    agent: &ApproxAgent,
+    seed: u64,
+) -> Result<Evaluation, Problem> {
+    let replay = Replay {
+        spec: spec.clone(),
+        world: world.clone(),
+        agent: agent.clone(),
+        source: String::new(),
+        seed: Some(seed),
+    };
+    let runs = Runs { seed: seed ^ EVAL_SEED, ..Runs::default() };
+    let runs = if agent.model.is_persistent() {
+        runs
+    } else {
+        Runs { starts: 1000, steps: task_steps(spec), ..runs }
+    };
+    evaluate(&replay, runs)
+}
+
+/// The steps a run of a task that is not persistent needs: its horizon and one, at most
+/// 100,000 (an unbounded task gets 2,000).
+pub fn task_steps(spec: &TaskSpec) -> usize {
+    spec.task.horizon().map_or(2000, |h| h.saturating_add(1).min(100_000))
+}
+
+/// `DIR/run_K.csv` of greedy runs (the contract "greedy runs as data"): `t,VAR...,action,
+/// option`, one row per step and one more for the final state.
+pub fn run_csv(replay: &Replay, run: &hstl_runtime::approx::GreedyRun) -> String {
+    let vars = replay.agent.model.vars.len();
+    let actions: Vec<String> =
+        with_world!(&replay.world, w => Ok::<_, Error>(hstl_runtime::World::actions(w)))
+            .unwrap_or_default();
+    let mut out = format!("t,{},action,option\n", replay.agent.model.vars.join(","));
+    for (t, row) in run.values.chunks(vars).enumerate() {
+        out.push_str(&t.to_string());
+        for &v in row {
+            out.push(',');
+            out.push_str(&number(v));
+        }
+        match (run.actions.get(t), run.options.get(t)) {
+            (Some(&a), Some(&o)) => {
+                out.push(',');
+                out.push_str(actions.get(a).map_or("", String::as_str));
+                out.push(',');
+                out.push_str(&replay.spec.options.get(o).map_or(String::new(), |x| x.name.clone()));
+            }
+            _ => out.push_str(",,"),
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// `runs` greedy runs of `steps` actions from the world's starts (seeded with `seed`).
+pub fn greedy_runs(
+    replay: &Replay,
+    runs: usize,
+    steps: usize,
+    seed: u64,
+) -> Vec<hstl_runtime::approx::GreedyRun> {
+    let mut rng = seeded_rng(seed);
+    let result: Result<Vec<_>, Error> = with_world!(&replay.world, w => {
+        Ok((0..runs).map(|_| {
+            let start = hstl_runtime::World::reset(w, &mut rng);
+            replay.agent.run(w, start, steps, &mut rng)
+        }).collect())
+    });
+    result.unwrap_or_default()
+}
+
+/// `v` in the shortest form that reads back to the same double (`inf`, `-inf`, `NaN` as
+/// such).
+pub fn number(v: f64) -> String {
+    match serde_json::Number::from_f64(v) {
+        Some(n) => n.to_string(),
+        None if v.is_nan() => "NaN".into(),
+        None if v > 0.0 => "inf".into(),
+        None => "-inf".into(),
+    }
+}

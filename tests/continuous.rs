@@ -1,0 +1,170 @@
+//! The approximate learner through the facade: a spec over a `float` state trains on a
+//! plane world and on `mountain-car`, the same seed gives the same weights bit for bit, its
+//! `policy.json` loads back to the same bits, and an edited document is refused.
+
+use hstl::continuous::{self as c, Evaluation};
+use hstl::world::AnyWorld;
+use serde_json::Value;
+
+/// Reach the top-right corner of `paper-plane` within 60 steps.
+const REACH: &str = "spec Reach {
+    world \"paper-plane\";
+    state { x: float in 0..=14, y: float in 0..=14 }
+    let A = x > 12 && y > 12;
+    task eventually[0..60] A;
+    option A;
+    learn { preset: auto, episodes: 1500, choices: 3 }
+}
+";
+
+/// Both corners of `paper-plane` within every 40 steps.
+const PATROL: &str = "spec Patrol {
+    world \"paper-plane\";
+    state { x: float in 0..=14, y: float in 0..=14 }
+    let A = x < 3 && y > 11;
+    let B = x > 11 && y < 3;
+    task always[0..] (eventually[0..40] A && eventually[0..40] B);
+    option A;
+    option B;
+    learn { preset: auto, episodes: 30, choices: 20 }
+}
+";
+
+fn lowered(src: &str, world: &AnyWorld) -> hstl::runtime::TaskSpec {
+    let loaded = hstl::load::load(src, None).expect("the spec checks");
+    let mut spec = hstl::train::trainable(&loaded.spec, src, "spec.hstl").expect("trainable");
+    c::fit_tiles(&mut spec, &loaded.spec, world);
+    spec
+}
+
+fn plane() -> AnyWorld {
+    AnyWorld::builtin("paper-plane").expect("built in")
+}
+
+#[test]
+fn the_same_seed_gives_the_same_weights_and_another_seed_others() {
+    let world = plane();
+    let spec = lowered(PATROL, &world);
+    let bits = |seed| {
+        let t = c::train(&spec, &world, seed, |_, _| {}).expect("trains");
+        let w = &t.agent.weights;
+        let mut all: Vec<u64> = w.flat.iter().flatten().map(|v| v.to_bits()).collect();
+        all.extend(w.options.iter().map(|v| v.to_bits()));
+        (all, t.curve.iter().map(|v| v.to_bits()).collect::<Vec<_>>())
+    };
+    let a = bits(7);
+    assert_eq!(a, bits(7));
+    assert_ne!(a, bits(8));
+    assert!(a.0.iter().any(|&b| b != 0), "training changed no weight");
+}
+
+#[test]
+fn a_reach_task_on_the_plane_is_learned() {
+    let world = plane();
+    let spec = lowered(REACH, &world);
+    // The tiles follow the world's step: 14 per variable on [0, 14] with step 1.
+    assert_eq!(spec.learn.tiles.as_ref().map(|t| t.bins.clone()), Some(vec![14, 14]));
+    let t = c::train(&spec, &world, 1, |_, _| {}).expect("trains");
+    match c::after_training(&spec, &world, &t.agent, 1).expect("evaluates") {
+        Evaluation::Satisfaction { rate } => assert!(rate > 0.9, "P = {rate}"),
+        other => panic!("a reach task is measured by satisfaction: {other:?}"),
+    }
+}
+
+#[test]
+fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
+    let world = plane();
+    let spec = lowered(PATROL, &world);
+    let t = c::train(&spec, &world, 2, |_, _| {}).expect("trains");
+    let text = c::policy_json(&spec, &world, &t.agent, PATROL, 2).expect("writes");
+    let doc: Value = serde_json::from_str(&text).expect("JSON");
+    assert!(c::is_learned_function(&doc));
+    let replay = c::replay(&doc).expect("loads");
+    assert_eq!(replay.seed, Some(2));
+    let bits = |w: &hstl::runtime::approx::Weights| -> Vec<u64> {
+        w.flat.iter().flatten().chain(&w.options).map(|v| v.to_bits()).collect()
+    };
+    assert!(bits(&replay.agent.weights) == bits(&t.agent.weights), "the weights differ");
+    assert_eq!(
+        (replay.agent.weights.steps, replay.agent.weights.choices),
+        (t.agent.weights.steps, t.agent.weights.choices)
+    );
+    // The same greedy runs from the same seed.
+    let runs = hstl::evaluate::Runs { starts: 3, steps: 300, burn_in: 10, seed: 5 };
+    let again = c::Replay { agent: t.agent.clone(), ..replay.clone() };
+    assert_eq!(c::evaluate(&replay, runs).unwrap(), c::evaluate(&again, runs).unwrap());
+    // Edits: a tiling that is not the spec's, an index out of range, a value that is not
+    // finite, a primitive missing, a grid as the world.
+    let edit = |f: &dyn Fn(&mut Value)| {
+        let mut d = doc.clone();
+        f(&mut d);
+        c::replay(&d).map(|_| ()).expect_err("an edited document is refused").message
+    };
+    let msg = edit(&|d| d["tiles"]["bins"] = serde_json::json!([13, 14]));
+    assert!(msg.contains("tiles"), "{msg}");
+    let one = format!("{:016x}", 1.0f64.to_bits());
+    let msg = edit(&|d| d["weights"]["options"] = serde_json::json!([[usize::MAX, one]]));
+    assert!(msg.contains("out of range"), "{msg}");
+    let msg = edit(&|d| d["weights"]["flat"]["A"] = serde_json::json!([[0, 1.5]]));
+    assert!(msg.contains("hex digits"), "{msg}");
+    let inf = format!("{:016x}", f64::INFINITY.to_bits());
+    let msg = edit(&|d| d["weights"]["flat"]["A"] = serde_json::json!([[0, inf]]));
+    assert!(msg.contains("finite"), "{msg}");
+    let msg = edit(&|d| {
+        d["weights"]["flat"].as_object_mut().unwrap().remove("B");
+    });
+    assert!(msg.contains("primitive"), "{msg}");
+    let msg = edit(&|d| {
+        d["env"] =
+            serde_json::json!({"name": "paper", "params": {"slip": 0.3, "map": ["..", ".."]}})
+    });
+    assert!(msg.contains("grid"), "{msg}");
+    assert!(!msg.ends_with('.'), "{msg}");
+}
+
+#[test]
+fn greedy_runs_as_data_have_the_contract_s_columns() {
+    let world = plane();
+    let spec = lowered(PATROL, &world);
+    let t = c::train(&spec, &world, 2, |_, _| {}).expect("trains");
+    let replay =
+        c::Replay { spec, world, agent: t.agent, source: PATROL.to_string(), seed: Some(2) };
+    let runs = c::greedy_runs(&replay, 2, 25, 9);
+    assert_eq!(runs.len(), 2);
+    let csv = c::run_csv(&replay, &runs[0]);
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines[0], "t,x,y,action,option");
+    // 25 actions, 26 rows; the last holds the final state with empty action and option.
+    assert_eq!(lines.len(), 1 + 26);
+    assert!(lines[26].starts_with("25,") && lines[26].ends_with(",,"), "{}", lines[26]);
+    for line in &lines[1..26] {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells.len(), 5, "{line}");
+        let (x, y): (f64, f64) = (cells[1].parse().unwrap(), cells[2].parse().unwrap());
+        assert!((0.0..=14.0).contains(&x) && (0.0..=14.0).contains(&y), "{line}");
+        assert!(["E", "N", "W", "S"].contains(&cells[3]), "{line}");
+        assert!(["A", "B"].contains(&cells[4]), "{line}");
+    }
+}
+
+#[test]
+fn mountain_car_trains_with_its_own_tiling() {
+    let world = AnyWorld::builtin("mountain-car").expect("built in");
+    let src = "spec Car {
+        world \"mountain-car\";
+        state { x: float in -1.2..=0.6, v: float in -0.07..=0.07 }
+        let Left = x < -1.0;
+        let Right = x > 0.4;
+        task always[0..] (eventually[0..200] Left && eventually[0..200] Right);
+        option Left;
+        option Right;
+        learn { preset: auto, episodes: 3, choices: 4 }
+    }";
+    let spec = lowered(src, &world);
+    assert_eq!(spec.learn.tiles.as_ref().map(|t| t.bins.clone()), Some(vec![12, 12]));
+    let t = c::train(&spec, &world, 0, |_, _| {}).expect("trains");
+    assert_eq!(t.curve.len(), 3);
+    let text = c::policy_json(&spec, &world, &t.agent, src, 0).expect("writes");
+    let replay = c::replay(&serde_json::from_str(&text).unwrap()).expect("loads");
+    assert_eq!(replay.world, world);
+}
