@@ -401,13 +401,18 @@ pub fn after_training(
         source: String::new(),
         seed: Some(seed),
     };
+    evaluate(&replay, runs_after_training(spec, seed))
+}
+
+/// The runs [`after_training`] scores a policy trained from `seed` with: 100 runs of 2,000
+/// steps for a persistent task, else 1,000 runs of the task's horizon.
+pub fn runs_after_training(spec: &TaskSpec, seed: u64) -> Runs {
     let runs = Runs { seed: seed ^ EVAL_SEED, ..Runs::default() };
-    let runs = if agent.model.is_persistent() {
-        runs
-    } else {
+    if spec.regions.is_empty() {
         Runs { starts: 1000, steps: task_steps(spec), ..runs }
-    };
-    evaluate(&replay, runs)
+    } else {
+        runs
+    }
 }
 
 /// The steps a run of a task that is not persistent needs: its horizon and one, at most

@@ -32,6 +32,7 @@ pub mod load;
 pub mod lower;
 pub mod monitor;
 mod problem;
+pub mod reference;
 pub mod reward;
 pub mod study;
 pub mod train;

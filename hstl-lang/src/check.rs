@@ -1790,6 +1790,9 @@ impl Cx<'_> {
             if let Terminate::Formula(f) = &p.terminate {
                 push_refs(f, &mut stack);
             }
+            if let Some(f) = &p.avoid {
+                push_refs(f, &mut stack);
+            }
         }
         while let Some(i) = stack.pop() {
             if let Some(l) = out.lets.get_mut(i)

@@ -22,9 +22,10 @@ pub struct EvalArgs {
     /// Greedy runs, each from a random start (at most 100,000).
     #[arg(long, default_value_t = 100, value_parser = count(MAX_STARTS))]
     pub starts: usize,
-    /// Steps per run (at most 1,000,000; a run is kept whole for its robustness).
-    #[arg(long, default_value_t = 2000, value_parser = count(MAX_STEPS))]
-    pub steps: usize,
+    /// Steps per run (at most 1,000,000; a run is kept whole for its robustness) [default:
+    /// 2000; on a continuous world, a task that is not persistent runs its horizon]
+    #[arg(long, value_parser = count(MAX_STEPS))]
+    pub steps: Option<usize>,
     /// Steps at the start of each run that the window rate does not count.
     #[arg(long, default_value_t = 100)]
     pub burn_in: usize,
@@ -39,6 +40,9 @@ pub struct EvalArgs {
     #[arg(long, value_name = "DIR")]
     pub runs: Option<PathBuf>,
 }
+
+/// Steps per greedy run unless `--steps` says otherwise.
+pub const DEFAULT_STEPS: usize = 2000;
 
 /// At most this many runs are written by `--runs`.
 pub const MAX_RUN_FILES: usize = 1000;
@@ -58,8 +62,8 @@ pub const SKIP_OPTIMUM: &str = "pass --no-optimum to skip the optimum W*";
 
 /// Runs `hstlc eval`.
 pub fn run(args: &EvalArgs) -> CmdResult {
-    let runs =
-        Runs { starts: args.starts, steps: args.steps, burn_in: args.burn_in, seed: args.seed };
+    let steps = args.steps.unwrap_or(DEFAULT_STEPS);
+    let runs = Runs { starts: args.starts, steps, burn_in: args.burn_in, seed: args.seed };
     // The flags first: nothing is read or printed for a run that cannot happen.
     runs.check_budget(flag)?;
     let input::Input { name, text, .. } =
@@ -78,7 +82,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         world_words(env, None),
         spec.options.len(),
         args.starts,
-        args.steps,
+        steps,
         args.seed
     )?;
     let report = match evaluate::evaluate(&replay, runs)? {
@@ -158,6 +162,12 @@ fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Ru
     use hstl::continuous as c;
     let replay = c::replay(doc).map_err(|p| p.in_file(name))?;
     let spec = &replay.spec;
+    // A reach task is decided within its horizon: a longer run only adds rows.
+    let steps = match args.steps {
+        None if spec.regions.is_empty() => c::task_steps(spec),
+        _ => runs.steps,
+    };
+    let runs = Runs { steps, ..runs };
     runs.check_burn_in(spec, flag)?;
     // Decide what can be written before anything is printed.
     let out = args
@@ -172,7 +182,7 @@ fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Ru
         spec.options.len(),
         crate::train::tiles_words(&replay.agent.model),
         args.starts,
-        args.steps,
+        steps,
         args.seed
     )?;
     match c::evaluate(&replay, runs)? {
@@ -192,20 +202,26 @@ fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Ru
             outln!(
                 "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
             )?;
-            outln!("  no exact optimum on a continuous world: W/W* is not defined here")?;
         }
         c::Evaluation::Satisfaction { rate } => {
-            outln!(
-                "  satisfied in {rate:.4} of {} runs of {} steps (no exact optimum on a continuous world: P/P* is not defined here)",
-                args.starts,
-                args.steps
-            )?;
+            outln!("  satisfied in {rate:.4} of {} runs of {} steps", args.starts, steps)?;
         }
+    }
+    // No exact optimum here: a planned reference on the same runs stands beside.
+    match hstl::reference::Reference::new(spec, &replay.world).map(|r| r.evaluate(runs)) {
+        Ok(c::Evaluation::Window(w)) => outln!(
+            "  planned reference: window rate {:.4} on the same runs (no exact optimum on a continuous world)",
+            w.rate
+        )?,
+        Ok(c::Evaluation::Satisfaction { rate }) => outln!(
+            "  planned reference: satisfied in {rate:.4} of the same runs (no exact optimum on a continuous world)"
+        )?,
+        Err(e) => outln!("  no exact optimum on a continuous world, and no reference: {}", e.message)?,
     }
     if let Some(out) = out {
         let n = args.starts.min(MAX_RUN_FILES);
         let files: Vec<hstl::artifacts::OutFile> =
-            c::greedy_runs(&replay, n, args.steps, args.seed)
+            c::greedy_runs(&replay, n, steps, args.seed)
                 .iter()
                 .enumerate()
                 .map(|(k, run)| {

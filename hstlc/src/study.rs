@@ -286,7 +286,31 @@ fn continuous_spec(
     row("reward per episode (last 100)", Stats::of(&rewards), 2)?;
     let name = if persistent { "window rate W" } else { "satisfaction rate P" };
     row(name, Stats::of(&rates), 3)?;
-    outln!("  no exact optimum on a continuous world: {measure} is not divided by one")?;
+    // No exact optimum here: a planned reference, scored on the same runs, stands beside.
+    match hstl::reference::Reference::new(&spec, world) {
+        Ok(reference) => {
+            let planned: Vec<f64> = seeds
+                .iter()
+                .map(|&s| match reference.evaluate(c::runs_after_training(&spec, s)) {
+                    c::Evaluation::Window(w) => w.rate,
+                    c::Evaluation::Satisfaction { rate } => rate,
+                })
+                .collect();
+            let ratio: Vec<f64> = rates
+                .iter()
+                .zip(&planned)
+                .map(|(r, p)| if *p > 0.0 { r / p } else { f64::NAN })
+                .collect();
+            row(&format!("planned reference {measure}"), Stats::of(&planned), 3)?;
+            row(&format!("{measure} / reference"), Stats::of(&ratio), 3)?;
+            outln!(
+                "  no exact optimum on a continuous world; the reference is a planner (LANGUAGE.md, \"References\")"
+            )?;
+        }
+        Err(e) => {
+            outln!("  no exact optimum on a continuous world, and no reference: {}", e.message)?
+        }
+    }
     // The median seed by the measure; its policy is trained again (same seed, same bits).
     let mut order: Vec<usize> = (0..runs.len()).collect();
     order.sort_by(|&a, &b| rates[a].total_cmp(&rates[b]).then(a.cmp(&b)));
