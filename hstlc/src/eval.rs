@@ -216,21 +216,22 @@ fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Ru
         Ok(c::Evaluation::Satisfaction { rate }) => outln!(
             "  planned reference: satisfied in {rate:.4} of the same runs (no exact optimum on a continuous world)"
         )?,
-        Err(e) => outln!("  no exact optimum on a continuous world, and no reference: {}", e.message)?,
+        Err(e) => {
+            outln!("  no exact optimum on a continuous world, and no reference: {}", e.message)?
+        }
     }
     if let Some(out) = out {
         let n = args.starts.min(MAX_RUN_FILES);
-        let files: Vec<hstl::artifacts::OutFile> =
-            c::greedy_runs(&replay, n, steps, args.seed)
-                .iter()
-                .enumerate()
-                .map(|(k, run)| {
-                    hstl::artifacts::OutFile::text(
-                        format!("run_{}.csv", k + 1),
-                        c::run_csv(&replay, run),
-                    )
-                })
-                .collect();
+        let files: Vec<hstl::artifacts::OutFile> = c::greedy_runs(&replay, n, steps, args.seed)
+            .iter()
+            .enumerate()
+            .map(|(k, run)| {
+                hstl::artifacts::OutFile::text(
+                    format!("run_{}.csv", k + 1),
+                    c::run_csv(&replay, run),
+                )
+            })
+            .collect();
         let dir = out.path().to_path_buf();
         out.write(&files)?;
         outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", dir.display())?;

@@ -40,6 +40,14 @@ pub trait World {
     /// The state after taking `action` in `state`. An action outside the set leaves the
     /// state unchanged.
     fn step(&self, state: &Self::State, action: usize, rng: &mut Rng) -> Self::State;
+    /// Whether `action`'s nominal move from `state` is blocked (a wall or the edge in its
+    /// way), so that but for noise it leaves the state where it is. The approximate
+    /// learner and its greedy agent never choose a blocked action: a function approximator
+    /// may rank one first at a wall, and a greedy run would then stand still forever. The
+    /// default: no action is ever blocked.
+    fn blocked(&self, _state: &Self::State, _action: usize) -> bool {
+        false
+    }
 }
 
 /// A finite environment for tabular learning: a [`World`] whose states are numbered

@@ -653,6 +653,13 @@ impl World for PlaneWorld {
         let to = Point { x: state.x + dx, y: state.y + dy };
         if self.segment_is_free(*state, to) { to } else { *state }
     }
+
+    /// The heading's move without slip or noise leaves the extent or touches an obstacle.
+    fn blocked(&self, state: &Point, action: usize) -> bool {
+        let Some(&(ux, uy)) = self.dirs.get(action) else { return true };
+        let step = self.config.step;
+        !self.segment_is_free(*state, Point { x: state.x + step * ux, y: state.y + step * uy })
+    }
 }
 
 /// What the quadtree found in a start rectangle.

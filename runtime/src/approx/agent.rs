@@ -57,6 +57,8 @@ struct Cursor {
     g: Vec<usize>,
     q: Vec<f64>,
     available: Vec<usize>,
+    /// The actions the world blocks in the current state.
+    blocked: Vec<bool>,
 }
 
 impl ApproxAgent {
@@ -93,6 +95,7 @@ impl ApproxAgent {
         self.model.start_counters(&mut eval, &x, &mut cur.tau);
         out.values.extend_from_slice(&x);
         for _ in 0..steps {
+            self.model.blocked(world, &state, &mut cur.blocked);
             let (action, option) = self.act(&mut eval, &mut cur, &x);
             state = world.step(&state, action, rng);
             world.valuation(&state, &mut x);
@@ -131,7 +134,7 @@ impl ApproxAgent {
         };
         let p = m.legs[o][leg];
         m.flat_coder.features(x, &mut cur.f);
-        (m.greedy_action(&self.weights, p, &cur.f, &mut cur.q), o)
+        (m.greedy_action(&self.weights, p, &cur.f, &cur.blocked, &mut cur.q), o)
     }
 
     fn observe(&self, eval: &mut StateEval, cur: &mut Cursor, next: &[f64]) {

@@ -8,6 +8,9 @@
 //! `alpha / tilings` times the error. A leg with `avoid: R` earns `min(rho(reach),
 //! rho(!R))` outside `R` and, on entering, a penalty worse than any reward outside (the
 //! worst over a lattice of the box, less one, earned forever), without bootstrapping.
+//! Actions the world blocks at a state ([`World::blocked`]) are never chosen there, and
+//! the target's `max` skips them: a function approximator may rank a move into a wall
+//! first, and a greedy run would then stand still for good.
 //!
 //! **Options level.** `Q(obs, o) = sum_t v_o[code][psi_t(s)]`, `psi` a coarser tiling of the
 //! state and `code` the memory's buckets of a persistent task (its counters, exact, are
@@ -66,6 +69,7 @@ pub struct Model {
     reach: Vec<Formula>,
     init: Vec<Formula>,
     terminate: Vec<Formula>,
+    /// Each leg's `avoid` region and the reward of entering it, worse than any outside.
     avoid: Vec<Option<(Formula, f64)>>,
     /// `legs[o]`: the primitives option `o` runs.
     pub legs: Vec<Vec<usize>>,
@@ -266,17 +270,26 @@ impl Model {
         }
     }
 
-    /// The greedy action of primitive `p` at the features `f`; the lowest index among ties.
+    /// The greedy action of primitive `p` at the features `f` among the actions not
+    /// `blocked` (all of them when every one is); the lowest index among ties.
     pub fn greedy_action(
         &self,
         weights: &Weights,
         p: usize,
         f: &[usize],
+        blocked: &[bool],
         scratch: &mut Vec<f64>,
     ) -> usize {
         scratch.resize(self.actions, 0.0);
         self.flat_values(&weights.flat[p], f, scratch);
+        mask(scratch, blocked);
         crate::learn::argmax(scratch)
+    }
+
+    /// Which actions the world blocks at `state`, into `out`.
+    pub fn blocked<W: World>(&self, world: &W, state: &W::State, out: &mut Vec<bool>) {
+        out.clear();
+        out.extend((0..self.actions).map(|a| world.blocked(state, a)));
     }
 
     /// `Q(obs, o)` under memory code `code`, from the options features `g`.
@@ -499,6 +512,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         run.codes.clear();
         run.psi.clear();
         let mut state = start.clone();
+        model.blocked(self.world, &state, &mut s.blocked);
         run.states.push(state.clone());
         run.values.extend_from_slice(&s.x);
         model.options_coder.features(&s.x, &mut s.g);
@@ -513,12 +527,13 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 let eps = flat.epsilon_at(self.weights.steps);
                 self.weights.steps += 1;
                 let a = if rng.random::<f64>() < eps {
-                    rng.random_range(0..model.actions)
+                    random_unblocked(&s.blocked, rng)
                 } else {
-                    model.greedy_action(&self.weights, p, &s.f, &mut s.q)
+                    model.greedy_action(&self.weights, p, &s.f, &s.blocked, &mut s.q)
                 };
                 let next = self.world.step(&state, a, rng);
                 self.world.valuation(&next, &mut s.x_next);
+                model.blocked(self.world, &next, &mut s.blocked_next);
                 model.flat_coder.features(&s.x_next, &mut s.f_next);
                 update_flat(model, &mut self.weights.flat, &mut self.eval, flat, a, s);
                 if model.is_persistent() {
@@ -533,6 +548,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 state = next;
                 std::mem::swap(&mut s.f, &mut s.f_next);
                 std::mem::swap(&mut s.x, &mut s.x_next);
+                std::mem::swap(&mut s.blocked, &mut s.blocked_next);
                 if model.stops(&mut self.eval, p, &s.x) {
                     break;
                 }
@@ -616,6 +632,9 @@ impl<S> Default for Run<S> {
 /// Buffers reused across steps.
 #[derive(Clone, Debug, Default)]
 struct Scratch {
+    /// The actions blocked at `x`, and at `x_next`.
+    blocked: Vec<bool>,
+    blocked_next: Vec<bool>,
     x: Vec<f64>,
     x_next: Vec<f64>,
     f: Vec<usize>,
@@ -628,7 +647,7 @@ struct Scratch {
 }
 
 /// The flat update of every primitive after the step `x -a-> x_next` (features `f`,
-/// `f_next` in `s`).
+/// `f_next` in `s`), bootstrapping from the actions not blocked at `x_next`.
 fn update_flat(
     model: &Model,
     flat_weights: &mut [Vec<f64>],
@@ -655,6 +674,7 @@ fn update_flat(
             0.0
         } else {
             model.flat_values(w, &s.f_next, &mut s.q);
+            mask(&mut s.q, &s.blocked_next);
             s.q.iter().copied().fold(f64::NEG_INFINITY, f64::max)
         };
         let row = &mut w[a * n..][..n];
@@ -664,4 +684,26 @@ fn update_flat(
             row[i] += delta;
         }
     }
+}
+
+/// Sets the values of the `blocked` actions to minus infinity, unless every one is blocked.
+fn mask(q: &mut [f64], blocked: &[bool]) {
+    if blocked.iter().all(|&b| b) {
+        return;
+    }
+    for (v, &b) in q.iter_mut().zip(blocked) {
+        if b {
+            *v = f64::NEG_INFINITY;
+        }
+    }
+}
+
+/// An action drawn uniformly from those not `blocked` (from all when every one is).
+fn random_unblocked(blocked: &[bool], rng: &mut Rng) -> usize {
+    let open = blocked.iter().filter(|&&b| !b).count();
+    if open == 0 {
+        return rng.random_range(0..blocked.len());
+    }
+    let k = rng.random_range(0..open);
+    blocked.iter().enumerate().filter(|(_, b)| !**b).nth(k).map_or(0, |(a, _)| a)
 }
