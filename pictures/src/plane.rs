@@ -492,40 +492,43 @@ fn frame_size(plane: &Plane, panels: usize) -> (i32, i32) {
     (fit(w), fit(h))
 }
 
+/// Tick labels written in exponent form: for steps too large or small for plain digits.
+const EXPONENT: usize = usize::MAX;
+
 /// Round tick values over `[lo, hi]` at least `gap` pixels apart on `pixels`, and the
-/// decimals to write them with.
+/// decimals to write them with ([`EXPONENT`] for exponent form).
 fn ticks([lo, hi]: [f64; 2], pixels: i32, gap: i32) -> (Vec<f64>, usize) {
     let most = (pixels / gap.max(1)).max(1) as f64;
     let raw = (hi - lo) / most;
     if !(raw.is_finite() && raw > 0.0) {
-        return (vec![lo, hi], 2);
+        return (vec![lo, hi], EXPONENT);
     }
     let exponent = raw.log10().floor();
     let unit = 10f64.powf(exponent);
     let step =
         [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * unit).find(|&s| s >= raw).unwrap_or(10.0 * unit);
-    let decimals = if step >= 1.0 { 0 } else { (-step.log10().floor()) as usize };
+    let decimals = if !(1e-5..1e7).contains(&step) {
+        EXPONENT
+    } else if step >= 1.0 {
+        0
+    } else {
+        (-step.log10().floor()) as usize
+    };
     let (first, last) = ((lo / step).ceil(), (hi / step).floor());
     if !(first.is_finite() && last.is_finite()) || last - first > 200.0 || last < first {
-        return (vec![lo, hi], 2);
+        return (vec![lo, hi], EXPONENT);
     }
     let values = (first as i64..=last as i64).map(|k| k as f64 * step).collect();
-    (values, decimals.min(12))
+    (values, decimals)
 }
 
-/// A tick value written with `decimals`, without a minus on zero; in exponent form when
-/// very large or small.
+/// A tick value written with `decimals` (or in exponent form for [`EXPONENT`]), without a
+/// minus on zero.
 fn tick_label(v: f64, decimals: usize) -> String {
-    let a = v.abs();
-    let text = if a != 0.0 && !(1e-5..1e7).contains(&a) {
-        format!("{v:.2e}")
-    } else {
-        format!("{v:.decimals$}")
-    };
-    if text.starts_with('-') && text[1..].chars().all(|c| c == '0' || c == '.') {
-        text[1..].to_owned()
-    } else {
-        text
+    let text = if decimals == EXPONENT { format!("{v:.2e}") } else { format!("{v:.decimals$}") };
+    match text.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_owned(),
+        _ => text,
     }
 }
 
@@ -1285,7 +1288,8 @@ mod tests {
         assert_eq!(tick_label(-0.0, 2), "0.00");
         assert_eq!(tick_label(-1e-17, 2), "0.00");
         assert_eq!(tick_label(0.04, 2), "0.04");
-        assert_eq!(tick_label(3e9, 0), "3.00e9");
+        assert_eq!(tick_label(3e9, EXPONENT), "3.00e9");
+        assert_eq!(ticks([0.0, 1e9], 600, 70).1, EXPONENT);
         // A huge extent falls back to its ends.
         let (t, _) = ticks([-1e300, 1e300], 600, 70);
         assert!(!t.is_empty() && t.len() <= 201);
