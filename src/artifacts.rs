@@ -602,13 +602,14 @@ fn arrow_lattice(world: &hstl_runtime::world::AnyWorld, plane: &pic::Plane) -> (
 }
 
 /// Steps of each sample run on a continuous world: twice the longest window of a
-/// persistent task, the task's horizon otherwise, between 60 and 1,000.
+/// persistent task (at least 120), the task's horizon and one otherwise (120 for a task
+/// without one); at most 400, which a picture still shows.
 fn plane_run_steps(spec: &TaskSpec, m: &hstl_runtime::approx::Model) -> usize {
     let steps = match m.horizons().max() {
         Some(h) => h.saturating_mul(2).max(RUN_STEPS),
-        None => crate::continuous::task_steps(spec),
+        None => spec.task.horizon().map_or(RUN_STEPS, |h| h.saturating_add(1)),
     };
-    steps.clamp(60, 1000)
+    steps.clamp(20, 400)
 }
 
 /// A greedy run as the picture's steps: each position, its option, what happened to its

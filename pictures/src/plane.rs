@@ -1026,7 +1026,7 @@ pub fn plane_options_policy(
 /// moves; the start and end marked; each slip a dotted stub towards where the chosen action
 /// led, ending in a cross, and each blocked move one ending in a red bar (from
 /// [`PlaneStep::intended`]; a blocked move without it is a bar at the point); each region
-/// entry a diamond with the region's name. Under the map, a timeline shows the option in
+/// entry a diamond, the first entry of each region with its name. Under the map, a timeline shows the option in
 /// force at every step, shaded the same way, with the slips, blocked moves and entries
 /// above it.
 ///
@@ -1128,10 +1128,16 @@ pub fn plane_sample_run(
                 _ => {}
             }
         }
+        // Every entry a diamond; the region's name beside its first only (the timeline
+        // names them all).
+        let mut named = HashSet::new();
         for s in steps {
             for &r in &s.entered {
                 let at = frame.at((s.x, s.y));
                 draw_entry(area, at, 6)?;
+                if !named.insert(r) {
+                    continue;
+                }
                 let name = shorten(&clean_text(&plane.regions[r].name));
                 let style = TextStyle::from(
                     (crate::draw::FONT, LABEL_SIZE * 0.7, FontStyle::Bold).into_font(),
