@@ -539,7 +539,9 @@ pub fn plane_pictures(
                 let start = hstl_runtime::World::reset(w, &mut rng);
                 agent.run(w, start, steps, &mut rng)
             }
-            AnyWorld::Grid(_) => unreachable!("a grid world returned above"),
+            AnyWorld::Grid(_) => {
+                return Err(Problem::new("a grid world is drawn by its own pictures", None));
+            }
         };
         let picture_steps = picture_run(world, &regions, &run, &mut eval);
         let title = format!(
