@@ -387,16 +387,276 @@ fn picture_error(e: pic::PictureError) -> Problem {
     Problem::new(format!("cannot draw a picture: {e}"), None)
 }
 
-/// The pictures of a policy learned on a continuous world (see [`crate::continuous`]).
+/// The pictures of a policy learned on a continuous world (see [`crate::continuous`]), as
+/// the grid's [`agent_pictures`] names them: `flat_{OPTION}.svg` (each primitive option's
+/// greedy action on a lattice of points, with the points where it terminates),
+/// `options.svg` (the option picked over the extent; with memory, one map per region, as
+/// the agent sees the world one step after leaving it with every other counter expired, all
+/// in this one picture) and `run_1.svg`, `run_2.svg` (greedy runs from the world's starts,
+/// drawn from `seed ^ PICTURE_SEED`, with their slips, blocked moves and region entries).
+///
+/// A plane world is drawn to scale with its obstacles and start area; `mountain-car` as its
+/// `(x, v)` phase plane. Regions are the spec's state formulas (see [`pictured_regions`])
+/// sampled at the centres of a fine raster. A slip is inferred from the step data: the
+/// move's direction lies nearer another heading than the one chosen (with noise this is a
+/// reading, not a record); a blocked move is one after which the robot stayed exactly
+/// where it was.
 pub fn plane_pictures(
-    _spec: &hstl_runtime::TaskSpec,
-    _world: &hstl_runtime::world::AnyWorld,
-    _checked: &CheckedSpec,
-    _agent: &hstl_runtime::approx::ApproxAgent,
-    _subject: &str,
-    _seed: u64,
+    spec: &hstl_runtime::TaskSpec,
+    world: &hstl_runtime::world::AnyWorld,
+    checked: &CheckedSpec,
+    agent: &hstl_runtime::approx::ApproxAgent,
+    subject: &str,
+    seed: u64,
 ) -> Result<Vec<OutFile>, Problem> {
-    Ok(Vec::new())
+    use hstl_runtime::world::AnyWorld;
+    let m = &agent.model;
+    let note = format!("seed {seed}");
+    let title = |what: &str| format!("{subject}: {what}\n{note}");
+    let regions = pictured_regions(checked, subject)?;
+    let mut plane = match world {
+        AnyWorld::Plane(w) => plane_frame(w),
+        AnyWorld::MountainCar(_) => {
+            use hstl_runtime::MountainCar as Car;
+            let mut p = pic::Plane::new(
+                [Car::MIN_POSITION, Car::MAX_POSITION],
+                [-Car::MAX_SPEED, Car::MAX_SPEED],
+            );
+            p.to_scale = false;
+            p
+        }
+        AnyWorld::Grid(_) => {
+            return Err(Problem::new("a grid world is drawn by its own pictures", None));
+        }
+    };
+    if let [x, y] = m.vars.as_slice() {
+        plane.x_label = x.clone();
+        plane.y_label = y.clone();
+    } else {
+        return Err(Problem::new(
+            format!("cannot draw a world of {} state variables on a plane", m.vars.len()),
+            None,
+        ));
+    }
+    let (columns, rows) = raster_size(&plane);
+    let mut eval = hstl_robustness::StateEval::new();
+    for r in &regions {
+        let holds = pic::Raster::from_fn(columns, rows, |i, j| {
+            let (x, y) = plane.centre(columns, rows, i, j);
+            eval.value(&r.formula, &[x, y]) > 0.0
+        })
+        .map_err(picture_error)?;
+        plane.regions.push(pic::PlaneRegion { name: r.name.clone(), kind: r.kind, holds });
+    }
+    let mut out = Vec::new();
+
+    // Flat policies: the greedy action on a lattice of free points.
+    let (lx, ly) = arrow_lattice(world, &plane);
+    let lattice: Vec<(f64, f64)> = plane
+        .lattice(lx, ly)
+        .map_err(picture_error)?
+        .into_iter()
+        .filter(|&(x, y)| match world {
+            AnyWorld::Plane(w) => w.is_free(hstl_runtime::plane::Point { x, y }),
+            _ => true,
+        })
+        .collect();
+    let direction = |a: usize| -> Option<(f64, f64)> {
+        match world {
+            AnyWorld::Plane(w) => w.heading(a),
+            _ => match a {
+                0 => Some((-1.0, 0.0)),
+                2 => Some((1.0, 0.0)),
+                _ => None,
+            },
+        }
+    };
+    let (mut f, mut scratch) = (Vec::new(), Vec::new());
+    for (p, prim) in spec.primitives.iter().enumerate() {
+        let mut arrows = Vec::with_capacity(lattice.len());
+        let mut terminate = Vec::new();
+        for &(x, y) in &lattice {
+            m.flat_coder.features(&[x, y], &mut f);
+            let a = m.greedy_action(&agent.weights, p, &f, &mut scratch);
+            arrows.push(pic::Arrow { x, y, direction: direction(a) });
+            if let hstl_runtime::spec::Terminate::Formula(stop) = &prim.terminate
+                && eval.value(stop, &[x, y]) > 0.0
+            {
+                terminate.push((x, y));
+            }
+        }
+        let title = title(&format!("flat policy of option {}", prim.name));
+        let svg =
+            pic::plane_flat_policy(&plane, &title, &arrows, &terminate).map_err(picture_error)?;
+        out.push(OutFile::text(format!("flat_{}.svg", file_safe(&prim.name)), svg));
+    }
+
+    // The options policy, one map per memory slice.
+    let names: Vec<String> = spec.options.iter().map(|o| o.name.clone()).collect();
+    let horizons: Vec<usize> = m.horizons().collect();
+    let slices: Vec<(String, Vec<usize>)> = if m.buckets == 0 || horizons.is_empty() {
+        vec![(String::new(), horizons.clone())]
+    } else {
+        spec.regions
+            .iter()
+            .enumerate()
+            .map(|(j, r)| {
+                let mut tau = horizons.clone();
+                tau[j] = 1;
+                (format!("one step after {}", r.name), tau)
+            })
+            .collect()
+    };
+    let (mut g, mut available) = (Vec::new(), Vec::new());
+    let mut maps = Vec::with_capacity(slices.len());
+    for (label, tau) in &slices {
+        let code = m.code(tau);
+        let choices = pic::Raster::from_fn(columns, rows, |i, j| {
+            let (x, y) = plane.centre(columns, rows, i, j);
+            m.available(&mut eval, &[x, y], &mut available);
+            m.options_coder.features(&[x, y], &mut g);
+            Some(m.best_option(&agent.weights, code, &g, &available))
+        })
+        .map_err(picture_error)?;
+        maps.push(pic::PlaneSlice { label: label.clone(), choices });
+    }
+    let what =
+        if maps.len() > 1 { "options policy by memory (others overdue)" } else { "options policy" };
+    let svg =
+        pic::plane_options_policy(&plane, &title(what), &maps, &names).map_err(picture_error)?;
+    out.push(OutFile::text("options.svg", svg));
+
+    // Sample runs of the greedy policy.
+    let steps = plane_run_steps(spec, m);
+    let mut rng = hstl_runtime::seeded_rng(seed ^ crate::train::PICTURE_SEED);
+    for k in 1..=2 {
+        let run = match world {
+            AnyWorld::Plane(w) => {
+                let start = hstl_runtime::World::reset(w, &mut rng);
+                agent.run(w, start, steps, &mut rng)
+            }
+            AnyWorld::MountainCar(w) => {
+                let start = hstl_runtime::World::reset(w, &mut rng);
+                agent.run(w, start, steps, &mut rng)
+            }
+            AnyWorld::Grid(_) => {
+                return Err(Problem::new("a grid world is drawn by its own pictures", None));
+            }
+        };
+        let picture_steps = picture_run(world, &regions, &run, &mut eval);
+        let title = format!(
+            "{subject}: sample run {k}\n{note}; {} steps of the greedy policy",
+            run.actions.len()
+        );
+        let svg =
+            pic::plane_sample_run(&plane, &title, &picture_steps, &names).map_err(picture_error)?;
+        out.push(OutFile::text(format!("run_{k}.svg"), svg));
+    }
+    uniquify(&mut out);
+    Ok(out)
+}
+
+/// The frame of a plane world: its extent, obstacles and start area (none when episodes
+/// start anywhere).
+fn plane_frame(w: &hstl_runtime::PlaneWorld) -> pic::Plane {
+    use hstl_runtime::plane::Obstacle;
+    let (x, y) = w.extent();
+    let mut plane = pic::Plane::new(x, y);
+    plane.obstacles = w
+        .obstacles()
+        .iter()
+        .map(|o| match *o {
+            Obstacle::Circle { cx, cy, r } => pic::Shape::Circle { cx, cy, r },
+            Obstacle::Rect { x0, y0, x1, y1 } => pic::Shape::Rect { x0, y0, x1, y1 },
+        })
+        .collect();
+    let start = w.start();
+    plane.start = (start != [x[0], y[0], x[1], y[1]]).then_some(start);
+    plane
+}
+
+/// Raster cells along each axis for regions and options maps: about four pixels each on a
+/// lone map, the longer side 150.
+fn raster_size(plane: &pic::Plane) -> (usize, usize) {
+    const SIDE: f64 = 150.0;
+    if !plane.to_scale {
+        return (160, 120);
+    }
+    let (w, h) = (plane.x[1] - plane.x[0], plane.y[1] - plane.y[0]);
+    let long = w.max(h);
+    let n = |v: f64| ((SIDE * v / long).round() as usize).clamp(30, 150);
+    (n(w), n(h))
+}
+
+/// Arrows along each axis: one per step of a plane world (between 2 and 40), a fixed
+/// lattice on `mountain-car`.
+fn arrow_lattice(world: &hstl_runtime::world::AnyWorld, plane: &pic::Plane) -> (usize, usize) {
+    match world {
+        hstl_runtime::world::AnyWorld::Plane(w) => {
+            let n = |[lo, hi]: [f64; 2]| {
+                let k = ((hi - lo) / w.step_length()).round();
+                if k.is_finite() { (k as usize).clamp(2, 40) } else { 2 }
+            };
+            (n(plane.x), n(plane.y))
+        }
+        _ => (18, 14),
+    }
+}
+
+/// Steps of each sample run on a continuous world: twice the longest window of a
+/// persistent task (at least 120), the task's horizon and one otherwise (120 for a task
+/// without one); at most 400, which a picture still shows.
+fn plane_run_steps(spec: &TaskSpec, m: &hstl_runtime::approx::Model) -> usize {
+    let steps = match m.horizons().max() {
+        Some(h) => h.saturating_mul(2).max(RUN_STEPS),
+        None => spec.task.horizon().map_or(RUN_STEPS, |h| h.saturating_add(1)),
+    };
+    steps.clamp(20, 400)
+}
+
+/// A greedy run as the picture's steps: each position, its option, what happened to its
+/// move (a plane's blocked moves and slips, inferred from the positions), where the chosen
+/// heading leads without slip or noise, and the regions entered there.
+fn picture_run(
+    world: &hstl_runtime::world::AnyWorld,
+    regions: &[PicturedRegion],
+    run: &hstl_runtime::approx::GreedyRun,
+    eval: &mut hstl_robustness::StateEval,
+) -> Vec<pic::PlaneStep> {
+    let points: Vec<(f64, f64)> = run.values.chunks_exact(2).map(|c| (c[0], c[1])).collect();
+    let mut before: Vec<bool> = Vec::new();
+    let mut steps = Vec::with_capacity(points.len());
+    for (t, &(x, y)) in points.iter().enumerate() {
+        let holds: Vec<bool> =
+            regions.iter().map(|r| eval.value(&r.formula, &[x, y]) > 0.0).collect();
+        let entered = if t == 0 {
+            Vec::new()
+        } else {
+            (0..regions.len()).filter(|&r| holds[r] && !before[r]).collect()
+        };
+        before = holds;
+        let mut step =
+            pic::PlaneStep { entered, ..pic::PlaneStep::at(x, y, run.options.get(t).copied()) };
+        if let (hstl_runtime::world::AnyWorld::Plane(w), Some(&a), Some(&(nx, ny))) =
+            (world, run.actions.get(t), points.get(t + 1))
+            && let Some((ux, uy)) = w.heading(a)
+        {
+            let length = w.step_length();
+            step.intended = Some((x + length * ux, y + length * uy));
+            let (dx, dy) = (nx - x, ny - y);
+            step.outcome = if dx == 0.0 && dy == 0.0 {
+                pic::Outcome::Blocked
+            } else {
+                let nearest = (0..w.headings())
+                    .filter_map(|k| w.heading(k).map(|(hx, hy)| (k, hx * dx + hy * dy)))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(k, _)| k);
+                if nearest == Some(a) { pic::Outcome::AsChosen } else { pic::Outcome::Slipped }
+            };
+        }
+        steps.push(step);
+    }
+    steps
 }
 
 #[cfg(test)]

@@ -168,3 +168,105 @@ fn mountain_car_trains_with_its_own_tiling() {
     let replay = c::replay(&serde_json::from_str(&text).unwrap()).expect("loads");
     assert_eq!(replay.world, world);
 }
+
+/// The trimmed contents of every `<text>` of an SVG.
+fn texts(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let body = &t[t.find('>')? + 1..];
+            Some(body[..body.find("</text>")?].trim().to_owned())
+        })
+        .collect()
+}
+
+/// The pictures of a learned function are named as a grid's (`flat_OPTION.svg`,
+/// `options.svg`, `run_K.svg`), draw the spec's regions by kind, and count the blocked
+/// moves of the greedy runs they draw: replaying them with the pictures' generator finds as
+/// many moves after which the robot stayed put as each picture says.
+#[test]
+fn plane_pictures_are_named_as_the_grid_s_and_count_blocked_moves() {
+    let world = plane();
+    let src = "spec Careful {
+        world \"paper-plane\";
+        state { x: float in 0..=14, y: float in 0..=14 }
+        let A = x > 12 && y > 12;
+        let Pond = (x - 7) * (x - 7) + (y - 7) * (y - 7) < 4;
+        task eventually[0..60] A && always[0..60] !Pond;
+        option A;
+        learn { preset: auto, episodes: 20, choices: 3 }
+    }";
+    let loaded = hstl::load::load(src, None).expect("the spec checks");
+    let spec = lowered(src, &world);
+    let t = c::train(&spec, &world, 1, |_, _| {}).expect("trains");
+    let files = hstl::artifacts::plane_pictures(&spec, &world, &loaded.spec, &t.agent, "c.hstl", 4)
+        .expect("draws");
+    let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["flat_A.svg", "options.svg", "run_1.svg", "run_2.svg"]);
+    let text = |name: &str| {
+        let f = files.iter().find(|f| f.name == name).expect("written");
+        String::from_utf8(f.contents.clone()).expect("utf-8")
+    };
+    let flat = text("flat_A.svg");
+    let words = texts(&flat);
+    for wanted in ["c.hstl: flat policy of option A", "seed 4", "Pond", "region to avoid", "A"] {
+        assert!(words.iter().any(|t| t == wanted), "flat_A.svg lacks {wanted}: {words:?}");
+    }
+    let options = text("options.svg");
+    assert!(options.contains("c.hstl: options policy") && !options.contains("one step after"));
+    let AnyWorld::Plane(w) = &world else { panic!("a plane") };
+    let mut rng = hstl::runtime::seeded_rng(4 ^ hstl::train::PICTURE_SEED);
+    // A run as long as the task: `eventually[0..60]` spans steps 0 to 59.
+    let steps = spec.task.horizon().expect("bounded") + 1;
+    assert_eq!(steps, 60);
+    for k in 1..=2 {
+        let start = hstl::runtime::World::reset(w, &mut rng);
+        let run = t.agent.run(w, start, steps, &mut rng);
+        let points: Vec<&[f64]> = run.values.chunks(2).collect();
+        let blocked = points.windows(2).filter(|p| p[0] == p[1]).count();
+        let svg = text(&format!("run_{k}.svg"));
+        let summary = format!("blocked: {blocked}");
+        assert!(
+            texts(&svg).iter().any(
+                |t| t.starts_with("60 moves, ") && t.ends_with(&format!(", {blocked} blocked"))
+            ),
+            "run {k}: {summary}, the picture: {:?}",
+            texts(&svg).iter().find(|t| t.contains(" moves, "))
+        );
+    }
+}
+
+/// `mountain-car`'s pictures are drawn in its `(x, v)` phase plane, named by the spec's
+/// variables.
+#[test]
+fn mountain_car_pictures_are_drawn_in_the_phase_plane() {
+    let world = AnyWorld::builtin("mountain-car").expect("built in");
+    let src = "spec Car {
+        world \"mountain-car\";
+        state { x: float in -1.2..=0.6, v: float in -0.07..=0.07 }
+        let Left = x < -1.0;
+        let Right = x > 0.4;
+        task always[0..] (eventually[0..100] Left && eventually[0..100] Right);
+        option Left;
+        option Right;
+        learn { preset: auto, episodes: 2, choices: 4 }
+    }";
+    let loaded = hstl::load::load(src, None).expect("the spec checks");
+    let spec = lowered(src, &world);
+    let t = c::train(&spec, &world, 0, |_, _| {}).expect("trains");
+    let files = hstl::artifacts::plane_pictures(&spec, &world, &loaded.spec, &t.agent, "car", 0)
+        .expect("draws");
+    let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+    assert_eq!(names, ["flat_Left.svg", "flat_Right.svg", "options.svg", "run_1.svg", "run_2.svg"]);
+    let flat = String::from_utf8(files[0].contents.clone()).expect("utf-8");
+    let words = texts(&flat);
+    for wanted in ["v", "x", "0.00", "-1.0", "Left", "Right"] {
+        assert!(words.iter().any(|t| t == wanted), "flat_Left.svg lacks {wanted}: {words:?}");
+    }
+    assert!(!flat.contains("start area") && !flat.contains("obstacle"));
+    let run = String::from_utf8(files[3].contents.clone()).expect("utf-8");
+    assert!(
+        texts(&run).iter().any(|t| t == "200 moves, 0 slips, 0 blocked"),
+        "twice the window, no slips"
+    );
+}

@@ -495,3 +495,72 @@ fn a_reach_avoid_preset_is_noted_studied_and_evaluated() {
     );
     assert!(stdout.contains(&format!("P* = {best:.4}")), "{stdout} vs {summary}");
 }
+
+/// `train` on a plane world writes the pictures a grid's folder holds, under the same
+/// names: each primitive option's arrows, the options policy (with memory, a map per
+/// memory slice in the one `options.svg`), two sample runs and the learning curve, each a
+/// parsing SVG that draws the world's extent, obstacles and regions.
+#[test]
+fn train_on_a_plane_world_writes_the_grid_s_pictures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let train_into = |out: &Path| {
+        let o = hstlc(&[
+            "train",
+            "plane_patrol.hstl",
+            "--world",
+            "yard.toml",
+            "--episodes",
+            "4",
+            "--seed",
+            "2",
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let out = dir.path().join("run");
+    let stdout = train_into(&out);
+    let pictures =
+        ["flat_A.svg", "flat_B.svg", "options.svg", "run_1.svg", "run_2.svg", "curve.svg"];
+    for name in pictures {
+        assert!(stdout.contains(name), "the summary does not name {name}: {stdout}");
+        let svg = read(&out.join(name));
+        let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg", "{name}");
+        let texts: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .filter_map(|n| n.text().map(str::trim))
+            .collect();
+        assert!(texts.iter().any(|t| t.starts_with("plane_patrol.hstl: ")), "{name}: {texts:?}");
+        assert!(texts.iter().any(|t| t.starts_with("seed 2")), "{name}: {texts:?}");
+        if name != "curve.svg" {
+            // The regions, the world's obstacles and start area, the extent's axes.
+            for wanted in ["A", "B", "x", "y", "14", "obstacle", "start area"] {
+                assert!(texts.contains(&wanted), "{name} lacks `{wanted}`: {texts:?}");
+            }
+        }
+    }
+    let options = read(&out.join("options.svg"));
+    assert!(options.contains("one step after A") && options.contains("one step after B"));
+    let flat = read(&out.join("flat_A.svg"));
+    assert!(flat.contains("flat policy of option A") && flat.contains("greedy action"));
+    // One arrow per step of the world, 14 x 14, but none on the 8 points inside the pond
+    // and the wall; and the legend's.
+    let arrows = roxmltree::Document::parse(&flat)
+        .expect("parses")
+        .descendants()
+        .filter(|n| n.has_tag_name("polygon") && n.attribute("fill") == Some("#222222"))
+        .filter(|n| n.attribute("points").is_some_and(|p| p.split_whitespace().count() == 7))
+        .count();
+    assert_eq!(arrows, 14 * 14 - 8 + 1);
+    // Twice the task's window, at least 120 steps as on a grid.
+    assert!(read(&out.join("run_1.svg")).contains("120 moves"), "the run's length");
+    // The same seed draws the same pictures.
+    let again = dir.path().join("again");
+    train_into(&again);
+    for name in pictures {
+        assert!(read(&out.join(name)) == read(&again.join(name)), "{name} differs");
+    }
+}

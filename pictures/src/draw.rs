@@ -55,6 +55,14 @@ pub(crate) enum Mark {
     Slip,
     /// No mark: a note.
     Blank,
+    /// An action without a direction on a plane's arrow field: a ring.
+    Still,
+    /// A plane's start area: a dashed square in the start colour.
+    StartArea,
+    /// A blocked move: the dotted intended move ending in a bar.
+    Blocked,
+    /// A region entered along a sample run: a small diamond.
+    Entry,
 }
 
 /// One legend row.
@@ -238,6 +246,16 @@ fn draw_mark(area: &Area<'_>, mark: Mark, centre: (i32, i32), size: i32) -> crat
         }
         Mark::End => draw_end(area, (cx, cy), half),
         Mark::Blank => Ok(()),
+        Mark::Still => draw_still(area, (cx, cy), size as f64 * 1.4),
+        Mark::StartArea => {
+            let corners = [square[0], (cx + half, cy - half), square[1], (cx - half, cy + half)];
+            for i in 0..4 {
+                draw_dashed(area, corners[i], corners[(i + 1) % 4], START_CELL.stroke_width(2))?;
+            }
+            Ok(())
+        }
+        Mark::Blocked => draw_blocked(area, (cx - half - 2, cy), (cx + half - 4, cy), 6),
+        Mark::Entry => draw_entry(area, (cx, cy), 6),
     }
 }
 
@@ -408,4 +426,45 @@ pub(crate) fn draw_end(area: &Area<'_>, centre: (i32, i32), half: i32) -> crate:
     let inner = [(cx - half + 1, cy - half + 1), (cx + half - 1, cy + half - 1)];
     area.draw(&Rectangle::new(outer, WHITE.filled())).map_err(draw_err)?;
     area.draw(&Rectangle::new(inner, INK.filled())).map_err(draw_err)
+}
+
+/// Draws an action without a direction (such as `none` on `mountain-car`) at `centre`, for
+/// arrows spaced `cell` pixels apart: a dark ring.
+pub(crate) fn draw_still(area: &Area<'_>, centre: (i32, i32), cell: f64) -> crate::Result<()> {
+    let radius = (cell * 0.16).round().max(2.0) as i32;
+    area.draw(&Circle::new(centre, radius, INK.stroke_width(2))).map_err(draw_err)
+}
+
+/// Draws a blocked move from the pixel `from` (where the robot stayed) towards `to` (where
+/// the chosen action would have led): a dotted line ending in a bar across it of half-size
+/// `arm`, dark on a white halo.
+pub(crate) fn draw_blocked(
+    area: &Area<'_>,
+    from: (i32, i32),
+    to: (i32, i32),
+    arm: i32,
+) -> crate::Result<()> {
+    let (dx, dy) = ((to.0 - from.0) as f64, (to.1 - from.1) as f64);
+    let length = dx.hypot(dy);
+    let (ux, uy) = if length > 0.0 { (dx / length, dy / length) } else { (1.0, 0.0) };
+    let arm = arm as f64;
+    let bar = vec![
+        ((to.0 as f64 - uy * arm).round() as i32, (to.1 as f64 + ux * arm).round() as i32),
+        ((to.0 as f64 + uy * arm).round() as i32, (to.1 as f64 - ux * arm).round() as i32),
+    ];
+    area.draw(&PathElement::new(bar.clone(), WHITE.stroke_width(6))).map_err(draw_err)?;
+    area.draw(&DashedPathElement::new(vec![from, to], 2, 3, INK.stroke_width(2)))
+        .map_err(draw_err)?;
+    area.draw(&PathElement::new(bar, AVOID.stroke_width(3))).map_err(draw_err)
+}
+
+/// Draws the mark of a region entered along a run: a white diamond of half-size `half`
+/// with a dark outline.
+pub(crate) fn draw_entry(area: &Area<'_>, centre: (i32, i32), half: i32) -> crate::Result<()> {
+    let (cx, cy) = centre;
+    let points = vec![(cx, cy - half), (cx + half, cy), (cx, cy + half), (cx - half, cy)];
+    area.draw(&Polygon::new(points.clone(), WHITE.filled())).map_err(draw_err)?;
+    let mut outline = points;
+    outline.push(outline[0]);
+    area.draw(&PathElement::new(outline, INK.stroke_width(2))).map_err(draw_err)
 }

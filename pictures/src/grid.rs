@@ -437,7 +437,7 @@ pub(crate) fn render(
 
 /// Gives every line of the picture round ends and corners, so that the pieces of a path
 /// join without notches (plotters writes neither attribute; they are inherited).
-fn round_joins(svg: String) -> String {
+pub(crate) fn round_joins(svg: String) -> String {
     let Some(open_end) = svg.find('>') else { return svg };
     let Some(close) = svg.rfind("</svg>") else { return svg };
     let mut out = String::with_capacity(svg.len() + 80);

@@ -10,6 +10,11 @@
 //! A title may hold a second line after a newline: a note drawn smaller under it (which
 //! seed a picture shows, say).
 //!
+//! Continuous worlds (a plane world, or a phase plane such as `mountain-car`'s) get the
+//! same pictures over a [`Plane`]: its extent in the world's units, obstacles, and regions
+//! sampled on a [`Raster`] ([`plane_flat_policy`], [`plane_options_policy`],
+//! [`plane_sample_run`]).
+//!
 //! Grid coordinates follow the GridWorld contract: `x` is the column from left to right, `y`
 //! the row from bottom to top, and `(0, 0)` is the bottom-left cell.
 //!
@@ -37,12 +42,18 @@ mod draw;
 mod grid;
 mod label;
 mod palette;
+mod plane;
 mod run;
 
 use std::fmt;
 
 pub use curve::{Panel, Series, learning_curve, learning_curves};
 pub use grid::{Slice, flat_policy, options_policy, options_policy_slices};
+pub use plane::{
+    Arrow, MAX_ARROWS, MAX_PANELS, MAX_RASTER_CELLS, MAX_RASTER_SIDE, MAX_RUN_STEPS, Outcome,
+    Plane, PlaneRegion, PlaneSlice, PlaneStep, Raster, Shape, plane_flat_policy,
+    plane_options_policy, plane_sample_run,
+};
 pub use run::{RunStep, sample_run};
 
 /// The largest grid side that can be drawn; larger grids would give unreadable pictures.

@@ -242,7 +242,7 @@ fn draw_timeline(
 
 /// The least of 1, 2, 5, 10, 20, 50, ... that labels `span` steps with at most `labels`
 /// numbers.
-fn tick_step(span: usize, labels: usize) -> usize {
+pub(crate) fn tick_step(span: usize, labels: usize) -> usize {
     let mut unit = 1;
     loop {
         for m in [1, 2, 5] {
@@ -259,7 +259,7 @@ fn tick_step(span: usize, labels: usize) -> usize {
 }
 
 /// Draws a small triangle in the middle of the move from `from` to `to`, pointing along it.
-fn draw_head(
+pub(crate) fn draw_head(
     area: &Area<'_>,
     from: (i32, i32),
     to: (i32, i32),
