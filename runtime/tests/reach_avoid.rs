@@ -55,8 +55,13 @@ fn a_corridor_matches_its_closed_forms() {
 fn an_unbounded_avoid_over_a_run_is_the_bounded_task() {
     let (moves, goal, avoid) = corridor(0.7);
     let solve = |task: ReachAvoid| solve_reach_avoid(&moves, &task, BUDGET).unwrap().probability;
-    let bounded =
-        ReachAvoid { goal: goal.clone(), avoid: avoid.clone(), reach_by: 4, avoid_through: 4, also: vec![] };
+    let bounded = ReachAvoid {
+        goal: goal.clone(),
+        avoid: avoid.clone(),
+        reach_by: 4,
+        avoid_through: 4,
+        also: vec![],
+    };
     let run = ReachAvoid::over_run(goal.clone(), avoid.clone(), 4, 5).unwrap();
     assert_eq!(run, bounded);
     assert_eq!(solve(run), solve(bounded));
@@ -111,8 +116,13 @@ fn the_optimal_controller_achieves_the_optimum_in_simulation() {
 #[test]
 fn bad_tasks_are_errors() {
     let (moves, goal, avoid) = corridor(0.7);
-    let short =
-        ReachAvoid { goal: vec![true; 3], avoid: avoid.clone(), reach_by: 3, avoid_through: 3, also: vec![] };
+    let short = ReachAvoid {
+        goal: vec![true; 3],
+        avoid: avoid.clone(),
+        reach_by: 3,
+        avoid_through: 3,
+        also: vec![],
+    };
     assert!(matches!(solve_reach_avoid(&moves, &short, BUDGET), Err(Error::Config(_))));
     // A deadline of a billion steps is refused before its table is allocated.
     let long = ReachAvoid { goal, avoid, reach_by: 1_000_000_000, avoid_through: 3, also: vec![] };
