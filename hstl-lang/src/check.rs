@@ -1392,7 +1392,8 @@ impl Cx<'_> {
             let horizons: Option<Vec<u64>> =
                 out.persistent_conjuncts(self.src).map(|cs| cs.iter().map(|c| c.steps).collect());
             out.learn.preset = Preset::Auto;
-            crate::preset::learn(horizons.as_deref(), out.is_continuous(), &mut out.learn);
+            let reach = crate::preset::is_reach_task(out);
+            crate::preset::learn(horizons.as_deref(), reach, out.is_continuous(), &mut out.learn);
         }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();
         for p in &l.params {
@@ -2398,7 +2399,14 @@ fn gen_positions(
 /// per region, each a single leg that stops on entering its region (no `avoid`).
 fn plan_missing(out: &CheckedSpec, src: &str) -> Option<&'static str> {
     let Some(regions) = out.persistent_conjuncts(src) else {
-        return Some("a persistent task `always[0..] (eventually[0..N] A && ...)`");
+        // A reach task: its legs are planned, whatever the options.
+        if crate::preset::is_reach_task(out) && !out.is_continuous() {
+            return None;
+        }
+        return Some(
+            "a persistent task `always[0..] (eventually[0..N] A && ...)` or a reach task \
+             `eventually[0..T] G && always !R`",
+        );
     };
     let l = &out.learn;
     if l.memory == 0 {

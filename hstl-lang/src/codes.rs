@@ -448,11 +448,14 @@ takes from each state and where in its region it arrives, and runs value iterati
 memory's counters, which the task determines exactly. That needs a persistent task \
 `always[0..] (eventually[0..N1] R1 && ...)`, `memory` and `reward: window` (the counters and \
 the reward it plans with), an options gamma below 1, and options of one leg each that stop on \
-entering one of the task's regions, without `avoid`.\n\n\
+entering one of the task's regions, without `avoid`. On a reach task `eventually[0..T] G && \
+always !R` (one to four goals, each by its deadline) it plans the legs instead: each leg that \
+stops on entering a goal takes the actions most likely, under the model, to enter it in time \
+without entering `R`.\n\n\
 Example:\n    task always[0..] eventually[0..40] A;\n    options sequences(A, B);\n    \
 learn { memory: 8, reward: window, plan: model }\n\n\
 Fix: write `option A;` per region and `learn { preset: auto }`, which sets `plan: model` on \
-a persistent task, or remove `plan: model`.",
+a persistent task or a reach task, or remove `plan: model`.",
     },
     CodeInfo {
         code: "HSTL101",

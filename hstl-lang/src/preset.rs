@@ -67,6 +67,43 @@ pub fn safety_conjuncts(spec: &CheckedSpec) -> Vec<SafetyConjunct<'_>> {
         .collect()
 }
 
+/// At most this many goals in a reach task the preset plans (as the runtime's
+/// `reach_avoid::MAX_GOALS`).
+pub const MAX_REACH_GOALS: usize = 4;
+
+/// Whether the task is a reach task the legs of which `plan: model` plans: its top-level
+/// conjuncts are one to [`MAX_REACH_GOALS`] `eventually[0..T] G` (bounded, from step 0) and
+/// one or more `always[0..T'] !R` sharing one window, every `G` and `R` a state formula.
+pub fn is_reach_task(spec: &CheckedSpec) -> bool {
+    use crate::checked::Bound;
+    let Some(task) = &spec.task else { return false };
+    let CFormulaKind::And(parts) = &task.formula.kind else { return false };
+    let (mut goals, mut window) = (0, None);
+    for part in parts {
+        match &part.kind {
+            CFormulaKind::Eventually(iv, g)
+                if iv.start == 0
+                    && matches!(iv.end, Bound::Inclusive(_) | Bound::Exclusive(1..))
+                    && spec.is_state_formula(g) =>
+            {
+                goals += 1;
+            }
+            CFormulaKind::Always(iv, body) => {
+                let CFormulaKind::Not(r) = &body.kind else { return false };
+                if iv.start != 0 || !spec.is_state_formula(r) {
+                    return false;
+                }
+                if window.is_some_and(|w| w != iv.end) {
+                    return false;
+                }
+                window = Some(iv.end);
+            }
+            _ => return false,
+        }
+    }
+    (1..=MAX_REACH_GOALS).contains(&goals) && window.is_some()
+}
+
 /// The `avoid` formula of the safety conjuncts: their region, or the `||` of their regions.
 pub fn avoid_formula(safety: &[SafetyConjunct<'_>]) -> Option<CFormula> {
     match safety {
@@ -106,11 +143,12 @@ pub fn memory_buckets(horizons: &[u64]) -> u64 {
 }
 
 /// The `learn` values the preset sets for a spec whose task has the persistent form with
-/// deadlines `horizons` (`None` for another form), before any value written beside it. On a
+/// deadlines `horizons` (`None` for another form), before any value written beside it; a
+/// `reach` task ([`is_reach_task`]) gets its legs planned (`plan: model`). On a
 /// `continuous` state the options level is Q-learned over tilings (`plan: model` plans over
 /// the finite states of a grid) and the legs learn with [`CONTINUOUS_FLAT_GAMMA`] and
 /// [`CONTINUOUS_FLAT_ALPHA`].
-pub fn learn(horizons: Option<&[u64]>, continuous: bool, learn: &mut LearnParams) {
+pub fn learn(horizons: Option<&[u64]>, reach: bool, continuous: bool, learn: &mut LearnParams) {
     if continuous {
         learn.flat.gamma = CONTINUOUS_FLAT_GAMMA;
         learn.flat.alpha = CONTINUOUS_FLAT_ALPHA;
@@ -131,6 +169,9 @@ pub fn learn(horizons: Option<&[u64]>, continuous: bool, learn: &mut LearnParams
         None => {
             learn.episodes = REACH_EPISODES;
             learn.choices = REACH_CHOICES;
+            if reach && !continuous {
+                learn.plan = crate::checked::Plan::Model;
+            }
         }
     }
 }

@@ -45,6 +45,7 @@ fn optimum(c: &mut Criterion) {
         avoid: cells.iter().map(|c| (5..=9).contains(&c.x) && (5..=9).contains(&c.y)).collect(),
         reach_by: 40,
         avoid_through: 40,
+        also: vec![],
     };
     group.bench_function("reach-avoid", |b| {
         b.iter(|| solve_reach_avoid(&moves, &task, 1 << 24).expect("solvable").probability)

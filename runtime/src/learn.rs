@@ -39,6 +39,7 @@ use rand::RngExt;
 
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
+use crate::plan_reach::ReachPlanner;
 use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
@@ -71,10 +72,18 @@ pub struct Learner<'e, E: Env> {
     /// The first primitive step from which the flat epsilon is at its floor, if any.
     flat_floor: Option<u64>,
     /// With `plan: model`: the planner and the transitions seen so far.
-    planning: Option<(Planner, Model)>,
+    planning: Option<(Plans, Model)>,
     /// With `plan: model`, after training: the learned flat and options values, which
     /// training continues from (the planned ones are in `q`).
     learned: Option<(Vec<Vec<f64>>, Vec<f64>)>,
+}
+
+/// What `plan: model` plans: the options level of a persistent task, or the legs of a reach
+/// task.
+#[derive(Clone, Debug)]
+enum Plans {
+    Options(Planner),
+    Reach(ReachPlanner),
 }
 
 /// The learned values, enough to continue training.
@@ -203,14 +212,19 @@ impl<'e, E: Env> Learner<'e, E> {
         let planning = match (spec.learn.plan, &memory) {
             (Plan::Off, _) => None,
             (Plan::Model, Some(m)) => Some((
-                Planner::new(&tables, m, &spec.learn)?,
+                Plans::Options(Planner::new(&tables, m, &spec.learn)?),
                 Model::new(tables.states, tables.actions),
             )),
-            (Plan::Model, None) => {
-                return Err(Error::Config(
-                    "plan: model needs a persistent task with `memory` and `reward: window`".into(),
-                ));
-            }
+            (Plan::Model, None) => match ReachPlanner::new(spec, env, &tables)? {
+                Some(p) => Some((Plans::Reach(p), Model::new(tables.states, tables.actions))),
+                None => {
+                    return Err(Error::Config(
+                        "plan: model needs a persistent task with `memory` and `reward: window`, \
+                         or a reach task `eventually[0..=T] Goal && always !R`"
+                            .into(),
+                    ));
+                }
+            },
         };
         Ok(Learner {
             env,
@@ -315,13 +329,21 @@ impl<'e, E: Env> Learner<'e, E> {
     /// With `plan: model`: the legs and the options values planned from what training has
     /// seen so far replace the learned ones, which are kept for training to continue from.
     fn plan(&mut self) {
-        let (Some((planner, model)), Some(memory)) = (&self.planning, &self.memory) else {
-            return;
-        };
-        let gamma = self.spec.learn.options.gamma;
+        let Some((plans, model)) = &self.planning else { return };
         let moves = model.moves();
-        let flat = planner.quickest_legs(&self.tables, memory, &self.q.flat, &moves);
-        let options = planner.options_values(&self.tables, memory, &flat, &moves, gamma);
+        let (flat, options) = match (plans, &self.memory) {
+            (Plans::Options(planner), Some(memory)) => {
+                let gamma = self.spec.learn.options.gamma;
+                let flat = planner.quickest_legs(&self.tables, memory, &self.q.flat, &moves);
+                let options = planner.options_values(&self.tables, memory, &flat, &moves, gamma);
+                (flat, options)
+            }
+            (Plans::Reach(planner), _) => {
+                let flat = planner.legs(&self.tables, &self.q.flat, &moves, model.starts());
+                (flat, self.q.options.clone())
+            }
+            (Plans::Options(_), None) => return,
+        };
         let flat = std::mem::replace(&mut self.q.flat, flat);
         self.learned = Some((flat, std::mem::replace(&mut self.q.options, options)));
     }
@@ -329,6 +351,9 @@ impl<'e, E: Env> Learner<'e, E> {
     fn episode(&mut self, rng: &mut Rng, run: &mut Run, rewards: &mut Vec<f64>) -> f64 {
         let start = self.env.reset(rng);
         let mut s = self.env.index(&start);
+        if let Some((_, model)) = &mut self.planning {
+            model.start(s);
+        }
         self.begin(s);
         let mut total = 0.0;
         for _ in 0..self.spec.learn.choices {

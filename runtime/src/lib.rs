@@ -36,6 +36,7 @@ pub mod memory;
 pub mod mountain_car;
 pub mod optimum;
 pub mod plan;
+mod plan_reach;
 pub mod plane;
 pub mod policy;
 pub mod reach_avoid;

@@ -51,12 +51,26 @@ pub(crate) struct Model {
     actions: usize,
     /// `next[s * actions + a]`: (next state, count).
     next: Vec<Vec<(usize, u32)>>,
+    /// `starts[s]`: the episodes that started in `s`.
+    starts: Vec<u32>,
 }
 
 impl Model {
     /// An empty model of `states` states and `actions` actions.
     pub fn new(states: usize, actions: usize) -> Model {
-        Model { actions, next: vec![Vec::new(); states * actions] }
+        Model { actions, next: vec![Vec::new(); states * actions], starts: vec![0; states] }
+    }
+
+    /// Counts an episode that starts in `s`.
+    pub fn start(&mut self, s: usize) {
+        if let Some(c) = self.starts.get_mut(s) {
+            *c = c.saturating_add(1);
+        }
+    }
+
+    /// `starts()[s]`: the episodes counted as starting in `s`.
+    pub fn starts(&self) -> &[u32] {
+        &self.starts
     }
 
     /// Counts one step `s -a-> next`.

@@ -2,16 +2,19 @@
 //!
 //! The task is `eventually[0..=T] Goal && always[0..=T_avoid] !Avoid` on a run from a
 //! uniformly drawn start of the world's [`Moves`]: the goal holds at some step `0..=T` and
-//! the avoided set at no step `0..=T_avoid`. (An unbounded `always[0..] !Avoid` over runs of
+//! the avoided set at no step `0..=T_avoid`. A task may name further goals, each with its own
+//! deadline (`eventually[0..=T1] A && eventually[0..=T2] B && always !Avoid`, a sequenced
+//! reach when `T1 < T2`): each must hold at some step up to its deadline. (An unbounded `always[0..] !Avoid` over runs of
 //! `L` states is the same task with `T_avoid = L - 1`, and the goal's window clipped to the
 //! run: [`ReachAvoid::over_run`].) Goal and avoided set are given per state.
 //!
 //! The most probable way to satisfy it may depend on the whole history of the run, but the
-//! step, the state and whether the goal has held yet say all that matters for the rest, so
+//! step, the state and which goals have held yet say all that matters for the rest, so
 //! dynamic programming on `(step, state, reached)`, backwards from the last step, gives the
 //! maximum over every policy, history-dependent ones included:
 //! `V_t(s, r) = max_a sum_s' P(s' | s, a) V_{t+1}(s', r')` with `r' = r || (t <= T &&
-//! Goal(s))`, 0 once the run fails and 1 once it cannot fail any more.
+//! Goal(s))` (a set of goals for several), 0 once the run fails and 1 once it cannot fail
+//! any more.
 
 use crate::Error;
 use std::fmt;
@@ -23,7 +26,7 @@ use crate::optimum::Moves;
 use crate::{Env, Rng, TaskSpec};
 
 /// A task of the reach-avoid form `eventually[0..T] Goal && always[I] !R1 && ...`, read off
-/// its formula by [`reach_avoid_form`].
+/// its formula by [`reach_avoid_form`], with at most [`MAX_GOALS`] goals in all.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReachAvoidForm {
     /// The goal's state formula.
@@ -34,7 +37,13 @@ pub struct ReachAvoidForm {
     pub avoid: Vec<Formula>,
     /// The last step they must not hold at (inclusive), or `None` for `always[0..]`.
     pub avoid_through: Option<usize>,
+    /// Further goals, `eventually[0..T'] G'` conjuncts after the first, each with its last
+    /// step.
+    pub also: Vec<(Formula, usize)>,
 }
+
+/// At most this many `eventually` conjuncts (goals) in a reach-avoid task.
+pub const MAX_GOALS: usize = 4;
 
 /// The last step of a window `[0..b]` or `[0..=b]` (inclusive), `None` for `[0..]`, and
 /// `Some(None)` when the window starts later or is empty.
@@ -49,17 +58,17 @@ fn last_step(i: &hstl_robustness::Interval) -> Option<Option<usize>> {
     }
 }
 
-/// The reach-avoid form of `task`: one conjunct `eventually[0..T] Goal` (bounded) and one or
-/// more `always[0..T'] !R` with one window among them, every `Goal` and `R` a state formula;
-/// `None` for a task of any other form.
+/// The reach-avoid form of `task`: one to [`MAX_GOALS`] conjuncts `eventually[0..T] Goal`
+/// (bounded) and one or more `always[0..T'] !R` with one window among them, every `Goal` and
+/// `R` a state formula; `None` for a task of any other form.
 pub fn reach_avoid_form(task: &Formula) -> Option<ReachAvoidForm> {
     let nodes = task.nodes();
     let Node::And(parts) = task.root_node() else { return None };
-    let (mut goal, mut avoid, mut through) = (None, Vec::new(), None);
+    let (mut goals, mut avoid, mut through) = (Vec::new(), Vec::new(), None);
     for part in parts {
         match &nodes[part.index()] {
-            Node::Eventually(i, g) if task.is_state(*g) && goal.is_none() => {
-                goal = Some((task.sub(*g), last_step(i)??));
+            Node::Eventually(i, g) if task.is_state(*g) && goals.len() < MAX_GOALS => {
+                goals.push((task.sub(*g), last_step(i)??));
             }
             Node::Always(i, body) => {
                 let Node::Not(r) = &nodes[body.index()] else { return None };
@@ -76,8 +85,9 @@ pub fn reach_avoid_form(task: &Formula) -> Option<ReachAvoidForm> {
             _ => return None,
         }
     }
-    let (goal, reach_by) = goal?;
-    Some(ReachAvoidForm { goal, reach_by, avoid, avoid_through: through? })
+    let mut goals = goals.into_iter();
+    let (goal, reach_by) = goals.next()?;
+    Some(ReachAvoidForm { goal, reach_by, avoid, avoid_through: through?, also: goals.collect() })
 }
 
 /// A reach-avoid task over the states of a world.
@@ -93,6 +103,8 @@ pub struct ReachAvoid {
     pub reach_by: usize,
     /// `T_avoid`: the avoided states must not occur at any step `0..=T_avoid`.
     pub avoid_through: usize,
+    /// Further goals, each with its `T`: each must hold at some step up to its own.
+    pub also: Vec<(Vec<bool>, usize)>,
 }
 
 /// The optimal probability of a [`ReachAvoid`] task, and the values behind it.
@@ -107,8 +119,9 @@ pub struct ReachAvoidOptimum {
     p: f64,
     /// The last step that matters, `max(T, T_avoid)`.
     last: usize,
-    /// `values[(2 * t + r) * states + s]`: `V_t(s, r)`, the best probability from state `s`
-    /// at step `t`, `r` saying whether the goal held at a step before `t`.
+    /// `values[(M * t + r) * states + s]`: `V_t(s, r)`, the best probability from state `s`
+    /// at step `t`, bit `j` of `r` saying whether goal `j` held at a step before `t` (`M`
+    /// sets of goals).
     values: Vec<f64>,
 }
 
@@ -118,7 +131,7 @@ pub struct ReachAvoidOptimum {
 pub struct ReachAvoidController<'a> {
     optimum: &'a ReachAvoidOptimum,
     step: usize,
-    reached: bool,
+    reached: usize,
 }
 
 impl ReachAvoid {
@@ -134,27 +147,63 @@ impl ReachAvoid {
         let Some(form) = reach_avoid_form(&spec.task) else { return Ok(None) };
         let trace = crate::tables::valuations(spec, env)?;
         let n = trace.len();
-        let goal = (0..n).map(|s| reference::robustness(&form.goal, &trace, s) > 0.0).collect();
+        let holds = |g: &Formula| -> Vec<bool> {
+            (0..n).map(|s| reference::robustness(g, &trace, s) > 0.0).collect()
+        };
+        let goal = holds(&form.goal);
         let avoid = (0..n)
             .map(|s| form.avoid.iter().any(|r| reference::robustness(r, &trace, s) >= 0.0))
             .collect();
-        match form.avoid_through {
-            None => ReachAvoid::over_run(goal, avoid, form.reach_by, len).map(Some),
-            Some(t) => {
-                Ok(Some(ReachAvoid { goal, avoid, reach_by: form.reach_by, avoid_through: t }))
-            }
-        }
+        let also: Vec<(Vec<bool>, usize)> = form.also.iter().map(|(g, t)| (holds(g), *t)).collect();
+        let mut task = match form.avoid_through {
+            None => ReachAvoid::over_run(goal, avoid, form.reach_by, len)?,
+            Some(t) => ReachAvoid {
+                goal,
+                avoid,
+                reach_by: form.reach_by,
+                avoid_through: t,
+                also: Vec::new(),
+            },
+        };
+        let last = match form.avoid_through {
+            None => task.avoid_through,
+            Some(_) => usize::MAX,
+        };
+        task.also = also.into_iter().map(|(g, t)| (g, t.min(last))).collect();
+        Ok(Some(task))
     }
 
     /// The states a run needs to decide the task: `max(T, T_avoid) + 1`.
     pub fn run_len(&self) -> usize {
-        self.reach_by.max(self.avoid_through).saturating_add(1)
+        self.last().saturating_add(1)
+    }
+
+    /// The last step that matters: the latest deadline or `T_avoid`.
+    fn last(&self) -> usize {
+        self.also.iter().fold(self.reach_by.max(self.avoid_through), |m, (_, t)| m.max(*t))
+    }
+
+    /// The goals reached by `reached` in a state where `goal[s]` for the first goal and
+    /// `also` for the others, at step `t`.
+    fn reach(&self, t: usize, s: usize, reached: usize) -> usize {
+        let mut r = reached | usize::from(t <= self.reach_by && self.goal[s]);
+        for (j, (g, by)) in self.also.iter().enumerate() {
+            if t <= *by && g[s] {
+                r |= 2 << j;
+            }
+        }
+        r
+    }
+
+    /// The sets of goals a run may have reached: `2^goals`.
+    fn masks(&self) -> usize {
+        2 << self.also.len()
     }
 
     /// Whether a run through `states` (from step 0) satisfies the task; a run that ends
     /// before the task is decided satisfies it when the goal has held.
     pub fn satisfied(&self, states: &[usize]) -> bool {
-        let mut reached = false;
+        let mut reached = 0;
         for (t, &s) in states.iter().enumerate().take(self.run_len()) {
             if s >= self.goal.len() || s >= self.avoid.len() {
                 return false;
@@ -164,7 +213,7 @@ impl ReachAvoid {
                 (None, r) => reached = r,
             }
         }
-        reached
+        reached == self.masks() - 1
     }
 
     /// The share of `runs` runs of [`ReachAvoid::run_len`] states, each from a start drawn by
@@ -199,21 +248,30 @@ impl ReachAvoid {
         let Some(last) = len.checked_sub(1) else {
             return Err(Error::Config("a run of 0 states cannot reach a goal".into()));
         };
-        Ok(ReachAvoid { goal, avoid, reach_by: reach_by.min(last), avoid_through: last })
+        Ok(ReachAvoid {
+            goal,
+            avoid,
+            reach_by: reach_by.min(last),
+            avoid_through: last,
+            also: Vec::new(),
+        })
     }
 
-    /// The outcome of step `t` in state `s` with `reached` from before: `Some(1)` when the
-    /// task can no longer fail, `Some(0)` when it has failed, else `None`; and the new
-    /// `reached`.
-    fn settle(&self, t: usize, s: usize, reached: bool) -> (Option<f64>, bool) {
+    /// The outcome of step `t` in state `s` with the goals `reached` from before (a bit per
+    /// goal): `Some(1)` when the task can no longer fail, `Some(0)` when it has failed, else
+    /// `None`; and the new `reached`.
+    fn settle(&self, t: usize, s: usize, reached: usize) -> (Option<f64>, usize) {
         if t <= self.avoid_through && self.avoid[s] {
             return (Some(0.0), reached);
         }
-        let reached = reached || (t <= self.reach_by && self.goal[s]);
-        if reached && t >= self.avoid_through {
-            (Some(1.0), true)
-        } else if !reached && t >= self.reach_by {
-            (Some(0.0), false)
+        let reached = self.reach(t, s, reached);
+        let all = self.masks() - 1;
+        let missed = (reached & 1 == 0 && t >= self.reach_by)
+            || self.also.iter().enumerate().any(|(j, (_, by))| reached & (2 << j) == 0 && t >= *by);
+        if reached == all && t >= self.avoid_through {
+            (Some(1.0), reached)
+        } else if missed {
+            (Some(0.0), reached)
         } else {
             (None, reached)
         }
@@ -230,7 +288,8 @@ pub fn solve_reach_avoid(
 ) -> Result<ReachAvoidOptimum, Error> {
     moves.check()?;
     let n = moves.states();
-    if task.goal.len() != n || task.avoid.len() != n {
+    if task.goal.len() != n || task.avoid.len() != n || task.also.iter().any(|(g, _)| g.len() != n)
+    {
         return Err(Error::Config(format!(
             "the goal and avoided states were not computed on this world, which has {n} \
              states (goal: {}, avoid: {})",
@@ -238,31 +297,35 @@ pub fn solve_reach_avoid(
             task.avoid.len()
         )));
     }
-    let last = task.reach_by.max(task.avoid_through);
-    let size = (last as u128 + 1) * 2 * n as u128;
+    if task.also.len() >= MAX_GOALS {
+        return Err(Error::Config(format!("a reach-avoid task has at most {MAX_GOALS} goals")));
+    }
+    let last = task.last();
+    let masks = task.masks();
+    let size = (last as u128 + 1) * masks as u128 * n as u128;
     if size > max_states as u128 {
         return Err(Error::Config(format!(
-            "the reach-avoid optimum needs {size} states ({n} states x {} steps x reached or \
-             not), more than the limit of {max_states}; use a shorter deadline or a smaller \
-             world",
+            "the reach-avoid optimum needs {size} states ({n} states x {} steps x {masks} sets \
+             of goals reached), more than the limit of {max_states}; use a shorter deadline or \
+             a smaller world",
             last as u128 + 1
         )));
     }
     let mut values = vec![0.0f64; size as usize];
     let q = (1.0 - moves.p) / 3.0;
     for t in (0..=last).rev() {
-        for r in [false, true] {
+        for r in 0..masks {
             for s in 0..n {
                 let (settled, reached) = task.settle(t, s, r);
                 let v = match settled {
                     Some(v) => v,
-                    None if t == last => f64::from(u8::from(reached)),
+                    None if t == last => f64::from(u8::from(reached == masks - 1)),
                     None => {
-                        let next = &values[(2 * (t + 1) + usize::from(reached)) * n..][..n];
+                        let next = &values[(masks * (t + 1) + reached) * n..][..n];
                         best_action(&moves.dest[s], next, moves.p, q).1
                     }
                 };
-                values[(2 * t + usize::from(r)) * n + s] = v;
+                values[(masks * t + r) * n + s] = v;
             }
         }
     }
@@ -303,7 +366,7 @@ impl fmt::Debug for ReachAvoidOptimum {
 impl ReachAvoidOptimum {
     /// A controller following the optimal policy.
     pub fn controller(&self) -> ReachAvoidController<'_> {
-        ReachAvoidController { optimum: self, step: 0, reached: false }
+        ReachAvoidController { optimum: self, step: 0, reached: 0 }
     }
 
     /// The last step that matters, `max(T, T_avoid)`: a run of this many states plus one
@@ -321,7 +384,7 @@ impl ReachAvoidOptimum {
 impl Controller for ReachAvoidController<'_> {
     fn reset(&mut self) {
         self.step = 0;
-        self.reached = false;
+        self.reached = 0;
     }
 
     fn act(&mut self, s: usize) -> Decision {
@@ -337,7 +400,8 @@ impl Controller for ReachAvoidController<'_> {
             // The task is decided: every action is as good.
             return Decision { action: 0, option: 0, leg: 0 };
         }
-        let next = &o.values[(2 * (self.step + 1) + usize::from(reached)) * n..][..n];
+        let masks = o.task.masks();
+        let next = &o.values[(masks * (self.step + 1) + reached) * n..][..n];
         let (action, _) = best_action(&o.dest[s], next, o.p, (1.0 - o.p) / 3.0);
         Decision { action, option: 0, leg: 0 }
     }

@@ -24,7 +24,7 @@ fn corridor(p: f64) -> (Moves, Vec<bool>, Vec<bool>) {
 /// step `avoid_through`, is `want`.
 fn check(p: f64, reach_by: usize, avoid_through: usize, want: f64) {
     let (moves, goal, avoid) = corridor(p);
-    let task = ReachAvoid { goal, avoid, reach_by, avoid_through };
+    let task = ReachAvoid { goal, avoid, reach_by, avoid_through, also: vec![] };
     let o = solve_reach_avoid(&moves, &task, BUDGET).unwrap();
     assert!(
         (o.probability - want).abs() < 1e-12,
@@ -55,8 +55,13 @@ fn a_corridor_matches_its_closed_forms() {
 fn an_unbounded_avoid_over_a_run_is_the_bounded_task() {
     let (moves, goal, avoid) = corridor(0.7);
     let solve = |task: ReachAvoid| solve_reach_avoid(&moves, &task, BUDGET).unwrap().probability;
-    let bounded =
-        ReachAvoid { goal: goal.clone(), avoid: avoid.clone(), reach_by: 4, avoid_through: 4 };
+    let bounded = ReachAvoid {
+        goal: goal.clone(),
+        avoid: avoid.clone(),
+        reach_by: 4,
+        avoid_through: 4,
+        also: vec![],
+    };
     let run = ReachAvoid::over_run(goal.clone(), avoid.clone(), 4, 5).unwrap();
     assert_eq!(run, bounded);
     assert_eq!(solve(run), solve(bounded));
@@ -85,6 +90,7 @@ fn the_optimal_controller_achieves_the_optimum_in_simulation() {
         avoid: cells.iter().map(|c| (5..=9).contains(&c.x) && (5..=9).contains(&c.y)).collect(),
         reach_by: 20,
         avoid_through: 25,
+        also: vec![],
     };
     let o = solve_reach_avoid(&moves, &task, BUDGET).unwrap();
     assert!(o.probability > 0.2 && o.probability < 0.9, "{}", o.probability);
@@ -110,11 +116,16 @@ fn the_optimal_controller_achieves_the_optimum_in_simulation() {
 #[test]
 fn bad_tasks_are_errors() {
     let (moves, goal, avoid) = corridor(0.7);
-    let short =
-        ReachAvoid { goal: vec![true; 3], avoid: avoid.clone(), reach_by: 3, avoid_through: 3 };
+    let short = ReachAvoid {
+        goal: vec![true; 3],
+        avoid: avoid.clone(),
+        reach_by: 3,
+        avoid_through: 3,
+        also: vec![],
+    };
     assert!(matches!(solve_reach_avoid(&moves, &short, BUDGET), Err(Error::Config(_))));
     // A deadline of a billion steps is refused before its table is allocated.
-    let long = ReachAvoid { goal, avoid, reach_by: 1_000_000_000, avoid_through: 3 };
+    let long = ReachAvoid { goal, avoid, reach_by: 1_000_000_000, avoid_through: 3, also: vec![] };
     let Err(Error::Config(message)) = solve_reach_avoid(&moves, &long, BUDGET) else {
         panic!("a billion steps were solved");
     };
@@ -219,4 +230,71 @@ fn a_spec_gives_its_reach_avoid_task_and_its_satisfaction_rate() {
     let mut other = spec.clone();
     other.task = Formula::eventually(Interval::ALL, cmp(0, Gt, 3.0));
     assert!(ReachAvoid::of_spec(&other, &env, 20).unwrap().is_none());
+}
+
+/// Several goals, each by its own deadline: on the corridor every way to `x = 4` passes
+/// `x = 3`, so adding `x = 3` by the same deadline changes nothing, and `x = 3` by step 2
+/// then `x = 4` by step 3 leaves no step to lose: `p^3`. The optimal controller's rate
+/// matches the optimum.
+#[test]
+fn several_goals_each_by_its_deadline() {
+    let (moves, goal, avoid) = corridor(0.7);
+    let p: f64 = 0.7;
+    let q = (1.0 - p) / 3.0;
+    let at = |x: usize| (0..5).map(|c| c == x).collect::<Vec<bool>>();
+    let solve = |task: &ReachAvoid| solve_reach_avoid(&moves, task, BUDGET).unwrap().probability;
+    let task = ReachAvoid {
+        goal: goal.clone(),
+        avoid: avoid.clone(),
+        reach_by: 4,
+        avoid_through: 4,
+        also: vec![(at(3), 4)],
+    };
+    assert!((solve(&task) - p.powi(3) * (1.0 + 6.0 * q)).abs() < 1e-12);
+    let task = ReachAvoid {
+        goal: at(3),
+        avoid: avoid.clone(),
+        reach_by: 2,
+        avoid_through: 3,
+        also: vec![(goal.clone(), 3)],
+    };
+    assert!((solve(&task) - p.powi(3)).abs() < 1e-12);
+    // Back to x = 2 after x = 4, both by step 5: right three times, then left twice.
+    let task = ReachAvoid { goal, avoid, reach_by: 3, avoid_through: 5, also: vec![(at(2), 5)] };
+    let want = solve(&task);
+    let o = solve_reach_avoid(&moves, &task, BUDGET).unwrap();
+    let env = GridWorld::new(5, 1, 0.7).unwrap();
+    let runs = 20_000;
+    let mut kept = 0;
+    let mut rng = seeded_rng(5);
+    for _ in 0..runs {
+        let states: Vec<usize> = rollout(&env, &mut o.controller(), 1, task.run_len(), &mut rng)
+            .iter()
+            .map(|s| s.state)
+            .collect();
+        kept += usize::from(task.satisfied(&states));
+    }
+    let rate = kept as f64 / runs as f64;
+    let sd = (want * (1.0 - want) / runs as f64).sqrt();
+    assert!(want > 0.1 && (rate - want).abs() < 5.0 * sd, "{rate} vs {want}");
+}
+
+/// `eventually[0..=T1] A && eventually[0..=T2] B && always !R` is of the form, with the
+/// second goal in `also`.
+#[test]
+fn a_sequenced_reach_is_of_the_form() {
+    use hstl_runtime::reach_avoid::reach_avoid_form;
+    use hstl_runtime::robustness::CmpOp::{Gt, Lt};
+    let (a, b, pit) = (cmp(0, Gt, 11.0), cmp(0, Lt, 3.0), cmp(1, Lt, 2.0));
+    let ev = |t, g: &Formula| {
+        Formula::eventually(Interval { start: 0, end: Bound::Inclusive(t) }, g.clone())
+    };
+    let task = Formula::and(vec![
+        ev(20, &a),
+        ev(45, &b),
+        Formula::always(Interval::ALL, Formula::not(pit.clone())),
+    ]);
+    let form = reach_avoid_form(&task).expect("reach-avoid");
+    assert_eq!((form.reach_by, form.avoid_through), (20, None));
+    assert_eq!(form.also, [(b, 45)]);
 }
