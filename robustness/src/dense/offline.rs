@@ -143,12 +143,10 @@ pub(crate) fn evaluate(df: &DenseFormula, rows: &Rows<'_>) -> Result<DenseSignal
                 let g = if and { min } else { max };
                 match gs.split_first() {
                     None => Val::Sig(constant(if and { f64::INFINITY } else { f64::NEG_INFINITY })),
-                    Some((first, rest)) => {
-                        let mut acc = s(first.index()).clone();
-                        for h in rest {
-                            acc = combine(&acc, s(h.index()), g);
-                        }
-                        Val::Sig(acc)
+                    Some((first, [])) => Val::Sig(s(first.index()).clone()),
+                    Some(_) => {
+                        let sigs: Vec<&DenseSignal> = gs.iter().map(|h| s(h.index())).collect();
+                        Val::Sig(combine_all(&sigs, g))
                     }
                 }
             }
@@ -209,6 +207,34 @@ pub(crate) fn combine(
             j += 1;
         }
         out.push(t, g(va[i.max(1) - 1], vb[j.max(1) - 1]));
+    }
+    out
+}
+
+/// `g` folded over every operand's value, point by point over the union of the change
+/// points: one pass for all operands.
+fn combine_all(sigs: &[&DenseSignal], g: fn(f64, f64) -> f64) -> DenseSignal {
+    let mut next = vec![0usize; sigs.len()];
+    let mut cur = vec![0.0; sigs.len()];
+    let mut out = DenseSignal::with_capacity(sigs.iter().map(|s| s.len()).max().unwrap_or(0));
+    loop {
+        let mut t: Option<f64> = None;
+        for (sig, &k) in sigs.iter().zip(&next) {
+            if let Some(&x) = sig.times.get(k)
+                && t.is_none_or(|t| x < t)
+            {
+                t = Some(x);
+            }
+        }
+        let Some(t) = t else { break };
+        for ((sig, k), c) in sigs.iter().zip(&mut next).zip(&mut cur) {
+            if sig.times.get(*k) == Some(&t) {
+                *c = sig.values[*k];
+                *k += 1;
+            }
+        }
+        let v = cur[1..].iter().fold(cur[0], |acc, &x| g(acc, x));
+        out.push(t, v);
     }
     out
 }
