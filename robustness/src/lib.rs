@@ -16,11 +16,15 @@
 //!   slices, for monitors that compute their operand signals themselves.
 //! - [`segment`] scores option executions and all their suffixes for the learner.
 //!
+//! - [`dense`] is dense time: time-stamped, piecewise-constant signals (rtamt's
+//!   dense-time STL), offline and online.
+//!
 //! - [`nan`] finds the comparisons that compute a NaN, so callers can refuse it.
 //!
 //! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
 pub mod complete;
+pub mod dense;
 pub mod formula;
 pub mod kernels;
 pub mod nan;

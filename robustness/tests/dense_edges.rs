@@ -1,0 +1,293 @@
+//! Dense time, case by case: DENSE-TIME.md's worked example, the places where hstl follows
+//! the definition and rtamt does not (docs/DENSE-TIME-DEVIATIONS.md), whole-number stamps,
+//! the online monitor's memory, and the errors.
+
+mod dense_common;
+
+use dense_common::{read_csv, reference};
+use hstl_robustness::dense::{
+    DenseError, DenseFormula, DenseMonitor, DenseTrace, DenseTraceBuilder, DenseTraceError,
+    TimeScale,
+};
+use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval};
+
+const EXAMPLE: &str = "t,x,y\n0,1,5\n1,2,\n1.5,,6\n2,3,\n3.5,0.5,\n4,,-1\n5,4,\n";
+
+fn gt(var: usize, c: f64) -> Formula {
+    Formula::cmp(Expr::var(var), CmpOp::Gt, Expr::constant(c))
+}
+
+/// `[a..=b]` in tenths.
+fn iv(a: usize, b: Option<usize>) -> Interval {
+    Interval { start: a, end: b.map_or(Bound::Unbounded, Bound::Inclusive) }
+}
+
+fn rows(f: &Formula, csv: &str) -> Vec<(f64, f64)> {
+    let (_, trace) = read_csv(csv);
+    let df = DenseFormula::new(f, TimeScale::decimals(1)).expect("a dense formula");
+    let sig = df.signal(&trace).expect("a signal");
+    // The reference agrees on every one of these (their numbers are exact in binary).
+    let want = reference::signal(f, TimeScale::decimals(1), &trace);
+    assert_eq!(sig, want, "{f}");
+    sig.until(trace.t_last()).collect()
+}
+
+#[test]
+fn the_worked_example_of_dense_time() {
+    let (x, y) = (gt(0, 1.0), gt(1, 5.0));
+    let inf = f64::INFINITY;
+    let cases: Vec<(Formula, Vec<(f64, f64)>)> = vec![
+        (
+            Formula::eventually(iv(0, Some(10)), x.clone()),
+            vec![(0.0, 1.0), (1.0, 2.0), (3.5, -0.5), (4.0, 3.0)],
+        ),
+        (
+            Formula::eventually(iv(10, Some(20)), x.clone()),
+            vec![(0.0, 2.0), (2.5, -0.5), (3.0, 3.0)],
+        ),
+        (
+            Formula::always(iv(5, Some(15)), x.clone()),
+            vec![(0.0, 0.0), (0.5, 1.0), (1.5, 2.0), (2.0, -0.5), (4.5, 3.0)],
+        ),
+        (Formula::always(iv(0, None), x.clone()), vec![(0.0, -0.5), (5.0, 3.0)]),
+        (Formula::eventually(iv(5, None), x.clone()), vec![(0.0, 3.0)]),
+        (
+            Formula::until(iv(0, Some(10)), x.clone(), y.clone()),
+            vec![(0.0, 0.0), (1.0, 1.0), (3.5, -0.5), (4.0, -6.0)],
+        ),
+        (
+            Formula::once(iv(10, Some(20)), x.clone()),
+            vec![(0.0, -inf), (1.0, 0.0), (2.0, 1.0), (3.0, 2.0)],
+        ),
+        (
+            Formula::historically(iv(0, Some(10)), x.clone()),
+            vec![(0.0, 0.0), (2.0, 1.0), (3.0, 2.0), (3.5, -0.5)],
+        ),
+        (
+            Formula::since(iv(0, Some(10)), x.clone(), y.clone()),
+            vec![(0.0, 0.0), (1.5, 1.0), (3.5, -0.5), (5.0, -6.0)],
+        ),
+        (
+            Formula::since(iv(0, None), x.clone(), y.clone()),
+            vec![(0.0, 0.0), (1.5, 1.0), (3.5, -0.5)],
+        ),
+    ];
+    for (f, want) in cases {
+        assert_eq!(rows(&f, EXAMPLE), want, "{f}");
+    }
+}
+
+#[test]
+fn decimal_breakpoints_are_one_subtraction_each() {
+    // DENSE-TIME.md: pieces 1, -1, 2, -3 from 0, 0.2, 0.7, 1 under eventually[0.1..=0.3].
+    let csv = "t,x\n0,1\n0.2,-1\n0.7,2\n1,-3\n";
+    let (_, trace) = read_csv(csv);
+    let f = Formula::eventually(iv(1, Some(3)), gt(0, 0.0));
+    let sig = DenseFormula::new(&f, TimeScale::decimals(1)).unwrap().signal(&trace).unwrap();
+    let times: Vec<f64> = sig.times().to_vec();
+    assert_eq!(times, vec![0.0, 0.1, 0.7 - 0.3, 0.9]);
+    assert_eq!(0.7 - 0.3, 0.39999999999999997);
+}
+
+/// rtamt defect 1: `since` drops a leading `-inf`. By the table `(x > 0) since (once[1..=2]
+/// y > 0)` is `-inf` on `[0, 1)`, and `always[0..=1]` of it is `-inf` at 0; rtamt says 2.
+#[test]
+fn a_since_that_starts_at_minus_infinity_keeps_it() {
+    let s = Formula::since(iv(0, None), gt(0, 0.0), Formula::once(iv(10, Some(20)), gt(1, 0.0)));
+    let r = rows(&s, EXAMPLE);
+    assert_eq!(r[0], (0.0, f64::NEG_INFINITY));
+    assert_eq!(r[1].0, 1.0);
+    let g = Formula::always(iv(0, Some(10)), s);
+    assert_eq!(rows(&g, EXAMPLE)[0], (0.0, f64::NEG_INFINITY));
+}
+
+/// rtamt defect 2: on a trace that starts after 0, timed past operators fill their empty
+/// windows from time 0. By the table (windows clipped at `t0 = 10`)
+/// `once[1..=1] (historically[1..=1] x > 0)` is `-inf` at 10; rtamt says `+inf`.
+#[test]
+fn past_windows_are_clipped_at_the_first_stamp() {
+    let f = Formula::once(iv(10, Some(10)), Formula::historically(iv(10, Some(10)), gt(0, 0.0)));
+    let r = rows(&f, "t,x\n10,1\n11,2\n13,-1\n");
+    assert_eq!(r[0], (10.0, f64::NEG_INFINITY));
+    assert_eq!(r[1], (11.0, f64::INFINITY));
+}
+
+/// rtamt defect 3: a piece one ulp long can map to an empty interval (`0.5 + 0.75` and
+/// `next_up(0.5) + 0.75` are one double). rtamt lists two points at one time and then
+/// fails in a binary operator; hstl skips the empty piece (the later value holds).
+#[test]
+fn a_piece_that_rounds_to_nothing_is_skipped() {
+    let s = 0.5f64.next_up();
+    assert_eq!(s + 0.75, 0.5 + 0.75);
+    let trace = DenseTrace::from_samples(&[vec![(0.5, 1.0), (s, 5.0), (2.0, 2.0)]]).unwrap();
+    let once = Formula::once(iv(75, Some(75)), gt(0, 0.0));
+    let f = Formula::and(vec![once.clone(), gt(0, 0.0)]);
+    let sig = DenseFormula::new(&once, TimeScale::decimals(2)).unwrap().signal(&trace).unwrap();
+    assert_eq!(
+        sig.points().collect::<Vec<_>>(),
+        vec![(0.5, f64::NEG_INFINITY), (1.25, 5.0), (2.75, 2.0)]
+    );
+    assert!(DenseFormula::new(&f, TimeScale::decimals(2)).unwrap().signal(&trace).is_ok());
+}
+
+/// rtamt defect 4: its constants start at time 0, so a trace from -2 loses what comes
+/// before 0. The table is defined there.
+#[test]
+fn negative_stamps_are_times_like_any_other() {
+    let r = rows(&Formula::eventually(iv(0, Some(10)), gt(0, 1.0)), "t,x\n-2,0\n-0.5,3\n1,1\n");
+    assert_eq!(r, vec![(-2.0, -1.0), (-1.5, 2.0), (1.0, 0.0)]);
+}
+
+#[test]
+fn nothing_is_clipped_at_the_end_of_the_trace() {
+    // eventually[5..=6] x > 0 on a trace ending at 2 reads the held last value.
+    let csv = "t,x\n0,-1\n1,3\n2,2\n";
+    assert_eq!(rows(&Formula::eventually(iv(50, Some(60)), gt(0, 0.0)), csv), vec![(0.0, 2.0)]);
+    assert_eq!(rows(&Formula::always(iv(20, Some(30)), gt(0, 0.0)), csv), vec![(0.0, 2.0)]);
+}
+
+#[test]
+fn until_asks_its_left_operand_at_the_witness_too() {
+    // rtamt issue #210: x steps from 0 to 1 at 0.5; (x < 0.5) until[0..=1] (x >= 0.5) at 0
+    // is -0.5 (the discrete reading would give +0.5). The mirror `since` is -0.5 too.
+    let csv = "t,x\n0,0\n0.5,1\n";
+    let lt = Formula::cmp(Expr::var(0), CmpOp::Lt, Expr::constant(0.5));
+    let ge = Formula::cmp(Expr::var(0), CmpOp::Ge, Expr::constant(0.5));
+    assert_eq!(rows(&Formula::until(iv(0, Some(10)), lt.clone(), ge.clone()), csv)[0].1, -0.5);
+    let csv = "t,x\n0,1\n0.5,0\n";
+    let r = rows(&Formula::since(iv(0, None), ge, lt), csv);
+    // At 0.5 the witness 0.5 itself needs `x >= 0.5` there: -0.5 (and -0.5 before).
+    assert_eq!(r, vec![(0.0, -0.5)]);
+}
+
+#[test]
+fn whole_number_stamps_are_relative_and_exact() {
+    // ROS 2 nanoseconds: far beyond 2^53, one nanosecond apart.
+    let base: i64 = 1_700_000_000_123_456_789;
+    let trace =
+        DenseTrace::from_int_samples(&[vec![(base, 1.0), (base + 1, -1.0), (base + 3, 2.0)]])
+            .unwrap();
+    assert_eq!(trace.origin(), Some(i128::from(base)));
+    assert_eq!(trace.times(), &[0.0, 1.0, 3.0]);
+    let f = Formula::eventually(iv(0, Some(1)), gt(0, 0.0));
+    let sig = DenseFormula::new(&f, TimeScale::WHOLE).unwrap().signal(&trace).unwrap();
+    assert_eq!(sig.points().collect::<Vec<_>>(), vec![(0.0, 1.0), (1.0, -1.0), (2.0, 2.0)]);
+    // u64 too, up to 2^64 - 1.
+    let top = u64::MAX;
+    let t = DenseTrace::from_int_samples(&[vec![(top - 2, 1.0), (top, 2.0)]]).unwrap();
+    assert_eq!(t.times(), &[0.0, 2.0]);
+    // 2^53 + 1 units after the first stamp: no double holds it.
+    let e =
+        DenseTrace::from_int_samples(&[vec![(0i64, 1.0), ((1i64 << 53) + 1, 2.0)]]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "row 1: the time stamp 9007199254740993 is 9007199254740993 units after the first stamp 0, \
+         more than a double holds exactly (exact up to 2^53 = 9007199254740992 units)"
+    );
+    // 2^54 is on the doubles' grid: exact, so accepted.
+    assert!(DenseTrace::from_int_samples(&[vec![(0i64, 1.0), (1i64 << 54, 2.0)]]).is_ok());
+    let mut b = DenseTraceBuilder::new(1);
+    b.push_int(base, &[Some(1.0)]).unwrap();
+    b.push_int(base + 10, &[None]).unwrap();
+    assert_eq!(b.push(3.0, &[Some(1.0)]).unwrap_err(), DenseTraceError::MixedStamps { row: 2 });
+    assert_eq!(b.build().unwrap().times(), &[0.0, 10.0]);
+}
+
+#[test]
+fn bad_traces_are_errors_with_clear_messages() {
+    let mut b = DenseTraceBuilder::new(2);
+    let e = b.push(0.0, &[Some(1.0), None]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "variable 1 has no sample at the first time stamp, 0 (no value exists before it)"
+    );
+    b.push(0.0, &[Some(1.0), Some(2.0)]).unwrap();
+    let e = b.push(0.0, &[Some(1.0), None]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "row 1: the time stamp 0 does not come after the previous one, 0 (stamps must strictly increase)"
+    );
+    let e = b.push(f64::NAN, &[None, None]).unwrap_err();
+    assert_eq!(e.to_string(), "row 1: the time stamp NaN is not a finite number");
+    let e = b.push(1.0, &[Some(f64::NAN), None]).unwrap_err();
+    assert_eq!(e.to_string(), "row 1: variable 0 is NaN");
+    let e = b.push(1.0, &[None]).unwrap_err();
+    assert_eq!(e.to_string(), "a row has 1 cells for 2 variables");
+    assert_eq!(
+        DenseTraceBuilder::new(1).build().unwrap_err().to_string(),
+        "the trace has no sample"
+    );
+    let e = DenseTrace::from_samples(&[vec![(0.0, 1.0)], vec![(0.5, 1.0)]]).unwrap_err();
+    assert_eq!(e, DenseTraceError::MissingFirst { var: 1, t0: "0".into() });
+    let e = DenseTrace::from_samples(&[vec![(0.0, 1.0), (2.0, 1.0), (1.0, 3.0)]]).unwrap_err();
+    assert!(matches!(e, DenseTraceError::NotIncreasing { row: 2, .. }));
+    assert!(!e.to_string().ends_with('.'));
+}
+
+#[test]
+fn formulas_without_a_dense_meaning_are_errors() {
+    let x = gt(0, 0.0);
+    let s = TimeScale::decimals(1);
+    let e = DenseFormula::new(&Formula::prev(x.clone()), s).unwrap_err();
+    assert_eq!(e, DenseError::NoDenseMeaning { op: "prev" });
+    let e = DenseFormula::new(&Formula::next(x.clone()), s).unwrap_err();
+    assert!(e.to_string().starts_with("`next` has no dense-time meaning"));
+    let half = Interval { start: 0, end: Bound::Exclusive(25) };
+    let e = DenseFormula::new(&Formula::eventually(half, x.clone()), s).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "the half-open interval `[0..2.5]` has no dense-time meaning; write `[a..=b]`"
+    );
+    let e = DenseFormula::new(&Formula::always(iv(20, Some(10)), x.clone()), s).unwrap_err();
+    assert_eq!(e.to_string(), "the interval `[2..=1]` ends before it starts");
+    let (_, trace) = read_csv("t,x\n0,1\n");
+    let e = DenseFormula::new(&gt(1, 0.0), s).unwrap().signal(&trace).unwrap_err();
+    assert_eq!(e.to_string(), "the formula reads variable 1, but the trace has 1 variable");
+    let nan = Formula::cmp(Expr::sub(Expr::var(0), Expr::var(0)), CmpOp::Gt, Expr::constant(0.0));
+    let (_, trace) = read_csv("t,x\n0,1\n2,inf\n");
+    let e = DenseFormula::new(&nan, s).unwrap().signal(&trace).unwrap_err();
+    assert_eq!(e.to_string(), "the comparison `v0 - v0 > 0` computes NaN at time 2");
+}
+
+#[test]
+fn time_scales_read_decimals_as_the_nearest_double() {
+    assert_eq!(TimeScale::decimals(1).bound(3), 0.3);
+    assert_ne!(3.0 * 0.1, 0.3);
+    assert_eq!(TimeScale::decimals(2).bound(250), 2.5);
+    assert_eq!(TimeScale::decimals(3).text(2500), "2.5");
+    assert_eq!(TimeScale::decimals(2).text(5), "0.05");
+    assert_eq!(TimeScale::parse_decimal("2.50"), Some((25, 1)));
+    assert_eq!(TimeScale::parse_decimal("10"), Some((10, 0)));
+    assert_eq!(TimeScale::parse_decimal("1e-3"), Some((1, 3)));
+    assert_eq!(TimeScale::parse_decimal("1.5e2"), Some((150, 0)));
+    assert_eq!(TimeScale::parse_decimal("0.0"), Some((0, 0)));
+    assert_eq!(TimeScale::parse_decimal("-1"), None);
+    assert_eq!(TimeScale::parse_decimal("x"), None);
+}
+
+#[test]
+fn the_online_monitor_decides_early_and_keeps_only_its_window() {
+    // always[0..=10] x > 0 over 0.1-spaced stamps: a window of about 100 rows.
+    let f = Formula::always(iv(100, Some(100)), gt(0, 0.0));
+    let df = DenseFormula::new(&f, TimeScale::decimals(1)).unwrap();
+    let mut m = DenseMonitor::new(&df, 1).unwrap();
+    let mut b = DenseTraceBuilder::new(1);
+    let mut online = Vec::new();
+    let mut most = 0;
+    for k in 0..20_000 {
+        let t = f64::from(k) * 0.1;
+        let v = if k % 37 < 20 { 1.0 } else { -1.0 };
+        let r = m.push(t, &[Some(v)]).unwrap();
+        if k > 200 && k % 37 == 0 {
+            assert!(!online.is_empty(), "verdicts before the end");
+        }
+        online.extend(r);
+        b.push(t, &[Some(v)]).unwrap();
+        most = most.max(m.kept());
+    }
+    assert!(most <= 250, "kept {most} rows");
+    online.extend(m.finish().unwrap());
+    let trace = b.build().unwrap();
+    let want: Vec<(f64, f64)> = df.signal(&trace).unwrap().until(trace.t_last()).collect();
+    assert_eq!(online, want);
+}
