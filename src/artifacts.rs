@@ -471,13 +471,22 @@ pub fn plane_pictures(
             },
         }
     };
-    let (mut f, mut scratch) = (Vec::new(), Vec::new());
+    // The agent never takes a move the world blocks: neither do the arrows.
+    let blocked = |x: f64, y: f64, out: &mut Vec<bool>| match world {
+        AnyWorld::Plane(w) => m.blocked(w, &hstl_runtime::plane::Point { x, y }, out),
+        _ => {
+            out.clear();
+            out.resize(m.actions, false);
+        }
+    };
+    let (mut f, mut scratch, mut mask) = (Vec::new(), Vec::new(), Vec::new());
     for (p, prim) in spec.primitives.iter().enumerate() {
         let mut arrows = Vec::with_capacity(lattice.len());
         let mut terminate = Vec::new();
         for &(x, y) in &lattice {
             m.flat_coder.features(&[x, y], &mut f);
-            let a = m.greedy_action(&agent.weights, p, &f, &mut scratch);
+            blocked(x, y, &mut mask);
+            let a = m.greedy_action(&agent.weights, p, &f, &mask, &mut scratch);
             arrows.push(pic::Arrow { x, y, direction: direction(a) });
             if let hstl_runtime::spec::Terminate::Formula(stop) = &prim.terminate
                 && eval.value(stop, &[x, y]) > 0.0

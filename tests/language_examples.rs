@@ -6,30 +6,31 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use hstl::lang::{Checked, SpecWorld, WorldFacts};
-use hstl::world::GridWorld;
+use hstl::lang::{Checked, SpecWorld};
+use hstl::world::{AnyWorld, Facts};
 
 /// Checks `src` as `hstlc check` does: every `world` item read relative to `base`. A world
 /// that cannot be read fails the test.
 fn check(name: &str, src: &str, base: &Path) -> Checked {
     let parsed = hstl::lang::parse(src);
-    let mut worlds: HashMap<String, WorldFacts> = HashMap::new();
+    let mut worlds: HashMap<String, Facts> = HashMap::new();
     for spec in &parsed.file.specs {
         let Some(item) = hstl::lang::world_item(spec) else { continue };
-        let world = GridWorld::builtin(&item.name).unwrap_or_else(|| {
+        let world = AnyWorld::builtin(&item.name).unwrap_or_else(|| {
             let path = base.join(&item.name);
             let text = std::fs::read_to_string(&path)
                 .unwrap_or_else(|e| panic!("{name}: world {}: {e}", path.display()));
-            GridWorld::from_toml(&text, "world")
+            AnyWorld::from_toml(&text, "world")
                 .unwrap_or_else(|e| panic!("{name}: world {}: {e}", path.display()))
         });
-        let label = hstl::world::label(&world, None);
-        worlds.insert(item.name.clone(), hstl::world::facts(&world, &label));
+        let label = hstl::world::any_label(&world, None);
+        worlds.insert(item.name.clone(), hstl::world::any_facts(&world, &label));
     }
     hstl::lang::check_parsed_with_worlds(src, parsed, &|spec| match hstl::lang::world_item(spec)
         .and_then(|w| worlds.get(&w.name))
     {
-        Some(facts) => SpecWorld::Facts(facts),
+        Some(Facts::Grid(facts)) => SpecWorld::Facts(facts),
+        Some(Facts::Box(facts)) => SpecWorld::Box(facts),
         None => SpecWorld::Alone,
     })
 }
@@ -76,8 +77,10 @@ fn every_spec_in_the_language_document_and_the_readme_checks() {
         let blocks = hstl_blocks(doc);
         let specs: Vec<&String> = blocks.iter().filter(|b| b.contains("spec ")).collect();
         assert!(!specs.is_empty(), "{doc}: no spec blocks");
+        // A block's world file is named as from a spec in examples/specs.
+        let base = root().join("examples/specs");
         for (i, block) in specs.iter().enumerate() {
-            assert_checks(&format!("{doc} spec block {}", i + 1), block, root());
+            assert_checks(&format!("{doc} spec block {}", i + 1), block, &base);
         }
     }
 }

@@ -287,29 +287,34 @@ fn continuous_spec(
     let name = if persistent { "window rate W" } else { "satisfaction rate P" };
     row(name, Stats::of(&rates), 3)?;
     // No exact optimum here: a planned reference, scored on the same runs, stands beside.
-    match hstl::reference::Reference::new(&spec, world) {
-        Ok(reference) => {
-            let planned: Vec<f64> = seeds
+    let planned: Result<Vec<f64>, String> = hstl::reference::Reference::new(&spec, world)
+        .map(|reference| {
+            seeds
                 .iter()
                 .map(|&s| match reference.evaluate(c::runs_after_training(&spec, s)) {
                     c::Evaluation::Window(w) => w.rate,
                     c::Evaluation::Satisfaction { rate } => rate,
                 })
-                .collect();
-            let ratio: Vec<f64> = rates
-                .iter()
-                .zip(&planned)
-                .map(|(r, p)| if *p > 0.0 { r / p } else { f64::NAN })
-                .collect();
-            row(&format!("planned reference {measure}"), Stats::of(&planned), 3)?;
-            row(&format!("{measure} / reference"), Stats::of(&ratio), 3)?;
+                .collect()
+        })
+        .map_err(|e| e.message);
+    match &planned {
+        Ok(planned) => {
+            let ratio: Vec<f64> =
+                rates.iter().zip(planned).filter(|(_, p)| **p > 0.0).map(|(r, p)| r / p).collect();
+            row(&format!("planned reference {measure}"), Stats::of(planned), 3)?;
+            if ratio.len() == rates.len() {
+                row(&format!("{measure} / reference"), Stats::of(&ratio), 3)?;
+            } else {
+                outln!(
+                    "  {measure} / reference undefined: the reference keeps nothing on some seeds"
+                )?;
+            }
             outln!(
                 "  no exact optimum on a continuous world; the reference is a planner (LANGUAGE.md, \"References\")"
             )?;
         }
-        Err(e) => {
-            outln!("  no exact optimum on a continuous world, and no reference: {}", e.message)?
-        }
+        Err(e) => outln!("  no exact optimum on a continuous world, and no reference: {e}")?,
     }
     // The median seed by the measure; its policy is trained again (same seed, same bits).
     let mut order: Vec<usize> = (0..runs.len()).collect();
@@ -320,17 +325,22 @@ fn continuous_spec(
         c::train(&spec, world, seed, |_, _| {}).map_err(|e| CliError::new(e.to_string(), None))?;
     let policy = c::policy_json(&spec, world, &trained.agent, &l.source, seed)
         .map_err(|e| CliError::new(e.to_string(), None))?;
-    let seeds_csv: String = std::iter::once(format!("seed,{measure},reward,train_secs\n"))
-        .chain(runs.iter().map(|(i, r)| {
-            format!(
-                "{},{},{},{}\n",
-                seeds[*i],
-                r.rate,
-                facade::tail_mean(&r.curve, facade::TAIL),
-                r.secs
-            )
-        }))
-        .collect();
+    let reference_at = |i: usize| {
+        planned.as_ref().ok().and_then(|p| p.get(i)).map_or(String::new(), f64::to_string)
+    };
+    let seeds_csv: String =
+        std::iter::once(format!("seed,{measure},reward,train_secs,reference_{measure}\n"))
+            .chain(runs.iter().map(|(i, r)| {
+                format!(
+                    "{},{},{},{},{}\n",
+                    seeds[*i],
+                    r.rate,
+                    facade::tail_mean(&r.curve, facade::TAIL),
+                    r.secs,
+                    reference_at(*i)
+                )
+            }))
+            .collect();
     let files = vec![
         OutFile::text("policy.json", policy),
         OutFile::text("curve.csv", hstl::artifacts::curve_csv(&trained.curve)),

@@ -458,7 +458,10 @@ fn a_reach_avoid_preset_is_noted_studied_and_evaluated() {
         ),
         "{text}"
     );
-    assert!(text.contains("learn { episodes: 300, choices: 10, flat: { alpha: 0.05 } }"), "{text}");
+    assert!(
+        text.contains("learn { episodes: 300, choices: 10, plan: model, flat: { alpha: 0.05 } }"),
+        "{text}"
+    );
     let json = hstlc(&["check", "reach_avoid.hstl", "--format", "json"]);
     assert_eq!(String::from_utf8_lossy(&json.stdout).trim(), "[]");
 
