@@ -71,6 +71,10 @@ pub struct Model {
     terminate: Vec<Formula>,
     /// Each leg's `avoid` region and the reward of entering it, worse than any outside.
     avoid: Vec<Option<(Formula, f64)>>,
+    /// For each region, the primitive whose reach formula it is, if any.
+    region_reach: Vec<Option<usize>>,
+    /// For each primitive, the primitive whose reach formula is its termination formula.
+    stop_reach: Vec<Option<usize>>,
     /// `legs[o]`: the primitives option `o` runs.
     pub legs: Vec<Vec<usize>>,
     /// The persistent task's regions and windows (empty for another task).
@@ -167,6 +171,10 @@ impl Model {
                  tilings or memory buckets"
             )));
         }
+        // Formulas the task and the options share are evaluated once per step.
+        let same_reach = |f: &Formula| reach.iter().position(|r| r == f);
+        let region_reach = regions.iter().map(|(r, _)| same_reach(r)).collect();
+        let stop_reach = terminate.iter().map(same_reach).collect();
         Ok(Model {
             vars,
             actions,
@@ -176,6 +184,8 @@ impl Model {
             init,
             terminate,
             avoid,
+            region_reach,
+            stop_reach,
             legs,
             regions,
             buckets,
@@ -218,6 +228,41 @@ impl Model {
     pub fn stops(&self, eval: &mut StateEval, p: usize, x: &[f64]) -> bool {
         eval.value(&self.terminate[p], x) > 0.0
             || self.avoid[p].as_ref().is_some_and(|(r, _)| eval.value(r, x) >= 0.0)
+    }
+
+    /// [`Model::stops`] with `rho(reach_q, x)` of every primitive `q` known (`reach`).
+    fn stops_knowing(&self, eval: &mut StateEval, p: usize, x: &[f64], reach: &[f64]) -> bool {
+        let stop = match self.stop_reach[p] {
+            Some(q) => reach[q],
+            None => eval.value(&self.terminate[p], x),
+        };
+        stop > 0.0 || self.avoid[p].as_ref().is_some_and(|(r, _)| eval.value(r, x) >= 0.0)
+    }
+
+    /// [`Model::step_counters`] with `rho(reach_q, x)` of every primitive `q` known.
+    fn step_counters_knowing(
+        &self,
+        eval: &mut StateEval,
+        x: &[f64],
+        reach: &[f64],
+        tau: &mut [usize],
+    ) -> bool {
+        let mut kept = true;
+        for (j, ((r, n), t)) in self.regions.iter().zip(tau.iter_mut()).enumerate() {
+            let v = match self.region_reach[j] {
+                Some(q) => reach[q],
+                None => eval.value(r, x),
+            };
+            *t = if v > 0.0 { 0 } else { (*t + 1).min(*n) };
+            kept &= *t < *n;
+        }
+        kept
+    }
+
+    /// `rho(reach_p, x)` of every primitive, into `out`.
+    fn reach_values(&self, eval: &mut StateEval, x: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.reach.iter().map(|r| eval.value(r, x)));
     }
 
     /// The window of each region of a persistent task, in conjunct order.
@@ -535,9 +580,15 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 self.world.valuation(&next, &mut s.x_next);
                 model.blocked(self.world, &next, &mut s.blocked_next);
                 model.flat_coder.features(&s.x_next, &mut s.f_next);
+                model.reach_values(&mut self.eval, &s.x_next, &mut s.reach_next);
                 update_flat(model, &mut self.weights.flat, &mut self.eval, flat, a, s);
                 if model.is_persistent() {
-                    let kept = model.step_counters(&mut self.eval, &s.x_next, &mut s.tau);
+                    let kept = model.step_counters_knowing(
+                        &mut self.eval,
+                        &s.x_next,
+                        &s.reach_next,
+                        &mut s.tau,
+                    );
                     run.psi.push(kept);
                 }
                 run.states.push(next.clone());
@@ -549,7 +600,8 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 std::mem::swap(&mut s.f, &mut s.f_next);
                 std::mem::swap(&mut s.x, &mut s.x_next);
                 std::mem::swap(&mut s.blocked, &mut s.blocked_next);
-                if model.stops(&mut self.eval, p, &s.x) {
+                std::mem::swap(&mut s.reach, &mut s.reach_next);
+                if model.stops_knowing(&mut self.eval, p, &s.x, &s.reach) {
                     break;
                 }
             }
@@ -635,6 +687,9 @@ struct Scratch {
     /// The actions blocked at `x`, and at `x_next`.
     blocked: Vec<bool>,
     blocked_next: Vec<bool>,
+    /// `rho(reach_p, .)` of every primitive at `x_next`, and after a step at `x`.
+    reach_next: Vec<f64>,
+    reach: Vec<f64>,
     x: Vec<f64>,
     x_next: Vec<f64>,
     f: Vec<usize>,
@@ -660,7 +715,7 @@ fn update_flat(
     let step = params.alpha / model.flat_coder.tilings() as f64;
     s.q.resize(model.actions, 0.0);
     for (p, w) in flat_weights.iter_mut().enumerate() {
-        let mut reward = eval.value(&model.reach[p], &s.x_next);
+        let mut reward = s.reach_next[p];
         let mut ends = false;
         if let Some((r, penalty)) = &model.avoid[p] {
             let inside = eval.value(r, &s.x_next);

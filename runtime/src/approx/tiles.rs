@@ -142,14 +142,26 @@ impl TileCoder {
     pub fn features(&self, x: &[f64], out: &mut Vec<usize>) {
         out.clear();
         let dims = self.lo.len();
+        // The position in tiles along each variable, shared by every tiling.
+        let mut scaled = [0.0f64; MAX_DENSE_DIMS];
+        let mut wide = Vec::new();
+        let scaled: &mut [f64] = if dims <= MAX_DENSE_DIMS {
+            &mut scaled[..dims]
+        } else {
+            wide.resize(dims, 0.0);
+            &mut wide
+        };
+        for (d, s) in scaled.iter_mut().enumerate() {
+            let v = x.get(d).copied().unwrap_or(self.lo[d]);
+            // `max` then `min` maps NaN to the lower bound.
+            let v = v.max(self.lo[d]).min(self.hi[d]);
+            *s = (v - self.lo[d]) * self.inv_width[d];
+        }
         for t in 0..self.tilings {
             let mut index = 0usize;
             let mut hash = 0x9e37_79b9_7f4a_7c15u64 ^ t as u64;
-            for d in 0..dims {
-                let v = x.get(d).copied().unwrap_or(self.lo[d]);
-                // `max` then `min` maps NaN to the lower bound.
-                let v = v.max(self.lo[d]).min(self.hi[d]);
-                let pos = (v - self.lo[d]) * self.inv_width[d] + self.offsets[t * dims + d];
+            for (d, s) in scaled.iter().enumerate() {
+                let pos = s + self.offsets[t * dims + d];
                 let tile = (pos as usize).min(self.spans[d] - 1);
                 if self.hashed {
                     hash = (hash ^ tile as u64).wrapping_mul(0x0000_0100_0000_01b3);
