@@ -477,7 +477,7 @@ pub fn plane_pictures(
         let mut terminate = Vec::new();
         for &(x, y) in &lattice {
             m.flat_coder.features(&[x, y], &mut f);
-            let a = m.greedy_action(&agent.weights, p, &f, &mut scratch);
+            let a = m.greedy_action(&agent.weights, p, &f, &[], &mut scratch);
             arrows.push(pic::Arrow { x, y, direction: direction(a) });
             if let hstl_runtime::spec::Terminate::Formula(stop) = &prim.terminate
                 && eval.value(stop, &[x, y]) > 0.0
