@@ -152,8 +152,7 @@ fn the_dense_example_gives_the_readme_numbers() {
     }
     let trace = b.build().expect("a trace");
     let signal = monitor.signal(&trace).expect("a signal");
-    let rows: Vec<String> =
-        signal.until(trace.t_last()).map(|(t, v)| format!("{t},{v}")).collect();
+    let rows: Vec<String> = signal.until(trace.t_last()).map(|(t, v)| format!("{t},{v}")).collect();
     let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
     let printed = format!("t,robustness\n{}\n", rows.join("\n"));
     assert!(readme.contains(&printed), "README.md does not show:\n{printed}");

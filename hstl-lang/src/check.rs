@@ -955,8 +955,12 @@ impl Cx<'_> {
             }
             Some(b) if b < a => {
                 self.push(
-                    Diagnostic::new("HSTL005", i.range.clone(), format!("inverted interval `{text}`"))
-                        .with_help("swap the bounds"),
+                    Diagnostic::new(
+                        "HSTL005",
+                        i.range.clone(),
+                        format!("inverted interval `{text}`"),
+                    )
+                    .with_help("swap the bounds"),
                 );
                 return None;
             }
@@ -969,17 +973,14 @@ impl Cx<'_> {
     fn no_dense_step(&mut self, f: &Formula, op: &str) {
         let at = f.range.start..(f.range.start + op.len()).min(f.range.end);
         self.push(
-            Diagnostic::new(
-                "HSTL081",
-                at,
-                format!("`{op}` has no dense-time meaning"),
-            )
-            .with_help(format!(
-                "in continuous time there is no {} sample: say how far with an interval, such \
+            Diagnostic::new("HSTL081", at, format!("`{op}` has no dense-time meaning")).with_help(
+                format!(
+                    "in continuous time there is no {} sample: say how far with an interval, such \
                  as `{}[0..=0.1] f`",
-                if op == "prev" { "previous" } else { "next" },
-                if op == "prev" { "once" } else { "eventually" }
-            )),
+                    if op == "prev" { "previous" } else { "next" },
+                    if op == "prev" { "once" } else { "eventually" }
+                ),
+            ),
         );
     }
 
@@ -2475,7 +2476,7 @@ fn decimal(text: &str) -> Option<(u128, u32)> {
         n = n.checked_mul(10)?;
         decimals += 1;
     }
-    while decimals > 0 && n % 10 == 0 && n != 0 {
+    while decimals > 0 && n.is_multiple_of(10) && n != 0 {
         n /= 10;
         decimals -= 1;
     }
@@ -2504,9 +2505,10 @@ fn time_decimals(spec: &syntax::Spec) -> u32 {
             | FormulaKind::Once(i, g)
             | FormulaKind::Historically(i, g) => (i.as_ref(), vec![g]),
             FormulaKind::Until(a, i, b) | FormulaKind::Since(a, i, b) => (i.as_ref(), vec![a, b]),
-            FormulaKind::Not(g) | FormulaKind::Paren(g) | FormulaKind::Prev(g) | FormulaKind::Next(g) => {
-                (None, vec![g])
-            }
+            FormulaKind::Not(g)
+            | FormulaKind::Paren(g)
+            | FormulaKind::Prev(g)
+            | FormulaKind::Next(g) => (None, vec![g]),
             FormulaKind::Implies(a, b) => (None, vec![a, b]),
             FormulaKind::And(v) | FormulaKind::Or(v) => (None, v.iter().collect()),
             FormulaKind::True

@@ -264,7 +264,12 @@ fn summarise(out: &mut String, spec: &CheckedSpec, src: &str) {
                     Bound::Inclusive(b) => format!("={}", spec.bound_text(b)),
                     Bound::Exclusive(b) => spec.bound_text(b),
                 };
-                bounds.push(format!("[{}..{end}] ({:?}..{:?})", spec.bound_text(i.start), i.start, i.end));
+                bounds.push(format!(
+                    "[{}..{end}] ({:?}..{:?})",
+                    spec.bound_text(i.start),
+                    i.start,
+                    i.end
+                ));
             }
             stack.extend(f.operands());
         }

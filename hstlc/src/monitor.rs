@@ -120,8 +120,9 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
             hstl::lower::LowerError::UnknownLet { .. } => {
                 Some("leave out `--formula` to score the task".to_string())
             }
-            hstl::lower::LowerError::Invalid { .. }
-            | hstl::lower::LowerError::TimeModel { .. } => None,
+            hstl::lower::LowerError::Invalid { .. } | hstl::lower::LowerError::TimeModel { .. } => {
+                None
+            }
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;

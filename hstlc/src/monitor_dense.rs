@@ -19,8 +19,7 @@ use crate::cli_error::CliError;
 use crate::monitor::{MonitorArgs, Windows, columns, note_ignored, read_error, trace_name};
 use crate::output::{errln, outln};
 use crate::trace_csv::{
-    Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, Stamp, StampOrder,
-    TraceRows,
+    Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, Stamp, StampOrder, TraceRows,
 };
 use crate::{CmdResult, Status};
 
@@ -83,9 +82,8 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
     note_ignored(&ignored, spec);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = match (batch, args.signal) {
-        (false, true) => writeln!(out, "t,robustness").and_then(|()| {
-            scored[0].1.iter().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))
-        }),
+        (false, true) => writeln!(out, "t,robustness")
+            .and_then(|()| scored[0].1.iter().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))),
         (false, false) => writeln!(out, "{}", scored[0].1[0].1),
         (true, true) => writeln!(out, "trace,t,robustness").and_then(|()| {
             scored.iter().try_for_each(|(path, rows)| {

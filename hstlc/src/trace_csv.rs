@@ -177,7 +177,8 @@ const EXACT: i128 = 1 << 53;
 impl StampOrder {
     /// The next row's stamp as the trace takes it, or what is wrong with it.
     pub fn next(&mut self, row: &DenseRow, time: &str) -> Result<Stamp, CsvError> {
-        let at = |message: String, help: &str| csv(row.line, row.stamp_column, message, help.into());
+        let at =
+            |message: String, help: &str| csv(row.line, row.stamp_column, message, help.into());
         let stamp = match (self.last, row.stamp) {
             (None, Stamp::Int(n)) if n.abs() >= EXACT => Stamp::Int(n),
             (Some(Stamp::Int(_)), Stamp::Int(n)) => Stamp::Int(n),
@@ -209,13 +210,17 @@ impl StampOrder {
         };
         let order = match (self.last, stamp) {
             (Some(Stamp::Int(p)), Stamp::Int(s)) if s <= p => Some((p.to_string(), s.to_string())),
-            (Some(Stamp::Real(p)), Stamp::Real(s)) if s <= p => Some((p.to_string(), s.to_string())),
+            (Some(Stamp::Real(p)), Stamp::Real(s)) if s <= p => {
+                Some((p.to_string(), s.to_string()))
+            }
             _ => None,
         };
         if let Some((previous, now)) = order {
             let how = if previous == now { "repeats" } else { "goes back from" };
             return Err(at(
-                format!("the time stamp {now} in column `{time}` {how} the previous one, {previous}"),
+                format!(
+                    "the time stamp {now} in column `{time}` {how} the previous one, {previous}"
+                ),
                 "time stamps must strictly increase: sort the rows, and merge the rows of one \
                  stamp into one (an empty cell keeps a variable's value)",
             ));
@@ -283,7 +288,10 @@ impl<R: BufRead> TraceRows<'_, R> {
                     }
                     None
                 } else {
-                    Some(value(field, var).map_err(|(message, help)| csv(i, column, message, help))?)
+                    Some(
+                        value(field, var)
+                            .map_err(|(message, help)| csv(i, column, message, help))?,
+                    )
                 };
             }
             return Ok(Some(DenseRow { line: i, stamp, stamp_column }));
@@ -305,7 +313,9 @@ fn stamp(field: &str, time: &str) -> Result<Stamp, (String, String)> {
     let digits = field.strip_prefix(['-', '+']).unwrap_or(field);
     if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
         return match field.parse::<i128>() {
-            Ok(n) if (i128::from(i64::MIN)..=i128::from(u64::MAX)).contains(&n) => Ok(Stamp::Int(n)),
+            Ok(n) if (i128::from(i64::MIN)..=i128::from(u64::MAX)).contains(&n) => {
+                Ok(Stamp::Int(n))
+            }
             _ => Err((format!("the time stamp `{field}` in column `{time}` is too large"), help())),
         };
     }

@@ -159,7 +159,10 @@ const CASES: &[Case] = &[
         "monitor_dense_irregular",
         &["monitor", "dense.hstl", "--trace", "dense_irregular.csv", "--signal"],
     ),
-    case("monitor_dense_nanoseconds", &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--signal"]),
+    case(
+        "monitor_dense_nanoseconds",
+        &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--signal"],
+    ),
     Case {
         name: "monitor_dense_online",
         args: &["monitor", "dense.hstl", "--trace", "-", "--online", "--formula", "Soon"],

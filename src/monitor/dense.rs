@@ -114,8 +114,13 @@ impl Dense {
     pub fn problem(&self, e: DenseError) -> DenseProblem {
         use hstl_robustness::dense::DenseTraceError as T;
         let name = |i: usize| self.vars.get(i).cloned().unwrap_or_else(|| format!("column {i}"));
-        let plain =
-            |message: String| DenseProblem { message, help: None, row: None, var: None, time: None };
+        let plain = |message: String| DenseProblem {
+            message,
+            help: None,
+            row: None,
+            var: None,
+            time: None,
+        };
         match e {
             DenseError::Nan { time, atom } => DenseProblem {
                 message: format!("the comparison `{}` computes NaN", self.named(&atom)),
@@ -156,9 +161,11 @@ impl Dense {
                     message: format!(
                         "the time stamp {stamp} does not come after the previous one, {previous}"
                     ),
-                    help: Some("time stamps must strictly increase: sort the rows, or merge \
+                    help: Some(
+                        "time stamps must strictly increase: sort the rows, or merge \
                                 rows with the same stamp"
-                        .to_string()),
+                            .to_string(),
+                    ),
                     row: Some(row),
                     var: None,
                     time: None,
@@ -178,15 +185,17 @@ impl Dense {
         let bytes = text.as_bytes();
         let mut i = 0;
         while i < bytes.len() {
-            let word_start = i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+            let word_start =
+                i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
             if word_start && bytes[i] == b'v' {
                 let digits = bytes[i + 1..].iter().take_while(|b| b.is_ascii_digit()).count();
                 let end = i + 1 + digits;
-                let word_end =
-                    end >= bytes.len() || !(bytes[end].is_ascii_alphanumeric() || bytes[end] == b'_');
+                let word_end = end >= bytes.len()
+                    || !(bytes[end].is_ascii_alphanumeric() || bytes[end] == b'_');
                 if digits > 0
                     && word_end
-                    && let Some(name) = text[i + 1..end].parse::<usize>().ok().and_then(|k| self.vars.get(k))
+                    && let Some(name) =
+                        text[i + 1..end].parse::<usize>().ok().and_then(|k| self.vars.get(k))
                 {
                     out.push_str(name);
                     i = end;

@@ -826,7 +826,9 @@ fn is_dense(spec: &syntax::Spec) -> bool {
 fn dense_window_words(iv: Option<&Interval>, past: bool) -> String {
     let (a, end, inclusive) = match iv {
         None => ("0", None, true),
-        Some(iv) => (iv.start.text.as_str(), iv.end.as_ref().map(|e| e.text.as_str()), iv.inclusive),
+        Some(iv) => {
+            (iv.start.text.as_str(), iv.end.as_ref().map(|e| e.text.as_str()), iv.inclusive)
+        }
     };
     let written = iv.map_or("No interval, so `[0..]`".to_string(), |_| match end {
         Some(b) if inclusive => format!("Interval `[{a}..={b}]`"),
