@@ -7,6 +7,10 @@
 //! header name are removed. Lines end at `\n`, `\r\n` or a lone `\r`; blank lines are
 //! skipped; a byte order mark before the header is dropped.
 //!
+//! A dense-time spec's trace ([`TraceRows::next_dense_row`]) has the time column first: each
+//! row's stamp (whole numbers read as integers, others as doubles, see [`StampOrder`]), and
+//! an empty cell of another column is no new sample.
+//!
 //! Limits, checked while reading: a file holds at most [`MAX_TRACE_BYTES`], a line at most
 //! [`MAX_LINE_BYTES`], the trace at most [`MAX_TRACE_VALUES`] values. The reader keeps one
 //! line and the trace's columns in memory, never the file.
