@@ -25,6 +25,14 @@ pub enum LowerError {
         /// The spec's name.
         spec: String,
     },
+    /// A dense-time spec (one with a `time` variable) asked for a discrete-time monitor,
+    /// or a discrete-time spec for a dense-time one.
+    TimeModel {
+        /// The spec's name.
+        spec: String,
+        /// Whether the spec is the dense-time one.
+        dense: bool,
+    },
     /// The spec has no `let` of this name.
     UnknownLet {
         /// The spec's name.
@@ -42,6 +50,16 @@ impl fmt::Display for LowerError {
             LowerError::Invalid { spec } => {
                 write!(f, "spec `{spec}` has errors; run `hstlc check` to see them")
             }
+            LowerError::TimeModel { spec, dense: true } => write!(
+                f,
+                "spec `{spec}` is a dense-time spec (it has a `time` variable): monitor it over \
+                 time stamps, not steps"
+            ),
+            LowerError::TimeModel { spec, dense: false } => write!(
+                f,
+                "spec `{spec}` is a discrete-time spec (it has no `time` variable): its \
+                 intervals count steps"
+            ),
             LowerError::UnknownLet { spec, name, known } if known.is_empty() => {
                 write!(f, "spec `{spec}` has no `let` named `{name}` (it has no lets)")
             }

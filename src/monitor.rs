@@ -6,7 +6,8 @@
 //! data is copied once into columns. A trace must have at least one sample, the same
 //! number for every state variable, and no NaN (NaN has no robustness meaning); `inf` and
 //! `-inf` are allowed. [`Monitor::signal_batch`] scores many traces on several threads;
-//! [`Online`] takes one state at a time.
+//! [`Online`] takes one state at a time. A dense-time spec (one with a `time` variable) is
+//! monitored by [`Dense`] instead, over time-stamped samples.
 
 use std::fmt;
 use std::sync::{Mutex, PoisonError};
@@ -16,6 +17,9 @@ use hstl_robustness::nan::NanCheck;
 use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
 
 use crate::lower::{self, LowerError};
+
+mod dense;
+pub use dense::{Dense, DenseProblem, time_text};
 
 /// The most threads [`Monitor::signal_batch`] starts, whatever it is asked for.
 pub const MAX_BATCH_THREADS: usize = 64;
@@ -195,6 +199,9 @@ pub struct Online {
 impl Monitor {
     /// The task of `spec` (`formula = None`) or the `let` called `formula`.
     pub fn new(spec: &CheckedSpec, formula: Option<&str>) -> Result<Monitor, LowerError> {
+        if spec.is_dense() {
+            return Err(LowerError::TimeModel { spec: spec.name.clone(), dense: true });
+        }
         let formula = match formula {
             None => lower::task(spec)?,
             Some(name) => lower::let_formula(spec, name)?,

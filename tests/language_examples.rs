@@ -127,3 +127,37 @@ fn every_example_spec_checks() {
     }
     assert!(n >= 5, "only {n} example specs");
 }
+
+/// The dense-time example checks, and its robustness is what the README prints.
+#[test]
+fn the_dense_example_gives_the_readme_numbers() {
+    let dir = root().join("examples/dense");
+    let src = std::fs::read_to_string(dir.join("braking.hstl")).expect("braking.hstl");
+    assert_checks("examples/dense/braking.hstl", &src, &dir);
+    let checked = hstl::lang::check(&src);
+    let monitor = hstl::monitor::Dense::new(&checked.specs[0], None).expect("a dense monitor");
+    let csv = std::fs::read_to_string(dir.join("braking.csv")).expect("braking.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    assert_eq!(header[0], monitor.time_var());
+    let mut b = hstl::robustness::dense::DenseTraceBuilder::new(monitor.state_vars().len());
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let values: Vec<Option<f64>> = monitor
+            .state_vars()
+            .iter()
+            .map(|v| {
+                let k = header.iter().position(|h| h == v).expect("a column");
+                (!cells[k].is_empty()).then(|| cells[k].parse().expect("a number"))
+            })
+            .collect();
+        b.push(cells[0].parse().expect("a stamp"), &values).expect("a row");
+    }
+    let trace = b.build().expect("a trace");
+    let signal = monitor.signal(&trace).expect("a signal");
+    let rows: Vec<String> = signal.until(trace.t_last()).map(|(t, v)| format!("{t},{v}")).collect();
+    let readme = std::fs::read_to_string(root().join("README.md")).expect("README.md");
+    let printed = format!("t,robustness\n{}\n", rows.join("\n"));
+    assert!(readme.contains(&printed), "README.md does not show:\n{printed}");
+    assert_eq!(signal.first().to_string(), "-0.09999999999999998");
+}

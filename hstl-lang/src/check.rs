@@ -149,6 +149,8 @@ pub(crate) fn check_parsed_in<'w>(
             let_refs: Vec::new(),
             broken_names: spec.broken.iter().flat_map(|b| b.names.iter().cloned()).collect(),
             suggest_budget,
+            dense: false,
+            time_decimals: 0,
         };
         let checked = cx.spec(spec);
         suggest_budget = cx.suggest_budget;
@@ -167,6 +169,8 @@ pub(crate) fn check_parsed_in<'w>(
 enum NameRef {
     Var(usize),
     Let(usize),
+    /// The time variable of a dense-time spec: no formula may read it.
+    Time,
 }
 
 /// Per-spec checking state.
@@ -187,6 +191,10 @@ struct Cx<'s> {
     broken_names: std::collections::HashSet<String>,
     /// What is left of the file's [`SUGGEST_BUDGET`].
     suggest_budget: u64,
+    /// The spec declares a time variable: a dense-time spec.
+    dense: bool,
+    /// The decimals of the dense spec's bounds (see [`CheckedSpec::time_decimals`]).
+    time_decimals: u32,
 }
 
 fn doc_text(d: &Option<syntax::Doc>) -> Option<String> {
@@ -329,7 +337,17 @@ impl Cx<'_> {
             learn: LearnParams::default(),
             preset_expansion: None,
             world: None,
+            time: None,
+            time_decimals: 0,
         };
+        self.dense = spec.items.iter().any(|i| match i {
+            Item::State(b) => b.vars.iter().any(|v| v.ty == syntax::VarType::Time),
+            _ => false,
+        });
+        if self.dense {
+            self.time_decimals = time_decimals(spec);
+            out.time_decimals = self.time_decimals;
+        }
         // Once-only items.
         let mut firsts: HashMap<&'static str, Range<usize>> = HashMap::new();
         let mut lets = Vec::new();
@@ -362,6 +380,42 @@ impl Cx<'_> {
                     continue;
                 }
                 firsts.insert(kw, kw_range);
+            }
+            if self.dense
+                && let Some(what) = match item {
+                    Item::Option(_) => Some("an `option`"),
+                    Item::Options(_) => Some("an `options` item"),
+                    Item::Learn(_) => Some("a `learn` item"),
+                    Item::World(_) => Some("a `world`"),
+                    _ => None,
+                }
+            {
+                let r = item.range();
+                let kw = match item {
+                    Item::Option(o) => o.name.range.clone(),
+                    Item::Options(_) => r.start..(r.start + "options".len()).min(r.end),
+                    Item::Learn(_) => r.start..(r.start + "learn".len()).min(r.end),
+                    Item::World(w) => w.name_range.clone(),
+                    _ => r.clone(),
+                };
+                let d = Diagnostic::new(
+                    "HSTL083",
+                    kw,
+                    format!(
+                        "{what} in a dense-time spec: a spec with a time variable is for \
+                         monitoring time-stamped traces, not for learning"
+                    ),
+                )
+                .with_help(
+                    "remove it, or remove the time variable to learn in discrete steps \
+                     (the learner's world moves in steps)",
+                );
+                let d = match &out.time {
+                    Some(t) => d.with_label(t.name_range.clone(), "the time variable"),
+                    None => d,
+                };
+                self.push(d);
+                continue;
             }
             match item {
                 Item::State(b) => self.state_block(b, &mut out),
@@ -480,6 +534,10 @@ impl Cx<'_> {
 
     fn state_block(&mut self, b: &syntax::StateBlock, out: &mut CheckedSpec) {
         for v in &b.vars {
+            if v.ty == syntax::VarType::Time {
+                self.time_var(v, out);
+                continue;
+            }
             let domain = self.domain(v);
             if let Some((_, first)) = self.names.get(&v.name.name) {
                 let first = first.clone();
@@ -509,6 +567,74 @@ impl Cx<'_> {
         }
     }
 
+    /// `t: time`: the spec's time variable (at most one, without a range).
+    fn time_var(&mut self, v: &syntax::StateVar, out: &mut CheckedSpec) {
+        if let Some(r) = &v.domain {
+            self.push(
+                Diagnostic::new(
+                    "HSTL080",
+                    r.range.clone(),
+                    format!("the time variable `{}` has a range", v.name.name),
+                )
+                .with_help(format!(
+                    "time stamps are any strictly increasing numbers: write `{}: time`",
+                    v.name.name
+                )),
+            );
+        }
+        if let Some(first) = &out.time {
+            self.push(
+                Diagnostic::new(
+                    "HSTL080",
+                    v.ty_range.clone(),
+                    format!("a second time variable `{}`", v.name.name),
+                )
+                .with_label(first.name_range.clone(), "the time variable")
+                .with_help(format!(
+                    "a trace has one time column: make `{}` a `float`, or remove it",
+                    v.name.name
+                )),
+            );
+            return;
+        }
+        if let Some((_, first)) = self.names.get(&v.name.name) {
+            let first = first.clone();
+            self.push(
+                Diagnostic::new(
+                    "HSTL003",
+                    v.name.range.clone(),
+                    format!("duplicate name `{}`", v.name.name),
+                )
+                .with_label(first, "first defined here")
+                .with_help("rename one of them"),
+            );
+            return;
+        }
+        self.names.insert(v.name.name.clone(), (NameRef::Time, v.name.range.clone()));
+        out.time = Some(TimeVarInfo {
+            name: v.name.name.clone(),
+            doc: doc_text(&v.doc),
+            name_range: v.name.range.clone(),
+            range: v.range.clone(),
+        });
+    }
+
+    /// The time variable used in a formula or an expression.
+    fn time_in_formula(&mut self, id: &syntax::Ident, def: Range<usize>) {
+        self.push(
+            Diagnostic::new(
+                "HSTL082",
+                id.range.clone(),
+                format!("`{}` is the time variable: a formula cannot read it", id.name),
+            )
+            .with_label(def, "declared as the time stamps here")
+            .with_help(
+                "robustness is a function of time, not of the stamps' values: say when with an \
+                 interval, such as `eventually[0..=2.5] x > 1`",
+            ),
+        );
+    }
+
     fn domain(&mut self, v: &syntax::StateVar) -> Domain {
         let Some(r) = &v.domain else { return Domain::Unbounded };
         match v.ty {
@@ -528,6 +654,7 @@ impl Cx<'_> {
                 }
                 Domain::Float { lo: r.lo.value, hi: r.hi.value, inclusive: r.inclusive }
             }
+            syntax::VarType::Time => Domain::Unbounded,
             syntax::VarType::Int => {
                 let lo = self.int_bound(&r.lo, "range");
                 let hi = self.int_bound(&r.hi, "range");
@@ -582,9 +709,14 @@ impl Cx<'_> {
                 } else {
                     format!("{what} bound `{}` is not a whole number", n.text)
                 };
-                self.push(Diagnostic::new("HSTL006", n.range.clone(), msg).with_help(
-                    "bounds count steps or integer values: write digits only, such as `40`",
-                ));
+                let help = if what == "interval" && !whole {
+                    "interval bounds count steps: write digits only, such as `40`; for bounds \
+                     in seconds (`[0..=2.5]`), monitor time-stamped traces: declare the time \
+                     column in `state`, such as `t: time`"
+                } else {
+                    "bounds count steps or integer values: write digits only, such as `40`"
+                };
+                self.push(Diagnostic::new("HSTL006", n.range.clone(), msg).with_help(help));
                 None
             }
         }
@@ -732,10 +864,37 @@ impl Cx<'_> {
         out.let_order = dependency_order(&edges, &placed);
     }
 
+    /// A bound of a dense spec's interval, in `10^-time_decimals` of the time unit.
+    fn time_bound(&mut self, n: &syntax::NumberLit) -> Option<u64> {
+        let scaled = decimal(&n.text).and_then(|(m, d)| {
+            let p = 10u128.checked_pow(self.time_decimals.checked_sub(d)?)?;
+            u64::try_from(m.checked_mul(p)?).ok().filter(|&v| v <= MAX_TIME_BOUND)
+        });
+        if scaled.is_none() {
+            self.push(
+                Diagnostic::new(
+                    "HSTL006",
+                    n.range.clone(),
+                    format!("interval bound `{}` is too large or has too many digits", n.text),
+                )
+                .with_help(format!(
+                    "the spec's bounds are counted in units of 10^-{} (its longest fraction): \
+                     write at most {} digits in all",
+                    self.time_decimals,
+                    MAX_TIME_BOUND.to_string().len() - 1
+                )),
+            );
+        }
+        scaled
+    }
+
     fn interval(&mut self, i: &Option<syntax::Interval>) -> Option<Interval> {
         let Some(i) = i else {
             return Some(Interval { start: 0, end: Bound::Unbounded, range: None });
         };
+        if self.dense {
+            return self.dense_interval(i);
+        }
         let a = self.int_bound(&i.start, "interval");
         let b = match &i.end {
             Some(e) => Some(self.int_bound(e, "interval")?),
@@ -767,6 +926,64 @@ impl Cx<'_> {
         Some(Interval { start: a as u64, end, range: Some(i.range.clone()) })
     }
 
+    /// An interval of a dense-time spec: decimal bounds, closed or unbounded.
+    fn dense_interval(&mut self, i: &syntax::Interval) -> Option<Interval> {
+        let a = self.time_bound(&i.start);
+        let b = match &i.end {
+            Some(e) => Some(self.time_bound(e)?),
+            None => None,
+        };
+        let a = a?;
+        let text = self.text(&i.range).to_string();
+        let end = match b {
+            None => Bound::Unbounded,
+            Some(_) if !i.inclusive => {
+                let lo = &i.start.text;
+                let hi = i.end.as_ref().map_or("", |e| e.text.as_str());
+                self.push(
+                    Diagnostic::new(
+                        "HSTL081",
+                        i.range.clone(),
+                        format!("the half-open interval `{text}` has no dense-time meaning"),
+                    )
+                    .with_help(format!(
+                        "it would give values that hold at single instants: write the closed \
+                         interval `[{lo}..={hi}]`"
+                    )),
+                );
+                return None;
+            }
+            Some(b) if b < a => {
+                self.push(
+                    Diagnostic::new(
+                        "HSTL005",
+                        i.range.clone(),
+                        format!("inverted interval `{text}`"),
+                    )
+                    .with_help("swap the bounds"),
+                );
+                return None;
+            }
+            Some(b) => Bound::Inclusive(b),
+        };
+        Some(Interval { start: a, end, range: Some(i.range.clone()) })
+    }
+
+    /// `prev` or `next` in a dense-time spec.
+    fn no_dense_step(&mut self, f: &Formula, op: &str) {
+        let at = f.range.start..(f.range.start + op.len()).min(f.range.end);
+        self.push(
+            Diagnostic::new("HSTL081", at, format!("`{op}` has no dense-time meaning")).with_help(
+                format!(
+                    "in continuous time there is no {} sample: say how far with an interval, such \
+                 as `{}[0..=0.1] f`",
+                    if op == "prev" { "previous" } else { "next" },
+                    if op == "prev" { "once" } else { "eventually" }
+                ),
+            ),
+        );
+    }
+
     fn formula(&mut self, f: &Formula) -> CFormula {
         let range = f.range.clone();
         let invalid = CFormula { kind: CFormulaKind::Invalid, range: range.clone() };
@@ -779,6 +996,11 @@ impl Cx<'_> {
                     let j = *j;
                     self.let_refs.push((j, id.range.clone()));
                     CFormulaKind::Let(j)
+                }
+                Some((NameRef::Time, def)) => {
+                    let def = def.clone();
+                    self.time_in_formula(id, def);
+                    return invalid;
                 }
                 Some((NameRef::Var(_), def)) => {
                     let def = def.clone();
@@ -899,6 +1121,16 @@ impl Cx<'_> {
                     None => return invalid,
                 }
             }
+            FormulaKind::Prev(g) if self.dense => {
+                self.no_dense_step(f, "prev");
+                self.formula(g);
+                return invalid;
+            }
+            FormulaKind::Next(g) if self.dense => {
+                self.no_dense_step(f, "next");
+                self.formula(g);
+                return invalid;
+            }
             FormulaKind::Prev(g) => CFormulaKind::Prev(Box::new(self.formula(g))),
             FormulaKind::Next(g) => CFormulaKind::Next(Box::new(self.formula(g))),
             FormulaKind::And(v) => CFormulaKind::And(v.iter().map(|g| self.formula(g)).collect()),
@@ -941,6 +1173,11 @@ impl Cx<'_> {
             K::Paren(a) => return self.expr(a),
             K::Name(id) => match self.names.get(&id.name) {
                 Some((NameRef::Var(i), _)) => CExprKind::Var(*i),
+                Some((NameRef::Time, def)) => {
+                    let def = def.clone();
+                    self.time_in_formula(id, def);
+                    return invalid;
+                }
                 Some((NameRef::Let(_), def)) => {
                     let def = def.clone();
                     self.push(
@@ -1116,7 +1353,7 @@ impl Cx<'_> {
                 None => {
                     let kind = match self.names.get(&o.name.name) {
                         Some((NameRef::Let(j), _)) => CFormulaKind::Let(*j),
-                        Some((NameRef::Var(_), def)) => {
+                        Some((NameRef::Var(_) | NameRef::Time, def)) => {
                             let def = def.clone();
                             self.push(
                                 Diagnostic::new(
@@ -1198,7 +1435,9 @@ impl Cx<'_> {
                 if v.domain == Domain::Unbounded {
                     let (ty, example) = match v.ty {
                         syntax::VarType::Int => ("int", "int in 0..=N"),
-                        syntax::VarType::Float => ("float", "float in LO..=HI"),
+                        syntax::VarType::Float | syntax::VarType::Time => {
+                            ("float", "float in LO..=HI")
+                        }
                     };
                     self.push(
                         Diagnostic::new(
@@ -2210,6 +2449,87 @@ impl Cx<'_> {
 }
 
 /// `1234567` as `1,234,567`.
+/// The largest interval bound of a dense-time spec once scaled by its decimals: 10^18,
+/// so that a bound and a sum of two stay far inside `u64` and `usize`.
+pub const MAX_TIME_BOUND: u64 = 1_000_000_000_000_000_000;
+
+/// A decimal as written (`2.5`, `10`, `1e-3`): its digits as a whole number and its
+/// number of decimals (`(25, 1)`), trailing zeros dropped. `None` for anything else.
+fn decimal(text: &str) -> Option<(u128, u32)> {
+    let (mantissa, exp) = match text.find(['e', 'E']) {
+        Some(k) => (&text[..k], text[k + 1..].parse::<i32>().ok()?),
+        None => (text, 0),
+    };
+    let (int, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+    if int.is_empty() || !int.bytes().chain(frac.bytes()).all(|c| c.is_ascii_digit()) {
+        return None;
+    }
+    let frac = frac.trim_end_matches('0');
+    let digits = format!("{int}{frac}");
+    let digits = digits.trim_start_matches('0');
+    if digits.len() > 38 {
+        return None;
+    }
+    let mut n: u128 = if digits.is_empty() { 0 } else { digits.parse().ok()? };
+    let mut decimals = i64::try_from(frac.len()).ok()? - i64::from(exp);
+    while decimals < 0 {
+        n = n.checked_mul(10)?;
+        decimals += 1;
+    }
+    while decimals > 0 && n.is_multiple_of(10) && n != 0 {
+        n /= 10;
+        decimals -= 1;
+    }
+    if n == 0 {
+        decimals = 0;
+    }
+    Some((n, u32::try_from(decimals).ok()?))
+}
+
+/// The most decimals any interval bound of the spec is written with (at most 18: more
+/// are reported as too many digits).
+fn time_decimals(spec: &syntax::Spec) -> u32 {
+    let mut most = 0;
+    let mut stack: Vec<&Formula> = Vec::new();
+    for item in &spec.items {
+        match item {
+            Item::Let(l) => stack.push(&l.formula),
+            Item::Task(t) => stack.push(&t.formula),
+            _ => {}
+        }
+    }
+    while let Some(f) = stack.pop() {
+        let (interval, kids): (Option<&syntax::Interval>, Vec<&Formula>) = match &f.kind {
+            FormulaKind::Always(i, g)
+            | FormulaKind::Eventually(i, g)
+            | FormulaKind::Once(i, g)
+            | FormulaKind::Historically(i, g) => (i.as_ref(), vec![g]),
+            FormulaKind::Until(a, i, b) | FormulaKind::Since(a, i, b) => (i.as_ref(), vec![a, b]),
+            FormulaKind::Not(g)
+            | FormulaKind::Paren(g)
+            | FormulaKind::Prev(g)
+            | FormulaKind::Next(g) => (None, vec![g]),
+            FormulaKind::Implies(a, b) => (None, vec![a, b]),
+            FormulaKind::And(v) | FormulaKind::Or(v) => (None, v.iter().collect()),
+            FormulaKind::True
+            | FormulaKind::False
+            | FormulaKind::Name(_)
+            | FormulaKind::Compare { .. } => (None, Vec::new()),
+        };
+        if let Some(i) = interval {
+            for n in std::iter::once(&i.start).chain(&i.end) {
+                if let Some((_, d)) = decimal(&n.text)
+                    && d <= 18
+                {
+                    most = most.max(d);
+                }
+            }
+        }
+        stack.extend(kids);
+    }
+    most
+}
+
 pub(crate) fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();

@@ -443,6 +443,28 @@ pub struct CheckedSpec {
     pub preset_expansion: Option<String>,
     /// The world the spec names with `world "...";`, if any.
     pub world: Option<WorldRef>,
+    /// The time variable (`t: time`), which makes the spec a dense-time spec; `None` for a
+    /// discrete-time spec. It is not one of [`CheckedSpec::state_vars`]: its trace column
+    /// holds the time stamps, and no formula reads it.
+    pub time: Option<TimeVarInfo>,
+    /// How the intervals' bounds read as times in a dense-time spec: every bound of
+    /// [`Interval`] counts `10^-time_decimals` of the time column's unit (with one decimal,
+    /// `[0..=2.5]` is stored as `[0..=25]`). The largest number of decimals any bound is
+    /// written with; always 0 in a discrete-time spec.
+    pub time_decimals: u32,
+}
+
+/// The time variable of a dense-time spec (`t: time`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeVarInfo {
+    /// Name: the trace column that holds the time stamps.
+    pub name: String,
+    /// Doc comment text.
+    pub doc: Option<String>,
+    /// Byte range of the name.
+    pub name_range: Range<usize>,
+    /// Byte range of the declaration.
+    pub range: Range<usize>,
 }
 
 /// The world a spec names: `world "four-rooms";` or `world "maps/yard.toml";`.
@@ -468,6 +490,25 @@ pub struct PersistentConjunct {
 }
 
 impl CheckedSpec {
+    /// Whether the spec is a dense-time spec: it declares a time variable (`t: time`), its
+    /// traces are time-stamped and its intervals are in the time column's unit.
+    pub fn is_dense(&self) -> bool {
+        self.time.is_some()
+    }
+
+    /// The time an interval bound stands for in a dense-time spec, as written (`25` with
+    /// one decimal is `"2.5"`); the bound itself in a discrete-time spec.
+    pub fn bound_text(&self, n: u64) -> String {
+        let d = self.time_decimals as usize;
+        if d == 0 {
+            return n.to_string();
+        }
+        let digits = format!("{n:0>width$}", width = d + 1);
+        let (int, frac) = digits.split_at(digits.len() - d);
+        let frac = frac.trim_end_matches('0');
+        if frac.is_empty() { int.to_string() } else { format!("{int}.{frac}") }
+    }
+
     /// The spec's tile coding over its domain box: `bins` tiles along every variable when
     /// given; else one tile per value of an `int` variable (at most 64) and
     /// [`DEFAULT_BINS`] along a `float` one (training narrows that to the world's step).

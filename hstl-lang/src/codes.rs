@@ -96,7 +96,10 @@ Fix: swap the bounds, or use `..=` to include the upper one (`[3..=3]` is the si
         explanation: "Time is discrete: interval bounds count steps. `int` ranges hold \
 integers. Bounds must be written as plain digits.\n\n\
 Example:\n    task eventually[0..2.5] A;\n    state { x: int in 0..=1e3 }\n\n\
-Fix: write an integer, such as `[0..3]` or `0..=1000`.",
+Fix: write an integer, such as `[0..3]` or `0..=1000`. Decimal bounds such as `[0..=2.5]` \
+belong to dense-time specs, which monitor time-stamped traces: declare the time column in \
+`state` (`t: time`). In a dense-time spec this code reports a bound with more digits than \
+fit (at most 18 in all, counted at the spec's longest fraction).",
     },
     CodeInfo {
         code: "HSTL007",
@@ -456,6 +459,59 @@ Example:\n    task always[0..] eventually[0..40] A;\n    options sequences(A, B)
 learn { memory: 8, reward: window, plan: model }\n\n\
 Fix: write `option A;` per region and `learn { preset: auto }`, which sets `plan: model` on \
 a persistent task or a reach task, or remove `plan: model`.",
+    },
+    CodeInfo {
+        code: "HSTL080",
+        name: "time-variable-declaration",
+        severity: E,
+        summary: "a second time variable, or a time variable with a range",
+        explanation: "A state variable of type `time` names the trace column that holds the \
+time stamps, which makes the spec a dense-time spec (see \"Dense time\" in LANGUAGE.md). A \
+trace has one time column, so a spec has at most one time variable, and stamps are any \
+strictly increasing numbers, so it takes no range.\n\n\
+Example:\n    state { t: time, stamp: time, x: float }\n    state { t: time in 0..=10 }\n\n\
+Fix: keep one time variable, declared `t: time`; a second clock is a `float` variable.",
+    },
+    CodeInfo {
+        code: "HSTL081",
+        name: "no-dense-meaning",
+        severity: E,
+        summary: "`prev`, `next` or a half-open interval in a dense-time spec",
+        explanation: "In a dense-time spec (one with a `time` variable) robustness is a \
+function of continuous time. `prev` and `next` step to the previous or next sample, which \
+continuous time does not have. A half-open interval `[a..b]` gives values that hold at \
+single instants (`eventually[0..1]` of a step up at 1 differs at one instant alone), which \
+the `t,robustness` change points cannot show. rtamt's dense-time STL has neither.\n\n\
+Example:\n    state { t: time, x: float }\n    task eventually[0..2] prev x > 1;\n\n\
+Fix: write closed intervals, `[0..=2]`; for `prev f` or `next f`, say how far back or ahead \
+with an interval, such as `once[0..=0.1] f` or `eventually[0..=0.1] f`.",
+    },
+    CodeInfo {
+        code: "HSTL082",
+        name: "time-variable-in-formula",
+        severity: E,
+        summary: "a formula reads the time variable",
+        explanation: "The time variable holds the trace's time stamps: it says when every \
+other variable takes its values, and is not a signal itself. Robustness is a function of \
+time, and the intervals of the temporal operators say when something must hold, relative to \
+now; a comparison such as `t > 5` would depend on where the log's clock started (a ROS 2 \
+bag counts nanoseconds since 1970).\n\n\
+Example:\n    state { t: time, x: float }\n    task eventually (t > 5 && x > 1);\n\n\
+Fix: say when with an interval: `eventually[5..] x > 1` (x exceeds 1 at some time at least \
+5 after the first stamp).",
+    },
+    CodeInfo {
+        code: "HSTL083",
+        name: "learning-in-dense-spec",
+        severity: E,
+        summary: "an `option`, `options`, `learn` or `world` item in a dense-time spec",
+        explanation: "A spec with a time variable monitors time-stamped traces (`hstlc \
+monitor`); the learner moves in discrete steps on a world, so options, the options set, \
+learning parameters and a world have no meaning in it.\n\n\
+Example:\n    state { t: time, x: float }\n    let Goal = x > 1;\n    \
+task eventually[0..=2.5] Goal;\n    option Goal;\n\n\
+Fix: remove those items from the dense spec (keep the learning in a discrete-time spec of \
+its own), or remove the time variable to learn in steps.",
     },
     CodeInfo {
         code: "HSTL101",

@@ -816,7 +816,7 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         Rule::interval => "an interval such as `[0..40]`",
         Rule::incl_op | Rule::excl_op | Rule::range_op => "`..` or `..=`",
         Rule::var => "a state variable",
-        Rule::var_type => "`int` or `float`",
+        Rule::var_type => "`int`, `float` or `time`",
         Rule::range_lit => "a range such as `0..=14`",
         Rule::field => "an option field (`reach`, `init` or `terminate`)",
         Rule::field_value => "a formula or `argmax`",
@@ -845,6 +845,7 @@ fn rule_words(r: Rule) -> Option<&'static str> {
         Rule::k_state => "`state`",
         Rule::k_int => "`int`",
         Rule::k_float => "`float`",
+        Rule::k_time => "`time`",
         Rule::k_in => "`in`",
         Rule::k_let => "`let`",
         Rule::k_task => "`task`",
@@ -1155,7 +1156,11 @@ impl Builder<'_> {
                 Rule::ident => name = ident(&c, self.offset),
                 Rule::var_type => {
                     ty_range = self.range(&c);
-                    ty = if c.as_str() == "int" { VarType::Int } else { VarType::Float };
+                    ty = match c.as_str() {
+                        "int" => VarType::Int,
+                        "time" => VarType::Time,
+                        _ => VarType::Float,
+                    };
                 }
                 Rule::range_lit => {
                     let r = self.range(&c);

@@ -168,6 +168,8 @@ pub enum VarType {
     Int,
     /// `float`.
     Float,
+    /// `time`: the trace's time stamps, which make the spec a dense-time spec.
+    Time,
 }
 
 /// `name: int in 0..=14`.

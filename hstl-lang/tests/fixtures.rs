@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use hstl_lang::{
-    CFormula, CFormulaKind, Checked, CheckedSpec, Domain, SpecWorld, Terminate, WorldFacts,
+    Bound, CFormula, CFormulaKind, Checked, CheckedSpec, Domain, SpecWorld, Terminate, WorldFacts,
     WorldProblem, codes, render_plain,
 };
 
@@ -246,6 +246,41 @@ fn summarise(out: &mut String, spec: &CheckedSpec, src: &str) {
             }
         };
         let _ = writeln!(out, "  var {}: {:?} in {dom} (doc: {:?})", v.name, v.ty, v.doc);
+    }
+    if let Some(t) = &spec.time {
+        let mut bounds = Vec::new();
+        let mut stack: Vec<&CFormula> = spec.lets.iter().map(|l| &l.formula).collect();
+        stack.extend(spec.task.as_ref().map(|t| &t.formula));
+        while let Some(f) = stack.pop() {
+            if let CFormulaKind::Always(i, _)
+            | CFormulaKind::Eventually(i, _)
+            | CFormulaKind::Once(i, _)
+            | CFormulaKind::Historically(i, _)
+            | CFormulaKind::Until(i, ..)
+            | CFormulaKind::Since(i, ..) = &f.kind
+            {
+                let end = match i.end {
+                    Bound::Unbounded => String::new(),
+                    Bound::Inclusive(b) => format!("={}", spec.bound_text(b)),
+                    Bound::Exclusive(b) => spec.bound_text(b),
+                };
+                bounds.push(format!(
+                    "[{}..{end}] ({:?}..{:?})",
+                    spec.bound_text(i.start),
+                    i.start,
+                    i.end
+                ));
+            }
+            stack.extend(f.operands());
+        }
+        let _ = writeln!(
+            out,
+            "  dense time: `{}` (doc: {:?}), {} decimals; intervals {}",
+            t.name,
+            t.doc,
+            spec.time_decimals,
+            bounds.join(" ")
+        );
     }
     for l in &spec.lets {
         let _ = writeln!(

@@ -258,3 +258,39 @@ fn locations_and_the_concise_format_count_characters() {
          checked 1 file: 1 error, 0 warnings\n"
     );
 }
+
+#[test]
+fn time_is_a_type_only_after_a_colon_and_makes_a_dense_spec() {
+    // `time` stays a valid name: a variable, a let, the time variable itself.
+    let src = "spec S { state { time: time, x: float } let tick = x > 1; \
+               task eventually[0..=2.5] tick && always[1e-1..=3] x < 9; }";
+    let checked = check(src);
+    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+    let spec = &checked.specs[0];
+    assert!(spec.is_dense());
+    assert_eq!(spec.time.as_ref().map(|t| t.name.as_str()), Some("time"));
+    assert_eq!(spec.state_vars.len(), 1, "the time variable is no state variable");
+    assert_eq!(spec.time_decimals, 1);
+    assert_eq!(spec.bound_text(25), "2.5");
+    assert_eq!(spec.bound_text(30), "3");
+    // A discrete spec: whole-number bounds, no time variable.
+    let discrete = check("spec D { state { time: int in 0..=9 } task eventually[0..3] time > 1; }");
+    assert!(!discrete.has_errors(), "{:?}", discrete.diagnostics);
+    assert!(!discrete.specs[0].is_dense());
+    assert_eq!(discrete.specs[0].time_decimals, 0);
+}
+
+#[test]
+fn dense_bounds_are_scaled_to_the_longest_fraction() {
+    let src = "spec S { state { t: time, x: float } \
+               task eventually[0.25..=1] always[2..] x > 0; }";
+    let checked = check(src);
+    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+    let spec = &checked.specs[0];
+    assert_eq!(spec.time_decimals, 2);
+    let Some(task) = &spec.task else { panic!("no task") };
+    let CFormulaKind::Eventually(i, inner) = &task.formula.kind else { panic!("{task:?}") };
+    assert_eq!((i.start, i.end), (25, hstl_lang::Bound::Inclusive(100)));
+    let CFormulaKind::Always(j, _) = &inner.kind else { panic!("{inner:?}") };
+    assert_eq!((j.start, j.end), (200, hstl_lang::Bound::Unbounded));
+}

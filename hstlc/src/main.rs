@@ -11,6 +11,7 @@ mod explain;
 mod fmt;
 use hstlc::input;
 mod monitor;
+mod monitor_dense;
 mod output;
 mod render;
 mod spec_file;

@@ -1,6 +1,7 @@
 //! `hstlc monitor`: the robustness of recorded traces, or of a stream as it arrives.
 //!
-//! One trace: the value at step 0, or `t,robustness` rows with `--signal`. Several traces
+//! One trace: the value at step 0, or `t,robustness` rows with `--signal`. A dense-time
+//! spec (one with a `time` variable) is monitored over time stamps (`monitor_dense`). Several traces
 //! (or a folder of `.csv` files): one `trace,robustness` row each, scored on every core.
 //! `--online`: one trace read row by row (a pipe), each step's row printed and flushed as
 //! soon as its value is final; the same rows as `--signal`.
@@ -34,14 +35,17 @@ pub struct MonitorArgs {
     #[arg(value_name = "SPEC")]
     pub spec: PathBuf,
     /// The trace: a CSV file whose header names the state variables (`-` reads standard
-    /// input). Give it more than once, or a folder (its `.csv` files), to score many
+    /// input); for a dense-time spec also its time variable, whose column holds each row's
+    /// time stamp (an empty cell of another column: no new sample). Give it more than once, or a folder (its `.csv` files), to score many
     /// traces: one `trace,robustness` row each.
     #[arg(long, value_name = "FILE.csv|DIR", required = true)]
     pub trace: Vec<PathBuf>,
     /// Score this `let` instead of the task.
     #[arg(long, value_name = "NAME")]
     pub formula: Option<String>,
-    /// Print `t,robustness` rows for every step instead of the value at step 0.
+    /// Print `t,robustness` rows for every step instead of the value at step 0 (for a
+    /// dense-time spec: at every change point of the signal, times in the time column's
+    /// scale).
     #[arg(long)]
     pub signal: bool,
     /// Read the trace as a stream (a pipe from a live system) and print each step's
@@ -108,12 +112,17 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
         return Ok(Status::Errors);
     };
     let (spec, name) = (&loaded.spec, &loaded.file);
+    if spec.is_dense() {
+        return crate::monitor_dense::run(args, spec, name, &traces);
+    }
     let monitor = Monitor::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {
             hstl::lower::LowerError::UnknownLet { .. } => {
                 Some("leave out `--formula` to score the task".to_string())
             }
-            hstl::lower::LowerError::Invalid { .. } => None,
+            hstl::lower::LowerError::Invalid { .. } | hstl::lower::LowerError::TimeModel { .. } => {
+                None
+            }
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
@@ -190,7 +199,7 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
 }
 
 /// The CSV columns the spec's state variables need.
-fn columns(spec: &CheckedSpec) -> Vec<Column<'_>> {
+pub(crate) fn columns(spec: &CheckedSpec) -> Vec<Column<'_>> {
     spec.state_vars
         .iter()
         .map(|v| Column {
@@ -205,7 +214,7 @@ fn columns(spec: &CheckedSpec) -> Vec<Column<'_>> {
 }
 
 /// Says once which columns of a trace the spec does not name.
-fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
+pub(crate) fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
     if ignored.is_empty() {
         return;
     }
@@ -219,7 +228,7 @@ fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
 }
 
 /// The name a trace path is reported by.
-fn trace_name(path: &Path) -> String {
+pub(crate) fn trace_name(path: &Path) -> String {
     if path == Path::new("-") { "<stdin>".to_string() } else { path.display().to_string() }
 }
 
@@ -310,7 +319,7 @@ fn trace_error(name: &str, read: &TraceRead, e: TraceError) -> CliError {
 }
 
 /// A reader's error, at the trace's `name:line:column`.
-fn read_error(name: &str, e: ReadError) -> CliError {
+pub(crate) fn read_error(name: &str, e: ReadError) -> CliError {
     match e {
         ReadError::Io(source) => CliError::Read { path: PathBuf::from(name), source },
         ReadError::Csv(e) => {

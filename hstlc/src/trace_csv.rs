@@ -7,6 +7,10 @@
 //! header name are removed. Lines end at `\n`, `\r\n` or a lone `\r`; blank lines are
 //! skipped; a byte order mark before the header is dropped.
 //!
+//! A dense-time spec's trace ([`TraceRows::next_dense_row`]) has the time column first: each
+//! row's stamp (whole numbers read as integers, others as doubles, see [`StampOrder`]), and
+//! an empty cell of another column is no new sample.
+//!
 //! Limits, checked while reading: a file holds at most [`MAX_TRACE_BYTES`], a line at most
 //! [`MAX_LINE_BYTES`], the trace at most [`MAX_TRACE_VALUES`] values. The reader keeps one
 //! line and the trace's columns in memory, never the file.
@@ -137,6 +141,195 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
     let trace =
         Trace::from_columns(columns).map_err(|e| csv(1, 1, e.to_string(), String::new()))?;
     Ok(TraceRead { trace, ignored, lines })
+}
+
+/// A row's time stamp, as written: whole numbers are read as integers (never rounded
+/// through a double), anything else as the nearest double.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stamp {
+    /// Digits, with an optional sign: nanoseconds since the epoch, say.
+    Int(i128),
+    /// A decimal number.
+    Real(f64),
+}
+
+/// One row of a dense-time trace: its line, its stamp (with the stamp's column) and one
+/// cell per variable, `None` where the cell is empty (no new sample).
+#[derive(Debug)]
+pub struct DenseRow {
+    /// The 1-based line.
+    pub line: usize,
+    /// The time stamp.
+    pub stamp: Stamp,
+    /// The 1-based column (in characters) of the stamp.
+    pub stamp_column: usize,
+}
+
+/// Reads a trace's stamps in one of two ways, decided by the first: a whole number of
+/// magnitude 2^53 or more (nanoseconds since the epoch, say) starts integer stamps, which
+/// must all be whole numbers and are taken relative to the first in integer arithmetic;
+/// any other first stamp starts double stamps, each the nearest double (a whole number that
+/// no double holds exactly is an error, never rounded). Stamps must strictly increase.
+#[derive(Clone, Debug, Default)]
+pub struct StampOrder {
+    last: Option<Stamp>,
+}
+
+/// 2^53: every whole number of smaller magnitude is a double.
+const EXACT: i128 = 1 << 53;
+
+impl StampOrder {
+    /// The next row's stamp as the trace takes it, or what is wrong with it.
+    pub fn next(&mut self, row: &DenseRow, time: &str) -> Result<Stamp, CsvError> {
+        let at =
+            |message: String, help: &str| csv(row.line, row.stamp_column, message, help.into());
+        let stamp = match (self.last, row.stamp) {
+            (None, Stamp::Int(n)) if n.abs() >= EXACT => Stamp::Int(n),
+            (Some(Stamp::Int(_)), Stamp::Int(n)) => Stamp::Int(n),
+            (Some(Stamp::Int(_)), Stamp::Real(_)) => {
+                return Err(at(
+                    format!(
+                        "the time stamp in column `{time}` is a decimal, but the trace's stamps \
+                         are whole numbers (its first is beyond 2^53)"
+                    ),
+                    "write every stamp as a whole number (such as nanoseconds since the epoch)",
+                ));
+            }
+            (_, Stamp::Int(n)) => {
+                let t = n as f64;
+                if t as i128 != n {
+                    return Err(at(
+                        format!(
+                            "the time stamp {n} in column `{time}` is not exactly a double, and \
+                             the trace's stamps are read as doubles (its first is below 2^53)"
+                        ),
+                        "stamps are taken relative to the first in integer arithmetic only when \
+                         the first is a whole number of 2^53 or more: write the stamps in \
+                         a unit that keeps them below 2^53, or all as such whole numbers",
+                    ));
+                }
+                Stamp::Real(t)
+            }
+            (_, Stamp::Real(t)) => Stamp::Real(t),
+        };
+        let order = match (self.last, stamp) {
+            (Some(Stamp::Int(p)), Stamp::Int(s)) if s <= p => Some((p.to_string(), s.to_string())),
+            (Some(Stamp::Real(p)), Stamp::Real(s)) if s <= p => {
+                Some((p.to_string(), s.to_string()))
+            }
+            _ => None,
+        };
+        if let Some((previous, now)) = order {
+            let how = if previous == now { "repeats" } else { "goes back from" };
+            return Err(at(
+                format!(
+                    "the time stamp {now} in column `{time}` {how} the previous one, {previous}"
+                ),
+                "time stamps must strictly increase: sort the rows, and merge the rows of one \
+                 stamp into one (an empty cell keeps a variable's value)",
+            ));
+        }
+        self.last = Some(stamp);
+        Ok(stamp)
+    }
+}
+
+impl<R: BufRead> TraceRows<'_, R> {
+    /// Reads the next row of a dense-time trace: `vars[0]` is the time column, and
+    /// `cells[i]` receives `vars[i + 1]`'s cell (`None` where it is empty). `None` at the
+    /// end of the input. Every cell of the first row must be filled.
+    pub fn next_dense_row(
+        &mut self,
+        cells: &mut [Option<f64>],
+        first: bool,
+    ) -> Result<Option<DenseRow>, ReadError> {
+        loop {
+            let Some((i, bytes)) = self.lines.next()? else { return Ok(None) };
+            let line = utf8(i, bytes)?;
+            if line.trim().is_empty() {
+                continue;
+            }
+            self.row.clear();
+            self.row.extend(field_ranges(line));
+            if self.row.len() != self.width {
+                let column = match self.row.get(self.width) {
+                    Some((column, _)) => *column,
+                    None => line.chars().count() + 1,
+                };
+                return Err(csv(
+                    i,
+                    column,
+                    format!(
+                        "this row has {}, the header has {}",
+                        fields_word(self.row.len()),
+                        self.width
+                    ),
+                    "every row needs one field per header column (an empty one keeps the \
+                     variable's value)"
+                        .to_string(),
+                )
+                .into());
+            }
+            let (time_pick, time) = (self.picks[0], self.vars[0].name);
+            let (stamp_column, field) =
+                (self.row[time_pick].0, &line[self.row[time_pick].1.clone()]);
+            let stamp = stamp(field, time).map_err(|(m, h)| csv(i, stamp_column, m, h))?;
+            for ((out, &pick), var) in cells.iter_mut().zip(&self.picks[1..]).zip(&self.vars[1..]) {
+                let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
+                *out = if field.is_empty() {
+                    if first {
+                        return Err(csv(
+                            i,
+                            column,
+                            format!("`{}` is empty in the first row", var.name),
+                            format!(
+                                "every variable needs a value at the first time stamp (no \
+                                 value exists before it): give `{}` one",
+                                var.name
+                            ),
+                        )
+                        .into());
+                    }
+                    None
+                } else {
+                    Some(
+                        value(field, var)
+                            .map_err(|(message, help)| csv(i, column, message, help))?,
+                    )
+                };
+            }
+            return Ok(Some(DenseRow { line: i, stamp, stamp_column }));
+        }
+    }
+}
+
+/// A time stamp: digits (with a sign) as an integer, any other number as a double.
+fn stamp(field: &str, time: &str) -> Result<Stamp, (String, String)> {
+    let help = || {
+        format!(
+            "`{time}` is the time variable: write each row's stamp as a finite number, such as \
+             `0.02` or `1700000000123456789`"
+        )
+    };
+    if field.is_empty() {
+        return Err((format!("the time stamp in column `{time}` is empty"), help()));
+    }
+    let digits = field.strip_prefix(['-', '+']).unwrap_or(field);
+    if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+        return match field.parse::<i128>() {
+            Ok(n) if (i128::from(i64::MIN)..=i128::from(u64::MAX)).contains(&n) => {
+                Ok(Stamp::Int(n))
+            }
+            _ => Err((format!("the time stamp `{field}` in column `{time}` is too large"), help())),
+        };
+    }
+    match field.parse::<f64>() {
+        Ok(t) if t.is_finite() => Ok(Stamp::Real(t)),
+        _ => Err((
+            format!("the time stamp `{field}` in column `{time}` is not a finite number"),
+            help(),
+        )),
+    }
 }
 
 /// How much of a stream the reader takes.

@@ -148,6 +148,45 @@ const CASES: &[Case] = &[
         "monitor_online_batch",
         &["monitor", "surveillance.hstl", "--trace", "traces", "--online"],
     ),
+    // dense time: a `time` variable; stamps, empty cells, change points
+    case("monitor_dense_task", &["monitor", "dense.hstl", "--trace", "dense.csv"]),
+    case("monitor_dense_signal", &["monitor", "dense.hstl", "--trace", "dense.csv", "--signal"]),
+    case(
+        "monitor_dense_let_signal",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--formula", "Soon", "--signal"],
+    ),
+    case(
+        "monitor_dense_irregular",
+        &["monitor", "dense.hstl", "--trace", "dense_irregular.csv", "--signal"],
+    ),
+    case(
+        "monitor_dense_nanoseconds",
+        &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--signal"],
+    ),
+    Case {
+        name: "monitor_dense_online",
+        args: &["monitor", "dense.hstl", "--trace", "-", "--online", "--formula", "Soon"],
+        stdin: "t,x,y\n0,1,5\n1,2,\n1.5,,6\n2,3,\n3.5,0.5,\n4,,-1\n5,4,\n",
+    },
+    case(
+        "monitor_dense_batch",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--trace", "dense_irregular.csv"],
+    ),
+    case("monitor_dense_bad_stamp", &["monitor", "dense.hstl", "--trace", "dense_bad_stamp.csv"]),
+    case("monitor_dense_bad_cell", &["monitor", "dense.hstl", "--trace", "dense_bad_cell.csv"]),
+    case(
+        "monitor_dense_missing_column",
+        &["monitor", "dense.hstl", "--trace", "missing_column.csv"],
+    ),
+    case(
+        "monitor_dense_windows_complete",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--windows", "complete"],
+    ),
+    case(
+        "monitor_decimal_bound_discrete",
+        &["monitor", "dense_decimal_discrete.hstl", "--trace", "dense.csv"],
+    ),
+    case("explain_dense_code", &["explain", "HSTL082"]),
     // train and eval: the errors (successful runs are in tests/train_eval.rs)
     case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
     case("train_float_state", &["train", "float_state.hstl", "--out", "unused"]),
@@ -376,5 +415,52 @@ fn online_rows_are_the_signal() {
         let online = run(&[pick.as_slice(), &["--online"]].concat());
         assert_eq!(online, signal, "{formula:?}");
         assert_eq!(signal.lines().count(), 201);
+    }
+}
+
+/// A dense-time spec's `--online` rows are its `--signal` rows, on an irregular trace with
+/// empty cells, for bounded, unbounded, past and `until` formulas with decimal bounds.
+#[test]
+fn dense_online_rows_are_the_signal() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let spec = "spec S {
+        state { t: time, x: float, y: float }
+        let P = x > 0.5;
+        let Q = y < -0.2;
+        let W = always[0..=0.3] (eventually[0.2..=0.5] P || Q);
+        let U = P until[0.1..=0.4] Q;
+        let H = historically[0..=0.25] P || once[0.1..] Q;
+        let F = eventually (P && Q);
+        task always[0..=0.7] eventually[0..=0.6] (P && !Q);
+    }";
+    std::fs::write(dir.path().join("s.hstl"), spec).expect("write spec");
+    // Irregular stamps and empty cells, deterministic.
+    let mut csv = String::from("t,x,y\n");
+    let mut t = 0.0f64;
+    for k in 0..300u32 {
+        let kf = f64::from(k);
+        t += 0.01 + 0.04 * ((kf * 0.7).sin() + 1.0) / 2.0;
+        let x = if k % 3 == 1 { String::new() } else { format!("{}", (kf * 0.37).sin()) };
+        let y = if k % 4 == 2 { String::new() } else { format!("{}", (kf * 0.11).cos() * 0.6) };
+        let (x, y) = if k == 0 { ("0".to_string(), "0".to_string()) } else { (x, y) };
+        csv.push_str(&format!("{t},{x},{y}\n"));
+    }
+    std::fs::write(dir.path().join("t.csv"), &csv).expect("write trace");
+    let run = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+            .args(["monitor", "s.hstl", "--trace", "t.csv"])
+            .args(extra)
+            .current_dir(dir.path())
+            .output()
+            .expect("hstlc runs");
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).expect("utf-8")
+    };
+    for formula in [None, Some("W"), Some("U"), Some("H"), Some("F"), Some("P")] {
+        let pick: Vec<&str> = formula.map_or(vec![], |f| vec!["--formula", f]);
+        let signal = run(&[pick.as_slice(), &["--signal"]].concat());
+        let online = run(&[pick.as_slice(), &["--online"]].concat());
+        assert_eq!(online, signal, "{formula:?}");
+        assert!(signal.lines().count() > 3, "{formula:?}: {signal}");
     }
 }

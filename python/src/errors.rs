@@ -75,7 +75,12 @@ pub fn batch_error(py: Python<'_>, e: &BatchError) -> PyErr {
 pub fn lower_error(file: &str, e: &LowerError) -> PyErr {
     let help = match e {
         LowerError::UnknownLet { .. } => Some("leave out `formula` to score the task".to_string()),
-        LowerError::Invalid { .. } => None,
+        LowerError::TimeModel { dense: true, .. } => Some(
+            "dense-time specs are monitored by `hstlc monitor` for now; the Python package \
+             monitors discrete-time specs"
+                .to_string(),
+        ),
+        LowerError::Invalid { .. } | LowerError::TimeModel { .. } => None,
     };
     value_error(format!("{file}: {e}"), help)
 }

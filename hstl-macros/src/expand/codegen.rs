@@ -170,11 +170,11 @@ impl<'a> Gen<'a> {
         });
         let values = vars.iter().zip(&fields).map(|(v, f)| match v.ty {
             VarType::Int => quote!(self.#f as f64),
-            VarType::Float => quote!(self.#f),
+            VarType::Float | VarType::Time => quote!(self.#f),
         });
         let from = vars.iter().zip(&fields).enumerate().map(|(i, (v, f))| match v.ty {
             VarType::Int => quote! { #f: int(*values.get(#i)?)?, },
-            VarType::Float => quote! { #f: *values.get(#i)?, },
+            VarType::Float | VarType::Time => quote! { #f: *values.get(#i)?, },
         });
         let has_int = vars.iter().any(|v| v.ty == VarType::Int);
         let int_fn = if has_int {
@@ -1406,7 +1406,7 @@ impl<'g, 'a> Body<'g, 'a> {
                     let f = ident(&v.name);
                     match v.ty {
                         VarType::Int => quote!(s.#f as f64),
-                        VarType::Float => quote!(s.#f),
+                        VarType::Float | VarType::Time => quote!(s.#f),
                     }
                 }
                 None => quote!(f64::NAN),
@@ -1578,7 +1578,7 @@ fn lit_f64(x: f64) -> TokenStream {
 fn rust_type(ty: VarType) -> TokenStream {
     match ty {
         VarType::Int => quote!(i64),
-        VarType::Float => quote!(f64),
+        VarType::Float | VarType::Time => quote!(f64),
     }
 }
 

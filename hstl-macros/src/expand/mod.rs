@@ -96,8 +96,28 @@ fn emit(
     root: &TokenStream,
 ) -> TokenStream {
     let mut seen = HashSet::new();
+    let mut dense: Option<syn::Error> = None;
     for spec in &checked.specs {
         if !seen.insert(codegen::module_name(spec)) {
+            continue;
+        }
+        if let Some(t) = &spec.time {
+            // The generated monitors count steps; a dense spec's meaning is in time.
+            let e = report::error_at(
+                target,
+                spec.name_range.clone(),
+                &format!(
+                    "`{}` is a dense-time spec (`{}: time`): `hstl!` generates discrete-time \
+                     monitors only\n  = help: monitor it at run time with \
+                     `hstl::monitor::Dense` (or `hstlc monitor`), or declare the time \
+                     variable's column as a `float` to count steps",
+                    spec.name, t.name
+                ),
+            );
+            match &mut dense {
+                Some(d) => d.combine(e),
+                None => dense = Some(e),
+            }
             continue;
         }
         let complete = !checked
@@ -105,6 +125,9 @@ fn emit(
             .iter()
             .any(|d| d.severity == Severity::Error && overlaps(d, &spec.range));
         out.extend(codegen::spec_module(spec, text, complete, root));
+    }
+    if let Some(e) = dense {
+        out.extend(e.to_compile_error());
     }
     out.extend(report::warnings(target, &checked.diagnostics));
     if let Some(e) = report::errors(target, &checked.diagnostics) {
@@ -289,6 +312,22 @@ mod tests {
         assert!(out.contains("pub struct State"), "{out}");
         assert!(out.contains("pub mod a"), "{out}");
         assert!(!out.contains("impl :: hstl :: runtime :: Spec"), "{out}");
+    }
+
+    #[test]
+    fn a_dense_spec_is_one_clear_error_and_no_module() {
+        let tokens: TokenStream =
+            "spec Log { state { t: time, x: float } task eventually[0..=2.5] x > 1; } \
+             spec Steps { state { x: float } task eventually[0..3] x > 1; }"
+                .parse()
+                .expect("lexes");
+        let out = expand(tokens).to_string();
+        assert_eq!(out.matches("compile_error").count(), 1, "{out}");
+        assert!(out.contains("is a dense-time spec"), "{out}");
+        assert!(out.contains("hstl::monitor::Dense"), "{out}");
+        assert!(!out.contains("pub mod log"), "{out}");
+        // The other spec of the input is generated as usual.
+        assert!(out.contains("pub mod steps"), "{out}");
     }
 
     #[test]

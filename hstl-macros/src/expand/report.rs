@@ -77,6 +77,17 @@ pub fn warnings(target: &Target, diagnostics: &[Diagnostic]) -> TokenStream {
         .collect()
 }
 
+/// An error of the macro's own at the text `range` (`path:line:col: ` in front for files).
+pub fn error_at(target: &Target, range: std::ops::Range<usize>, message: &str) -> syn::Error {
+    let (first, last) = spans(target, range.clone());
+    match target {
+        Target::Tokens(_) => spanned_error(first, last, message),
+        Target::File { path, text, .. } => {
+            spanned_error(first, last, &format!("{}: {message}", location(path, text, range.start)))
+        }
+    }
+}
+
 fn spans(target: &Target, range: std::ops::Range<usize>) -> (Span, Span) {
     match target {
         Target::Tokens(src) => src.spans(range),

@@ -418,8 +418,15 @@ fn symbol_hover(a: &Analysis, s: &Symbol) -> Option<String> {
                 _ => None,
             })?;
             let start = v.name.range.start;
+            let what = if v.ty == syntax::VarType::Time {
+                "time variable (dense time): its trace column holds the time stamps, strictly \
+                 increasing; the other variables hold each sample until their next one, and \
+                 the intervals are in this column's unit. No formula reads it."
+            } else {
+                "state variable"
+            };
             out.push_str(&format!(
-                "```hstl\n{}\n```\nstate variable",
+                "```hstl\n{}\n```\n{what}",
                 snippet(&a.text, &(start..v.range.end))
             ));
             if let Some(d) = &v.doc {
@@ -612,6 +619,7 @@ fn count_states(spec: &CheckedSpec, f: &hstl::lang::CFormula) -> Option<Result<(
 fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)> {
     let mut found = None;
     for spec in &a.checked.file.specs {
+        let dense = is_dense(spec);
         for item in &spec.items {
             let mut formulas: Vec<&Formula> = Vec::new();
             match item {
@@ -628,7 +636,7 @@ fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)>
             }
             for f in formulas {
                 if found.is_none() {
-                    found = find_operator(&a.text, f, offset);
+                    found = find_operator(&a.text, f, offset, dense);
                 }
             }
         }
@@ -638,13 +646,18 @@ fn operator_hover(a: &Analysis, offset: usize) -> Option<(Range<usize>, String)>
 
 /// The first operator, in a pre-order walk of `root`, whose token(s) cover `at`. The walk
 /// keeps its own stack, so a tall tree cannot overflow the thread's.
-fn find_operator(text: &str, root: &Formula, at: usize) -> Option<(Range<usize>, String)> {
+fn find_operator(
+    text: &str,
+    root: &Formula,
+    at: usize,
+    dense: bool,
+) -> Option<(Range<usize>, String)> {
     let mut stack = vec![root];
     while let Some(f) = stack.pop() {
         if at < f.range.start || at > f.range.end {
             continue;
         }
-        if let Some(found) = operator_of(text, f, at, &mut stack) {
+        if let Some(found) = operator_of(text, f, at, dense, &mut stack) {
             return Some(found);
         }
     }
@@ -657,6 +670,7 @@ fn operator_of<'a>(
     text: &str,
     f: &'a Formula,
     at: usize,
+    dense: bool,
     stack: &mut Vec<&'a Formula>,
 ) -> Option<(Range<usize>, String)> {
     let kw_end = |start: usize, kw: &str| start + kw.len();
@@ -693,7 +707,7 @@ fn operator_of<'a>(
             if hit(&span) {
                 return Some((
                     span,
-                    format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref(), past)),
+                    format!("**{kw}**: {meaning}.\n\n{}", window_words(iv.as_ref(), past, dense)),
                 ));
             }
             stack.push(g);
@@ -726,7 +740,7 @@ fn operator_of<'a>(
                 };
                 return Some((
                     start..end,
-                    format!("{meaning}\n\n{}", window_words(iv.as_ref(), since)),
+                    format!("{meaning}\n\n{}", window_words(iv.as_ref(), since, dense)),
                 ));
             }
             stack.push(r);
@@ -800,7 +814,48 @@ fn operator_of<'a>(
 }
 
 /// A time interval in words: a future window (from now on), or a past one (`past`).
-fn window_words(iv: Option<&Interval>, past: bool) -> String {
+/// Whether a spec declares a time variable (`t: time`): a dense-time spec.
+fn is_dense(spec: &syntax::Spec) -> bool {
+    spec.items.iter().any(|i| match i {
+        Item::State(b) => b.vars.iter().any(|v| v.ty == syntax::VarType::Time),
+        _ => false,
+    })
+}
+
+/// A dense-time spec's window in words: times, not steps.
+fn dense_window_words(iv: Option<&Interval>, past: bool) -> String {
+    let (a, end, inclusive) = match iv {
+        None => ("0", None, true),
+        Some(iv) => {
+            (iv.start.text.as_str(), iv.end.as_ref().map(|e| e.text.as_str()), iv.inclusive)
+        }
+    };
+    let written = iv.map_or("No interval, so `[0..]`".to_string(), |_| match end {
+        Some(b) if inclusive => format!("Interval `[{a}..={b}]`"),
+        Some(b) => format!("Interval `[{a}..{b}]`"),
+        None => format!("Interval `[{a}..]`"),
+    });
+    let span = match (end, past) {
+        (Some(b), false) => format!("the times `t+{a}` to `t+{b}`, both included"),
+        (None, false) => format!("every time from `t+{a}` on"),
+        (Some(b), true) => format!("the times `t-{b}` to `t-{a}`, both included"),
+        (None, true) => format!("every time from the first stamp to `t-{a}`"),
+    };
+    let edge = if past {
+        "clipped at the first time stamp"
+    } else {
+        "never clipped: after the last stamp every variable keeps its last value"
+    };
+    format!(
+        "Dense time: {written}: the window is {span}, in the time column's unit ({edge}). \
+         Each sample holds until its variable's next one."
+    )
+}
+
+fn window_words(iv: Option<&Interval>, past: bool, dense: bool) -> String {
+    if dense {
+        return dense_window_words(iv, past);
+    }
     let step = |k: u64| step(k, past);
     let Some(iv) = iv else {
         return if past {
@@ -1132,6 +1187,22 @@ mod tests {
             Some(HoverContents::Markup(m)) => m.value,
             other => panic!("no hover at `{word}`: {other:?}"),
         }
+    }
+
+    #[test]
+    fn the_time_variable_and_dense_windows_hover_as_dense_time() {
+        let text = "spec S {
+    state { t: time, x: float }
+    let P = once[0.5..=1] x > 0;
+    task eventually[0..=2.5] P;
+}
+";
+        let t = hover_at(text, "t:", 0);
+        assert!(t.contains("time variable (dense time)"), "{t}");
+        let e = hover_at(text, "eventually", 0);
+        assert!(e.contains("the times `t+0` to `t+2.5`"), "{e}");
+        let o = hover_at(text, "once", 0);
+        assert!(o.contains("`t-1` to `t-0.5`") && o.contains("first time stamp"), "{o}");
     }
 
     /// Each past-time operator's hover: its meaning, and its window counted back from now.

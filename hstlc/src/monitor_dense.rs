@@ -1,0 +1,267 @@
+//! `hstlc monitor` on a dense-time spec (one with a `time` variable): the trace's time
+//! column holds each row's stamp, an empty cell is no new sample, and the output's times
+//! are in the time column's own scale.
+//!
+//! One trace: the robustness at the first stamp, or `t,robustness` rows at the change
+//! points of the signal with `--signal`. Several traces: one `trace,robustness` row each
+//! (`trace,t,robustness` rows with `--signal`). `--online`: the change points printed as
+//! soon as no later row can change them. The facade computes ([`hstl::monitor::Dense`]);
+//! this module reads and prints.
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+use hstl::lang::CheckedSpec;
+use hstl::monitor::{Dense, DenseProblem, time_text};
+use hstl::robustness::dense::{DenseTrace, DenseTraceBuilder, DenseTraceError};
+
+use crate::cli_error::CliError;
+use crate::monitor::{MonitorArgs, Windows, columns, note_ignored, read_error, trace_name};
+use crate::output::{errln, outln};
+use crate::trace_csv::{
+    Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, Stamp, StampOrder, TraceRows,
+};
+use crate::{CmdResult, Status};
+
+/// A dense-time trace read whole, with the line of every row.
+struct DenseRead {
+    trace: DenseTrace,
+    ignored: Vec<String>,
+    lines: Vec<usize>,
+}
+
+/// Runs `hstlc monitor` for the dense-time spec `spec` (from the file `name`).
+pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf]) -> CmdResult {
+    if args.windows == Windows::Complete {
+        return Err(CliError::new(
+            format!(
+                "{name}: `--windows complete` is not supported yet for dense-time specs (spec \
+                 `{}` has a `time` variable)",
+                spec.name
+            ),
+            Some(
+                "leave it out: a dense-time window is never cut at the end of the trace (after \
+                 the last stamp every variable keeps its last value)"
+                    .to_string(),
+            ),
+        ));
+    }
+    let monitor = Dense::new(spec, args.formula.as_deref()).map_err(|e| {
+        let help = match &e {
+            hstl::lower::LowerError::UnknownLet { .. } => {
+                Some("leave out `--formula` to score the task".to_string())
+            }
+            _ => None,
+        };
+        CliError::new(format!("{name}: {e}"), help)
+    })?;
+    let mut cols = vec![Column { name: monitor.time_var(), kind: ColumnKind::Real }];
+    cols.extend(columns(spec));
+    if args.online {
+        return online(&monitor, &cols, &traces[0], spec, args.formula.as_deref());
+    }
+    let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
+    let mut scored = Vec::with_capacity(traces.len());
+    let mut ignored: Vec<String> = Vec::new();
+    for path in traces {
+        let read = read_dense(path, &cols, &monitor)?;
+        for n in &read.ignored {
+            if !ignored.contains(n) {
+                ignored.push(n.clone());
+            }
+        }
+        let signal = monitor.signal(&read.trace).map_err(|e| located(path, &read, e))?;
+        let origin = read.trace.origin();
+        let rows: Vec<(String, f64)> = if args.signal {
+            signal.until(read.trace.t_last()).map(|(t, v)| (time_text(origin, t), v)).collect()
+        } else {
+            vec![(String::new(), signal.first())]
+        };
+        scored.push((path, rows));
+    }
+    note_ignored(&ignored, spec);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let written = match (batch, args.signal) {
+        (false, true) => writeln!(out, "t,robustness")
+            .and_then(|()| scored[0].1.iter().try_for_each(|(t, v)| writeln!(out, "{t},{v}"))),
+        (false, false) => writeln!(out, "{}", scored[0].1[0].1),
+        (true, true) => writeln!(out, "trace,t,robustness").and_then(|()| {
+            scored.iter().try_for_each(|(path, rows)| {
+                let name = csv_field(&trace_name(path));
+                rows.iter().try_for_each(|(t, v)| writeln!(out, "{name},{t},{v}"))
+            })
+        }),
+        (true, false) => writeln!(out, "trace,robustness").and_then(|()| {
+            scored.iter().try_for_each(|(path, rows)| {
+                writeln!(out, "{},{}", csv_field(&trace_name(path)), rows[0].1)
+            })
+        }),
+    }
+    .and_then(|()| out.flush());
+    written.map_err(crate::output::stdout_error)?;
+    Ok(Status::Clean)
+}
+
+/// Opens a trace (standard input for `-`).
+fn open(path: &Path) -> Result<Box<dyn BufRead>, CliError> {
+    if path == Path::new("-") {
+        return Ok(Box::new(std::io::stdin().lock()));
+    }
+    let file = std::fs::File::open(path)
+        .map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
+    Ok(Box::new(BufReader::new(file)))
+}
+
+/// Reads a whole dense-time trace: `cols[0]` is the time column.
+fn read_dense(path: &Path, cols: &[Column<'_>], monitor: &Dense) -> Result<DenseRead, CliError> {
+    let name = trace_name(path);
+    let mut rows =
+        TraceRows::new(open(path)?, cols, Limit::File).map_err(|e| read_error(&name, e))?;
+    let mut builder = DenseTraceBuilder::new(cols.len() - 1);
+    let mut order = StampOrder::default();
+    let mut cells = vec![None; cols.len() - 1];
+    let mut lines = Vec::new();
+    while let Some(row) =
+        rows.next_dense_row(&mut cells, lines.is_empty()).map_err(|e| read_error(&name, e))?
+    {
+        let stamp =
+            order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
+        if (lines.len() + 1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
+            return Err(CliError::new(
+                format!(
+                    "{name}:{}:1: the trace holds more than {MAX_TRACE_VALUES} values (rows \
+                     times columns)",
+                    row.line
+                ),
+                Some("monitor a shorter stretch of it: split the file".to_string()),
+            ));
+        }
+        push(&mut builder, stamp, &cells).map_err(|e| stamp_error(&name, &row, monitor, e))?;
+        lines.push(row.line);
+    }
+    if lines.is_empty() {
+        return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
+    }
+    let ignored = rows.ignored;
+    let trace = builder.build().map_err(|e| CliError::new(format!("{name}: {e}"), None))?;
+    Ok(DenseRead { trace, ignored, lines })
+}
+
+fn push(
+    b: &mut DenseTraceBuilder,
+    stamp: Stamp,
+    cells: &[Option<f64>],
+) -> Result<(), DenseTraceError> {
+    match stamp {
+        Stamp::Int(s) => b.push_int(s, cells),
+        Stamp::Real(t) => b.push(t, cells),
+    }
+}
+
+/// A stamp the trace cannot take (the reader checked everything else), at its cell.
+fn stamp_error(name: &str, row: &DenseRow, monitor: &Dense, e: DenseTraceError) -> CliError {
+    let p = monitor.problem(hstl::robustness::dense::DenseError::Trace(e));
+    CliError::new(format!("{name}:{}:{}: {}", row.line, row.stamp_column, p.message), p.help)
+}
+
+/// The monitor's error on a trace read whole, at the line of its row where it has one.
+fn located(path: &Path, read: &DenseRead, p: DenseProblem) -> CliError {
+    let times = read.trace.times();
+    // A time falls in the row whose stamp is the last at or before it.
+    let row = p.row.or_else(|| p.time.map(|t| times.partition_point(|&s| s <= t).max(1) - 1));
+    let line = row.and_then(|r| read.lines.get(r)).copied().unwrap_or(1);
+    CliError::new(
+        format!("{}:{line}:1: {}{}", trace_name(path), p.message, at_time(&p, read.trace.origin())),
+        p.help,
+    )
+}
+
+/// ` at time T` for a problem about a time, in the time column's scale.
+fn at_time(p: &DenseProblem, origin: Option<i128>) -> String {
+    p.time.map_or_else(String::new, |t| format!(" at time {}", time_text(origin, t)))
+}
+
+/// `--online`: each change point printed (and flushed) once no later row can change it.
+fn online(
+    monitor: &Dense,
+    cols: &[Column<'_>],
+    path: &Path,
+    spec: &CheckedSpec,
+    formula: Option<&str>,
+) -> CmdResult {
+    let name = trace_name(path);
+    let mut rows =
+        TraceRows::new(open(path)?, cols, Limit::Stream).map_err(|e| read_error(&name, e))?;
+    note_ignored(&rows.ignored, spec);
+    let mut live = monitor.online().map_err(|p| CliError::new(format!("{name}: {p}"), p.help))?;
+    let what = formula.map_or_else(|| "the task".to_string(), |f| format!("`{f}`"));
+    let bounded = monitor.formula().future_reach().is_finite();
+    if !bounded {
+        errln!(
+            "note: {what} has an unbounded future operator (such as `always`): no value is \
+             final before the input ends, so the rows follow at its end, and the stream may \
+             hold at most {MAX_TRACE_VALUES} values"
+        );
+    }
+    outln!("t,robustness")?;
+    let mut order = StampOrder::default();
+    let mut cells = vec![None; cols.len() - 1];
+    let mut count = 0usize;
+    while let Some(row) =
+        rows.next_dense_row(&mut cells, count == 0).map_err(|e| read_error(&name, e))?
+    {
+        let stamp =
+            order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
+        count += 1;
+        if live.kept().saturating_add(1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
+            return Err(CliError::new(
+                format!(
+                    "{name}:{}:1: the monitor holds more than {MAX_TRACE_VALUES} values, and \
+                     {what} keeps every row its windows read",
+                    row.line
+                ),
+                Some(
+                    "monitor a formula with bounded windows (`--formula` with a `let`), or end \
+                     the stream sooner"
+                        .to_string(),
+                ),
+            ));
+        }
+        let decided = match stamp {
+            Stamp::Int(s) => live.push_int(s, &cells),
+            Stamp::Real(t) => live.push(t, &cells),
+        }
+        .map_err(|e| {
+            let p = monitor.problem(e);
+            let when = at_time(&p, live.origin());
+            CliError::new(
+                format!("{name}:{}:{}: {}{when}", row.line, row.stamp_column, p.message),
+                p.help,
+            )
+        })?;
+        for (t, v) in decided {
+            outln!("{},{v}", time_text(live.origin(), t))?;
+        }
+    }
+    if count == 0 {
+        return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
+    }
+    let origin = live.origin();
+    let rest = live.finish().map_err(|e| {
+        let p = monitor.problem(e);
+        CliError::new(format!("{name}: {}{}", p.message, at_time(&p, origin)), p.help)
+    })?;
+    for (t, v) in rest {
+        outln!("{},{v}", time_text(origin, t))?;
+    }
+    Ok(Status::Clean)
+}
+
+/// A CSV field, quoted when it holds a comma, a quote or a line break.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}

@@ -1,0 +1,292 @@
+//! Monitoring a dense-time spec (one with a `time` variable) over time-stamped samples:
+//! what `hstlc monitor` computes for such a spec. The semantics are rtamt's dense-time STL
+//! ([`hstl_robustness::dense`]); the spec's decimal bounds are read through its
+//! [`TimeScale`].
+
+use std::fmt;
+
+use hstl_lang::CheckedSpec;
+use hstl_robustness::dense::{
+    DenseError, DenseFormula, DenseMonitor, DenseSignal, DenseTrace, TimeScale,
+};
+
+use crate::lower::{self, LowerError};
+
+/// The task of a dense-time spec, or one of its `let`s, ready to score time-stamped
+/// traces.
+///
+/// ```
+/// use hstl::robustness::dense::DenseTrace;
+/// let src = "spec Log { state { t: time, x: float } task eventually[0..=1.5] x > 1; }";
+/// let checked = hstl::lang::check(src);
+/// let monitor = hstl::monitor::Dense::new(&checked.specs[0], None).unwrap();
+/// // x is 0 from t = 0, 2 from t = 1.5: the window [0, 1.5] at t = 0 sees the 2.
+/// let trace = DenseTrace::from_samples(&[vec![(0.0, 0.0), (1.5, 2.0)]]).unwrap();
+/// assert_eq!(monitor.robustness(&trace).unwrap(), 1.0);
+/// ```
+#[derive(Clone, Debug)]
+pub struct Dense {
+    time: String,
+    vars: Vec<String>,
+    formula: DenseFormula,
+}
+
+/// Why a dense-time trace cannot be scored, in the spec's names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseProblem {
+    /// What is wrong.
+    pub message: String,
+    /// How to fix it, where one fits.
+    pub help: Option<String>,
+    /// The trace row it is about (counted from 0), where it is about one.
+    pub row: Option<usize>,
+    /// The state variable it is about, where it is about one (its index in
+    /// [`Dense::state_vars`]).
+    pub var: Option<usize>,
+    /// The time it is about (relative to [`DenseTrace::origin`] when set), where it is
+    /// about one: the message does not say it, so that callers write it in their scale.
+    pub time: Option<f64>,
+}
+
+impl fmt::Display for DenseProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for DenseProblem {}
+
+impl Dense {
+    /// The task of the dense-time spec `spec` (`formula = None`) or the `let` called
+    /// `formula`.
+    pub fn new(spec: &CheckedSpec, formula: Option<&str>) -> Result<Dense, LowerError> {
+        let Some(time) = &spec.time else {
+            return Err(LowerError::TimeModel { spec: spec.name.clone(), dense: false });
+        };
+        let f = match formula {
+            None => lower::task(spec)?,
+            Some(name) => lower::let_formula(spec, name)?,
+        };
+        // The checker rejects what has no dense meaning; a spec with errors does not
+        // lower, so this only fails on a spec whose errors were ignored.
+        let formula = DenseFormula::new(&f, TimeScale::decimals(spec.time_decimals))
+            .map_err(|_| LowerError::Invalid { spec: spec.name.clone() })?;
+        Ok(Dense {
+            time: time.name.clone(),
+            vars: spec.state_vars.iter().map(|v| v.name.clone()).collect(),
+            formula,
+        })
+    }
+
+    /// The time variable: the trace column with the time stamps.
+    pub fn time_var(&self) -> &str {
+        &self.time
+    }
+
+    /// The spec's state variables, in order (the time variable is not one).
+    pub fn state_vars(&self) -> &[String] {
+        &self.vars
+    }
+
+    /// The formula, checked for dense time, with its bounds' time scale.
+    pub fn formula(&self) -> &DenseFormula {
+        &self.formula
+    }
+
+    /// The robustness signal from the trace's first stamp on, as change points (relative
+    /// to [`DenseTrace::origin`] when the stamps are whole numbers).
+    pub fn signal(&self, trace: &DenseTrace) -> Result<DenseSignal, DenseProblem> {
+        self.formula.signal(trace).map_err(|e| self.problem(e))
+    }
+
+    /// The robustness at the trace's first stamp.
+    pub fn robustness(&self, trace: &DenseTrace) -> Result<f64, DenseProblem> {
+        Ok(self.signal(trace)?.first())
+    }
+
+    /// An online monitor: rows pushed one at a time, each change point returned once no
+    /// later row can change it.
+    pub fn online(&self) -> Result<DenseMonitor, DenseProblem> {
+        DenseMonitor::new(&self.formula, self.vars.len()).map_err(|e| self.problem(e))
+    }
+
+    /// The core's error in the spec's names.
+    pub fn problem(&self, e: DenseError) -> DenseProblem {
+        use hstl_robustness::dense::DenseTraceError as T;
+        let name = |i: usize| self.vars.get(i).cloned().unwrap_or_else(|| format!("column {i}"));
+        let plain = |message: String| DenseProblem {
+            message,
+            help: None,
+            row: None,
+            var: None,
+            time: None,
+        };
+        match e {
+            DenseError::Nan { time, atom } => DenseProblem {
+                message: format!("the comparison `{}` computes NaN", self.named(&atom)),
+                help: Some(
+                    "robustness has no meaning for NaN: write the comparison so that it is \
+                     defined on every sample (`sqrt` of a negative, `0 / 0` and `inf - inf` \
+                     are NaN)"
+                        .to_string(),
+                ),
+                row: None,
+                var: None,
+                time: Some(time),
+            },
+            DenseError::Trace(t) => match t {
+                T::NanValue { var, row } => DenseProblem {
+                    message: format!("`{}` is NaN", name(var)),
+                    help: Some(
+                        "robustness has no meaning for NaN: give a number (`inf` and `-inf` \
+                         are allowed), or leave the cell empty to keep the last value"
+                            .to_string(),
+                    ),
+                    row: Some(row),
+                    var: Some(var),
+                    time: None,
+                },
+                T::MissingFirst { var, t0 } => DenseProblem {
+                    message: format!("`{}` has no sample at the first time stamp, {t0}", name(var)),
+                    help: Some(
+                        "every variable needs a value at the first stamp: no value exists \
+                         before it"
+                            .to_string(),
+                    ),
+                    row: Some(0),
+                    var: Some(var),
+                    time: None,
+                },
+                T::NotIncreasing { row, previous, stamp } => DenseProblem {
+                    message: format!(
+                        "the time stamp {stamp} does not come after the previous one, {previous}"
+                    ),
+                    help: Some(
+                        "time stamps must strictly increase: sort the rows, or merge \
+                                rows with the same stamp"
+                            .to_string(),
+                    ),
+                    row: Some(row),
+                    var: None,
+                    time: None,
+                },
+                T::Inexact { row, .. } | T::MixedStamps { row } | T::BadStamp { row, .. } => {
+                    DenseProblem { row: Some(row), ..plain(strip_row(&t.to_string())) }
+                }
+                T::Empty | T::RowWidth { .. } => plain(t.to_string()),
+            },
+            other => plain(self.named(&other.to_string())),
+        }
+    }
+
+    /// `text` with the core's variable names (`v0`, `v1`, ...) replaced by the spec's.
+    fn named(&self, text: &str) -> String {
+        let mut out = String::with_capacity(text.len());
+        let bytes = text.as_bytes();
+        let mut i = 0;
+        while i < bytes.len() {
+            let word_start =
+                i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+            if word_start && bytes[i] == b'v' {
+                let digits = bytes[i + 1..].iter().take_while(|b| b.is_ascii_digit()).count();
+                let end = i + 1 + digits;
+                let word_end = end >= bytes.len()
+                    || !(bytes[end].is_ascii_alphanumeric() || bytes[end] == b'_');
+                if digits > 0
+                    && word_end
+                    && let Some(name) =
+                        text[i + 1..end].parse::<usize>().ok().and_then(|k| self.vars.get(k))
+                {
+                    out.push_str(name);
+                    i = end;
+                    continue;
+                }
+            }
+            let c = text[i..].chars().next().unwrap_or(' ');
+            out.push(c);
+            i += c.len_utf8();
+        }
+        out
+    }
+}
+
+/// The core's `row N: ` prefix dropped (callers say where themselves).
+fn strip_row(message: &str) -> String {
+    match message.strip_prefix("row ").and_then(|m| m.split_once(": ")) {
+        Some((n, rest)) if n.bytes().all(|b| b.is_ascii_digit()) => rest.to_string(),
+        _ => message.to_string(),
+    }
+}
+
+/// A time of a signal as the trace's time column writes it: `t` itself for decimal
+/// stamps, `origin + t` for whole-number stamps (exactly, in integer arithmetic for the
+/// whole part: nanoseconds since the epoch stay exact).
+pub fn time_text(origin: Option<i128>, t: f64) -> String {
+    let Some(origin) = origin else { return t.to_string() };
+    if !t.is_finite() || t < 0.0 {
+        return t.to_string();
+    }
+    let whole = t.trunc();
+    // Every double at or above 2^53 is whole; below it the cast is exact.
+    let Some(w) = (whole < 1.7e38).then_some(whole as i128) else { return t.to_string() };
+    let int = origin + w;
+    if whole == t {
+        return int.to_string();
+    }
+    // `t` has a fraction, so it is below 2^53: its shortest decimal's digits after the point.
+    let shortest = t.to_string();
+    match shortest.split_once('.') {
+        Some((_, frac)) => format!("{int}.{frac}"),
+        None => shortest,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn whole_number_times_print_exactly_in_the_column_scale() {
+        let ns = 1_700_000_000_123_456_789i128;
+        assert_eq!(time_text(Some(ns), 0.0), "1700000000123456789");
+        assert_eq!(time_text(Some(ns), 250.0), "1700000000123457039");
+        assert_eq!(time_text(Some(ns), 2.5), "1700000000123456791.5");
+        assert_eq!(time_text(Some(10), 0.39999999999999997), "10.39999999999999997");
+        assert_eq!(time_text(None, 0.39999999999999997), "0.39999999999999997");
+        assert_eq!(time_text(None, 3.0), "3");
+    }
+
+    #[test]
+    fn core_names_become_the_spec_names() {
+        let src = "spec S { state { t: time, speed: float, v1: float } \
+                   task eventually[0..=1] speed > 1; }";
+        let checked = hstl_lang::check(src);
+        let d = Dense::new(&checked.specs[0], None).unwrap();
+        assert_eq!(d.named("v0 - v1 > 0 and v10"), "speed - v1 > 0 and v10");
+        assert_eq!(d.time_var(), "t");
+        assert_eq!(d.state_vars(), ["speed", "v1"]);
+        // A discrete monitor refuses the dense spec, and the reverse.
+        assert!(matches!(
+            crate::monitor::Monitor::new(&checked.specs[0], None),
+            Err(LowerError::TimeModel { dense: true, .. })
+        ));
+        let discrete = hstl_lang::check("spec D { state { x: float } task x > 1; }");
+        assert!(matches!(
+            Dense::new(&discrete.specs[0], None),
+            Err(LowerError::TimeModel { dense: false, .. })
+        ));
+    }
+
+    #[test]
+    fn decimal_bounds_read_through_the_spec_scale() {
+        // The worked example of DENSE-TIME.md: `always[0.5..=1.5] x > 1`.
+        let src = "spec S { state { t: time, x: float } task always[0.5..=1.5] x > 1; }";
+        let checked = hstl_lang::check(src);
+        let d = Dense::new(&checked.specs[0], None).unwrap();
+        let x = vec![(0.0, 1.0), (1.0, 2.0), (2.0, 3.0), (3.5, 0.5), (5.0, 4.0)];
+        let trace = DenseTrace::from_samples(&[x]).unwrap();
+        let s = d.signal(&trace).unwrap();
+        let points: Vec<(f64, f64)> = s.until(trace.t_last()).collect();
+        assert_eq!(points, [(0.0, 0.0), (0.5, 1.0), (1.5, 2.0), (2.0, -0.5), (4.5, 3.0)]);
+    }
+}
