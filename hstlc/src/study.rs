@@ -341,11 +341,21 @@ fn continuous_spec(
                 )
             }))
             .collect();
-    let files = vec![
+    let mut files = vec![
         OutFile::text("policy.json", policy),
         OutFile::text("curve.csv", hstl::artifacts::curve_csv(&trained.curve)),
         OutFile::text("seeds.csv", seeds_csv),
     ];
+    // The median seed's pictures, as `train` draws them.
+    let subject = hstl::artifacts::subject(&l.file, None);
+    files.extend(hstl::artifacts::plane_pictures(
+        &spec,
+        world,
+        &l.spec,
+        &trained.agent,
+        &subject,
+        seed,
+    )?);
     let dir = out.path().to_path_buf();
     out.write(&files)?;
     outln!(

@@ -111,6 +111,11 @@ fn mountain_car_trains_and_studies_with_its_planned_reference() {
     ]));
     assert!(stdout.contains("window rate W"), "{stdout}");
     assert!(stdout.contains("planned reference W"), "{stdout}");
+    for picture in ["flat_left.svg", "flat_right.svg", "options.svg", "run_1.svg"] {
+        let svg = std::fs::read_to_string(dir.path().join("mountain_car_patrol").join(picture))
+            .unwrap_or_else(|e| panic!("{picture}: {e}"));
+        assert!(svg.contains("<svg"), "{picture}");
+    }
     let policy = dir.path().join("mountain_car_patrol/policy.json");
     let report = ok(&hstlc(&["eval", path(&policy), "--starts", "2", "--steps", "400"]));
     assert!(report.contains("window rate"), "{report}");
