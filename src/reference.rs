@@ -34,8 +34,12 @@ use crate::Problem;
 use crate::continuous::Evaluation;
 use crate::evaluate::Runs;
 
-/// Lattice points of one distance field, at most.
+/// Lattice points of all distance fields together, at most.
 pub const MAX_LATTICE: usize = 1 << 22;
+
+/// Segment tests against one obstacle that planning may make in all, at most (about a
+/// second): a world with many obstacles gets a coarser lattice.
+pub const MAX_PLAN_WORK: usize = 1 << 28;
 
 /// A reference policy for one spec on one world.
 #[derive(Clone, Debug)]
@@ -71,7 +75,11 @@ impl Reference {
         }
         let legs = match world {
             AnyWorld::Plane(p) => {
-                Legs::Plane(spec.primitives.iter().map(|o| Field::plan(p, o)).collect())
+                // Each field gets an equal share of the budgets.
+                let fields = spec.primitives.len();
+                let per_point = 8 * (1 + p.obstacles().len());
+                let points = (MAX_LATTICE / fields).min(MAX_PLAN_WORK / fields / per_point).max(4);
+                Legs::Plane(spec.primitives.iter().map(|o| Field::plan(p, o, points)).collect())
             }
             AnyWorld::MountainCar(_) => Legs::Car,
             AnyWorld::Grid(_) => {
@@ -260,14 +268,15 @@ impl Reference {
 }
 
 impl Field {
-    fn plan(world: &PlaneWorld, option: &hstl_runtime::PrimitiveOption) -> Field {
+    /// The field of `option`'s stop region on a lattice of at most `points` points.
+    fn plan(world: &PlaneWorld, option: &hstl_runtime::PrimitiveOption, points: usize) -> Field {
         let ([x0, x1], [y0, y1]) = world.extent();
         let mut spacing = world.step_length() / 2.0;
         let cells =
             |s: f64| (((x1 - x0) / s).ceil() as usize + 1, ((y1 - y0) / s).ceil() as usize + 1);
         while {
             let (nx, ny) = cells(spacing);
-            nx.saturating_mul(ny) > MAX_LATTICE
+            nx.saturating_mul(ny) > points
         } {
             spacing *= 2.0;
         }

@@ -270,3 +270,52 @@ fn mountain_car_pictures_are_drawn_in_the_phase_plane() {
         "twice the window, no slips"
     );
 }
+
+#[test]
+fn the_planned_reference_reaches_and_patrols_and_refuses_a_grid() {
+    use hstl::evaluate::Runs;
+    use hstl::reference::Reference;
+    let world = plane();
+    let reach = Reference::new(&lowered(REACH, &world), &world).expect("plans");
+    let runs = Runs { starts: 50, steps: 61, burn_in: 0, seed: 3 };
+    match reach.evaluate(runs) {
+        Evaluation::Satisfaction { rate } => assert!(rate > 0.9, "{rate}"),
+        other => panic!("{other:?}"),
+    }
+    let patrol = Reference::new(&lowered(PATROL, &world), &world).expect("plans");
+    let runs = Runs { starts: 5, steps: 600, burn_in: 100, seed: 3 };
+    match patrol.evaluate(runs) {
+        // Opposite corners about 22 moves apart within 40-step windows: with slip 0.3 a
+        // move gains 0.6 of a step on average, so only some windows can be kept.
+        Evaluation::Window(w) => assert!(w.rate > 0.25, "{}", w.rate),
+        other => panic!("{other:?}"),
+    }
+    let grid = AnyWorld::builtin("paper").expect("built in");
+    let e = Reference::new(&lowered(PATROL, &world), &grid).expect_err("a grid has W*");
+    assert!(e.message.contains("grid"), "{}", e.message);
+}
+
+#[test]
+fn a_crowded_plane_plans_on_a_coarser_lattice_within_its_budget() {
+    let mut obstacles = String::new();
+    for i in 0..1024 {
+        let (x, y) = (5.0 + (i % 32) as f64 * 3.0, 5.0 + (i / 32) as f64 * 3.0);
+        obstacles.push_str(&format!("{{ circle = [{x}, {y}, 0.5] }},\n"));
+    }
+    let toml = format!(
+        "kind = \"plane\"\nx = [0.0, 100.0]\ny = [0.0, 100.0]\nstep = 0.5\nheadings = 8\n\
+         obstacles = [\n{obstacles}]\n"
+    );
+    let world = AnyWorld::from_toml(&toml, "crowded").expect("a valid world");
+    let src = PATROL
+        .replace("world \"paper-plane\";", "")
+        .replace("0..=14", "0..=100")
+        .replace("x < 3 && y > 11", "x < 3 && y > 97")
+        .replace("x > 11 && y < 3", "x > 97 && y < 3");
+    let spec = lowered(&src, &world);
+    // Planning is bounded by `MAX_PLAN_WORK` segment tests: it returns, and its legs move.
+    let reference = hstl::reference::Reference::new(&spec, &world).expect("plans");
+    let values = reference.run(50, &mut hstl::runtime::seeded_rng(1));
+    assert_eq!(values.len(), 51 * 2);
+    assert!(values.chunks(2).any(|p| p != &values[..2]), "the robot never moved");
+}
