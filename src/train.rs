@@ -119,11 +119,15 @@ pub fn train_until<E: Env>(
 /// Training `spec_name` (from `file`) failed with `error`: the spec does not fit the
 /// environment in a way its check cannot see.
 pub fn cannot_train(file: &str, spec_name: &str, error: &Error) -> Problem {
-    Problem::new(
-        format!("{file}: cannot train `{spec_name}`: {error}"),
-        "run `hstlc check` with the same `--world` to see where the spec and the world differ"
-            .to_string(),
-    )
+    let help = match error {
+        // Often a size the spec chose, which the message names; sometimes the world.
+        Error::Config(_) => {
+            "lower the sizes the message names in the spec's `learn` item, or run `hstlc \
+             check` with the same `--world` to see where the spec and the world differ"
+        }
+        _ => "run `hstlc check` with the same `--world` to see where the spec and the world differ",
+    };
+    Problem::new(format!("{file}: cannot train `{spec_name}`: {error}"), help.to_string())
 }
 
 /// `policy.json`: the runtime's document, plus the spec's source and the seed, so that a
