@@ -274,6 +274,25 @@ pub fn pictured_regions(spec: &CheckedSpec, file: &str) -> Result<Vec<PicturedRe
         let kind = if negated_only { pic::RegionKind::Avoid } else { pic::RegionKind::Other };
         out.push(PicturedRegion { name: l.name.clone(), formula, kind });
     }
+    // The regions the legs keep out of (`avoid:`), when the task does not name them.
+    for p in &spec.primitives {
+        let Some(avoid) = &p.avoid else { continue };
+        let parts = match &avoid.kind {
+            CFormulaKind::Or(parts) => parts.iter().collect(),
+            _ => vec![avoid],
+        };
+        for part in parts {
+            let Some(formula) = crate::lower::formula(spec, part) else { continue };
+            if out.iter().any(|r| r.formula == formula) {
+                continue;
+            }
+            let name = match part.kind {
+                CFormulaKind::Let(i) => spec.lets.get(i).map_or("avoid".into(), |l| l.name.clone()),
+                _ => "avoid".into(),
+            };
+            out.push(PicturedRegion { name, formula, kind: pic::RegionKind::Avoid });
+        }
+    }
     Ok(out)
 }
 
@@ -717,5 +736,24 @@ mod tests {
             kinds("eventually[0..40] Goal && always[0..5] !!Pit"),
             named(&[("Goal", Reach), ("Pit", Other)])
         );
+    }
+
+    #[test]
+    fn a_region_only_an_option_avoids_is_a_region_to_avoid() {
+        let source = "spec Legs {\n    state { x: int in 0..=14, y: int in 0..=14 }\n    \
+                      let Goal = x > 11 && y > 11;\n    let Pit = x < 2 && y < 2;\n    \
+                      let Pond = x > 5 && x < 9 && y > 5 && y < 9;\n    \
+                      task eventually[0..40] Goal;\n    option Goal { avoid: Pit || Pond }\n}\n";
+        let world = GridWorld::builtin("paper").expect("paper");
+        let loaded = crate::load::load_in_world(source, None, &world, "world `paper`")
+            .unwrap_or_else(|e| panic!("{e}"));
+        let got: Vec<(String, pic::RegionKind)> = pictured_regions(&loaded.spec, "legs.hstl")
+            .expect("regions")
+            .into_iter()
+            .map(|r| (r.name, r.kind))
+            .collect();
+        use pic::RegionKind::{Avoid, Reach};
+        let want = [("Goal", Reach), ("Pit", Avoid), ("Pond", Avoid)];
+        assert_eq!(got, want.map(|(n, k)| (n.to_owned(), k)).to_vec());
     }
 }
