@@ -81,6 +81,7 @@ pub fn run(args: &CheckArgs) -> CmdResult {
                 if let Some(e) = &spec.preset_expansion {
                     notes.push_str(&preset_note(&name, &spec.name, e));
                 }
+                notes.push_str(&continuous_note(&name, spec));
             }
             Checked { name, source, diagnostics: result.diagnostics }
         })
@@ -105,6 +106,25 @@ pub fn preset_note(file: &str, spec: &str, expansion: &str) -> String {
     format!(
         "note: {file}: in spec `{spec}`, `preset: auto` stands for\n    {}\n",
         expansion.replace('\n', "\n    ")
+    )
+}
+
+/// The note that the finite-domain checks, which enumerate an `int` domain, skip a spec
+/// with options over a `float` state (empty for any other spec), as `HSTL022` says for a
+/// domain too large to enumerate.
+pub fn continuous_note(file: &str, spec: &hstl::lang::CheckedSpec) -> String {
+    let Some(v) = spec.state_vars.iter().find(|v| v.ty == hstl::lang::syntax::VarType::Float)
+    else {
+        return String::new();
+    };
+    if spec.primitives.is_empty() {
+        return String::new();
+    }
+    format!(
+        "note: {file}: in spec `{}`, `{}` is a `float`: the checks that enumerate the domain \
+         (empty or full regions, states where no option can start, gaps in sequences: \
+         HSTL018, HSTL020, HSTL102, HSTL103) do not run on a continuous state\n",
+        spec.name, v.name
     )
 }
 

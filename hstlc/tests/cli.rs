@@ -32,6 +32,7 @@ const CASES: &[Case] = &[
     case("check_missing_file", &["check", "surveillance.hstl", "nowhere.hstl"]),
     case("check_bad_format", &["check", "--format", "xml", "errors.hstl"]),
     case("check_no_files", &["check"]),
+    case("check_plane_notes", &["check", "--format", "concise", "plane_patrol.hstl"]),
     // explain
     case("explain_code", &["explain", "HSTL003"]),
     case("explain_lowercase", &["explain", "hstl101"]),
