@@ -22,7 +22,8 @@ use crate::Problem;
 
 pub use hstl_runtime::GridWorld;
 pub use hstl_runtime::world::{
-    AnyWorld, BUILTIN, CAR_BUILTIN, DEFAULT_SLIP, PLANE_BUILTIN, WorldError,
+    AnyWorld, BUILTIN, CAR_BUILTIN, DEFAULT_SLIP, MAX_WORLD_BYTES, MAX_WORLD_LINES, PLANE_BUILTIN,
+    WorldError,
 };
 
 /// What the front end's checks need to know of `world`; `label` names it in messages,

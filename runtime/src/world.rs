@@ -282,6 +282,25 @@ type Document<'t> = (Spanned<DeTable<'t>>, Option<(Kind, Range<usize>)>);
 
 /// Parses the TOML and reads `kind`.
 fn document(text: &str) -> Result<Document<'_>, WorldError> {
+    // The TOML parser keeps tens of bytes per line: the size is checked before it runs.
+    if text.len() > MAX_WORLD_BYTES {
+        return Err(WorldError::new(
+            format!(
+                "the world file has {} bytes, more than the {} a world file may have",
+                grouped(text.len()),
+                grouped(MAX_WORLD_BYTES)
+            ),
+            None,
+            SIZE_HELP,
+        ));
+    }
+    if let Some((at, _)) = text.match_indices('\n').nth(MAX_WORLD_LINES) {
+        return Err(WorldError::new(
+            format!("the world file has more than {} lines", grouped(MAX_WORLD_LINES)),
+            Some(at..at + 1),
+            SIZE_HELP,
+        ));
+    }
     let table = DeTable::parse(text).map_err(|e| {
         let message = e.message().trim_end_matches(['\n', '.']).replace('\n', "; ");
         WorldError::new(message, e.span(), TOML_HELP)
@@ -313,6 +332,30 @@ fn document(text: &str) -> Result<Document<'_>, WorldError> {
     };
     Ok((table, kind))
 }
+
+/// The most bytes a world file may have: a map of [`crate::grid::MAX_GRID_CELLS`] cells,
+/// its line ends and comments, or a plane's [`crate::plane::MAX_OBSTACLES`] obstacles, fit.
+pub const MAX_WORLD_BYTES: usize = 8 << 20;
+
+/// The most lines a world file may have: a map's rows (one cell wide, at most
+/// [`crate::grid::MAX_GRID_CELLS`] of them) and room for the rest.
+pub const MAX_WORLD_LINES: usize = crate::grid::MAX_GRID_CELLS + 4096;
+
+/// `n` with a comma between groups of three digits: `1,052,672`.
+fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+const SIZE_HELP: &str = "a world file holds one map of at most 1,048,576 cells, or a plane with at \
+                         most 1,024 obstacles; check that this is the file you meant";
 
 const TOML_HELP: &str =
     "a world file is TOML: `name = \"...\"`, `slip = 0.3`, `map = \"\"\"...\"\"\"`";
@@ -487,6 +530,22 @@ impl Locator {
 mod tests {
     use super::*;
     use crate::Env;
+
+    /// A file of line ends only cost the TOML parser tens of bytes a line (a 63 MiB one took
+    /// 3.1 GB and 12 s): past the limits it is refused before parsing, the line named.
+    #[test]
+    fn oversized_world_files_are_refused_before_parsing() {
+        let lines = "\n".repeat(MAX_WORLD_LINES + 1);
+        let e = AnyWorld::from_toml(&lines, "w").expect_err("too many lines");
+        assert_eq!(e.message, "the world file has more than 1,052,672 lines");
+        assert_eq!(e.span, Some(MAX_WORLD_LINES..MAX_WORLD_LINES + 1));
+        let bytes = " ".repeat(MAX_WORLD_BYTES + 1);
+        let e = AnyWorld::from_toml(&bytes, "w").expect_err("too many bytes");
+        assert!(e.message.contains("8,388,609 bytes, more than the 8,388,608"), "{}", e.message);
+        // A tall map, 65,536 rows of one cell, still reads.
+        let tall = format!("map = \"\"\"\n{}\"\"\"\n", ".\n".repeat(1 << 16));
+        assert!(AnyWorld::from_toml(&tall, "tall").is_ok());
+    }
 
     #[test]
     fn builtins_parse_and_the_paper_is_the_open_grid() {
