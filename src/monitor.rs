@@ -164,6 +164,16 @@ pub enum TraceError {
         /// Values per row.
         width: usize,
     },
+    /// The online monitor would pass its memory budget: `steps` states wait for verdicts
+    /// that the formula's horizon (`None`: unbounded) holds back.
+    Budget {
+        /// The states kept.
+        steps: usize,
+        /// The formula's horizon in steps.
+        horizon: Option<usize>,
+        /// The most values the monitor keeps.
+        limit: usize,
+    },
 }
 
 /// A trace of a batch that cannot be scored.
@@ -530,9 +540,12 @@ impl Online {
             return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
         }
         self.nan_prone.check_state(state, self.steps())?;
-        self.inner
-            .push(state)
-            .map_err(|_| TraceError::Width { vars: self.vars.clone(), found: state.len() })
+        self.inner.push(state).map_err(|e| match e {
+            rob::TraceError::Budget { steps, horizon, limit } => {
+                TraceError::Budget { steps, horizon, limit }
+            }
+            _ => TraceError::Width { vars: self.vars.clone(), found: state.len() },
+        })
     }
 
     /// What `rho(f, t)` at the first step without a verdict would be if the trace ended
@@ -672,6 +685,10 @@ impl TraceError {
                 example `sqrt(abs(x))`), or fix the trace"
                 .to_string(),
             TraceError::Layout { .. } => return None,
+            TraceError::Budget { .. } => "a verdict waits until the formula's window has passed: \
+                monitor the whole trace offline instead (without `--online`), or shorten the \
+                window"
+                .to_string(),
         })
     }
 }
@@ -708,6 +725,17 @@ impl fmt::Display for TraceError {
             ),
             TraceError::Layout { len, width } => {
                 write!(f, "{len} samples do not make whole rows of {width}")
+            }
+            TraceError::Budget { steps, horizon, limit } => {
+                let window = match horizon {
+                    Some(h) => format!("the formula looks {h} steps ahead"),
+                    None => "the formula has an unbounded operator".to_string(),
+                };
+                write!(
+                    f,
+                    "the online monitor holds {steps} states without a verdict ({window}), \
+                     and one more would pass its budget of {limit} values"
+                )
             }
         }
     }

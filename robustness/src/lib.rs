@@ -38,6 +38,6 @@ pub mod trace;
 
 pub use formula::{Bound, CmpOp, Expr, ExprId, Formula, FormulaBuilder, Interval, Node, NodeId};
 pub use offline::Evaluator;
-pub use online::{OnlineMonitor, Verdict};
+pub use online::{MAX_ONLINE_VALUES, OnlineMonitor, Verdict};
 pub use state::StateEval;
 pub use trace::{Trace, TraceError};

@@ -19,6 +19,10 @@
 use crate::stream::Stream;
 use crate::{Formula, TraceError, offline::Evaluator};
 
+/// The most values (states' samples and the operators' kept values, one of each per kept
+/// state) an [`OnlineMonitor`] keeps: 1 GiB of doubles.
+pub const MAX_ONLINE_VALUES: usize = 1 << 27;
+
 /// The final robustness of the trace at one step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Verdict {
@@ -45,6 +49,8 @@ pub struct OnlineMonitor {
     /// The step number of that index.
     first_step: usize,
     eval: Evaluator,
+    /// The most values kept, [`MAX_ONLINE_VALUES`] unless set.
+    limit: usize,
 }
 
 impl OnlineMonitor {
@@ -59,7 +65,14 @@ impl OnlineMonitor {
             start: 0,
             first_step: 0,
             eval: Evaluator::new(),
+            limit: MAX_ONLINE_VALUES,
         }
+    }
+
+    /// The same monitor keeping at most `limit` values (see [`MAX_ONLINE_VALUES`]).
+    pub fn with_limit(mut self, limit: usize) -> OnlineMonitor {
+        self.limit = limit;
+        self
     }
 
     /// The formula's horizon; `None` when unbounded (no verdict before [`finish`]).
@@ -81,6 +94,15 @@ impl OnlineMonitor {
     pub fn push(&mut self, state: &[f64]) -> Result<Option<Verdict>, TraceError> {
         if state.len() != self.columns.len() {
             return Err(TraceError::RowWidth { expected: self.columns.len(), found: state.len() });
+        }
+        // Each kept state costs its samples and, at worst, a value in every operator.
+        let per_state = self.columns.len() + self.formula.nodes().len();
+        if (self.len + 1).saturating_mul(per_state) > self.limit {
+            return Err(TraceError::Budget {
+                steps: self.len,
+                horizon: self.horizon,
+                limit: self.limit,
+            });
         }
         for (c, v) in self.columns.iter_mut().zip(state) {
             c.push(*v);

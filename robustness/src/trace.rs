@@ -28,6 +28,17 @@ pub enum TraceError {
         /// The number of values given.
         found: usize,
     },
+    /// The online monitor would keep more than `limit` values: `steps` states wait for
+    /// their verdicts, which a window as long as the formula's `horizon` (`None`:
+    /// unbounded) holds back.
+    Budget {
+        /// The states kept when the next one was refused.
+        steps: usize,
+        /// The formula's horizon in steps, `None` when unbounded.
+        horizon: Option<usize>,
+        /// The most values the monitor keeps.
+        limit: usize,
+    },
 }
 
 impl fmt::Display for TraceError {
@@ -38,6 +49,17 @@ impl fmt::Display for TraceError {
             }
             TraceError::RowWidth { expected, found } => {
                 write!(f, "a row has {found} values for {expected} variables")
+            }
+            TraceError::Budget { steps, horizon, limit } => {
+                let window = match horizon {
+                    Some(h) => format!("a horizon of {h} steps"),
+                    None => "an unbounded operator".to_string(),
+                };
+                write!(
+                    f,
+                    "the online monitor keeps {steps} states waiting for verdicts that {window} \
+                     holds back, and would pass its budget of {limit} values"
+                )
             }
         }
     }

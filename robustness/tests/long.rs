@@ -67,3 +67,36 @@ fn pieces_join_without_a_seam() {
         assert_same(&format!("online {src}"), &got, &want);
     }
 }
+
+/// A window longer than any trace (`eventually[0..10^12]`) or an unbounded operator holds
+/// every state back: the monitor stops at its budget with an error that names the window,
+/// instead of growing without end (an unlimited one took 2.2 GB at 40M rows).
+#[test]
+fn the_online_monitor_stops_at_its_memory_budget() {
+    for (text, horizon) in
+        [("eventually[0..1000000000000] x > 3", Some(999_999_999_999)), ("always[0..] x > 3", None)]
+    {
+        let f = parse(text);
+        let limit = 1000;
+        let mut m = OnlineMonitor::new(&f, 2).with_limit(limit);
+        let per_state = 2 + f.nodes().len();
+        let fits = limit / per_state;
+        for _ in 0..fits {
+            m.push(&[1.0, 2.0]).expect("within the budget");
+        }
+        let e = m.push(&[1.0, 2.0]).expect_err("past the budget");
+        assert_eq!(
+            e,
+            hstl_robustness::TraceError::Budget { steps: fits, horizon, limit },
+            "{text}"
+        );
+        assert!(e.to_string().contains("budget of 1000 values"), "{e}");
+        // What was kept still finishes.
+        assert_eq!(m.finish().len(), fits);
+    }
+    // A short window never comes near it: its decided states are dropped as it goes.
+    let mut m = OnlineMonitor::new(&parse("eventually[0..10] x > 3"), 2).with_limit(1000);
+    for _ in 0..100_000 {
+        m.push(&[1.0, 2.0]).expect("a short window stays small");
+    }
+}
