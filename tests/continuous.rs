@@ -79,6 +79,12 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
     let text = c::policy_json(&spec, &world, &t.agent, PATROL, 2).expect("writes");
     let doc: Value = serde_json::from_str(&text).expect("JSON");
     assert!(c::is_learned_function(&doc));
+    assert!(c::is_learned_function_text(&text));
+    // A tabular policy, another document, and text that is not JSON are not.
+    assert!(!c::is_learned_function_text(r#"{"spec": "S", "learner": 3, "flat_policies": {}}"#));
+    assert!(!c::is_learned_function_text(r#"{"learner": "table"}"#));
+    assert!(!c::is_learned_function_text("[1, 2]"));
+    assert!(!c::is_learned_function_text("{\"learner\": \"tiles\""));
     let replay = c::replay(&doc).expect("loads");
     assert_eq!(replay.seed, Some(2));
     let bits = |w: &hstl::runtime::approx::Weights| -> Vec<u64> {

@@ -68,9 +68,13 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     runs.check_budget(flag)?;
     let input::Input { name, text, .. } =
         input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
-    if let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text)
-        && hstl::continuous::is_learned_function(&doc)
-    {
+    if hstl::continuous::is_learned_function_text(&text) {
+        let doc = serde_json::from_str::<serde_json::Value>(&text).map_err(|e| {
+            CliError::new(
+                format!("{name}: not a valid policy.json: {e}"),
+                Some("train the policy again with `hstlc train`".into()),
+            )
+        })?;
         return run_continuous(args, &name, &doc, runs);
     }
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
