@@ -238,6 +238,217 @@ pub struct Replay {
 /// Reads a learned-function `policy.json` (see the module docs); messages are worded as
 /// `hstlc eval` prints them, after `FILE: `.
 pub fn replay(doc: &Value) -> Result<Replay, Problem> {
+    let weights = doc.get("weights").map(SparseWeights::of_value);
+    replay_parts(doc, weights)
+}
+
+/// [`replay`] of a `policy.json`'s text, read in one pass: the weights (most of a large
+/// document) straight into compact `(index, bits)` pairs, the rest as a document, so that
+/// memory stays near the text's own size, not the 16 times a generic document takes.
+pub fn replay_text(text: &str) -> Result<Replay, Problem> {
+    let edited = "the file was edited or damaged: train the policy again with `hstlc train`";
+    let mut de = serde_json::Deserializer::from_str(text);
+    let (doc, weights) = serde::Deserializer::deserialize_map(&mut de, TopLevel)
+        .and_then(|parts| de.end().map(|()| parts))
+        .map_err(|e| Problem::new(format!("not a valid policy.json: {e}"), Some(edited.into())))?;
+    replay_parts(&doc, weights)
+}
+
+/// The learned weights as a document gives them: each list of sparse entries, an entry
+/// `None` where it is not `[INDEX, "16 hex digits"]`.
+#[derive(Clone, Debug, Default)]
+struct SparseWeights {
+    flat_len: Option<u64>,
+    options_len: Option<u64>,
+    /// `None`: no `flat` object.
+    flat: Option<Vec<(String, Option<Vec<Option<(u64, u64)>>>)>>,
+    options: Option<Option<Vec<Option<(u64, u64)>>>>,
+}
+
+impl SparseWeights {
+    fn of_value(v: &Value) -> SparseWeights {
+        let list = |v: &Value| v.as_array().map(|a| a.iter().map(entry).collect());
+        SparseWeights {
+            flat_len: v.get("flat_len").and_then(Value::as_u64),
+            options_len: v.get("options_len").and_then(Value::as_u64),
+            flat: v
+                .get("flat")
+                .and_then(Value::as_object)
+                .map(|m| m.iter().map(|(k, e)| (k.clone(), list(e))).collect()),
+            options: v.get("options").map(list),
+        }
+    }
+}
+
+/// `[INDEX, "16 hex digits"]` as `(index, bits)`.
+fn entry(e: &Value) -> Option<(u64, u64)> {
+    let pair = e.as_array().filter(|p| p.len() == 2)?;
+    let h =
+        pair[1].as_str().filter(|h| h.len() == 16 && h.bytes().all(|b| b.is_ascii_hexdigit()))?;
+    Some((pair[0].as_u64()?, u64::from_str_radix(h, 16).ok()?))
+}
+
+/// Reads the top level of a `policy.json`: `weights` as [`SparseWeights`], the rest kept.
+struct TopLevel;
+
+impl<'de> serde::de::Visitor<'de> for TopLevel {
+    type Value = (Value, Option<SparseWeights>);
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON object")
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        let (mut doc, mut weights) = (serde_json::Map::new(), None);
+        while let Some(key) = map.next_key::<String>()? {
+            if key == "weights" {
+                weights = Some(map.next_value_seed(WeightsSeed)?);
+            } else {
+                let v = map.next_value::<Value>()?;
+                doc.insert(key, v);
+            }
+        }
+        Ok((Value::Object(doc), weights))
+    }
+}
+
+/// Reads `weights`: its lengths, and its lists entry by entry.
+struct WeightsSeed;
+
+impl<'de> serde::de::DeserializeSeed<'de> for WeightsSeed {
+    type Value = SparseWeights;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<SparseWeights, D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for WeightsSeed {
+    type Value = SparseWeights;
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("the weights object")
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(
+        self,
+        mut map: A,
+    ) -> Result<SparseWeights, A::Error> {
+        let mut out = SparseWeights::default();
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "flat_len" => out.flat_len = map.next_value::<Value>()?.as_u64(),
+                "options_len" => out.options_len = map.next_value::<Value>()?.as_u64(),
+                "options" => out.options = Some(map.next_value_seed(EntriesSeed)?),
+                "flat" => out.flat = map.next_value_seed(FlatSeed)?,
+                _ => {
+                    map.next_value::<serde::de::IgnoredAny>()?;
+                }
+            }
+        }
+        Ok(out)
+    }
+    // Anything else is no weights object: replay then says which field is missing.
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(
+        self,
+        mut seq: A,
+    ) -> Result<SparseWeights, A::Error> {
+        while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {}
+        Ok(SparseWeights::default())
+    }
+    fn visit_str<E>(self, _: &str) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+    fn visit_unit<E>(self) -> Result<SparseWeights, E> {
+        Ok(SparseWeights::default())
+    }
+}
+
+/// Reads `weights.flat`: option name to entries; `None` for anything but an object.
+struct FlatSeed;
+
+impl<'de> serde::de::DeserializeSeed<'de> for FlatSeed {
+    type Value = Option<Vec<(String, Option<Vec<Option<(u64, u64)>>>)>>;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        let v = d.deserialize_any(EntriesOrMap)?;
+        Ok(match v {
+            Lists::Map(m) => Some(m),
+            _ => None,
+        })
+    }
+}
+
+/// Reads a list of entries; `None` for anything but a list.
+struct EntriesSeed;
+
+impl<'de> serde::de::DeserializeSeed<'de> for EntriesSeed {
+    type Value = Option<Vec<Option<(u64, u64)>>>;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        Ok(match d.deserialize_any(EntriesOrMap)? {
+            Lists::List(l) => Some(l),
+            _ => None,
+        })
+    }
+}
+
+/// A list of entries, a map of such lists, or something else.
+enum Lists {
+    List(Vec<Option<(u64, u64)>>),
+    Map(Vec<(String, Option<Vec<Option<(u64, u64)>>>)>),
+    Other,
+}
+
+struct EntriesOrMap;
+
+impl<'de> serde::de::Visitor<'de> for EntriesOrMap {
+    type Value = Lists;
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a list of weights")
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Lists, A::Error> {
+        let mut out = Vec::new();
+        // One small entry at a time: only its compact form stays.
+        while let Some(e) = seq.next_element::<Value>()? {
+            out.push(entry(&e));
+        }
+        Ok(Lists::List(out))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Lists, A::Error> {
+        let mut out = Vec::new();
+        while let Some(key) = map.next_key::<String>()? {
+            out.push((key, map.next_value_seed(EntriesSeed)?));
+        }
+        Ok(Lists::Map(out))
+    }
+    fn visit_str<E>(self, _: &str) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+    fn visit_bool<E>(self, _: bool) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+    fn visit_unit<E>(self) -> Result<Lists, E> {
+        Ok(Lists::Other)
+    }
+}
+
+/// [`replay`] of the document `doc` and its weights, read apart.
+fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Replay, Problem> {
     let retrain = || "train the policy again with `hstlc train`".to_string();
     let edited =
         || "the file was edited or damaged: train the policy again with `hstlc train`".to_string();
@@ -304,12 +515,12 @@ pub fn replay(doc: &Value) -> Result<Replay, Problem> {
             edited(),
         ));
     }
-    let weights_doc = field("weights")?;
+    let weights_doc =
+        weights_doc.ok_or_else(|| Problem::new("it has no `weights` entry", edited()))?;
     let mut weights = agent0.weights.clone();
     let flat_len = weights.flat.first().map_or(0, Vec::len);
-    if weights_doc.get("flat_len").and_then(Value::as_u64) != Some(flat_len as u64)
-        || weights_doc.get("options_len").and_then(Value::as_u64)
-            != Some(weights.options.len() as u64)
+    if weights_doc.flat_len != Some(flat_len as u64)
+        || weights_doc.options_len != Some(weights.options.len() as u64)
     {
         return Err(Problem::new(
             "its weights do not have the shape of its spec and world",
@@ -317,29 +528,33 @@ pub fn replay(doc: &Value) -> Result<Replay, Problem> {
         ));
     }
     let flat = weights_doc
-        .get("flat")
-        .and_then(Value::as_object)
+        .flat
+        .as_ref()
         .ok_or_else(|| Problem::new("its `weights.flat` is not an object", edited()))?;
-    if flat.len() != spec.primitives.len() {
+    let mut names: Vec<&str> = flat.iter().map(|(k, _)| k.as_str()).collect();
+    names.sort_unstable();
+    names.dedup();
+    if names.len() != flat.len() || flat.len() != spec.primitives.len() {
         return Err(Problem::new(
             "its `weights.flat` does not name every primitive option once",
             edited(),
         ));
     }
     for (p, prim) in spec.primitives.iter().enumerate() {
-        let entries = flat.get(&prim.name).ok_or_else(|| {
+        let entries = flat.iter().find(|(k, _)| *k == prim.name).ok_or_else(|| {
             Problem::new(
                 format!("its `weights.flat` has no entry for option `{}`", prim.name),
                 edited(),
             )
         })?;
-        fill(&mut weights.flat[p], entries, &format!("weights.flat.{}", prim.name))
+        fill(&mut weights.flat[p], entries.1.as_deref(), &format!("weights.flat.{}", prim.name))
             .map_err(|m| Problem::new(m, edited()))?;
     }
     let options = weights_doc
-        .get("options")
+        .options
+        .as_ref()
         .ok_or_else(|| Problem::new("it has no `weights.options`", edited()))?;
-    fill(&mut weights.options, options, "weights.options")
+    fill(&mut weights.options, options.as_deref(), "weights.options")
         .map_err(|m| Problem::new(m, edited()))?;
     weights.steps = doc.get("steps").and_then(Value::as_u64).unwrap_or(0);
     weights.choices = doc.get("choices").and_then(Value::as_u64).unwrap_or(0);
@@ -352,27 +567,25 @@ fn zero_of<W: hstl_runtime::World>(spec: &TaskSpec, w: &W) -> Result<Weights, Er
     Ok(hstl_runtime::approx::Model::new(spec, w)?.zero_weights())
 }
 
-/// Fills `into` from sparse `[[index, "hex bits"], ...]` entries: every index in range and
-/// given once, every value finite.
-fn fill(into: &mut [f64], entries: &Value, what: &str) -> Result<(), String> {
-    let list = entries.as_array().ok_or_else(|| format!("its `{what}` is not a list"))?;
+/// Fills `into` from sparse `[[index, "hex bits"], ...]` entries (`None`: not a list; an
+/// entry `None`: not of that form): every index in range and given once, every value
+/// finite.
+fn fill(
+    into: &mut [f64],
+    entries: Option<&[Option<(u64, u64)>]>,
+    what: &str,
+) -> Result<(), String> {
+    let list = entries.ok_or_else(|| format!("its `{what}` is not a list"))?;
     if list.len() > into.len() {
         return Err(format!("its `{what}` has more entries than weights"));
     }
     let mut seen = vec![false; into.len()];
     for e in list {
-        let pair = e.as_array().filter(|p| p.len() == 2);
-        let bits = |v: &Value| {
-            let h =
-                v.as_str().filter(|h| h.len() == 16 && h.bytes().all(|b| b.is_ascii_hexdigit()))?;
-            u64::from_str_radix(h, 16).ok().map(f64::from_bits)
-        };
-        let (Some(i), Some(v)) = (
-            pair.and_then(|p| p[0].as_u64()).and_then(|i| usize::try_from(i).ok()),
-            pair.and_then(|p| bits(&p[1])),
-        ) else {
+        let Some((i, bits)) = *e else {
             return Err(format!("an entry of its `{what}` is not `[INDEX, \"16 hex digits\"]`"));
         };
+        let v = f64::from_bits(bits);
+        let i = usize::try_from(i).unwrap_or(usize::MAX);
         if i >= into.len() || seen[i] {
             return Err(format!("its `{what}` has index {i} out of range or twice"));
         }

@@ -87,6 +87,9 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
     assert!(!c::is_learned_function_text("{\"learner\": \"tiles\""));
     let replay = c::replay(&doc).expect("loads");
     assert_eq!(replay.seed, Some(2));
+    // Read from the text in one pass (the weights straight into pairs), the same agent.
+    let streamed = c::replay_text(&text).expect("loads from text");
+    assert_eq!(streamed.agent.weights, replay.agent.weights);
     let bits = |w: &hstl::runtime::approx::Weights| -> Vec<u64> {
         w.flat.iter().flatten().chain(&w.options).map(|v| v.to_bits()).collect()
     };
@@ -104,7 +107,11 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
     let edit = |f: &dyn Fn(&mut Value)| {
         let mut d = doc.clone();
         f(&mut d);
-        c::replay(&d).map(|_| ()).expect_err("an edited document is refused").message
+        let from_doc = c::replay(&d).map(|_| ()).expect_err("an edited document is refused");
+        let text = serde_json::to_string(&d).expect("writes");
+        let from_text = c::replay_text(&text).map(|_| ()).expect_err("and its text too");
+        assert_eq!(from_doc.message, from_text.message);
+        from_doc.message
     };
     let msg = edit(&|d| d["tiles"]["bins"] = serde_json::json!([13, 14]));
     assert!(msg.contains("tiles"), "{msg}");
@@ -125,6 +132,14 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
             serde_json::json!({"name": "paper", "params": {"slip": 0.3, "map": ["..", ".."]}})
     });
     assert!(msg.contains("grid"), "{msg}");
+    // Weights of the wrong type anywhere, and text that is not a whole document.
+    for weights in [serde_json::json!(3), serde_json::json!({"flat": [1], "options": "x"})] {
+        let msg = edit(&|d| d["weights"] = weights.clone());
+        assert!(msg.contains("weights"), "{msg}");
+    }
+    let cut = &text[..text.len() / 2];
+    let msg = c::replay_text(cut).map(|_| ()).expect_err("a cut document").message;
+    assert!(msg.starts_with("not a valid policy.json"), "{msg}");
     assert!(!msg.ends_with('.'), "{msg}");
 }
 

@@ -69,13 +69,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let input::Input { name, text, .. } =
         input::read_text(&args.policy, "<stdin>", input::MAX_POLICY_BYTES, "policy")?;
     if hstl::continuous::is_learned_function_text(&text) {
-        let doc = serde_json::from_str::<serde_json::Value>(&text).map_err(|e| {
-            CliError::new(
-                format!("{name}: not a valid policy.json: {e}"),
-                Some("train the policy again with `hstlc train`".into()),
-            )
-        })?;
-        return run_continuous(args, &name, &doc, runs);
+        return run_continuous(args, &name, &text, runs);
     }
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
@@ -162,9 +156,9 @@ pub fn run(args: &EvalArgs) -> CmdResult {
 /// `hstlc eval` of a learned function (a continuous world): the window rate of a
 /// persistent task or the satisfaction rate of another, with no exact optimum to divide by;
 /// `--runs` writes the greedy runs as data.
-fn run_continuous(args: &EvalArgs, name: &str, doc: &serde_json::Value, runs: Runs) -> CmdResult {
+fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdResult {
     use hstl::continuous as c;
-    let replay = c::replay(doc).map_err(|p| p.in_file(name))?;
+    let replay = c::replay_text(text).map_err(|p| p.in_file(name))?;
     let spec = &replay.spec;
     // A reach task is decided within its horizon: a longer run only adds rows.
     let steps = match args.steps {
