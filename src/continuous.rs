@@ -254,15 +254,21 @@ pub fn replay_text(text: &str) -> Result<Replay, Problem> {
     replay_parts(&doc, weights)
 }
 
-/// The learned weights as a document gives them: each list of sparse entries, an entry
-/// `None` where it is not `[INDEX, "16 hex digits"]`.
+/// A list of sparse entries as a document gives it (`None`: not a list), each `(index,
+/// bits)`, or `None` where it is not `[INDEX, "16 hex digits"]`.
+type Entries = Option<Vec<Option<(u64, u64)>>>;
+
+/// `weights.flat`: each option's name and entries, in the document's order.
+type FlatEntries = Vec<(String, Entries)>;
+
+/// The learned weights as a document gives them.
 #[derive(Clone, Debug, Default)]
 struct SparseWeights {
     flat_len: Option<u64>,
     options_len: Option<u64>,
     /// `None`: no `flat` object.
-    flat: Option<Vec<(String, Option<Vec<Option<(u64, u64)>>>)>>,
-    options: Option<Option<Vec<Option<(u64, u64)>>>>,
+    flat: Option<FlatEntries>,
+    options: Option<Entries>,
 }
 
 impl SparseWeights {
@@ -375,7 +381,7 @@ impl<'de> serde::de::Visitor<'de> for WeightsSeed {
 struct FlatSeed;
 
 impl<'de> serde::de::DeserializeSeed<'de> for FlatSeed {
-    type Value = Option<Vec<(String, Option<Vec<Option<(u64, u64)>>>)>>;
+    type Value = Option<FlatEntries>;
     fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
         let v = d.deserialize_any(EntriesOrMap)?;
         Ok(match v {
@@ -389,7 +395,7 @@ impl<'de> serde::de::DeserializeSeed<'de> for FlatSeed {
 struct EntriesSeed;
 
 impl<'de> serde::de::DeserializeSeed<'de> for EntriesSeed {
-    type Value = Option<Vec<Option<(u64, u64)>>>;
+    type Value = Entries;
     fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
         Ok(match d.deserialize_any(EntriesOrMap)? {
             Lists::List(l) => Some(l),
@@ -401,7 +407,7 @@ impl<'de> serde::de::DeserializeSeed<'de> for EntriesSeed {
 /// A list of entries, a map of such lists, or something else.
 enum Lists {
     List(Vec<Option<(u64, u64)>>),
-    Map(Vec<(String, Option<Vec<Option<(u64, u64)>>>)>),
+    Map(FlatEntries),
     Other,
 }
 
