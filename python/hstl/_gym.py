@@ -133,7 +133,21 @@ class STLReward(gymnasium.Wrapper):
     ``GridWorldEnv`` (its observation is ``(x, y)``) or an observation that is itself a
     dict of the state variables.
 
-    The reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
+    ``reward`` picks what a step earns (then ``scale * value + offset``, ``scale`` positive,
+    ``offset`` added to every step):
+
+    - ``"robustness"`` (the default): ``rho(formula, t)``, described below;
+    - ``"increment"``: the change of ``rho(formula, 0)`` over the trace so far since the
+      step before, so an episode's rewards add up to the formula's robustness over the
+      whole episode (the last ``info["task_robustness"]`` for the task; a value that is not
+      finite counts as 0): a shaped reward with the task's own optimum;
+    - ``"window"``: for a persistent task, 1 for a step whose windows are all kept
+      (``info["window_kept"]``) and 0 otherwise, the learner's reward: an episode's sum is
+      the number of kept steps, so longer episodes never earn less;
+    - ``"sparse"``: ``rho(formula, 0)`` over the episode, on its last step (``terminated``
+      or ``truncated``; put ``STLReward`` outside any ``TimeLimit``) and 0 before.
+
+    The robustness reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
     ``s_0 ..= s_t`` (``s_0`` is the state ``reset`` returns), for the task or the ``let``
     called ``formula``. The future operators' windows are clipped at the end of the trace,
     so without a past-time operator this is the formula on ``s_t`` alone: for a state
@@ -163,16 +177,22 @@ class STLReward(gymnasium.Wrapper):
         spec: Union[Spec, str, "os.PathLike[str]"],
         valuation: Valuation = None,
         formula: Optional[str] = None,
+        reward: str = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
     ) -> None:
         super().__init__(env)
         # `spec` is gymnasium's (the environment's registration) on a wrapper.
         self.stl_spec = spec if isinstance(spec, Spec) else Spec.load(spec)
         self.formula = formula
-        self._monitor = EpisodeMonitor(self.stl_spec, formula)
+        self._monitor = EpisodeMonitor(self.stl_spec, formula, reward, offset, scale)
+        self.reward_form = reward
+        self.reward_offset = offset
+        self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
 
-    def _score(self, obs: Any, info: Mapping[str, Any]) -> tuple[float, dict]:
-        reward, robustness, kept = self._monitor.push(self._valuation(obs))
+    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict]:
+        reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
         info = dict(info)
         info["task_robustness"] = robustness
         if kept is not None:
@@ -187,7 +207,7 @@ class STLReward(gymnasium.Wrapper):
 
     def step(self, action: Any):
         obs, env_reward, terminated, truncated, info = self.env.step(action)
-        reward, info = self._score(obs, info)
+        reward, info = self._score(obs, info, bool(terminated or truncated))
         info["env_reward"] = env_reward
         return obs, reward, terminated, truncated, info
 

@@ -1,7 +1,7 @@
 """Type stubs of the native module ``hstl._hstl`` (re-exported by ``hstl``)."""
 
 from os import PathLike
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +17,8 @@ Trace = Union[Mapping[str, Any], npt.ArrayLike]
 Batch = Union[Sequence[Trace], Mapping[str, Any], npt.ArrayLike]
 #: One state for the online monitor: names to numbers, or numbers in state-variable order.
 State = Union[Mapping[str, float], Sequence[float], npt.ArrayLike]
+#: What ``hstl.STLReward`` rewards a step with (see its docs).
+RewardForm = Literal["robustness", "increment", "window", "sparse"]
 
 class Diagnostic:
     """One diagnostic, positioned as ``hstlc check --format json`` gives it (1-based,
@@ -201,9 +203,22 @@ class Policy:
 class EpisodeMonitor:
     """Scores an episode state by state, for ``hstl.STLReward``."""
 
-    def __init__(self, spec: Spec, formula: Optional[str] = None) -> None: ...
+    def __init__(
+        self,
+        spec: Spec,
+        formula: Optional[str] = None,
+        reward: RewardForm = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
+    ) -> None: ...
     def reset(self) -> None: ...
-    def push(self, state: State) -> Tuple[float, float, Optional[bool]]: ...
+    def push(self, state: State, last: bool = False) -> Tuple[float, float, Optional[bool]]: ...
+    @property
+    def reward(self) -> RewardForm: ...
+    @property
+    def offset(self) -> float: ...
+    @property
+    def scale(self) -> float: ...
     @property
     def state_vars(self) -> list[str]: ...
     @property
