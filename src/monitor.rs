@@ -194,6 +194,21 @@ pub struct Online {
     domains: Vec<ValueDomain>,
     nan_prone: NanProne,
     inner: OnlineMonitor,
+    /// The steps before the states `inner` was given: a restored monitor's.
+    offset: usize,
+    /// Every state of the trace, row after row, for a formula with a past-time operator
+    /// (whose verdicts read states the monitor no longer holds): what a snapshot replays.
+    log: Option<Vec<f64>>,
+}
+
+/// An online monitor's state as plain data ([`Online::snapshot`]): the states it replays
+/// and the steps before them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OnlineState {
+    /// The steps before `states`, whose verdicts were all given.
+    pub skipped: usize,
+    /// States, row after row (one value per state variable).
+    pub states: Vec<f64>,
 }
 
 impl Monitor {
@@ -388,6 +403,8 @@ impl Monitor {
             domains: self.domains.clone(),
             nan_prone: self.nan_prone.clone(),
             inner: OnlineMonitor::new(&self.formula, self.vars.len()),
+            offset: 0,
+            log: self.formula.has_past().then(Vec::new),
         }
     }
 
@@ -508,7 +525,40 @@ impl Online {
 
     /// The number of states pushed since creation or the last [`Online::finish`].
     pub fn steps(&self) -> usize {
-        self.inner.steps()
+        self.offset + self.inner.steps()
+    }
+
+    /// The monitor's state as plain data: the states from the first step without a
+    /// verdict on (at most `H` for a bounded formula; every state of the trace for an
+    /// unbounded one or one with a past-time operator) and how many steps came before.
+    /// [`Online::restore`] on a monitor of the same formula continues exactly from it.
+    pub fn snapshot(&self) -> OnlineState {
+        if let Some(log) = &self.log {
+            return OnlineState { skipped: 0, states: log.clone() };
+        }
+        let columns = self.inner.open_columns();
+        let open = columns.first().map_or(0, |c| c.len());
+        let states = (0..open).flat_map(|t| columns.iter().map(move |c| c[t])).collect();
+        OnlineState { skipped: self.steps() - open, states }
+    }
+
+    /// Starts a new trace and replays `state`, so the monitor continues where the one
+    /// that gave the snapshot was (same formula). States it would refuse are refused and
+    /// leave it at a new trace.
+    pub fn restore(&mut self, state: &OnlineState) -> Result<(), TraceError> {
+        self.finish();
+        let width = self.vars.len();
+        if width == 0 || !state.states.len().is_multiple_of(width) {
+            return Err(TraceError::Layout { len: state.states.len(), width });
+        }
+        for row in state.states.chunks(width) {
+            if let Err(e) = self.push(row) {
+                self.finish();
+                return Err(e);
+            }
+        }
+        self.offset = state.skipped;
+        Ok(())
     }
 
     /// Appends one state (`state[i]` is state variable `i`) and returns the verdict it
@@ -530,9 +580,14 @@ impl Online {
             return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
         }
         self.nan_prone.check_state(state, self.steps())?;
-        self.inner
+        let verdict = self
+            .inner
             .push(state)
-            .map_err(|_| TraceError::Width { vars: self.vars.clone(), found: state.len() })
+            .map_err(|_| TraceError::Width { vars: self.vars.clone(), found: state.len() })?;
+        if let Some(log) = &mut self.log {
+            log.extend_from_slice(state);
+        }
+        Ok(verdict.map(|v| Verdict { step: v.step + self.offset, ..v }))
     }
 
     /// What `rho(f, t)` at the first step without a verdict would be if the trace ended
@@ -544,14 +599,25 @@ impl Online {
     /// Ends the trace: the verdicts of every step still open, windows clipped at the end.
     /// The monitor then starts a new trace at step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
-        self.inner.finish()
+        let out = self.inner.finish();
+        self.new_trace(out)
     }
 
     /// Ends the trace over complete windows: the verdicts of the open steps whose windows
     /// all lie inside the trace (none for a bounded formula); later steps are undetermined.
     /// The monitor then starts a new trace at step 0.
     pub fn finish_complete(&mut self) -> Vec<Verdict> {
-        self.inner.finish_complete()
+        let out = self.inner.finish_complete();
+        self.new_trace(out)
+    }
+
+    /// The verdicts `out` numbered from the trace's start; the monitor at a new trace.
+    fn new_trace(&mut self, out: Vec<Verdict>) -> Vec<Verdict> {
+        let offset = std::mem::take(&mut self.offset);
+        if let Some(log) = &mut self.log {
+            log.clear();
+        }
+        out.into_iter().map(|v| Verdict { step: v.step + offset, ..v }).collect()
     }
 }
 

@@ -179,6 +179,9 @@ pub struct EpisodeMonitor {
     prefix: Option<Running>,
     /// The last finite `rho(formula, 0)` that an increment counted from (0 at first).
     baseline: f64,
+    /// The states of the episode so far, row after row: what [`EpisodeMonitor::restore`]
+    /// replays.
+    log: Vec<f64>,
     /// Scratch values of [`at_state`].
     scratch: Vec<f64>,
     /// The states so far, when the reward formula has a past-time operator.
@@ -304,6 +307,7 @@ impl EpisodeMonitor {
             shaping: Shaping::default(),
             prefix: None,
             baseline: 0.0,
+            log: Vec::new(),
             scratch,
             history,
             regions,
@@ -375,7 +379,36 @@ impl EpisodeMonitor {
             prefix.reset();
         }
         self.baseline = 0.0;
+        self.log.clear();
         self.steps = 0;
+    }
+
+    /// The states of the episode so far, row after row (`state_vars().len()` values a
+    /// state): plain data from which [`EpisodeMonitor::restore`] makes a monitor with the
+    /// same spec, formula and shaping continue exactly where this one is, as a copy or
+    /// across processes. It grows by one state a step until the next reset.
+    pub fn episode_states(&self) -> &[f64] {
+        &self.log
+    }
+
+    /// Starts a new episode and pushes `states` (as [`EpisodeMonitor::episode_states`]
+    /// gives them), leaving the monitor as the one that gave them was.
+    pub fn restore(&mut self, states: &[f64]) -> Result<(), TraceError> {
+        self.reset();
+        let width = self.vars.len();
+        if width == 0 {
+            return Ok(());
+        }
+        if !states.len().is_multiple_of(width) {
+            return Err(TraceError::Layout { len: states.len(), width });
+        }
+        for state in states.chunks(width) {
+            if let Err(e) = self.push(state) {
+                self.reset();
+                return Err(e);
+            }
+        }
+        Ok(())
     }
 
     /// Appends state `s_t` (`state[i]` is state variable `i`) and scores it. A state with
@@ -404,6 +437,7 @@ impl EpisodeMonitor {
         }
         self.nan_prone.check_state(state, self.steps)?;
         self.steps += 1;
+        self.log.extend_from_slice(state);
         let robustness = match &mut self.history {
             _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
             Some(history) => {

@@ -419,3 +419,58 @@ fn complete_windows_agree_offline_and_online_and_leave_the_end_undetermined() {
     let bad = [4.0, -1.0, 9.0];
     assert!(m.complete_signal(&Samples::Columns(vec![&bad])).is_err());
 }
+
+/// An online monitor restored from its snapshot after every prefix continues exactly as
+/// the original: the same verdicts, numbered from the trace's start.
+fn check_snapshots(cases: &[Case]) {
+    for c in cases {
+        let m = case_monitor(&c.task);
+        let label = format!("case {}: {}", c.id, c.task);
+        let mut whole = m.online();
+        let mut want = Vec::new();
+        for (x, y) in c.x.iter().zip(&c.y) {
+            want.extend(whole.push(&[*x, *y]).unwrap());
+        }
+        want.extend(whole.finish());
+        for cut in 0..=c.x.len() {
+            let mut first = m.online();
+            let mut got = Vec::new();
+            for t in 0..cut {
+                got.extend(first.push(&[c.x[t], c.y[t]]).unwrap());
+            }
+            let snapshot = first.snapshot();
+            let mut back = m.online();
+            back.restore(&snapshot).unwrap();
+            assert_eq!(back.steps(), cut, "{label}, cut {cut}");
+            assert_eq!(back.snapshot(), snapshot, "{label}, cut {cut}");
+            for t in cut..c.x.len() {
+                got.extend(back.push(&[c.x[t], c.y[t]]).unwrap());
+            }
+            got.extend(back.finish());
+            assert_eq!(got, want, "{label}, cut {cut}");
+            assert_eq!(back.steps(), 0, "a new trace after finish");
+        }
+    }
+}
+
+#[test]
+fn online_monitors_restored_from_snapshots_continue_exactly() {
+    check_snapshots(&cases());
+    let past = cases_of(PAST);
+    check_snapshots(&past[..200]);
+}
+
+#[test]
+fn a_bounded_monitors_snapshot_holds_at_most_its_horizon() {
+    let m = case_monitor("always[0..=3] (x > 1)");
+    let mut online = m.online();
+    for t in 0..100 {
+        online.push(&[f64::from(t), 0.0]).unwrap();
+    }
+    let snapshot = online.snapshot();
+    assert_eq!((snapshot.skipped, snapshot.states.len()), (97, 3 * 2));
+    let mut back = m.online();
+    let e = back.restore(&hstl::monitor::OnlineState { skipped: 0, states: vec![1.0, f64::NAN] });
+    assert_eq!(e.unwrap_err().to_string(), "`y` is NaN at step 0");
+    assert_eq!(back.steps(), 0);
+}

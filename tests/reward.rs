@@ -5,7 +5,7 @@
 //! and random formulas of every shape (unbounded, nested, until).
 
 use hstl::load::load;
-use hstl::reward::{EpisodeMonitor, RewardError, RewardForm, Shaping};
+use hstl::reward::{EpisodeMonitor, RewardError, RewardForm, Shaping, StepScore};
 use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::RegionTable;
 use hstl::runtime::{Env, GridWorld};
@@ -346,5 +346,34 @@ fn reward_forms_that_do_not_fit_are_refused_with_a_way_out() {
     assert!(matches!(e, Err(RewardError::Offset(_))));
     for f in RewardForm::ALL {
         assert_eq!(RewardForm::parse(f.name()), Ok(f));
+    }
+}
+
+#[test]
+fn an_episode_monitor_restored_from_its_states_continues_exactly() {
+    for (task, x, y) in oracle_cases().into_iter().step_by(7) {
+        let src = spec_text(&task);
+        for f in [RewardForm::Robustness, RewardForm::Increment, RewardForm::Sparse] {
+            let mut whole = shaped(&src, None, form(f));
+            let want: Vec<StepScore> =
+                (0..x.len()).map(|t| whole.push(&[x[t], y[t]]).unwrap()).collect();
+            for cut in [0, 1, x.len() / 2, x.len()] {
+                let mut first = shaped(&src, None, form(f));
+                for t in 0..cut {
+                    first.push(&[x[t], y[t]]).unwrap();
+                }
+                let mut back = shaped(&src, None, form(f));
+                back.restore(first.episode_states()).unwrap();
+                assert_eq!(back.steps(), cut);
+                for t in cut..x.len() {
+                    let got = back.push(&[x[t], y[t]]).unwrap();
+                    let w = want[t];
+                    assert!(
+                        same(got.reward, w.reward) && same(got.task_robustness, w.task_robustness),
+                        "{task}, {f:?}, cut {cut}, step {t}"
+                    );
+                }
+            }
+        }
     }
 }

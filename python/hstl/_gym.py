@@ -121,7 +121,7 @@ class GridWorldEnv(gymnasium.Env):
 Valuation = Union[Callable[[Any], Any], Mapping[str, Any], None]
 
 
-class STLReward(gymnasium.Wrapper):
+class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     """Rewards any environment with STL robustness computed in Rust, and reports the task's
     own success apart from the reward.
 
@@ -164,6 +164,12 @@ class STLReward(gymnasium.Wrapper):
     held within its window ending at ``t``, the steps the window rate counts. ``step``'s
     ``info["env_reward"]`` is the wrapped environment's reward.
 
+    The wrapper records its arguments as gymnasium asks (``env.spec`` lists it, so
+    ``gymnasium.make(env.spec)`` makes it again) and passes ``check_env``. It pickles and
+    deep-copies mid-episode (for ``SubprocVecEnv``, Ray, ``copy.deepcopy``) when the wrapped
+    environment and ``valuation`` do (a dict valuation does; a lambda does not pickle): the
+    copy continues the episode with the same rewards.
+
     Cost per step: the reward is one evaluation of the formula on one state; the task's
     robustness is kept up to date incrementally, not by scoring the whole trace again:
     O(1) amortised for a persistent task (``always[0..] (eventually[0..N1] R1 && ...)``)
@@ -181,7 +187,10 @@ class STLReward(gymnasium.Wrapper):
         offset: float = 0.0,
         scale: float = 1.0,
     ) -> None:
-        super().__init__(env)
+        gymnasium.utils.RecordConstructorArgs.__init__(
+            self, spec=spec, valuation=valuation, formula=formula, reward=reward, offset=offset, scale=scale
+        )
+        gymnasium.Wrapper.__init__(self, env)
         # `spec` is gymnasium's (the environment's registration) on a wrapper.
         self.stl_spec = spec if isinstance(spec, Spec) else Spec.load(spec)
         self.formula = formula
@@ -221,8 +230,7 @@ def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Calla
         missing = [v for v in vars if v not in valuation]
         if missing:
             raise _missing(f"valuation has no entry for state variable `{missing[0]}`", vars)
-        picks = [(v, valuation[v]) for v in vars]
-        return lambda obs: {v: obs[k] for v, k in picks}
+        return _Picks([(v, valuation[v]) for v in vars])
     if valuation is not None:
         raise TypeError(
             f"valuation must be a callable or a dict from state variables to observation indices; got {type(valuation).__name__}"
@@ -235,15 +243,30 @@ def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Calla
                 "  help: pass valuation=, a function from the observation to the state variables"
             )
         if vars == ["x", "y"]:
-            return lambda obs: obs
-        picks = [(v, 0 if v == "x" else 1) for v in vars]
-        return lambda obs: {v: obs[k] for v, k in picks}
+            return _identity
+        return _Picks([(v, 0 if v == "x" else 1) for v in vars])
     if isinstance(env.observation_space, spaces.Dict):
-        return lambda obs: obs
+        return _identity
     raise TypeError(
         f"STLReward cannot read state variables from a {type(env.observation_space).__name__} observation\n"
         '  help: pass valuation=, a function from the observation to the state variables (or a dict such as {"x": 0, "y": 1})'
     )
+
+
+def _identity(obs: Any) -> Any:
+    """An observation that is the state itself (a module function, so that it pickles)."""
+    return obs
+
+
+class _Picks:
+    """The state variables picked from an observation by index or key (a class, so that it
+    pickles)."""
+
+    def __init__(self, picks: Sequence[tuple[str, Any]]) -> None:
+        self.picks = list(picks)
+
+    def __call__(self, obs: Any) -> dict:
+        return {v: obs[k] for v, k in self.picks}
 
 
 def _missing(message: str, vars: Sequence[str]) -> Exception:

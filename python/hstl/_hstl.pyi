@@ -93,7 +93,8 @@ class Spec:
     def online(self, formula: Optional[str] = None) -> OnlineMonitor: ...
 
 class OnlineMonitor:
-    """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``."""
+    """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``. It pickles
+    and deep-copies mid-trace."""
 
     @property
     def horizon(self) -> Optional[int]: ...
@@ -104,6 +105,8 @@ class OnlineMonitor:
     def update(self, state: State) -> Optional[Tuple[int, float]]: ...
     def provisional(self) -> Optional[float]: ...
     def finish(self) -> list[Tuple[int, float]]: ...
+    @staticmethod
+    def _restore(spec: Spec, formula: Optional[str], skipped: int, states: Sequence[float]) -> OnlineMonitor: ...
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
@@ -150,9 +153,12 @@ class World:
     def _index(self, x: int, y: int) -> Optional[int]: ...
 
 class Generator:
-    """The one random generator of a ``GridWorldEnv`` (ChaCha8, as the learner's)."""
+    """The one random generator of a ``GridWorldEnv`` (ChaCha8, as the learner's); it
+    pickles and copies by its whole state."""
 
     def __init__(self, seed: int) -> None: ...
+    @staticmethod
+    def _from_state(key: Sequence[int], stream: int, pos_high: int, pos_low: int) -> Generator: ...
 
 class Policy:
     """A trained policy and its ``policy.json``; see ``help(hstl.Policy)``."""
@@ -201,7 +207,8 @@ class Policy:
     ) -> dict[str, Any]: ...
 
 class EpisodeMonitor:
-    """Scores an episode state by state, for ``hstl.STLReward``."""
+    """Scores an episode state by state, for ``hstl.STLReward``; it pickles and
+    deep-copies mid-episode."""
 
     def __init__(
         self,
@@ -213,6 +220,10 @@ class EpisodeMonitor:
     ) -> None: ...
     def reset(self) -> None: ...
     def push(self, state: State, last: bool = False) -> Tuple[float, float, Optional[bool]]: ...
+    @staticmethod
+    def _restore(
+        spec: Spec, formula: Optional[str], reward: RewardForm, offset: float, scale: float, states: Sequence[float]
+    ) -> EpisodeMonitor: ...
     @property
     def reward(self) -> RewardForm: ...
     @property

@@ -2,6 +2,7 @@
 
 use hstl::reward::{EpisodeMonitor as Inner, RewardForm, Shaping};
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
 use crate::errors::{lower_error, trace_error, value_error};
 use crate::spec::Spec;
@@ -10,9 +11,14 @@ use crate::trace::state_values;
 /// Scores the states of one episode as they arrive: the reward `rho(formula, t)` over the
 /// states so far, the task's robustness `rho(task, 0)` over them and, for a persistent
 /// task, whether the window ending at `t` is kept. See `hstl.STLReward`.
+///
+/// It pickles and copies mid-episode: by its spec, formula, reward form and the states of
+/// the episode so far, which the copy replays.
 #[pyclass(module = "hstl._hstl")]
 pub struct EpisodeMonitor {
     inner: Inner,
+    spec: Py<Spec>,
+    formula: Option<String>,
 }
 
 #[pymethods]
@@ -26,13 +32,52 @@ impl EpisodeMonitor {
         offset: f64,
         scale: f64,
     ) -> PyResult<EpisodeMonitor> {
+        let spec_obj = spec;
         let spec = spec.get();
         let inner = Inner::new(&spec.spec, &spec.source, formula)
             .map_err(|e| lower_error(&spec.filename, &e))?;
         let bad = |e: hstl::reward::RewardError| value_error(e.to_string(), e.help());
         let form = RewardForm::parse(reward).map_err(bad)?;
         let inner = inner.with_shaping(Shaping { form, offset, scale }, formula).map_err(bad)?;
-        Ok(EpisodeMonitor { inner })
+        Ok(EpisodeMonitor {
+            inner,
+            spec: spec_obj.clone().unbind(),
+            formula: formula.map(String::from),
+        })
+    }
+
+    /// The monitor `__reduce__` describes: made anew, then the episode's states replayed.
+    #[staticmethod]
+    #[allow(clippy::too_many_arguments)]
+    fn _restore(
+        py: Python<'_>,
+        spec: &Bound<'_, Spec>,
+        formula: Option<&str>,
+        reward: &str,
+        offset: f64,
+        scale: f64,
+        states: Vec<f64>,
+    ) -> PyResult<EpisodeMonitor> {
+        let mut monitor = EpisodeMonitor::new(spec, formula, reward, offset, scale)?;
+        monitor.inner.restore(&states).map_err(|e| trace_error(py, &e))?;
+        Ok(monitor)
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let this = slf.borrow();
+        let shaping = this.inner.shaping();
+        let args = (
+            this.spec.clone_ref(slf.py()),
+            this.formula.clone(),
+            shaping.form.name(),
+            shaping.offset,
+            shaping.scale,
+            this.inner.episode_states().to_vec(),
+        )
+            .into_pyobject(slf.py())?;
+        Ok((slf.get_type().getattr("_restore")?, args))
     }
 
     /// Starts a new episode.

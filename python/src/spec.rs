@@ -140,6 +140,11 @@ impl Spec {
         })
     }
 
+    /// A new online monitor of the task or of the `let` called `formula`.
+    pub(crate) fn online_of(&self, formula: Option<&str>) -> PyResult<hstl::monitor::Online> {
+        Ok(self.monitor(formula)?.online())
+    }
+
     /// The monitor of the task or of the `let` called `formula`, lowered once.
     fn monitor(&self, formula: Option<&str>) -> PyResult<Arc<Monitor>> {
         let key = formula.map(str::to_string);
@@ -308,8 +313,9 @@ impl Spec {
     /// An online monitor of the task (or of the `let` called `formula`), fed one state at
     /// a time; see `hstl.OnlineMonitor`.
     #[pyo3(signature = (formula=None))]
-    fn online(&self, formula: Option<&str>) -> PyResult<OnlineMonitor> {
-        Ok(OnlineMonitor::new(self.monitor(formula)?.online()))
+    fn online(slf: &Bound<'_, Self>, formula: Option<&str>) -> PyResult<OnlineMonitor> {
+        let inner = slf.get().online_of(formula)?;
+        Ok(OnlineMonitor::new(inner, slf.clone().unbind(), formula.map(String::from)))
     }
 
     fn __reduce__<'py>(
