@@ -46,6 +46,18 @@ class Diagnostic:
         help: Optional[str] = None,
     ) -> None: ...
 
+def check(
+    path_or_text: Union[str, PathLike[str]], world: Union["World", str, PathLike[str], None] = None
+) -> list[Diagnostic]:
+    """Every diagnostic of a spec file or text (errors, warnings and notes, in source
+    order), as ``hstlc check --format json`` gives them; the specs with options are checked
+    against ``world`` too when one is given. A ``str`` with a newline or ``{`` is spec
+    text, another ``str`` or an ``os.PathLike`` a path."""
+
+def explain(code: str) -> str:
+    """The long explanation of a diagnostic code (``"HSTL150"``), as ``hstlc explain``
+    prints it; ``ValueError`` for an unknown code."""
+
 class Spec:
     """A checked hstl spec, ready to monitor traces."""
 
@@ -53,6 +65,8 @@ class Spec:
     def load(path: Union[str, PathLike[str]], name: Optional[str] = None) -> Spec: ...
     @staticmethod
     def parse(text: str, filename: str = "<string>", name: Optional[str] = None) -> Spec: ...
+    @staticmethod
+    def _unpickle(text: str, filename: str, name: Optional[str]) -> Spec: ...
     @property
     def name(self) -> str: ...
     @property

@@ -62,6 +62,19 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// The line `hstlc check --format concise` prints for it.
+    pub fn concise(&self) -> String {
+        format!(
+            "{}:{}:{}: {} {}: {}",
+            self.file, self.line, self.column, self.code, self.severity, self.message
+        )
+    }
+
+    /// How to fix it.
+    pub fn help(&self) -> Option<&str> {
+        self.help.as_deref()
+    }
+
     pub fn new(file: &str, d: &hstl::lang::Diagnostic, at: Location) -> Diagnostic {
         Diagnostic {
             file: file.to_string(),
@@ -112,24 +125,26 @@ impl Diagnostic {
 
     /// The line `hstlc check --format concise` prints for it.
     fn __str__(&self) -> String {
-        format!(
-            "{}:{}:{}: {} {}: {}",
-            self.file, self.line, self.column, self.code, self.severity, self.message
-        )
+        self.concise()
     }
 }
 
 impl Spec {
-    /// Checks `source` (reported as `filename`) and picks the spec called `name`.
+    /// Checks `source` (reported as `filename`) and picks the spec called `name`; its
+    /// warnings are issued as `hstl.SpecWarning`s unless `quiet`.
     pub(crate) fn from_source(
         py: Python<'_>,
         source: String,
         filename: String,
         name: Option<String>,
+        quiet: bool,
     ) -> PyResult<Spec> {
         let loaded = py
             .detach(|| hstl::load::load(&source, name.as_deref()))
             .map_err(|e| errors::load_error(py, &filename, &source, e))?;
+        if !quiet {
+            errors::warn_spec(py, &filename, &source, &loaded.diagnostics)?;
+        }
         Ok(Spec {
             source,
             filename,
@@ -173,7 +188,7 @@ impl Spec {
         let source = crate::files::read_text(&path, hstl::lang::MAX_SOURCE_BYTES, "spec", |e| {
             errors::read_error(&path, e)
         })?;
-        Spec::from_source(py, source, path.display().to_string(), name)
+        Spec::from_source(py, source, path.display().to_string(), name, false)
     }
 
     /// Checks the spec text `text` (reported as `filename`), and picks the spec called
@@ -188,7 +203,19 @@ impl Spec {
         filename: String,
         name: Option<String>,
     ) -> PyResult<Spec> {
-        Spec::from_source(py, text, filename, name)
+        Spec::from_source(py, text, filename, name, false)
+    }
+
+    /// `parse` without the warnings, which the original already issued: how a spec
+    /// unpickles.
+    #[staticmethod]
+    fn _unpickle(
+        py: Python<'_>,
+        text: String,
+        filename: String,
+        name: Option<String>,
+    ) -> PyResult<Spec> {
+        Spec::from_source(py, text, filename, name, true)
     }
 
     /// The spec's name.
@@ -323,7 +350,7 @@ impl Spec {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let py = slf.py();
         let this = slf.get();
-        let parse = slf.get_type().getattr("parse")?;
+        let parse = slf.get_type().getattr("_unpickle")?;
         let args = PyTuple::new(
             py,
             [

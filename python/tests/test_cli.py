@@ -116,8 +116,11 @@ def test_spec_error_is_check_concise_and_json(hstlc, monkeypatch):
 def test_warnings_come_with_the_spec_as_check_lists_them(hstlc, monkeypatch):
     monkeypatch.chdir(CLI_FIXTURES)
     listed = json.loads(run_cli(hstlc, "check", "--format", "json", "warnings.hstl").stdout)
-    spec = hstl.Spec.load("warnings.hstl")
+    with pytest.warns(hstl.SpecWarning) as issued:
+        spec = hstl.Spec.load("warnings.hstl")
     assert listed and all(d["severity"] == "warning" for d in listed)
+    # Each is issued as a Python warning, and hstl.check lists the same.
+    assert [w.message.diagnostic for w in issued] == spec.diagnostics == hstl.check("warnings.hstl")
     assert [d.code for d in spec.diagnostics] == [d["code"] for d in listed]
     assert [(d.line, d.column, d.end_line, d.end_column) for d in spec.diagnostics] == [
         (d["line"], d["column"], d["end_line"], d["end_column"]) for d in listed

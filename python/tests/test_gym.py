@@ -213,8 +213,8 @@ def test_increments_add_up_to_the_task_robustness_of_the_episode():
 
 PATROL = """spec Patrol {
     state { x: int in 0..=14, y: int in 0..=14 }
-    let Low = y <= 5;
-    let Left = x <= 5;
+    let Low = y < 6;
+    let Left = x < 6;
     task always[0..] (eventually[0..=10] Low && eventually[0..=10] Left);
 }"""
 
