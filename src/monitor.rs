@@ -187,6 +187,49 @@ pub enum BatchError {
     },
 }
 
+/// How the windows at the end of a finite trace count (`hstlc monitor --windows`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Windows {
+    /// Clipped at the end of the trace (rtamt's semantics, the default).
+    #[default]
+    Clipped,
+    /// A step counts only if every window its value needs lies inside the trace
+    /// ([`hstl_robustness::complete`]); later steps are undetermined (NaN).
+    Complete,
+}
+
+impl Windows {
+    /// The choice called `name` (`"clipped"` or `"complete"`).
+    pub fn parse(name: &str) -> Result<Windows, UnknownWindows> {
+        match name {
+            "clipped" => Ok(Windows::Clipped),
+            "complete" => Ok(Windows::Complete),
+            _ => Err(UnknownWindows(name.to_string())),
+        }
+    }
+}
+
+/// A `windows` choice that is neither `clipped` nor `complete`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownWindows(pub String);
+
+impl UnknownWindows {
+    /// How to fix it.
+    pub fn help(&self) -> String {
+        "pass \"clipped\" (windows cut at the end of the trace, the default) or \"complete\" \
+         (only steps whose windows lie inside the trace)"
+            .to_string()
+    }
+}
+
+impl fmt::Display for UnknownWindows {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown windows `{}`", self.0)
+    }
+}
+
+impl std::error::Error for UnknownWindows {}
+
 /// An online monitor over named state variables: one state at a time, NaN refused.
 #[derive(Clone, Debug)]
 pub struct Online {
@@ -291,6 +334,39 @@ impl Monitor {
         Ok(rob::complete::signal(&self.formula, &trace))
     }
 
+    /// The signal with `windows` counted as asked, one value per step: over complete
+    /// windows the undetermined steps (past the complete prefix) are NaN.
+    pub fn signal_in(
+        &self,
+        samples: &Samples<'_>,
+        windows: Windows,
+    ) -> Result<Vec<f64>, TraceError> {
+        match windows {
+            Windows::Clipped => self.signal(samples),
+            Windows::Complete => {
+                let len = self.lengths(samples)?;
+                let mut signal = self.complete_signal(samples)?;
+                signal.resize(len, f64::NAN);
+                Ok(signal)
+            }
+        }
+    }
+
+    /// The robustness at step 0 with `windows` counted as asked: NaN over complete windows
+    /// when step 0 is undetermined (the trace is too short for its windows).
+    pub fn robustness_in(
+        &self,
+        samples: &Samples<'_>,
+        windows: Windows,
+    ) -> Result<f64, TraceError> {
+        match windows {
+            Windows::Clipped => self.robustness(samples),
+            Windows::Complete => {
+                Ok(self.complete_signal(samples)?.first().copied().unwrap_or(f64::NAN))
+            }
+        }
+    }
+
     /// [`Monitor::complete_signal`] of a trace whose samples its reader checked.
     pub fn complete_signal_of_trace(&self, trace: &rob::Trace) -> Result<Vec<f64>, TraceError> {
         self.nan_prone.check_trace(trace, trace.len())?;
@@ -336,6 +412,17 @@ impl Monitor {
         traces: &[Samples<'_>],
         threads: usize,
     ) -> Result<(Vec<f64>, usize), BatchError> {
+        self.signal_batch_in(traces, threads, Windows::Clipped)
+    }
+
+    /// [`Monitor::signal_batch`] with `windows` counted as asked (see
+    /// [`Monitor::signal_in`]).
+    pub fn signal_batch_in(
+        &self,
+        traces: &[Samples<'_>],
+        threads: usize,
+        windows: Windows,
+    ) -> Result<(Vec<f64>, usize), BatchError> {
         let steps = self.batch_steps(traces)?;
         let mut out = vec![0.0; traces.len() * steps];
         if traces.is_empty() {
@@ -352,6 +439,14 @@ impl Monitor {
                 let fail = |error| BatchError::Trace { trace: first + k, error };
                 self.check_nan(samples, steps).map_err(fail)?;
                 let cols = columns(samples, steps, &mut scratch);
+                if windows == Windows::Complete {
+                    let trace = rob::Trace::from_columns(cols.iter().map(|c| c.to_vec()).collect())
+                        .map_err(|e| fail(self.ragged(&cols, e)))?;
+                    let signal = rob::complete::signal(&self.formula, &trace);
+                    row.fill(f64::NAN);
+                    row[..signal.len()].copy_from_slice(&signal);
+                    continue;
+                }
                 let signal = eval
                     .signal_of_slices(&self.formula, &cols)
                     .map_err(|e| fail(self.ragged(&cols, e)))?;

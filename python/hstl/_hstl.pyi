@@ -17,6 +17,9 @@ Trace = Union[Mapping[str, Any], npt.ArrayLike]
 Batch = Union[Sequence[Trace], Mapping[str, Any], npt.ArrayLike]
 #: One state for the online monitor: names to numbers, or numbers in state-variable order.
 State = Union[Mapping[str, float], Sequence[float], npt.ArrayLike]
+#: How the windows at the end of a trace count: cut there (``"clipped"``, the default), or a
+#: step counts only if its windows lie inside the trace (``"complete"``; later steps NaN).
+Windows = Literal["clipped", "complete"]
 #: What ``hstl.STLReward`` rewards a step with (see its docs).
 RewardForm = Literal["robustness", "increment", "window", "sparse"]
 
@@ -88,6 +91,7 @@ class Spec:
         formula: Optional[str] = None,
         *,
         columns: Optional[Sequence[str]] = None,
+        windows: Windows = "clipped",
     ) -> float: ...
     def signal(
         self,
@@ -95,6 +99,7 @@ class Spec:
         formula: Optional[str] = None,
         *,
         columns: Optional[Sequence[str]] = None,
+        windows: Windows = "clipped",
     ) -> npt.NDArray[np.float64]: ...
     def signal_batch(
         self,
@@ -103,6 +108,7 @@ class Spec:
         *,
         columns: Optional[Sequence[str]] = None,
         threads: Optional[int] = None,
+        windows: Windows = "clipped",
     ) -> npt.NDArray[np.float64]: ...
     def online(self, formula: Optional[str] = None) -> OnlineMonitor: ...
 

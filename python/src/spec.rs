@@ -175,6 +175,11 @@ impl Spec {
     }
 }
 
+/// The `windows=` choice, or a `ValueError` naming both.
+fn windows_of(name: &str) -> PyResult<hstl::monitor::Windows> {
+    hstl::monitor::Windows::parse(name).map_err(|e| value_error(e.to_string(), Some(e.help())))
+}
+
 #[pymethods]
 impl Spec {
     /// Reads and checks the spec file at `path`, and picks the spec called `name` (needed
@@ -273,34 +278,47 @@ impl Spec {
     ///
     /// For a formula with horizon `H` only the first `H + 1` steps are read (and checked
     /// for NaN), so a long float64 trace costs no more than a short one.
-    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    ///
+    /// `windows="complete"` counts a step only if every window its value needs lies
+    /// inside the trace (`hstlc monitor --windows complete`): NaN when step 0 is
+    /// undetermined (the trace is too short for its windows). The whole trace is read.
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
     fn robustness(
         &self,
         py: Python<'_>,
         trace: &Bound<'_, PyAny>,
         formula: Option<&str>,
         columns: Option<&Bound<'_, PyAny>>,
+        windows: &str,
     ) -> PyResult<f64> {
+        let windows = windows_of(windows)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
-        py.detach(|| monitor.robustness(&samples)).map_err(|e| trace_error(py, &e))
+        py.detach(|| monitor.robustness_in(&samples, windows)).map_err(|e| trace_error(py, &e))
     }
 
     /// The robustness signal of the trace: a float64 array with one value per step, the
     /// rows `hstlc monitor --signal` prints.
-    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    ///
+    /// `windows="complete"` counts a step only if every window its value needs lies
+    /// inside the trace (`--windows complete`); the later steps, undetermined, are NaN
+    /// (the empty fields of `--signal`).
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
     fn signal<'py>(
         &self,
         py: Python<'py>,
         trace: &Bound<'py, PyAny>,
         formula: Option<&str>,
         columns: Option<&Bound<'py, PyAny>>,
+        windows: &str,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let windows = windows_of(windows)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
-        let signal = py.detach(|| monitor.signal(&samples)).map_err(|e| trace_error(py, &e))?;
+        let signal =
+            py.detach(|| monitor.signal_in(&samples, windows)).map_err(|e| trace_error(py, &e))?;
         Ok(PyArray1::from_vec(py, signal))
     }
 
@@ -310,8 +328,9 @@ impl Spec {
     ///
     /// `traces` is a list of traces (as `signal` takes them), a 3-D array of shape
     /// (traces, steps, columns) whose columns `columns=` names, or a mapping from each
-    /// state variable to a 2-D array of shape (traces, steps).
-    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None))]
+    /// state variable to a 2-D array of shape (traces, steps). `windows` is as for
+    /// `signal`.
+    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None, windows="clipped"))]
     fn signal_batch<'py>(
         &self,
         py: Python<'py>,
@@ -319,7 +338,9 @@ impl Spec {
         formula: Option<&str>,
         columns: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
+        windows: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let windows = windows_of(windows)?;
         let threads = match threads {
             Some(0) => return Err(value_error("`threads` must be at least 1", None)),
             Some(n) => n,
@@ -330,7 +351,7 @@ impl Spec {
         let samples = held.samples()?;
         let n = samples.len();
         let (out, steps) = py
-            .detach(|| monitor.signal_batch(&samples, threads))
+            .detach(|| monitor.signal_batch_in(&samples, threads, windows))
             .map_err(|e| batch_error(py, &e))?;
         // An array of no traces still has steps.
         let steps = if n == 0 { held.shape_steps().unwrap_or(0) } else { steps };
