@@ -109,6 +109,50 @@ pub fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loa
     Ok(Loaded { spec, diagnostics: checked.diagnostics })
 }
 
+/// Every diagnostic of `source` (errors, warnings and notes, in source order), as `hstlc
+/// check` reports them; the specs with options are also checked against `world` (its label
+/// naming it in messages) when one is given.
+pub fn check(source: &str, world: Option<(&crate::world::GridWorld, &str)>) -> Vec<Diagnostic> {
+    match world {
+        Some((world, label)) => crate::world::check(source, world, label).diagnostics,
+        None => hstl_lang::check(source).diagnostics,
+    }
+}
+
+/// The long explanation of a diagnostic code (case-insensitive), as `hstlc explain`
+/// prints it: `CODE (name): summary`, a blank line and the explanation.
+pub fn explain(code: &str) -> Result<String, UnknownCode> {
+    let wanted = code.trim().to_ascii_uppercase();
+    let info = hstl_lang::codes::lookup(&wanted).ok_or_else(|| UnknownCode(code.to_string()))?;
+    Ok(format!(
+        "{} ({}): {}\n\n{}",
+        info.code,
+        info.name,
+        info.summary,
+        info.explanation.trim_end()
+    ))
+}
+
+/// A code that names no diagnostic.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownCode(pub String);
+
+impl UnknownCode {
+    /// How to fix it: the known codes.
+    pub fn help(&self) -> String {
+        let known: Vec<&str> = hstl_lang::codes::CODES.iter().map(|c| c.code).collect();
+        format!("known codes: {}", known.join(", "))
+    }
+}
+
+impl fmt::Display for UnknownCode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown diagnostic code `{}`", self.0)
+    }
+}
+
+impl std::error::Error for UnknownCode {}
+
 /// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
 /// "(os error N)" tail.
 pub fn read_error(path: &Path, error: &std::io::Error) -> String {

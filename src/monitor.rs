@@ -197,6 +197,49 @@ pub enum BatchError {
     },
 }
 
+/// How the windows at the end of a finite trace count (`hstlc monitor --windows`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Windows {
+    /// Clipped at the end of the trace (rtamt's semantics, the default).
+    #[default]
+    Clipped,
+    /// A step counts only if every window its value needs lies inside the trace
+    /// ([`hstl_robustness::complete`]); later steps are undetermined (NaN).
+    Complete,
+}
+
+impl Windows {
+    /// The choice called `name` (`"clipped"` or `"complete"`).
+    pub fn parse(name: &str) -> Result<Windows, UnknownWindows> {
+        match name {
+            "clipped" => Ok(Windows::Clipped),
+            "complete" => Ok(Windows::Complete),
+            _ => Err(UnknownWindows(name.to_string())),
+        }
+    }
+}
+
+/// A `windows` choice that is neither `clipped` nor `complete`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownWindows(pub String);
+
+impl UnknownWindows {
+    /// How to fix it.
+    pub fn help(&self) -> String {
+        "pass \"clipped\" (windows cut at the end of the trace, the default) or \"complete\" \
+         (only steps whose windows lie inside the trace)"
+            .to_string()
+    }
+}
+
+impl fmt::Display for UnknownWindows {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "unknown windows `{}`", self.0)
+    }
+}
+
+impl std::error::Error for UnknownWindows {}
+
 /// An online monitor over named state variables: one state at a time, NaN refused.
 #[derive(Clone, Debug)]
 pub struct Online {
@@ -204,6 +247,21 @@ pub struct Online {
     domains: Vec<ValueDomain>,
     nan_prone: NanProne,
     inner: OnlineMonitor,
+    /// The steps before the states `inner` was given: a restored monitor's.
+    offset: usize,
+    /// Every state of the trace, row after row, for a formula with a past-time operator
+    /// (whose verdicts read states the monitor no longer holds): what a snapshot replays.
+    log: Option<Vec<f64>>,
+}
+
+/// An online monitor's state as plain data ([`Online::snapshot`]): the states it replays
+/// and the steps before them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OnlineState {
+    /// The steps before `states`, whose verdicts were all given.
+    pub skipped: usize,
+    /// States, row after row (one value per state variable).
+    pub states: Vec<f64>,
 }
 
 impl Monitor {
@@ -286,6 +344,39 @@ impl Monitor {
         Ok(rob::complete::signal(&self.formula, &trace))
     }
 
+    /// The signal with `windows` counted as asked, one value per step: over complete
+    /// windows the undetermined steps (past the complete prefix) are NaN.
+    pub fn signal_in(
+        &self,
+        samples: &Samples<'_>,
+        windows: Windows,
+    ) -> Result<Vec<f64>, TraceError> {
+        match windows {
+            Windows::Clipped => self.signal(samples),
+            Windows::Complete => {
+                let len = self.lengths(samples)?;
+                let mut signal = self.complete_signal(samples)?;
+                signal.resize(len, f64::NAN);
+                Ok(signal)
+            }
+        }
+    }
+
+    /// The robustness at step 0 with `windows` counted as asked: NaN over complete windows
+    /// when step 0 is undetermined (the trace is too short for its windows).
+    pub fn robustness_in(
+        &self,
+        samples: &Samples<'_>,
+        windows: Windows,
+    ) -> Result<f64, TraceError> {
+        match windows {
+            Windows::Clipped => self.robustness(samples),
+            Windows::Complete => {
+                Ok(self.complete_signal(samples)?.first().copied().unwrap_or(f64::NAN))
+            }
+        }
+    }
+
     /// [`Monitor::complete_signal`] of a trace whose samples its reader checked.
     pub fn complete_signal_of_trace(&self, trace: &rob::Trace) -> Result<Vec<f64>, TraceError> {
         self.nan_prone.check_trace(trace, trace.len())?;
@@ -331,6 +422,17 @@ impl Monitor {
         traces: &[Samples<'_>],
         threads: usize,
     ) -> Result<(Vec<f64>, usize), BatchError> {
+        self.signal_batch_in(traces, threads, Windows::Clipped)
+    }
+
+    /// [`Monitor::signal_batch`] with `windows` counted as asked (see
+    /// [`Monitor::signal_in`]).
+    pub fn signal_batch_in(
+        &self,
+        traces: &[Samples<'_>],
+        threads: usize,
+        windows: Windows,
+    ) -> Result<(Vec<f64>, usize), BatchError> {
         let steps = self.batch_steps(traces)?;
         let mut out = vec![0.0; traces.len() * steps];
         if traces.is_empty() {
@@ -347,6 +449,14 @@ impl Monitor {
                 let fail = |error| BatchError::Trace { trace: first + k, error };
                 self.check_nan(samples, steps).map_err(fail)?;
                 let cols = columns(samples, steps, &mut scratch);
+                if windows == Windows::Complete {
+                    let trace = rob::Trace::from_columns(cols.iter().map(|c| c.to_vec()).collect())
+                        .map_err(|e| fail(self.ragged(&cols, e)))?;
+                    let signal = rob::complete::signal(&self.formula, &trace);
+                    row.fill(f64::NAN);
+                    row[..signal.len()].copy_from_slice(&signal);
+                    continue;
+                }
                 let signal = eval
                     .signal_of_slices(&self.formula, &cols)
                     .map_err(|e| fail(self.ragged(&cols, e)))?;
@@ -398,6 +508,8 @@ impl Monitor {
             domains: self.domains.clone(),
             nan_prone: self.nan_prone.clone(),
             inner: OnlineMonitor::new(&self.formula, self.vars.len()),
+            offset: 0,
+            log: self.formula.has_past().then(Vec::new),
         }
     }
 
@@ -518,7 +630,40 @@ impl Online {
 
     /// The number of states pushed since creation or the last [`Online::finish`].
     pub fn steps(&self) -> usize {
-        self.inner.steps()
+        self.offset + self.inner.steps()
+    }
+
+    /// The monitor's state as plain data: the states from the first step without a
+    /// verdict on (at most `H` for a bounded formula; every state of the trace for an
+    /// unbounded one or one with a past-time operator) and how many steps came before.
+    /// [`Online::restore`] on a monitor of the same formula continues exactly from it.
+    pub fn snapshot(&self) -> OnlineState {
+        if let Some(log) = &self.log {
+            return OnlineState { skipped: 0, states: log.clone() };
+        }
+        let columns = self.inner.open_columns();
+        let open = columns.first().map_or(0, |c| c.len());
+        let states = (0..open).flat_map(|t| columns.iter().map(move |c| c[t])).collect();
+        OnlineState { skipped: self.steps() - open, states }
+    }
+
+    /// Starts a new trace and replays `state`, so the monitor continues where the one
+    /// that gave the snapshot was (same formula). States it would refuse are refused and
+    /// leave it at a new trace.
+    pub fn restore(&mut self, state: &OnlineState) -> Result<(), TraceError> {
+        self.finish();
+        let width = self.vars.len();
+        if width == 0 || !state.states.len().is_multiple_of(width) {
+            return Err(TraceError::Layout { len: state.states.len(), width });
+        }
+        for row in state.states.chunks(width) {
+            if let Err(e) = self.push(row) {
+                self.finish();
+                return Err(e);
+            }
+        }
+        self.offset = state.skipped;
+        Ok(())
     }
 
     /// Appends one state (`state[i]` is state variable `i`) and returns the verdict it
@@ -540,12 +685,16 @@ impl Online {
             return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
         }
         self.nan_prone.check_state(state, self.steps())?;
-        self.inner.push(state).map_err(|e| match e {
+        let verdict = self.inner.push(state).map_err(|e| match e {
             rob::TraceError::Budget { steps, horizon, limit } => {
                 TraceError::Budget { steps, horizon, limit }
             }
             _ => TraceError::Width { vars: self.vars.clone(), found: state.len() },
-        })
+        })?;
+        if let Some(log) = &mut self.log {
+            log.extend_from_slice(state);
+        }
+        Ok(verdict.map(|v| Verdict { step: v.step + self.offset, ..v }))
     }
 
     /// What `rho(f, t)` at the first step without a verdict would be if the trace ended
@@ -557,14 +706,25 @@ impl Online {
     /// Ends the trace: the verdicts of every step still open, windows clipped at the end.
     /// The monitor then starts a new trace at step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
-        self.inner.finish()
+        let out = self.inner.finish();
+        self.new_trace(out)
     }
 
     /// Ends the trace over complete windows: the verdicts of the open steps whose windows
     /// all lie inside the trace (none for a bounded formula); later steps are undetermined.
     /// The monitor then starts a new trace at step 0.
     pub fn finish_complete(&mut self) -> Vec<Verdict> {
-        self.inner.finish_complete()
+        let out = self.inner.finish_complete();
+        self.new_trace(out)
+    }
+
+    /// The verdicts `out` numbered from the trace's start; the monitor at a new trace.
+    fn new_trace(&mut self, out: Vec<Verdict>) -> Vec<Verdict> {
+        let offset = std::mem::take(&mut self.offset);
+        if let Some(log) = &mut self.log {
+            log.clear();
+        }
+        out.into_iter().map(|v| Verdict { step: v.step + offset, ..v }).collect()
     }
 }
 

@@ -16,6 +16,14 @@
 //!   window ending at `t` is **kept** (`psi(t)` of LANGUAGE.md: every region held within
 //!   its last `N_j` steps), the measure the window rate counts.
 //!
+//! The reward takes one of four forms ([`RewardForm`]), then `scale * value + offset`
+//! ([`Shaping`]): the robustness above, `rho(formula, t)`; its **increment**, the change
+//! of `rho(formula, 0)` over the prefix since the state before, so the rewards of an
+//! episode add up to the formula's robustness over the whole episode; the **window**
+//! reward of a persistent task, 1 for a state whose windows are all kept and 0 otherwise
+//! (the learner's reward); and the **sparse** reward, `rho(formula, 0)` over the episode
+//! at its last state ([`EpisodeMonitor::push_last`]) and 0 before.
+//!
 //! Cost per state: the reward is `O(|formula|)` (the formula on one state, each shared
 //! node once; `O(t |formula|)` with a past-time operator). The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
@@ -46,8 +54,118 @@ use hstl_robustness::{
     Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor,
 };
 
+use std::fmt;
+
 use crate::lower::{self, LowerError};
 use crate::monitor::{NanProne, TraceError};
+
+/// What an [`EpisodeMonitor`] rewards a state with (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RewardForm {
+    /// `rho(formula, t)` over the trace so far.
+    Robustness,
+    /// The change of `rho(formula, 0)` over the prefix since the state before: an
+    /// episode's rewards add up to the formula's robustness over the episode.
+    Increment,
+    /// 1 when every window of the persistent task ending at the state is kept, else 0.
+    Window,
+    /// `rho(formula, 0)` over the episode at its last state, 0 before.
+    Sparse,
+}
+
+impl RewardForm {
+    /// Every form, in the order of [`RewardForm::NAMES`].
+    pub const ALL: [RewardForm; 4] =
+        [RewardForm::Robustness, RewardForm::Increment, RewardForm::Window, RewardForm::Sparse];
+
+    /// The forms' names, as `STLReward(reward=...)` takes them.
+    pub const NAMES: [&str; 4] = ["robustness", "increment", "window", "sparse"];
+
+    /// The form called `name`.
+    pub fn parse(name: &str) -> Result<RewardForm, RewardError> {
+        Self::NAMES
+            .iter()
+            .position(|n| *n == name)
+            .map(|i| Self::ALL[i])
+            .ok_or_else(|| RewardError::UnknownForm(name.to_string()))
+    }
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[Self::ALL.iter().position(|f| *f == self).unwrap_or(0)]
+    }
+}
+
+/// The reward's form and the affine map applied to it: `scale * value + offset`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shaping {
+    /// The form.
+    pub form: RewardForm,
+    /// Added to every state's reward (a bonus per step when positive).
+    pub offset: f64,
+    /// Multiplies the form's value; positive and finite.
+    pub scale: f64,
+}
+
+impl Default for Shaping {
+    fn default() -> Shaping {
+        Shaping { form: RewardForm::Robustness, offset: 0.0, scale: 1.0 }
+    }
+}
+
+/// A reward form that does not fit the spec, or an offset or scale out of range.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RewardError {
+    /// No form has this name.
+    UnknownForm(String),
+    /// The window reward of a task that is not persistent.
+    NotPersistent,
+    /// The window reward with a `let` named: it scores the task's windows.
+    WindowOfLet(String),
+    /// An offset that is not finite.
+    Offset(f64),
+    /// A scale that is not positive and finite.
+    Scale(f64),
+}
+
+impl fmt::Display for RewardError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RewardError::UnknownForm(name) => write!(f, "unknown reward form `{name}`"),
+            RewardError::NotPersistent => {
+                write!(f, "reward form `window` needs a persistent task, and this task is not one")
+            }
+            RewardError::WindowOfLet(name) => {
+                write!(f, "reward form `window` scores the task's windows, not the `let` `{name}`")
+            }
+            RewardError::Offset(v) => write!(f, "reward offset must be a finite number; got {v}"),
+            RewardError::Scale(v) => {
+                write!(f, "reward scale must be a positive finite number; got {v}")
+            }
+        }
+    }
+}
+
+impl RewardError {
+    /// How to fix it.
+    pub fn help(&self) -> Option<String> {
+        Some(match self {
+            RewardError::UnknownForm(_) => {
+                format!("the forms are {}", RewardForm::NAMES.map(|n| format!("`{n}`")).join(", "))
+            }
+            RewardError::NotPersistent => {
+                "a persistent task reads `always[0..] (eventually[0..N1] R1 && ...)`; \
+                 for another task use `increment` or `sparse`"
+                    .to_string()
+            }
+            RewardError::WindowOfLet(_) => "leave out the formula".to_string(),
+            RewardError::Offset(_) => "pass a number such as 0.0 or 1.0".to_string(),
+            RewardError::Scale(_) => "pass a number such as 1.0 or 0.1".to_string(),
+        })
+    }
+}
+
+impl std::error::Error for RewardError {}
 
 /// Scores the states of one episode as they arrive (see the module docs).
 #[derive(Clone, Debug)]
@@ -55,6 +173,15 @@ pub struct EpisodeMonitor {
     vars: Vec<String>,
     reward: Formula,
     task: Running,
+    shaping: Shaping,
+    /// `rho(formula, 0)` over the prefix, for a `let` rewarded by increment or sparsely
+    /// (the task's is `task`).
+    prefix: Option<Running>,
+    /// The last finite `rho(formula, 0)` that an increment counted from (0 at first).
+    baseline: f64,
+    /// The states of the episode so far, row after row: what [`EpisodeMonitor::restore`]
+    /// replays.
+    log: Vec<f64>,
     /// Scratch values of [`at_state`].
     scratch: Vec<f64>,
     /// The states so far, when the reward formula has a past-time operator.
@@ -72,7 +199,8 @@ pub struct EpisodeMonitor {
 /// What one state of an episode earned.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepScore {
-    /// `rho(formula, t)` over the trace so far.
+    /// The reward in the monitor's form (`rho(formula, t)` over the trace so far by
+    /// default), scaled and offset.
     pub reward: f64,
     /// `rho(task, 0)` over the trace so far.
     pub task_robustness: f64,
@@ -176,6 +304,10 @@ impl EpisodeMonitor {
             vars,
             reward,
             task,
+            shaping: Shaping::default(),
+            prefix: None,
+            baseline: 0.0,
+            log: Vec::new(),
             scratch,
             history,
             regions,
@@ -184,6 +316,41 @@ impl EpisodeMonitor {
             eval: Evaluator::new(),
             nan_prone,
         })
+    }
+
+    /// The same monitor rewarding in the form and with the offset and scale of `shaping`;
+    /// `formula` is the `let` it was made for (`None`: the task).
+    pub fn with_shaping(
+        mut self,
+        shaping: Shaping,
+        formula: Option<&str>,
+    ) -> Result<EpisodeMonitor, RewardError> {
+        if !shaping.offset.is_finite() {
+            return Err(RewardError::Offset(shaping.offset));
+        }
+        if !(shaping.scale.is_finite() && shaping.scale > 0.0) {
+            return Err(RewardError::Scale(shaping.scale));
+        }
+        match (shaping.form, formula) {
+            (RewardForm::Window, Some(name)) => {
+                return Err(RewardError::WindowOfLet(name.to_string()));
+            }
+            (RewardForm::Window, None) if !self.is_persistent() => {
+                return Err(RewardError::NotPersistent);
+            }
+            (RewardForm::Increment | RewardForm::Sparse, Some(_)) => {
+                self.prefix = Some(Running::new(&self.reward, self.vars.len()));
+            }
+            _ => self.prefix = None,
+        }
+        self.shaping = shaping;
+        self.reset();
+        Ok(self)
+    }
+
+    /// The reward's form, offset and scale.
+    pub fn shaping(&self) -> Shaping {
+        self.shaping
     }
 
     /// The state variables, in the order [`EpisodeMonitor::push`] takes their values.
@@ -208,12 +375,60 @@ impl EpisodeMonitor {
             h.clear();
         }
         self.tau.iter_mut().zip(&self.regions).for_each(|(t, r)| *t = r.1);
+        if let Some(prefix) = &mut self.prefix {
+            prefix.reset();
+        }
+        self.baseline = 0.0;
+        self.log.clear();
         self.steps = 0;
+    }
+
+    /// The states of the episode so far, row after row (`state_vars().len()` values a
+    /// state): plain data from which [`EpisodeMonitor::restore`] makes a monitor with the
+    /// same spec, formula and shaping continue exactly where this one is, as a copy or
+    /// across processes. It grows by one state a step until the next reset.
+    pub fn episode_states(&self) -> &[f64] {
+        &self.log
+    }
+
+    /// Starts a new episode and pushes `states` (as [`EpisodeMonitor::episode_states`]
+    /// gives them), leaving the monitor as the one that gave them was.
+    pub fn restore(&mut self, states: &[f64]) -> Result<(), TraceError> {
+        self.reset();
+        let width = self.vars.len();
+        if width == 0 {
+            return Ok(());
+        }
+        if !states.len().is_multiple_of(width) {
+            return Err(TraceError::Layout { len: states.len(), width });
+        }
+        for state in states.chunks(width) {
+            if let Err(e) = self.push(state) {
+                self.reset();
+                return Err(e);
+            }
+        }
+        Ok(())
     }
 
     /// Appends state `s_t` (`state[i]` is state variable `i`) and scores it. A state with
     /// NaN or the wrong number of values is refused and changes nothing.
+    ///
+    /// The first state of an episode (the one a reset gives, which no action led to) earns
+    /// no increment: the increments of the later states add up to `rho(formula, 0)` over
+    /// the episode (a value that is not finite counting as 0).
     pub fn push(&mut self, state: &[f64]) -> Result<StepScore, TraceError> {
+        self.push_scored(state, false)
+    }
+
+    /// [`EpisodeMonitor::push`] for the episode's last state: the sparse form rewards it
+    /// with `rho(formula, 0)` over the episode. The next push still continues the episode;
+    /// [`EpisodeMonitor::reset`] starts the next one.
+    pub fn push_last(&mut self, state: &[f64]) -> Result<StepScore, TraceError> {
+        self.push_scored(state, true)
+    }
+
+    fn push_scored(&mut self, state: &[f64], last: bool) -> Result<StepScore, TraceError> {
         if state.len() != self.vars.len() {
             return Err(TraceError::Width { vars: self.vars.clone(), found: state.len() });
         }
@@ -222,7 +437,9 @@ impl EpisodeMonitor {
         }
         self.nan_prone.check_state(state, self.steps)?;
         self.steps += 1;
-        let reward = match &mut self.history {
+        self.log.extend_from_slice(state);
+        let robustness = match &mut self.history {
+            _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
             Some(history) => {
                 history.push(state);
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
@@ -242,6 +459,30 @@ impl EpisodeMonitor {
             Some(kept)
         };
         let task_robustness = self.task.push(state, self.steps, &mut self.eval, &mut self.scratch);
+        let prefix = match &mut self.prefix {
+            Some(p) => p.push(state, self.steps, &mut self.eval, &mut self.scratch),
+            None => task_robustness,
+        };
+        let value = match self.shaping.form {
+            RewardForm::Robustness => robustness,
+            RewardForm::Window => f64::from(u8::from(window_kept == Some(true))),
+            RewardForm::Sparse if last => prefix,
+            RewardForm::Sparse => 0.0,
+            RewardForm::Increment => {
+                let now = if prefix.is_finite() { prefix } else { 0.0 };
+                // The first state of an episode earns nothing; the baseline stays 0.
+                let gain = if self.steps == 1 { 0.0 } else { now - self.baseline };
+                if self.steps > 1 {
+                    self.baseline = now;
+                }
+                gain
+            }
+        };
+        let reward = match self.shaping {
+            // Bit for bit the form's value (`-0.0 + 0.0` would be `0.0`).
+            Shaping { offset: 0.0, scale: 1.0, .. } => value,
+            Shaping { offset, scale, .. } => scale * value + offset,
+        };
         Ok(StepScore { reward, task_robustness, window_kept })
     }
 }

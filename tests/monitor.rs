@@ -4,7 +4,7 @@
 //! input against its message.
 
 use hstl::load::{LoadError, load};
-use hstl::monitor::{BatchError, Monitor, Samples, TraceError};
+use hstl::monitor::{BatchError, Monitor, Samples, TraceError, Windows};
 use hstl::robustness::{Trace, offline};
 use serde_json::Value;
 
@@ -418,4 +418,91 @@ fn complete_windows_agree_offline_and_online_and_leave_the_end_undetermined() {
     let m = monitor("spec S { state { x: float } task always[0..=1] (sqrt(x) > 1); }", None);
     let bad = [4.0, -1.0, 9.0];
     assert!(m.complete_signal(&Samples::Columns(vec![&bad])).is_err());
+}
+
+/// An online monitor restored from its snapshot after every prefix continues exactly as
+/// the original: the same verdicts, numbered from the trace's start.
+fn check_snapshots(cases: &[Case]) {
+    for c in cases {
+        let m = case_monitor(&c.task);
+        let label = format!("case {}: {}", c.id, c.task);
+        let mut whole = m.online();
+        let mut want = Vec::new();
+        for (x, y) in c.x.iter().zip(&c.y) {
+            want.extend(whole.push(&[*x, *y]).unwrap());
+        }
+        want.extend(whole.finish());
+        for cut in 0..=c.x.len() {
+            let mut first = m.online();
+            let mut got = Vec::new();
+            for t in 0..cut {
+                got.extend(first.push(&[c.x[t], c.y[t]]).unwrap());
+            }
+            let snapshot = first.snapshot();
+            let mut back = m.online();
+            back.restore(&snapshot).unwrap();
+            assert_eq!(back.steps(), cut, "{label}, cut {cut}");
+            assert_eq!(back.snapshot(), snapshot, "{label}, cut {cut}");
+            for t in cut..c.x.len() {
+                got.extend(back.push(&[c.x[t], c.y[t]]).unwrap());
+            }
+            got.extend(back.finish());
+            assert_eq!(got, want, "{label}, cut {cut}");
+            assert_eq!(back.steps(), 0, "a new trace after finish");
+        }
+    }
+}
+
+#[test]
+fn online_monitors_restored_from_snapshots_continue_exactly() {
+    check_snapshots(&cases());
+    let past = cases_of(PAST);
+    check_snapshots(&past[..200]);
+}
+
+#[test]
+fn a_bounded_monitors_snapshot_holds_at_most_its_horizon() {
+    let m = case_monitor("always[0..=3] (x > 1)");
+    let mut online = m.online();
+    for t in 0..100 {
+        online.push(&[f64::from(t), 0.0]).unwrap();
+    }
+    let snapshot = online.snapshot();
+    assert_eq!((snapshot.skipped, snapshot.states.len()), (97, 3 * 2));
+    let mut back = m.online();
+    let e = back.restore(&hstl::monitor::OnlineState { skipped: 0, states: vec![1.0, f64::NAN] });
+    assert_eq!(e.unwrap_err().to_string(), "`y` is NaN at step 0");
+    assert_eq!(back.steps(), 0);
+}
+
+#[test]
+fn windows_complete_pads_the_undetermined_steps_with_nan_alone_and_in_batches() {
+    let m = monitor(
+        "spec S { state { x: float, y: float } \
+         task always[0..] (eventually[0..=4] x > 0 && eventually[0..=4] y > 0); }",
+        None,
+    );
+    let x: Vec<f64> = (0..12).map(|t| if t % 3 == 0 { 1.0 } else { -1.0 }).collect();
+    let y: Vec<f64> = (0..12).map(|t| if t % 3 == 1 { 1.0 } else { -1.0 }).collect();
+    let samples = Samples::Columns(vec![&x, &y]);
+    let signal = m.signal_in(&samples, Windows::Complete).unwrap();
+    assert_eq!(signal.len(), 12);
+    assert_eq!(signal[..8], [1.0; 8]);
+    assert!(signal[8..].iter().all(|v| v.is_nan()));
+    assert_eq!(m.robustness_in(&samples, Windows::Complete).unwrap(), 1.0);
+    assert_eq!(m.robustness_in(&samples, Windows::Clipped).unwrap(), -1.0);
+    assert_eq!(m.signal_in(&samples, Windows::Clipped).unwrap(), m.signal(&samples).unwrap());
+    let short = Samples::Columns(vec![&x[..3], &y[..3]]);
+    assert!(m.robustness_in(&short, Windows::Complete).unwrap().is_nan(), "undetermined");
+    let batch = [Samples::Columns(vec![&x, &y]), Samples::Columns(vec![&y, &x])];
+    let (out, steps) = m.signal_batch_in(&batch, 2, Windows::Complete).unwrap();
+    assert_eq!(steps, 12);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&out[..12]), bits(&signal));
+    let alone = m.signal_in(&batch[1], Windows::Complete).unwrap();
+    assert_eq!(bits(&out[12..]), bits(&alone));
+    assert_eq!(Windows::parse("complete"), Ok(Windows::Complete));
+    let e = Windows::parse("full").unwrap_err();
+    assert_eq!(e.to_string(), "unknown windows `full`");
+    assert!(e.help().contains("\"clipped\""));
 }

@@ -5,7 +5,7 @@
 //! and random formulas of every shape (unbounded, nested, until).
 
 use hstl::load::load;
-use hstl::reward::EpisodeMonitor;
+use hstl::reward::{EpisodeMonitor, RewardError, RewardForm, Shaping, StepScore};
 use hstl::robustness::{Trace, offline};
 use hstl::runtime::eval::RegionTable;
 use hstl::runtime::{Env, GridWorld};
@@ -232,4 +232,148 @@ fn bad_states_are_refused_and_change_nothing() {
     assert_eq!(episode.push(&[5.0, 0.0]).unwrap().task_robustness, 3.0);
     let e = EpisodeMonitor::new(&loaded.spec, &src, Some("Nope")).unwrap_err();
     assert_eq!(e.to_string(), "spec `T` has no `let` named `Nope` (it has no lets)");
+}
+
+/// The oracle's tasks with their traces.
+fn oracle_cases() -> Vec<(String, Vec<f64>, Vec<f64>)> {
+    let column = |v: &Value| -> Vec<f64> {
+        v.as_array().unwrap().iter().map(|n| n.as_f64().unwrap()).collect()
+    };
+    ORACLE
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|line| {
+            let c: Value = serde_json::from_str(line).unwrap();
+            let task = c["task"].as_str().unwrap().to_string();
+            (task, column(&c["trace"]["x"]), column(&c["trace"]["y"]))
+        })
+        .collect()
+}
+
+fn shaped(src: &str, formula: Option<&str>, shaping: Shaping) -> EpisodeMonitor {
+    let loaded = load(src, None).unwrap();
+    EpisodeMonitor::new(&loaded.spec, src, formula).unwrap().with_shaping(shaping, formula).unwrap()
+}
+
+fn form(form: RewardForm) -> Shaping {
+    Shaping { form, ..Shaping::default() }
+}
+
+#[test]
+fn increments_add_up_to_the_robustness_over_the_episode() {
+    for (task, x, y) in oracle_cases() {
+        let src = spec_text(&task);
+        let mut episode = shaped(&src, None, form(RewardForm::Increment));
+        for _round in 0..2 {
+            episode.reset();
+            let first = episode.push(&[x[0], y[0]]).unwrap();
+            assert_eq!(first.reward, 0.0, "{task}: the reset's state earns nothing");
+            let mut sum = 0.0;
+            let mut last = first.task_robustness;
+            for t in 1..x.len() {
+                let score = episode.push(&[x[t], y[t]]).unwrap();
+                sum += score.reward;
+                last = score.task_robustness;
+            }
+            let want = if last.is_finite() { last } else { 0.0 };
+            assert!((sum - want).abs() <= 1e-9 * want.abs().max(1.0), "{task}: {sum} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn the_sparse_reward_is_the_robustness_at_the_last_state_only() {
+    for (task, x, y) in oracle_cases().into_iter().take(40) {
+        let src = spec_text(&task);
+        let mut episode = shaped(&src, None, form(RewardForm::Sparse));
+        let n = x.len();
+        for t in 0..n - 1 {
+            assert_eq!(episode.push(&[x[t], y[t]]).unwrap().reward, 0.0, "{task}");
+        }
+        let end = episode.push_last(&[x[n - 1], y[n - 1]]).unwrap();
+        assert!(same(end.reward, end.task_robustness), "{task}");
+    }
+}
+
+#[test]
+fn a_let_is_rewarded_by_its_own_prefix_robustness() {
+    let src = "spec S { state { x: float } let Hot = x > 2; \
+               task always[0..] eventually[0..=3] Hot; }";
+    let mut episode = shaped(src, Some("Hot"), form(RewardForm::Increment));
+    let rewards: Vec<f64> =
+        [1.0, 5.0, 0.0, 7.0].iter().map(|&x| episode.push(&[x]).unwrap().reward).collect();
+    // rho(Hot, 0) over every prefix is Hot at step 0: -1 throughout, after the first 0.
+    assert_eq!(rewards, [0.0, -1.0, 0.0, 0.0]);
+    let mut sparse = shaped(src, Some("Hot"), form(RewardForm::Sparse));
+    sparse.push(&[4.0]).unwrap();
+    assert_eq!(sparse.push_last(&[0.0]).unwrap().reward, 2.0);
+}
+
+#[test]
+fn the_window_reward_counts_kept_windows_and_offset_and_scale_apply() {
+    let src = "spec S { state { x: float } let Hot = x > 2; \
+               task always[0..] eventually[0..=1] Hot; }";
+    let shaping = Shaping { form: RewardForm::Window, offset: -0.5, scale: 2.0 };
+    let mut episode = shaped(src, None, shaping);
+    let rewards: Vec<f64> =
+        [5.0, 0.0, 0.0, 0.0, 3.0].iter().map(|&x| episode.push(&[x]).unwrap().reward).collect();
+    // Kept, kept (held one step ago), lost, lost, kept: 2 * (1 or 0) - 0.5.
+    assert_eq!(rewards, [1.5, 1.5, -0.5, -0.5, 1.5]);
+    let mut robust =
+        shaped(src, None, Shaping { offset: 1.0, scale: 0.5, ..form(RewardForm::Robustness) });
+    assert_eq!(robust.push(&[4.0]).unwrap().reward, 0.5 * 2.0 + 1.0);
+}
+
+#[test]
+fn reward_forms_that_do_not_fit_are_refused_with_a_way_out() {
+    let src = spec_text("eventually[0..] (x > 2)");
+    let loaded = load(&src, None).unwrap();
+    let episode = || EpisodeMonitor::new(&loaded.spec, &src, None).unwrap();
+    let e = episode().with_shaping(form(RewardForm::Window), None).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "reward form `window` needs a persistent task, and this task is not one"
+    );
+    assert!(e.help().unwrap().contains("`increment`"));
+    let e = RewardForm::parse("dense").unwrap_err();
+    assert_eq!(e.to_string(), "unknown reward form `dense`");
+    assert_eq!(e.help().unwrap(), "the forms are `robustness`, `increment`, `window`, `sparse`");
+    for bad in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+        let e = episode().with_shaping(Shaping { scale: bad, ..Shaping::default() }, None);
+        assert!(matches!(e, Err(RewardError::Scale(_))), "{bad}");
+    }
+    let e = episode().with_shaping(Shaping { offset: f64::NAN, ..Shaping::default() }, None);
+    assert!(matches!(e, Err(RewardError::Offset(_))));
+    for f in RewardForm::ALL {
+        assert_eq!(RewardForm::parse(f.name()), Ok(f));
+    }
+}
+
+#[test]
+fn an_episode_monitor_restored_from_its_states_continues_exactly() {
+    for (task, x, y) in oracle_cases().into_iter().step_by(7) {
+        let src = spec_text(&task);
+        for f in [RewardForm::Robustness, RewardForm::Increment, RewardForm::Sparse] {
+            let mut whole = shaped(&src, None, form(f));
+            let want: Vec<StepScore> =
+                (0..x.len()).map(|t| whole.push(&[x[t], y[t]]).unwrap()).collect();
+            for cut in [0, 1, x.len() / 2, x.len()] {
+                let mut first = shaped(&src, None, form(f));
+                for t in 0..cut {
+                    first.push(&[x[t], y[t]]).unwrap();
+                }
+                let mut back = shaped(&src, None, form(f));
+                back.restore(first.episode_states()).unwrap();
+                assert_eq!(back.steps(), cut);
+                for t in cut..x.len() {
+                    let got = back.push(&[x[t], y[t]]).unwrap();
+                    let w = want[t];
+                    assert!(
+                        same(got.reward, w.reward) && same(got.task_robustness, w.task_robustness),
+                        "{task}, {f:?}, cut {cut}, step {t}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -16,14 +16,8 @@ pub struct ExplainArgs {
 
 /// Runs `hstlc explain`.
 pub fn run(args: &ExplainArgs) -> CmdResult {
-    let wanted = args.code.trim().to_ascii_uppercase();
-    let Some(info) = hstl::lang::codes::lookup(&wanted) else {
-        let known: Vec<&str> = hstl::lang::codes::CODES.iter().map(|c| c.code).collect();
-        return Err(CliError::new(
-            format!("unknown diagnostic code `{}`", args.code),
-            Some(format!("known codes: {}", known.join(", "))),
-        ));
-    };
-    outln!("{} ({}): {}\n\n{}", info.code, info.name, info.summary, info.explanation.trim_end())?;
+    let text = hstl::load::explain(&args.code)
+        .map_err(|e| CliError::new(e.to_string(), Some(e.help())))?;
+    outln!("{text}")?;
     Ok(Status::Clean)
 }

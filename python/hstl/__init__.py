@@ -22,13 +22,16 @@ does (the same ``policy.json``, byte for byte); ``policy.evaluate()`` measures i
 ``gymnasium.Env`` (``gymnasium.make("hstl/GridWorld-v0")``, ``"hstl/FourRooms-v0"``) and
 ``hstl.STLReward`` rewards any environment by robustness.
 
+``hstl.check(path_or_text)`` lists a spec's diagnostics (warnings included; loading issues
+the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a code.
+
 ``hstl.study(specs, seeds=20)`` trains specs over many seeds and compares them as
 ``hstlc study`` does, on this machine's cores or on a Ray cluster (``backend="ray"``);
 ``hstl.tune.trainable`` tunes a spec's ``learn`` values with Ray Tune.
 """
 
-from ._errors import MissingVariableError, PolicyError, SpecError, WorldError
-from ._hstl import MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__
+from ._errors import MissingVariableError, PolicyError, SpecError, SpecWarning, WorldError
+from ._hstl import MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain
 from ._study import StudyResult, study
 from ._train import train
 
@@ -41,10 +44,13 @@ __all__ = [
     "PolicyError",
     "Spec",
     "SpecError",
+    "SpecWarning",
     "StudyResult",
     "World",
     "WorldError",
     "__version__",
+    "check",
+    "explain",
     "study",
     "train",
 ]

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
+
+if TYPE_CHECKING:
+    from ._hstl import Diagnostic
 
 
 class SpecError(ValueError):
@@ -15,12 +18,33 @@ class SpecError(ValueError):
     ``diagnostics`` is empty and the message says which.
     """
 
-    def __init__(self, message: str, diagnostics: Sequence[object] = ()) -> None:
+    diagnostics: "list[Diagnostic]"
+
+    def __init__(self, message: str, diagnostics: "Sequence[Diagnostic]" = ()) -> None:
         super().__init__(message)
         self.diagnostics = list(diagnostics)
 
     def __reduce__(self):
         return (type(self), (self.args[0], self.diagnostics))
+
+
+class SpecWarning(UserWarning):
+    """A warning of a spec that loads (``Spec.load``, ``Spec.parse``), such as HSTL150 on
+    ``x >= 8`` over an ``int`` variable: issued through ``warnings``, so filters apply
+    (``warnings.simplefilter("error", hstl.SpecWarning)`` makes them errors, ``"ignore"``
+    silences them). ``str(warning)`` is the ``hstlc check --format concise`` line and the
+    hint; ``diagnostic`` is the ``hstl.Diagnostic``. ``hstl.check`` lists them all without
+    warning, and ``hstl.explain(code)`` explains one.
+    """
+
+    diagnostic: "Diagnostic"
+
+    def __init__(self, message: str, diagnostic: "Diagnostic") -> None:
+        super().__init__(message)
+        self.diagnostic = diagnostic
+
+    def __reduce__(self):
+        return (type(self), (self.args[0], self.diagnostic))
 
 
 class MissingVariableError(KeyError):

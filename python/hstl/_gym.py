@@ -121,7 +121,7 @@ class GridWorldEnv(gymnasium.Env):
 Valuation = Union[Callable[[Any], Any], Mapping[str, Any], None]
 
 
-class STLReward(gymnasium.Wrapper):
+class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     """Rewards any environment with STL robustness computed in Rust, and reports the task's
     own success apart from the reward.
 
@@ -133,7 +133,21 @@ class STLReward(gymnasium.Wrapper):
     ``GridWorldEnv`` (its observation is ``(x, y)``) or an observation that is itself a
     dict of the state variables.
 
-    The reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
+    ``reward`` picks what a step earns (then ``scale * value + offset``, ``scale`` positive,
+    ``offset`` added to every step):
+
+    - ``"robustness"`` (the default): ``rho(formula, t)``, described below;
+    - ``"increment"``: the change of ``rho(formula, 0)`` over the trace so far since the
+      step before, so an episode's rewards add up to the formula's robustness over the
+      whole episode (the last ``info["task_robustness"]`` for the task; a value that is not
+      finite counts as 0): a shaped reward with the task's own optimum;
+    - ``"window"``: for a persistent task, 1 for a step whose windows are all kept
+      (``info["window_kept"]``) and 0 otherwise, the learner's reward: an episode's sum is
+      the number of kept steps, so longer episodes never earn less;
+    - ``"sparse"``: ``rho(formula, 0)`` over the episode, on its last step (``terminated``
+      or ``truncated``; put ``STLReward`` outside any ``TimeLimit``) and 0 before.
+
+    The robustness reward of the step into state ``s_t`` is ``rho(formula, t)`` over the trace so far,
     ``s_0 ..= s_t`` (``s_0`` is the state ``reset`` returns), for the task or the ``let``
     called ``formula``. The future operators' windows are clipped at the end of the trace,
     so without a past-time operator this is the formula on ``s_t`` alone: for a state
@@ -150,6 +164,12 @@ class STLReward(gymnasium.Wrapper):
     held within its window ending at ``t``, the steps the window rate counts. ``step``'s
     ``info["env_reward"]`` is the wrapped environment's reward.
 
+    The wrapper records its arguments as gymnasium asks (``env.spec`` lists it, so
+    ``gymnasium.make(env.spec)`` makes it again) and passes ``check_env``. It pickles and
+    deep-copies mid-episode (for ``SubprocVecEnv``, Ray, ``copy.deepcopy``) when the wrapped
+    environment and ``valuation`` do (a dict valuation does; a lambda does not pickle): the
+    copy continues the episode with the same rewards.
+
     Cost per step: the reward is one evaluation of the formula on one state; the task's
     robustness is kept up to date incrementally, not by scoring the whole trace again:
     O(1) amortised for a persistent task (``always[0..] (eventually[0..N1] R1 && ...)``)
@@ -163,16 +183,25 @@ class STLReward(gymnasium.Wrapper):
         spec: Union[Spec, str, "os.PathLike[str]"],
         valuation: Valuation = None,
         formula: Optional[str] = None,
+        reward: str = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
     ) -> None:
-        super().__init__(env)
+        gymnasium.utils.RecordConstructorArgs.__init__(
+            self, spec=spec, valuation=valuation, formula=formula, reward=reward, offset=offset, scale=scale
+        )
+        gymnasium.Wrapper.__init__(self, env)
         # `spec` is gymnasium's (the environment's registration) on a wrapper.
         self.stl_spec = spec if isinstance(spec, Spec) else Spec.load(spec)
         self.formula = formula
-        self._monitor = EpisodeMonitor(self.stl_spec, formula)
+        self._monitor = EpisodeMonitor(self.stl_spec, formula, reward, offset, scale)
+        self.reward_form = reward
+        self.reward_offset = offset
+        self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
 
-    def _score(self, obs: Any, info: Mapping[str, Any]) -> tuple[float, dict]:
-        reward, robustness, kept = self._monitor.push(self._valuation(obs))
+    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict]:
+        reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
         info = dict(info)
         info["task_robustness"] = robustness
         if kept is not None:
@@ -187,7 +216,7 @@ class STLReward(gymnasium.Wrapper):
 
     def step(self, action: Any):
         obs, env_reward, terminated, truncated, info = self.env.step(action)
-        reward, info = self._score(obs, info)
+        reward, info = self._score(obs, info, bool(terminated or truncated))
         info["env_reward"] = env_reward
         return obs, reward, terminated, truncated, info
 
@@ -201,8 +230,7 @@ def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Calla
         missing = [v for v in vars if v not in valuation]
         if missing:
             raise _missing(f"valuation has no entry for state variable `{missing[0]}`", vars)
-        picks = [(v, valuation[v]) for v in vars]
-        return lambda obs: {v: obs[k] for v, k in picks}
+        return _Picks([(v, valuation[v]) for v in vars])
     if valuation is not None:
         raise TypeError(
             f"valuation must be a callable or a dict from state variables to observation indices; got {type(valuation).__name__}"
@@ -215,15 +243,30 @@ def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Calla
                 "  help: pass valuation=, a function from the observation to the state variables"
             )
         if vars == ["x", "y"]:
-            return lambda obs: obs
-        picks = [(v, 0 if v == "x" else 1) for v in vars]
-        return lambda obs: {v: obs[k] for v, k in picks}
+            return _identity
+        return _Picks([(v, 0 if v == "x" else 1) for v in vars])
     if isinstance(env.observation_space, spaces.Dict):
-        return lambda obs: obs
+        return _identity
     raise TypeError(
         f"STLReward cannot read state variables from a {type(env.observation_space).__name__} observation\n"
         '  help: pass valuation=, a function from the observation to the state variables (or a dict such as {"x": 0, "y": 1})'
     )
+
+
+def _identity(obs: Any) -> Any:
+    """An observation that is the state itself (a module function, so that it pickles)."""
+    return obs
+
+
+class _Picks:
+    """The state variables picked from an observation by index or key (a class, so that it
+    pickles)."""
+
+    def __init__(self, picks: Sequence[tuple[str, Any]]) -> None:
+        self.picks = list(picks)
+
+    def __call__(self, obs: Any) -> dict:
+        return {v: obs[k] for v, k in self.picks}
 
 
 def _missing(message: str, vars: Sequence[str]) -> Exception:

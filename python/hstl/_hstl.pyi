@@ -1,7 +1,7 @@
 """Type stubs of the native module ``hstl._hstl`` (re-exported by ``hstl``)."""
 
 from os import PathLike
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +17,11 @@ Trace = Union[Mapping[str, Any], npt.ArrayLike]
 Batch = Union[Sequence[Trace], Mapping[str, Any], npt.ArrayLike]
 #: One state for the online monitor: names to numbers, or numbers in state-variable order.
 State = Union[Mapping[str, float], Sequence[float], npt.ArrayLike]
+#: How the windows at the end of a trace count: cut there (``"clipped"``, the default), or a
+#: step counts only if its windows lie inside the trace (``"complete"``; later steps NaN).
+Windows = Literal["clipped", "complete"]
+#: What ``hstl.STLReward`` rewards a step with (see its docs).
+RewardForm = Literal["robustness", "increment", "window", "sparse"]
 
 class Diagnostic:
     """One diagnostic, positioned as ``hstlc check --format json`` gives it (1-based,
@@ -44,6 +49,18 @@ class Diagnostic:
         help: Optional[str] = None,
     ) -> None: ...
 
+def check(
+    path_or_text: Union[str, PathLike[str]], world: Union["World", str, PathLike[str], None] = None
+) -> list[Diagnostic]:
+    """Every diagnostic of a spec file or text (errors, warnings and notes, in source
+    order), as ``hstlc check --format json`` gives them; the specs with options are checked
+    against ``world`` too when one is given. A ``str`` with a newline or ``{`` is spec
+    text, another ``str`` or an ``os.PathLike`` a path."""
+
+def explain(code: str) -> str:
+    """The long explanation of a diagnostic code (``"HSTL150"``), as ``hstlc explain``
+    prints it; ``ValueError`` for an unknown code."""
+
 class Spec:
     """A checked hstl spec, ready to monitor traces."""
 
@@ -51,6 +68,8 @@ class Spec:
     def load(path: Union[str, PathLike[str]], name: Optional[str] = None) -> Spec: ...
     @staticmethod
     def parse(text: str, filename: str = "<string>", name: Optional[str] = None) -> Spec: ...
+    @staticmethod
+    def _unpickle(text: str, filename: str, name: Optional[str]) -> Spec: ...
     @property
     def name(self) -> str: ...
     @property
@@ -72,6 +91,7 @@ class Spec:
         formula: Optional[str] = None,
         *,
         columns: Optional[Sequence[str]] = None,
+        windows: Windows = "clipped",
     ) -> float: ...
     def signal(
         self,
@@ -79,6 +99,7 @@ class Spec:
         formula: Optional[str] = None,
         *,
         columns: Optional[Sequence[str]] = None,
+        windows: Windows = "clipped",
     ) -> npt.NDArray[np.float64]: ...
     def signal_batch(
         self,
@@ -87,11 +108,13 @@ class Spec:
         *,
         columns: Optional[Sequence[str]] = None,
         threads: Optional[int] = None,
+        windows: Windows = "clipped",
     ) -> npt.NDArray[np.float64]: ...
     def online(self, formula: Optional[str] = None) -> OnlineMonitor: ...
 
 class OnlineMonitor:
-    """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``."""
+    """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``. It pickles
+    and deep-copies mid-trace."""
 
     @property
     def horizon(self) -> Optional[int]: ...
@@ -102,6 +125,8 @@ class OnlineMonitor:
     def update(self, state: State) -> Optional[Tuple[int, float]]: ...
     def provisional(self) -> Optional[float]: ...
     def finish(self) -> list[Tuple[int, float]]: ...
+    @staticmethod
+    def _restore(spec: Spec, formula: Optional[str], skipped: int, states: Sequence[float]) -> OnlineMonitor: ...
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
@@ -148,9 +173,12 @@ class World:
     def _index(self, x: int, y: int) -> Optional[int]: ...
 
 class Generator:
-    """The one random generator of a ``GridWorldEnv`` (ChaCha8, as the learner's)."""
+    """The one random generator of a ``GridWorldEnv`` (ChaCha8, as the learner's); it
+    pickles and copies by its whole state."""
 
     def __init__(self, seed: int) -> None: ...
+    @staticmethod
+    def _from_state(key: Sequence[int], stream: int, pos_high: int, pos_low: int) -> Generator: ...
 
 class Policy:
     """A trained policy and its ``policy.json``; see ``help(hstl.Policy)``."""
@@ -199,11 +227,29 @@ class Policy:
     ) -> dict[str, Any]: ...
 
 class EpisodeMonitor:
-    """Scores an episode state by state, for ``hstl.STLReward``."""
+    """Scores an episode state by state, for ``hstl.STLReward``; it pickles and
+    deep-copies mid-episode."""
 
-    def __init__(self, spec: Spec, formula: Optional[str] = None) -> None: ...
+    def __init__(
+        self,
+        spec: Spec,
+        formula: Optional[str] = None,
+        reward: RewardForm = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
+    ) -> None: ...
     def reset(self) -> None: ...
-    def push(self, state: State) -> Tuple[float, float, Optional[bool]]: ...
+    def push(self, state: State, last: bool = False) -> Tuple[float, float, Optional[bool]]: ...
+    @staticmethod
+    def _restore(
+        spec: Spec, formula: Optional[str], reward: RewardForm, offset: float, scale: float, states: Sequence[float]
+    ) -> EpisodeMonitor: ...
+    @property
+    def reward(self) -> RewardForm: ...
+    @property
+    def offset(self) -> float: ...
+    @property
+    def scale(self) -> float: ...
     @property
     def state_vars(self) -> list[str]: ...
     @property

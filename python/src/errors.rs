@@ -180,6 +180,29 @@ pub fn diagnostics_of(file: &str, source: &str, diagnostics: &[LangDiagnostic]) 
     diagnostics.iter().map(|d| Diagnostic::new(file, d, index.location(source, &d.range))).collect()
 }
 
+/// Issues each of `warnings` (the diagnostics of `source`, reported as `file`) as a Python
+/// warning of category `hstl.SpecWarning`: its text is the `hstlc check --format concise`
+/// line and the hint, and its `diagnostic` the `hstl.Diagnostic`. Raises when a warnings
+/// filter turns them into errors.
+pub fn warn_spec(
+    py: Python<'_>,
+    file: &str,
+    source: &str,
+    warnings: &[LangDiagnostic],
+) -> PyResult<()> {
+    if warnings.is_empty() {
+        return Ok(());
+    }
+    let category = python_class(py, &SPEC_WARNING, "SpecWarning")?;
+    let warn = py.import("warnings")?.getattr("warn")?;
+    for d in diagnostics_of(file, source, warnings) {
+        let text = with_help(d.concise(), d.help().map(String::from));
+        warn.call1((category.call1((text, d))?,))?;
+    }
+    Ok(())
+}
+
+static SPEC_WARNING: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static SPEC_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static MISSING_VARIABLE: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 static WORLD_ERROR: PyOnceLock<Py<PyType>> = PyOnceLock::new();

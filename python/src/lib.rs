@@ -7,6 +7,7 @@
 //! numbers are converted once by numpy), releases the GIL while Rust computes, and turns
 //! the facade's errors into Python exceptions with the command line's words.
 
+mod check;
 mod errors;
 mod files;
 mod gym;
@@ -31,6 +32,8 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<world::Generator>()?;
     m.add_class::<policy::Policy>()?;
     m.add_class::<reward::EpisodeMonitor>()?;
+    m.add_function(wrap_pyfunction!(check::check, m)?)?;
+    m.add_function(wrap_pyfunction!(check::explain, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
     m.add_class::<study::_StudyOut>()?;

@@ -1,9 +1,11 @@
 //! `hstl.OnlineMonitor`.
 
-use hstl::monitor::Online;
+use hstl::monitor::{Online, OnlineState};
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
 use crate::errors::trace_error;
+use crate::spec::Spec;
 use crate::trace::state_values;
 
 /// An online monitor: states arrive one at a time, each step's robustness leaves as soon as
@@ -19,19 +21,51 @@ use crate::trace::state_values;
 /// For an unbounded formula (`horizon` is None) no value is final before the trace ends:
 /// `update` returns None, and `provisional()` gives what the first open step would be if
 /// the trace ended now (a running value, not a verdict).
+///
+/// It pickles and copies mid-trace (for worker processes, `copy.deepcopy`): by its spec,
+/// formula and the states of the steps still open (at most `H`; every state of the trace
+/// for an unbounded formula or one with a past-time operator), which the copy replays.
 #[pyclass(module = "hstl")]
 pub struct OnlineMonitor {
     inner: Online,
+    spec: Py<Spec>,
+    formula: Option<String>,
 }
 
 impl OnlineMonitor {
-    pub fn new(inner: Online) -> OnlineMonitor {
-        OnlineMonitor { inner }
+    pub fn new(inner: Online, spec: Py<Spec>, formula: Option<String>) -> OnlineMonitor {
+        OnlineMonitor { inner, spec, formula }
     }
 }
 
 #[pymethods]
 impl OnlineMonitor {
+    /// The monitor `__reduce__` describes: `spec.online(formula)`, then the states
+    /// replayed after `skipped` steps.
+    #[staticmethod]
+    fn _restore(
+        py: Python<'_>,
+        spec: &Bound<'_, Spec>,
+        formula: Option<String>,
+        skipped: usize,
+        states: Vec<f64>,
+    ) -> PyResult<OnlineMonitor> {
+        let mut inner = spec.get().online_of(formula.as_deref())?;
+        inner.restore(&OnlineState { skipped, states }).map_err(|e| trace_error(py, &e))?;
+        Ok(OnlineMonitor::new(inner, spec.clone().unbind(), formula))
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let this = slf.borrow();
+        let state = this.inner.snapshot();
+        let args =
+            (this.spec.clone_ref(slf.py()), this.formula.clone(), state.skipped, state.states)
+                .into_pyobject(slf.py())?;
+        Ok((slf.get_type().getattr("_restore")?, args))
+    }
+
     /// Appends one state, a mapping from state variable names to numbers (or a sequence of
     /// numbers in the order of `state_vars`), and returns the verdict it completes,
     /// `(step, value)`, or None while no new step is final. A state with NaN or a missing

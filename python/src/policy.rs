@@ -329,7 +329,7 @@ impl Policy {
             Replayed::Listed(r, _) => r.source.clone(),
         };
         let name = self.replayed.spec().name.clone();
-        Spec::from_source(py, source, "<spec_source>".into(), Some(name))
+        Spec::from_source(py, source, "<spec_source>".into(), Some(name), true)
     }
 
     /// The spec's name.

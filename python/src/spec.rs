@@ -62,6 +62,19 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
+    /// The line `hstlc check --format concise` prints for it.
+    pub fn concise(&self) -> String {
+        format!(
+            "{}:{}:{}: {} {}: {}",
+            self.file, self.line, self.column, self.code, self.severity, self.message
+        )
+    }
+
+    /// How to fix it.
+    pub fn help(&self) -> Option<&str> {
+        self.help.as_deref()
+    }
+
     pub fn new(file: &str, d: &hstl::lang::Diagnostic, at: Location) -> Diagnostic {
         Diagnostic {
             file: file.to_string(),
@@ -112,24 +125,26 @@ impl Diagnostic {
 
     /// The line `hstlc check --format concise` prints for it.
     fn __str__(&self) -> String {
-        format!(
-            "{}:{}:{}: {} {}: {}",
-            self.file, self.line, self.column, self.code, self.severity, self.message
-        )
+        self.concise()
     }
 }
 
 impl Spec {
-    /// Checks `source` (reported as `filename`) and picks the spec called `name`.
+    /// Checks `source` (reported as `filename`) and picks the spec called `name`; its
+    /// warnings are issued as `hstl.SpecWarning`s unless `quiet`.
     pub(crate) fn from_source(
         py: Python<'_>,
         source: String,
         filename: String,
         name: Option<String>,
+        quiet: bool,
     ) -> PyResult<Spec> {
         let loaded = py
             .detach(|| hstl::load::load(&source, name.as_deref()))
             .map_err(|e| errors::load_error(py, &filename, &source, e))?;
+        if !quiet {
+            errors::warn_spec(py, &filename, &source, &loaded.diagnostics)?;
+        }
         Ok(Spec {
             source,
             filename,
@@ -138,6 +153,11 @@ impl Spec {
             warnings: loaded.diagnostics,
             monitors: Mutex::new(HashMap::new()),
         })
+    }
+
+    /// A new online monitor of the task or of the `let` called `formula`.
+    pub(crate) fn online_of(&self, formula: Option<&str>) -> PyResult<hstl::monitor::Online> {
+        Ok(self.monitor(formula)?.online())
     }
 
     /// The monitor of the task or of the `let` called `formula`, lowered once.
@@ -155,6 +175,11 @@ impl Spec {
     }
 }
 
+/// The `windows=` choice, or a `ValueError` naming both.
+fn windows_of(name: &str) -> PyResult<hstl::monitor::Windows> {
+    hstl::monitor::Windows::parse(name).map_err(|e| value_error(e.to_string(), Some(e.help())))
+}
+
 #[pymethods]
 impl Spec {
     /// Reads and checks the spec file at `path`, and picks the spec called `name` (needed
@@ -168,7 +193,7 @@ impl Spec {
         let source = crate::files::read_text(&path, hstl::lang::MAX_SOURCE_BYTES, "spec", |e| {
             errors::read_error(&path, e)
         })?;
-        Spec::from_source(py, source, path.display().to_string(), name)
+        Spec::from_source(py, source, path.display().to_string(), name, false)
     }
 
     /// Checks the spec text `text` (reported as `filename`), and picks the spec called
@@ -183,7 +208,19 @@ impl Spec {
         filename: String,
         name: Option<String>,
     ) -> PyResult<Spec> {
-        Spec::from_source(py, text, filename, name)
+        Spec::from_source(py, text, filename, name, false)
+    }
+
+    /// `parse` without the warnings, which the original already issued: how a spec
+    /// unpickles.
+    #[staticmethod]
+    fn _unpickle(
+        py: Python<'_>,
+        text: String,
+        filename: String,
+        name: Option<String>,
+    ) -> PyResult<Spec> {
+        Spec::from_source(py, text, filename, name, true)
     }
 
     /// The spec's name.
@@ -241,34 +278,47 @@ impl Spec {
     ///
     /// For a formula with horizon `H` only the first `H + 1` steps are read (and checked
     /// for NaN), so a long float64 trace costs no more than a short one.
-    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    ///
+    /// `windows="complete"` counts a step only if every window its value needs lies
+    /// inside the trace (`hstlc monitor --windows complete`): NaN when step 0 is
+    /// undetermined (the trace is too short for its windows). The whole trace is read.
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
     fn robustness(
         &self,
         py: Python<'_>,
         trace: &Bound<'_, PyAny>,
         formula: Option<&str>,
         columns: Option<&Bound<'_, PyAny>>,
+        windows: &str,
     ) -> PyResult<f64> {
+        let windows = windows_of(windows)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
-        py.detach(|| monitor.robustness(&samples)).map_err(|e| trace_error(py, &e))
+        py.detach(|| monitor.robustness_in(&samples, windows)).map_err(|e| trace_error(py, &e))
     }
 
     /// The robustness signal of the trace: a float64 array with one value per step, the
     /// rows `hstlc monitor --signal` prints.
-    #[pyo3(signature = (trace, formula=None, *, columns=None))]
+    ///
+    /// `windows="complete"` counts a step only if every window its value needs lies
+    /// inside the trace (`--windows complete`); the later steps, undetermined, are NaN
+    /// (the empty fields of `--signal`).
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
     fn signal<'py>(
         &self,
         py: Python<'py>,
         trace: &Bound<'py, PyAny>,
         formula: Option<&str>,
         columns: Option<&Bound<'py, PyAny>>,
+        windows: &str,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let windows = windows_of(windows)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
-        let signal = py.detach(|| monitor.signal(&samples)).map_err(|e| trace_error(py, &e))?;
+        let signal =
+            py.detach(|| monitor.signal_in(&samples, windows)).map_err(|e| trace_error(py, &e))?;
         Ok(PyArray1::from_vec(py, signal))
     }
 
@@ -278,8 +328,9 @@ impl Spec {
     ///
     /// `traces` is a list of traces (as `signal` takes them), a 3-D array of shape
     /// (traces, steps, columns) whose columns `columns=` names, or a mapping from each
-    /// state variable to a 2-D array of shape (traces, steps).
-    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None))]
+    /// state variable to a 2-D array of shape (traces, steps). `windows` is as for
+    /// `signal`.
+    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None, windows="clipped"))]
     fn signal_batch<'py>(
         &self,
         py: Python<'py>,
@@ -287,7 +338,9 @@ impl Spec {
         formula: Option<&str>,
         columns: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
+        windows: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let windows = windows_of(windows)?;
         let threads = match threads {
             Some(0) => return Err(value_error("`threads` must be at least 1", None)),
             Some(n) => n,
@@ -298,7 +351,7 @@ impl Spec {
         let samples = held.samples()?;
         let n = samples.len();
         let (out, steps) = py
-            .detach(|| monitor.signal_batch(&samples, threads))
+            .detach(|| monitor.signal_batch_in(&samples, threads, windows))
             .map_err(|e| batch_error(py, &e))?;
         // An array of no traces still has steps.
         let steps = if n == 0 { held.shape_steps().unwrap_or(0) } else { steps };
@@ -308,8 +361,9 @@ impl Spec {
     /// An online monitor of the task (or of the `let` called `formula`), fed one state at
     /// a time; see `hstl.OnlineMonitor`.
     #[pyo3(signature = (formula=None))]
-    fn online(&self, formula: Option<&str>) -> PyResult<OnlineMonitor> {
-        Ok(OnlineMonitor::new(self.monitor(formula)?.online()))
+    fn online(slf: &Bound<'_, Self>, formula: Option<&str>) -> PyResult<OnlineMonitor> {
+        let inner = slf.get().online_of(formula)?;
+        Ok(OnlineMonitor::new(inner, slf.clone().unbind(), formula.map(String::from)))
     }
 
     fn __reduce__<'py>(
@@ -317,7 +371,7 @@ impl Spec {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let py = slf.py();
         let this = slf.get();
-        let parse = slf.get_type().getattr("parse")?;
+        let parse = slf.get_type().getattr("_unpickle")?;
         let args = PyTuple::new(
             py,
             [

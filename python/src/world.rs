@@ -2,7 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use hstl::runtime::{Cell, Env, GridWorld, Rng, Value, json, seeded_rng};
+use hstl::runtime::{
+    Cell, Env, GridWorld, Rng, Value, json, rng_from_state, rng_state, seeded_rng,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -24,7 +26,8 @@ pub struct World {
 }
 
 /// The one random generator of a `GridWorldEnv` (ChaCha8, as the learner's), seeded by
-/// `reset(seed=...)`.
+/// `reset(seed=...)`. It pickles and copies by its whole state: the copy draws what the
+/// original would.
 #[pyclass(module = "hstl._hstl")]
 pub struct Generator {
     pub rng: Rng,
@@ -35,6 +38,22 @@ impl Generator {
     #[new]
     fn new(seed: u64) -> Generator {
         Generator { rng: seeded_rng(seed) }
+    }
+
+    /// The generator whose state `__reduce__` gave: key, stream and word position (high
+    /// and low 64 bits).
+    #[staticmethod]
+    fn _from_state(key: [u8; 32], stream: u64, pos_high: u64, pos_low: u64) -> Generator {
+        let pos = (u128::from(pos_high) << 64) | u128::from(pos_low);
+        Generator { rng: rng_from_state(key, stream, pos) }
+    }
+
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (key, stream, pos) = rng_state(&slf.borrow().rng);
+        let args = (key, stream, (pos >> 64) as u64, pos as u64).into_pyobject(slf.py())?;
+        Ok((slf.get_type().getattr("_from_state")?, args))
     }
 }
 

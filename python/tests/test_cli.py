@@ -116,8 +116,11 @@ def test_spec_error_is_check_concise_and_json(hstlc, monkeypatch):
 def test_warnings_come_with_the_spec_as_check_lists_them(hstlc, monkeypatch):
     monkeypatch.chdir(CLI_FIXTURES)
     listed = json.loads(run_cli(hstlc, "check", "--format", "json", "warnings.hstl").stdout)
-    spec = hstl.Spec.load("warnings.hstl")
+    with pytest.warns(hstl.SpecWarning) as issued:
+        spec = hstl.Spec.load("warnings.hstl")
     assert listed and all(d["severity"] == "warning" for d in listed)
+    # Each is issued as a Python warning, and hstl.check lists the same.
+    assert [w.message.diagnostic for w in issued] == spec.diagnostics == hstl.check("warnings.hstl")
     assert [d.code for d in spec.diagnostics] == [d["code"] for d in listed]
     assert [(d.line, d.column, d.end_line, d.end_column) for d in spec.diagnostics] == [
         (d["line"], d["column"], d["end_line"], d["end_column"]) for d in listed
@@ -163,3 +166,37 @@ def test_errors_read_as_the_cli_prints_them(hstlc, monkeypatch, cli, call, kind)
     with pytest.raises(kind) as e:
         call()
     assert str(e.value).splitlines()[0] == first_line_of_cli_error(result)
+
+
+PATROL = CLI_FIXTURES / "patrol.hstl"
+
+
+@pytest.mark.filterwarnings("ignore::hstl.SpecWarning")
+@pytest.mark.parametrize("csv_name", ["cycle.csv", "cycle_short.csv"])
+@pytest.mark.parametrize("formula", [None, "SoonA"])
+def test_windows_complete_is_hstlc_monitor_windows_complete(hstlc, csv_name, formula):
+    spec = hstl.Spec.load(PATROL)
+    trace_path = CLI_FIXTURES / csv_name
+    trace = read_csv(trace_path, ["x", "y"])
+    extra = ["--formula", formula] if formula else []
+    out = run_cli(hstlc, "monitor", str(PATROL), "--trace", str(trace_path), "--windows", "complete", "--signal", *extra)
+    assert out.returncode == 0, out.stderr
+    # Undetermined steps: empty fields in the CLI, NaN in Python.
+    want = [float(line.split(",")[1] or "nan") for line in out.stdout.splitlines()[1:]]
+    signal = spec.signal(trace, formula, windows="complete")
+    assert bits(signal) == bits(want)
+    batch = spec.signal_batch([trace, trace], formula, windows="complete", threads=2)
+    assert bits(batch[1]) == bits(want)
+    step0 = run_cli(hstlc, "monitor", str(PATROL), "--trace", str(trace_path), "--windows", "complete", *extra)
+    first = step0.stdout.strip()
+    value = spec.robustness(trace, formula, windows="complete")
+    assert (np.isnan(value) and first == "undetermined") or value == float(first)
+    # Clipped stays the default.
+    assert bits(spec.signal(trace, formula, windows="clipped")) == bits(spec.signal(trace, formula))
+
+
+@pytest.mark.filterwarnings("ignore::hstl.SpecWarning")
+def test_windows_must_be_clipped_or_complete():
+    spec = hstl.Spec.load(PATROL)
+    with pytest.raises(ValueError, match='unknown windows `full`\n  help: pass "clipped"'):
+        spec.signal({"x": [1.0], "y": [1.0]}, windows="full")

@@ -6,15 +6,17 @@ from __future__ import annotations
 import collections
 
 import os
+import pickle
 import random
 import subprocess
+import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
 import hstl
-from conftest import CLI_FIXTURES
+from conftest import CLI_FIXTURES, run_cli
 
 SPEC = hstl.Spec.parse(
     "spec S { state { x: int in 0..=9, y: float } let A = x > 3; let B = y < 2;"
@@ -577,3 +579,75 @@ def test_int_variables_hold_whole_numbers_in_their_range_as_hstlc_monitor_asks(t
     assert str(e.value) == message
     # Fractions in a `float` variable are fine.
     assert INT_SPEC.signal({"x": [4, 5], "k": [-3, 8], "r": [0.25, np.inf]}).tolist() == [1.0, 2.0]
+
+
+INCLUSIVE = """spec S {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let Top = x >= 8;
+    task eventually[0..] Top;
+}"""
+
+
+def test_spec_warnings_reach_python_as_spec_warnings():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        spec = hstl.Spec.parse(INCLUSIVE, filename="inclusive.hstl")
+    assert [w.category for w in caught] == [hstl.SpecWarning]
+    w = caught[0]
+    assert issubclass(w.category, UserWarning)
+    assert str(w.message).startswith("inclusive.hstl:3:15: HSTL150 warning: ")
+    assert "\n  help: " in str(w.message)
+    assert w.message.diagnostic == spec.diagnostics[0] and w.message.diagnostic.code == "HSTL150"
+    assert w.filename == __file__, "the warning points at the caller's line"
+    # Filterable: an error, or nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", hstl.SpecWarning)
+        with pytest.raises(hstl.SpecWarning, match="HSTL150"):
+            hstl.Spec.parse(INCLUSIVE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", category=hstl.SpecWarning)
+        hstl.Spec.parse(INCLUSIVE)
+        # Unpickling does not warn again.
+        pickle.loads(pickle.dumps(spec))
+
+
+def test_check_lists_every_diagnostic_of_a_path_or_a_text(tmp_path):
+    path = tmp_path / "inclusive.hstl"
+    path.write_text(INCLUSIVE)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        from_path = hstl.check(path)
+        assert hstl.check(str(path)) == from_path
+        from_text = hstl.check(INCLUSIVE)
+    assert [d.code for d in from_path] == ["HSTL150"] and from_path[0].file == str(path)
+    assert all(isinstance(d, hstl.Diagnostic) for d in from_text) and from_text[0].file == "<string>"
+    assert hstl.check(CLI_FIXTURES / "reach.hstl") == []
+    # A spec that does not check: its errors, as SpecError.diagnostics lists them.
+    with pytest.raises(hstl.SpecError) as e:
+        hstl.Spec.load(CLI_FIXTURES / "errors.hstl")
+    assert hstl.check(CLI_FIXTURES / "errors.hstl") == e.value.diagnostics
+    with pytest.raises(FileNotFoundError, match="cannot read `nope.hstl`"):
+        hstl.check("nope.hstl")
+    with pytest.raises(TypeError, match="`path_or_text` must be a path or spec text; got int\n  help: "):
+        hstl.check(3)
+
+
+def test_check_against_a_world_adds_the_worlds_diagnostics():
+    far = """spec S { state { x: int in 0..=14, y: int in 0..=14 }
+        let Far = x > 40; task always[0..] eventually[0..=20] Far; option Far; }"""
+    alone = hstl.check(far)
+    for world in ("paper", hstl.World.builtin("paper")):
+        in_world = hstl.check(far, world=world)
+        assert any(d.code == "HSTL031" and "world `paper`" in d.message for d in in_world)
+    assert not any(d.code == "HSTL031" for d in alone)
+    with pytest.raises(hstl.WorldError):
+        hstl.check(far, world="nowhere")
+
+
+def test_explain_gives_hstlc_explains_text(hstlc):
+    text = hstl.explain("hstl150")
+    assert text.startswith("HSTL150 (inclusive-bound-on-int): ")
+    assert text + "\n" == run_cli(hstlc, "explain", "HSTL150").stdout
+    with pytest.raises(ValueError, match="unknown diagnostic code `HSTL9`\n  help: known codes: HSTL001, "):
+        hstl.explain("HSTL9")

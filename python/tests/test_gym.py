@@ -200,3 +200,56 @@ def test_a_policy_replayed_in_gymnasium_is_hstlc_evals_run(tmp_path):
     assert sum(kept[burn_in:]) / (steps - burn_in) == report["window_rate"]
     assert info["task_robustness"] == report["robustness"][0]
     assert 0 < sum(kept) < steps
+
+
+def test_increments_add_up_to_the_task_robustness_of_the_episode():
+    env = hstl.STLReward(gymnasium.make("hstl/GridWorld-v0"), REACH, reward="increment")
+    for seed in (1, 2, 3):
+        _, rewards, infos = episode(env, seed, 120, up=0.4)
+        final = infos[-1]["task_robustness"]
+        assert sum(rewards) == pytest.approx(final if np.isfinite(final) else 0.0)
+        assert all(np.isfinite(rewards))
+
+
+PATROL = """spec Patrol {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let Low = y < 6;
+    let Left = x < 6;
+    task always[0..] (eventually[0..=10] Low && eventually[0..=10] Left);
+}"""
+
+
+def test_the_window_reward_is_one_per_kept_step_with_offset_and_scale():
+    patrol = hstl.Spec.parse(PATROL)
+    env = hstl.STLReward(hstl.GridWorldEnv(), patrol, reward="window")
+    _, rewards, infos = episode(env, 2016, 300, start=(6, 6), up=0.3)
+    assert rewards == [1.0 if i["window_kept"] else 0.0 for i in infos[1:]]
+    assert 0 < sum(rewards) < len(rewards)
+    shifted = hstl.STLReward(hstl.GridWorldEnv(), patrol, reward="window", offset=-0.5, scale=2.0)
+    _, twice, _ = episode(shifted, 2016, 300, start=(6, 6), up=0.3)
+    assert twice == [2.0 * r - 0.5 for r in rewards]
+    assert (shifted.reward_form, shifted.reward_offset, shifted.reward_scale) == ("window", -0.5, 2.0)
+
+
+def test_the_sparse_reward_comes_at_the_episodes_end_only():
+    env = hstl.STLReward(gymnasium.make("hstl/GridWorld-v0", max_episode_steps=30), REACH, reward="sparse")
+    env.reset(seed=5)
+    rewards, truncated, info = [], False, {}
+    while not truncated:
+        _, reward, _, truncated, info = env.step(0)
+        rewards.append(reward)
+    assert len(rewards) == 30 and rewards[:-1] == [0.0] * 29
+    assert rewards[-1] == info["task_robustness"]
+
+
+def test_reward_forms_that_do_not_fit_say_what_to_pick():
+    with pytest.raises(ValueError, match="unknown reward form `dense`\n  help: the forms are `robustness`, `increment`"):
+        hstl.STLReward(hstl.GridWorldEnv(), REACH, reward="dense")
+    with pytest.raises(ValueError, match="`window` needs a persistent task.*\n  help: .*use `increment` or `sparse`"):
+        hstl.STLReward(hstl.GridWorldEnv(), REACH, reward="window")
+    with pytest.raises(ValueError, match="`window` scores the task's windows, not the `let` `A`"):
+        hstl.STLReward(hstl.GridWorldEnv(), SURVEILLANCE, reward="window", formula="A")
+    with pytest.raises(ValueError, match="scale must be a positive finite number; got 0"):
+        hstl.STLReward(hstl.GridWorldEnv(), REACH, scale=0.0)
+    with pytest.raises(ValueError, match="offset must be a finite number; got NaN"):
+        hstl.STLReward(hstl.GridWorldEnv(), REACH, offset=float("nan"))

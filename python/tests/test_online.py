@@ -14,6 +14,7 @@ TRACE = np.clip(7 + np.cumsum(rng.integers(-1, 2, size=(500, 2)), axis=0), 0, 14
 
 
 @pytest.mark.parametrize("formula", ["A", "B"])
+@pytest.mark.filterwarnings("ignore:.*unused `let`:hstl.SpecWarning")
 def test_a_bounded_formula_gives_each_verdict_h_states_late(formula):
     bounded = hstl.Spec.parse(
         "spec W { state { x: int in 0..=14, y: int in 0..=14 } let A = x > 3 && y > 10;"

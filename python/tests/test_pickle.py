@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import copy
 import multiprocessing
+import warnings
 import pickle
 
 import numpy as np
@@ -74,3 +76,98 @@ def test_a_policy_crosses_to_a_spawned_process():
     policy = hstl.train(CLI_FIXTURES / "small.hstl", seed=4, episodes=2)
     with multiprocessing.get_context("spawn").Pool(1) as pool:
         assert pool.map(window_rate, [policy]) == [window_rate(policy)]
+
+
+def _steps(env, actions):
+    out = []
+    for a in actions:
+        obs, reward, terminated, truncated, info = env.step(a)
+        out.append((tuple(int(v) for v in obs), reward, terminated, truncated, info))
+    return out
+
+
+@pytest.mark.parametrize("reward", ["robustness", "increment", "window", "sparse"])
+def test_an_stl_reward_env_pickles_and_copies_mid_episode(reward):
+    gymnasium = pytest.importorskip("gymnasium")
+    env = hstl.STLReward(
+        gymnasium.make("hstl/GridWorld-v0", max_episode_steps=40),
+        CLI_FIXTURES / "surveillance.hstl",
+        reward=reward,
+        offset=0.5,
+    )
+    env.reset(seed=11)
+    actions = np.random.default_rng(0).integers(0, 4, size=50).tolist()
+    _steps(env, actions[:20])
+    copies = [pickle.loads(pickle.dumps(env)), copy.deepcopy(env)]
+    want = _steps(env, actions[20:])
+    for other in copies:
+        # The same cells (the generator continues), rewards and task robustness.
+        assert _steps(other, actions[20:]) == want
+    assert any(step[3] for step in want), "the episode ends by truncation"
+
+
+def test_an_stl_reward_env_of_a_dict_valuation_pickles():
+    gymnasium = pytest.importorskip("gymnasium")
+    spec = hstl.Spec.parse("spec P { state { y: float, x: float } let Top = y > 12; task eventually[0..] Top; }")
+    env = hstl.STLReward(hstl.GridWorldEnv(), spec, valuation={"x": 0, "y": 1}, formula="Top")
+    env.reset(seed=3)
+    back = pickle.loads(pickle.dumps(env))
+    assert _steps(back, [0, 0, 3]) == _steps(env, [0, 0, 3])
+    assert isinstance(back, gymnasium.Wrapper)
+
+
+ONLINE_FORMULAS = [
+    (CLI_FIXTURES / "surveillance.hstl", None),  # unbounded
+    (CLI_FIXTURES / "surveillance.hstl", "A"),
+    (None, "always[0..=3] eventually[1..=2] (x >= 4)"),  # bounded
+    (None, "once[0..=4] (x > 6) && historically[0..] (y >= 0)"),  # past-time
+]
+
+
+@pytest.mark.parametrize("path, formula", ONLINE_FORMULAS)
+def test_an_online_monitor_pickles_and_copies_mid_trace(path, formula):
+    if path is None:
+        spec = hstl.Spec.parse(f"spec T {{ state {{ x: float, y: float }} task {formula}; }}")
+        formula = None
+    else:
+        spec = hstl.Spec.load(path)
+    rng = np.random.default_rng(5)
+    states = [{"x": float(x), "y": float(y)} for x, y in rng.integers(0, 15, size=(40, 2))]
+    for cut in (0, 1, 17, 40):
+        online = spec.online(formula)
+        got = [online.update(s) for s in states[:cut]]
+        copies = [pickle.loads(pickle.dumps(online)), copy.deepcopy(online)]
+        want = [online.update(s) for s in states[cut:]] + [online.finish()]
+        for other in copies:
+            assert other.steps == cut and other.horizon == online.horizon
+            assert [other.update(s) for s in states[cut:]] + [other.finish()] == want
+        assert len(got) == cut
+
+
+def test_gymnasium_checks_and_remakes_an_stl_reward_env():
+    gymnasium = pytest.importorskip("gymnasium")
+    from gymnasium.utils.env_checker import check_env
+
+    env = hstl.STLReward(gymnasium.make("hstl/GridWorld-v0"), CLI_FIXTURES / "reach.hstl", reward="increment")
+    with warnings.catch_warnings():
+        # Only the advice to check the unwrapped env, which check_env gives every wrapper.
+        warnings.filterwarnings("ignore", message=".*different from the unwrapped version")
+        check_env(env)
+    again = gymnasium.make(env.spec)
+    assert isinstance(again, hstl.STLReward) and again.reward_form == "increment"
+    env.reset(seed=4)
+    again.reset(seed=4)
+    assert _steps(again, [0, 3, 3, 1]) == _steps(env, [0, 3, 3, 1])
+
+
+def test_stl_reward_envs_run_in_a_vector_env():
+    gymnasium = pytest.importorskip("gymnasium")
+
+    def make():
+        return hstl.STLReward(gymnasium.make("hstl/GridWorld-v0"), CLI_FIXTURES / "reach.hstl", reward="increment")
+
+    envs = gymnasium.vector.SyncVectorEnv([make, make])
+    envs.reset(seed=[1, 2])
+    _, rewards, _, _, infos = envs.step(np.array([0, 3]))
+    assert rewards.shape == (2,) and "task_robustness" in infos
+    envs.close()

@@ -89,6 +89,12 @@ impl OnlineMonitor {
         self.first_step + self.buffered()
     }
 
+    /// The states of the steps without a verdict, one column per variable (the last `H`
+    /// states of a bounded formula once warmed up; every state of an unbounded one).
+    pub fn open_columns(&self) -> Vec<&[f64]> {
+        self.columns.iter().map(|c| &c[self.start..]).collect()
+    }
+
     /// Appends one state, `state[i]` being variable `i`, and returns the verdict it
     /// completes: `rho(f, t)` for `t = steps - 1 - H`, once `H + 1` states are in.
     pub fn push(&mut self, state: &[f64]) -> Result<Option<Verdict>, TraceError> {

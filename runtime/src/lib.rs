@@ -69,3 +69,17 @@ pub type Rng = rand_chacha::ChaCha8Rng;
 pub fn seeded_rng(seed: u64) -> Rng {
     rand::SeedableRng::seed_from_u64(seed)
 }
+
+/// A generator's whole state as plain data: its key, stream and position (in 32-bit
+/// words), from which [`rng_from_state`] makes a generator that draws what it would draw.
+pub fn rng_state(rng: &Rng) -> ([u8; 32], u64, u128) {
+    (rng.get_seed(), rng.get_stream(), rng.get_word_pos())
+}
+
+/// The generator whose state [`rng_state`] gave.
+pub fn rng_from_state(key: [u8; 32], stream: u64, word_pos: u128) -> Rng {
+    let mut rng: Rng = rand::SeedableRng::from_seed(key);
+    rng.set_stream(stream);
+    rng.set_word_pos(word_pos);
+    rng
+}

@@ -756,3 +756,17 @@ fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
         Policy::from_json(&text.replace("\"switch\": \"step\"", "\"switch\": \"often\"")).is_err()
     );
 }
+
+#[test]
+fn a_generator_restored_from_its_state_draws_what_it_would_have_drawn() {
+    use hstl_runtime::{RngExt, rng_from_state, rng_state};
+    let mut rng = seeded_rng(42);
+    for _ in 0..37 {
+        rng.random::<u32>();
+    }
+    let (key, stream, pos) = rng_state(&rng);
+    let mut back = rng_from_state(key, stream, pos);
+    let ahead: Vec<u64> = (0..100).map(|_| rng.random::<u64>()).collect();
+    let again: Vec<u64> = (0..100).map(|_| back.random::<u64>()).collect();
+    assert_eq!(ahead, again);
+}
