@@ -61,6 +61,17 @@ pub struct MonitorArgs {
     /// leaves later steps undetermined (empty in `--signal` rows). See docs/LANGUAGE.md.
     #[arg(long, value_enum, default_value_t = Windows::Clipped)]
     pub windows: Windows,
+    /// Dense-time specs: the largest gap allowed between consecutive time stamps, in the
+    /// time column's unit (`0.5`, or `500000000` for nanoseconds). A larger gap is an error
+    /// naming the line and both stamps, instead of each variable's value silently held
+    /// across it.
+    #[arg(long, value_name = "SECONDS")]
+    pub max_gap: Option<String>,
+    /// Dense-time specs: print times relative to the first stamp (exact: the difference of
+    /// the stamps as written, in integer arithmetic for whole-number stamps) instead of in
+    /// the time column's own scale.
+    #[arg(long)]
+    pub relative: bool,
     /// Threads that score a batch of traces (default: one per core).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..=256))]
     pub threads: Option<u16>,
@@ -114,6 +125,20 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
     let (spec, name) = (&loaded.spec, &loaded.file);
     if spec.is_dense() {
         return crate::monitor_dense::run(args, spec, name, &traces);
+    }
+    let dense_only = [(args.max_gap.is_some(), "--max-gap"), (args.relative, "--relative")];
+    if let Some((_, flag)) = dense_only.iter().find(|(set, _)| *set) {
+        return Err(CliError::new(
+            format!(
+                "{name}: `{flag}` is for dense-time specs, and spec `{}` counts steps (it has \
+                 no `time` variable)",
+                spec.name
+            ),
+            Some(format!(
+                "leave out `{flag}`, or give the spec a state variable `t: time` whose column \
+                 holds each row's time stamp"
+            )),
+        ));
     }
     let monitor = Monitor::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {

@@ -55,25 +55,28 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
+    let gap = args.max_gap.as_deref().map(MaxGap::parse).transpose()?;
     let mut cols = vec![Column { name: monitor.time_var(), kind: ColumnKind::Real }];
     cols.extend(columns(spec));
+    let opts = Options { gap: gap.as_ref(), relative: args.relative };
     if args.online {
-        return online(&monitor, &cols, &traces[0], spec, args.formula.as_deref());
+        return online(&monitor, &cols, &traces[0], spec, args.formula.as_deref(), opts);
     }
     let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
     let mut scored = Vec::with_capacity(traces.len());
     let mut ignored: Vec<String> = Vec::new();
     for path in traces {
-        let read = read_dense(path, &cols, &monitor)?;
+        let read = read_dense(path, &cols, &monitor, opts.gap)?;
         for n in &read.ignored {
             if !ignored.contains(n) {
                 ignored.push(n.clone());
             }
         }
         let signal = monitor.signal(&read.trace).map_err(|e| located(path, &read, e))?;
-        let origin = read.trace.origin();
+        let times =
+            Times { relative: opts.relative, origin: read.trace.origin(), t0: read.trace.t0() };
         let rows: Vec<(String, f64)> = if args.signal {
-            signal.until(read.trace.t_last()).map(|(t, v)| (time_text(origin, t), v)).collect()
+            signal.until(read.trace.t_last()).map(|(t, v)| (times.text(t), v)).collect()
         } else {
             vec![(String::new(), signal.first())]
         };
@@ -113,7 +116,12 @@ fn open(path: &Path) -> Result<Box<dyn BufRead>, CliError> {
 }
 
 /// Reads a whole dense-time trace: `cols[0]` is the time column.
-fn read_dense(path: &Path, cols: &[Column<'_>], monitor: &Dense) -> Result<DenseRead, CliError> {
+fn read_dense(
+    path: &Path,
+    cols: &[Column<'_>],
+    monitor: &Dense,
+    gap: Option<&MaxGap>,
+) -> Result<DenseRead, CliError> {
     let name = trace_name(path);
     let mut rows =
         TraceRows::new(open(path)?, cols, Limit::File).map_err(|e| read_error(&name, e))?;
@@ -121,11 +129,13 @@ fn read_dense(path: &Path, cols: &[Column<'_>], monitor: &Dense) -> Result<Dense
     let mut order = StampOrder::default();
     let mut cells = vec![None; cols.len() - 1];
     let mut lines = Vec::new();
+    let mut gaps = Gaps::default();
     while let Some(row) =
         rows.next_dense_row(&mut cells, lines.is_empty()).map_err(|e| read_error(&name, e))?
     {
         let stamp =
             order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
+        gaps.check(gap, stamp, &row, &name, cols[0].name)?;
         if (lines.len() + 1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
             return Err(CliError::new(
                 format!(
@@ -188,6 +198,7 @@ fn online(
     path: &Path,
     spec: &CheckedSpec,
     formula: Option<&str>,
+    opts: Options<'_>,
 ) -> CmdResult {
     let name = trace_name(path);
     let mut rows =
@@ -207,11 +218,19 @@ fn online(
     let mut order = StampOrder::default();
     let mut cells = vec![None; cols.len() - 1];
     let mut count = 0usize;
+    let mut gaps = Gaps::default();
+    let mut times = Times { relative: opts.relative, origin: None, t0: 0.0 };
     while let Some(row) =
         rows.next_dense_row(&mut cells, count == 0).map_err(|e| read_error(&name, e))?
     {
         let stamp =
             order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
+        gaps.check(opts.gap, stamp, &row, &name, cols[0].name)?;
+        if count == 0
+            && let Stamp::Real(t) = stamp
+        {
+            times.t0 = t;
+        }
         count += 1;
         if live.kept().saturating_add(1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
             return Err(CliError::new(
@@ -239,8 +258,9 @@ fn online(
                 p.help,
             )
         })?;
+        times.origin = live.origin();
         for (t, v) in decided {
-            outln!("{},{v}", time_text(live.origin(), t))?;
+            outln!("{},{v}", times.text(t))?;
         }
     }
     if count == 0 {
@@ -252,7 +272,7 @@ fn online(
         CliError::new(format!("{name}: {}{}", p.message, at_time(&p, origin)), p.help)
     })?;
     for (t, v) in rest {
-        outln!("{},{v}", time_text(origin, t))?;
+        outln!("{},{v}", times.text(t))?;
     }
     Ok(Status::Clean)
 }
@@ -263,5 +283,251 @@ fn csv_field(text: &str) -> String {
         format!("\"{}\"", text.replace('"', "\"\""))
     } else {
         text.to_string()
+    }
+}
+
+/// The options that shape reading and printing a dense-time trace.
+#[derive(Clone, Copy)]
+struct Options<'a> {
+    gap: Option<&'a MaxGap>,
+    relative: bool,
+}
+
+/// How the output's times print: in the time column's scale, or relative to the first
+/// stamp (`--relative`).
+struct Times {
+    relative: bool,
+    /// The first whole-number stamp, when stamps are whole numbers beyond 2^53 (the times
+    /// are then relative to it already, computed in integer arithmetic).
+    origin: Option<i128>,
+    /// The first stamp, when stamps are doubles.
+    t0: f64,
+}
+
+impl Times {
+    fn text(&self, t: f64) -> String {
+        match (self.relative, self.origin) {
+            (false, origin) => time_text(origin, t),
+            (true, Some(_)) => t.to_string(),
+            // Exact: the difference of the two times as they print.
+            (true, None) => decimal_difference(&t.to_string(), &self.t0.to_string()),
+        }
+    }
+}
+
+/// `--max-gap`: the bound exactly as written (`digits / 10^decimals`) and as the nearest
+/// double.
+struct MaxGap {
+    text: String,
+    digits: u128,
+    decimals: u32,
+    bound: f64,
+}
+
+impl MaxGap {
+    fn parse(text: &str) -> Result<MaxGap, CliError> {
+        let bad = || {
+            CliError::new(
+                format!("`--max-gap {text}` is not a time: give a number of 0 or more"),
+                Some(
+                    "the gap is in the time column's unit, such as `0.5` for stamps in \
+                     seconds or `500000000` for nanoseconds"
+                        .to_string(),
+                ),
+            )
+        };
+        let (digits, decimals) =
+            hstl::robustness::dense::TimeScale::parse_decimal(text).ok_or_else(bad)?;
+        let bound: f64 = text.trim().parse().map_err(|_| bad())?;
+        if !bound.is_finite() {
+            return Err(bad());
+        }
+        Ok(MaxGap { text: text.trim().to_string(), digits, decimals, bound })
+    }
+
+    /// Whether the gap from `prev` to `now` is larger than the bound, computed exactly;
+    /// with the gap as written.
+    fn exceeded(&self, prev: Stamp, now: Stamp) -> Option<String> {
+        match (prev, now) {
+            (Stamp::Int(p), Stamp::Int(s)) => {
+                let gap = u128::try_from(s - p).unwrap_or(0);
+                // gap > digits / 10^decimals, with no rounding (an overflow is larger).
+                let scaled = 10u128.checked_pow(self.decimals).and_then(|m| gap.checked_mul(m));
+                scaled.is_none_or(|g| g > self.digits).then(|| gap.to_string())
+            }
+            (Stamp::Real(p), Stamp::Real(s)) => {
+                // `d` is `s - p` rounded and `err` the rounding error (Knuth's two-sum):
+                // rounding is monotone, so the exact gap exceeds the bound exactly when
+                // `d` does, or `d` equals it and the error is positive.
+                let d = s - p;
+                let sv = d + p;
+                let err = (s - sv) + (-p - (d - sv));
+                (d > self.bound || d == self.bound && err > 0.0)
+                    .then(|| decimal_difference(&s.to_string(), &p.to_string()))
+            }
+            // A trace's stamps are all of one kind (`StampOrder`).
+            _ => None,
+        }
+    }
+}
+
+/// The previous row's stamp and line, for `--max-gap`.
+#[derive(Default)]
+struct Gaps {
+    last: Option<(Stamp, usize)>,
+}
+
+impl Gaps {
+    /// An error if the gap from the previous row to `row` (with stamp `stamp`) is larger
+    /// than `gap`.
+    fn check(
+        &mut self,
+        gap: Option<&MaxGap>,
+        stamp: Stamp,
+        row: &DenseRow,
+        name: &str,
+        time: &str,
+    ) -> Result<(), CliError> {
+        let Some(gap) = gap else { return Ok(()) };
+        if let Some((prev, line)) = self.last
+            && let Some(width) = gap.exceeded(prev, stamp)
+        {
+            return Err(CliError::new(
+                format!(
+                    "{name}:{}:{}: the time stamp {} in column `{time}` comes {width} after the \
+                     previous one, {} (line {line}): more than `--max-gap {}`",
+                    row.line,
+                    row.stamp_column,
+                    stamp_text(stamp),
+                    stamp_text(prev),
+                    gap.text
+                ),
+                Some(
+                    "each variable would keep its value across the gap: fill the gap with \
+                     samples, monitor the parts before and after it separately, or raise \
+                     `--max-gap`"
+                        .to_string(),
+                ),
+            ));
+        }
+        self.last = Some((stamp, row.line));
+        Ok(())
+    }
+}
+
+fn stamp_text(stamp: Stamp) -> String {
+    match stamp {
+        Stamp::Int(n) => n.to_string(),
+        Stamp::Real(t) => t.to_string(),
+    }
+}
+
+/// `a - b` for two decimals as Rust prints doubles (`-12.5`, `0.001`: no exponent),
+/// exactly, printed the same way.
+fn decimal_difference(a: &str, b: &str) -> String {
+    fn parts(x: &str) -> (bool, &str, &str) {
+        let (neg, x) = x.strip_prefix('-').map_or((false, x), |r| (true, r));
+        let (int, frac) = x.split_once('.').unwrap_or((x, ""));
+        (neg, int, frac)
+    }
+    let ((na, ia, fa), (nb, ib, fb)) = (parts(a), parts(b));
+    let scale = fa.len().max(fb.len());
+    // One more integer digit than either, for a carry.
+    let width = ia.len().max(ib.len()) + 1;
+    let digits = |int: &str, frac: &str| {
+        let mut v = vec![0u8; width - int.len()];
+        v.extend(int.bytes().chain(frac.bytes()).map(|c| c.wrapping_sub(b'0')));
+        v.resize(width + scale, 0);
+        v
+    };
+    let (da, db) = (digits(ia, fa), digits(ib, fb));
+    // `a - b` is `±(|a| + |b|)` for opposite signs, `±(|a| - |b|)` otherwise.
+    let (neg, mag) = if na != nb {
+        (na, add_digits(&da, &db))
+    } else if da >= db {
+        (na, sub_digits(&da, &db))
+    } else {
+        (!na, sub_digits(&db, &da))
+    };
+    let text = |d: &[u8]| d.iter().map(|&c| char::from(b'0' + c)).collect::<String>();
+    let int = text(&mag[..width]);
+    let int = int.trim_start_matches('0');
+    let frac = text(&mag[width..]);
+    let frac = frac.trim_end_matches('0');
+    if int.is_empty() && frac.is_empty() {
+        return "0".to_string();
+    }
+    let sign = if neg { "-" } else { "" };
+    let int = if int.is_empty() { "0" } else { int };
+    if frac.is_empty() { format!("{sign}{int}") } else { format!("{sign}{int}.{frac}") }
+}
+
+/// The sum of two equally long digit strings (most significant first; no overflow out of
+/// the first digit).
+fn add_digits(a: &[u8], b: &[u8]) -> Vec<u8> {
+    let mut out = vec![0u8; a.len()];
+    let mut carry = 0u8;
+    for k in (0..a.len()).rev() {
+        let s = a[k] + b[k] + carry;
+        out[k] = s % 10;
+        carry = s / 10;
+    }
+    out
+}
+
+/// `a - b` for two equally long digit strings with `a >= b`.
+fn sub_digits(a: &[u8], b: &[u8]) -> Vec<u8> {
+    let mut out = vec![0u8; a.len()];
+    let mut borrow = 0u8;
+    for k in (0..a.len()).rev() {
+        let (d, sub) = (a[k], b[k] + borrow);
+        if d >= sub {
+            out[k] = d - sub;
+            borrow = 0;
+        } else {
+            out[k] = d + 10 - sub;
+            borrow = 1;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimal_differences_are_exact() {
+        assert_eq!(decimal_difference("0.3", "0.1"), "0.2");
+        assert_eq!(decimal_difference("1700000000.4", "1700000000"), "0.4");
+        assert_eq!(decimal_difference("5", "-2.25"), "7.25");
+        assert_eq!(decimal_difference("-2.25", "5"), "-7.25");
+        assert_eq!(decimal_difference("-1", "-3.5"), "2.5");
+        assert_eq!(decimal_difference("0.1", "0.3"), "-0.2");
+        assert_eq!(decimal_difference("99.99", "0.01"), "99.98");
+        assert_eq!(decimal_difference("99.99", "-0.01"), "100");
+        assert_eq!(decimal_difference("2", "2"), "0");
+        assert_eq!(decimal_difference("-0", "0"), "0");
+        assert_eq!(decimal_difference("0.30000000000000004", "0"), "0.30000000000000004");
+    }
+
+    #[test]
+    fn gaps_compare_exactly() {
+        let g = MaxGap::parse("0.1").expect("a time");
+        // 0.3 - 0.2 (as doubles) is exactly 0.0999999999999999778: below the double 0.1.
+        assert!(g.exceeded(Stamp::Real(0.2), Stamp::Real(0.3)).is_none());
+        assert!(g.exceeded(Stamp::Real(0.0), Stamp::Real(0.1)).is_none());
+        assert_eq!(g.exceeded(Stamp::Real(0.0), Stamp::Real(0.25)).as_deref(), Some("0.25"));
+        let ns = MaxGap::parse("0.5").expect("a time");
+        let t = 1_700_000_000_000_000_000i128;
+        assert!(ns.exceeded(Stamp::Int(t), Stamp::Int(t + 1)).is_some());
+        let ns = MaxGap::parse("500000000").expect("a time");
+        assert!(ns.exceeded(Stamp::Int(t), Stamp::Int(t + 500_000_000)).is_none());
+        assert_eq!(
+            ns.exceeded(Stamp::Int(t), Stamp::Int(t + 500_000_001)).as_deref(),
+            Some("500000001")
+        );
+        assert!(MaxGap::parse("-1").is_err());
+        assert!(MaxGap::parse("inf").is_err());
     }
 }

@@ -173,6 +173,59 @@ const CASES: &[Case] = &[
         "monitor_dense_batch",
         &["monitor", "dense.hstl", "--trace", "dense.csv", "--trace", "dense_irregular.csv"],
     ),
+    // `--max-gap`: a gap larger than the bound is an error naming both stamps
+    case(
+        "monitor_dense_max_gap",
+        &["monitor", "dense.hstl", "--trace", "dense_irregular.csv", "--max-gap", "0.1"],
+    ),
+    case(
+        "monitor_dense_max_gap_held",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--max-gap", "1.5", "--signal"],
+    ),
+    case(
+        "monitor_dense_max_gap_nanoseconds",
+        &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--max-gap", "1000000000"],
+    ),
+    Case {
+        name: "monitor_dense_max_gap_online",
+        args: &["monitor", "dense.hstl", "--trace", "-", "--online", "--max-gap", "1"],
+        stdin: "t,x,y\n0,1,5\n0.5,2,\n1,,6\n1.25,3,\n2.5,0.5,\n3,,-1\n",
+    },
+    case(
+        "monitor_dense_max_gap_not_a_time",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--max-gap", "soon"],
+    ),
+    case(
+        "monitor_max_gap_discrete",
+        &["monitor", "surveillance.hstl", "--trace", "trace.csv", "--max-gap", "1"],
+    ),
+    // `--relative`: times from the first stamp, exactly
+    case(
+        "monitor_dense_relative",
+        &["monitor", "dense.hstl", "--trace", "dense_offset.csv", "--signal", "--relative"],
+    ),
+    case(
+        "monitor_dense_relative_nanoseconds",
+        &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--signal", "--relative"],
+    ),
+    case(
+        "monitor_dense_offset",
+        &["monitor", "dense.hstl", "--trace", "dense_offset.csv", "--signal"],
+    ),
+    Case {
+        name: "monitor_dense_relative_online",
+        args: &[
+            "monitor",
+            "dense.hstl",
+            "--trace",
+            "-",
+            "--online",
+            "--relative",
+            "--formula",
+            "Soon",
+        ],
+        stdin: "t,x,y\n-1.5,1,5\n-0.5,2,\n0,,6\n0.5,3,\n2,0.5,\n2.5,,-1\n3.5,4,\n",
+    },
     case("monitor_dense_bad_stamp", &["monitor", "dense.hstl", "--trace", "dense_bad_stamp.csv"]),
     case("monitor_dense_bad_cell", &["monitor", "dense.hstl", "--trace", "dense_bad_cell.csv"]),
     case(
