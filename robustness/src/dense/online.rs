@@ -37,9 +37,9 @@ use std::collections::VecDeque;
 /// value holds from `t` until the next change point); [`DenseMonitor::finish`] ends the
 /// trace and returns the rest up to the last stamp. Together they are exactly
 /// [`DenseFormula::signal`]'s change points up to the last stamp. A change point at `t` is
-/// given once the rows up to `t + H` have arrived, `H` the formula's future reach
-/// ([`DenseFormula::future_reach`]), and never before the row at or after `t` (past
-/// operators could tell earlier, but the trace may end first).
+/// given once a row stamped after `t + H` has arrived (give or take a few ulps), `H` the
+/// formula's future reach ([`DenseFormula::future_reach`]), and never before a row stamped
+/// at or after `t` (past operators could tell earlier, but the trace may end first).
 ///
 /// The monitor is incremental: each operator keeps only the pieces its window spans (see
 /// the module's source for how), so the work per row does not grow with the windows'
