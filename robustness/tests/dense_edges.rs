@@ -291,3 +291,76 @@ fn the_online_monitor_decides_early_and_keeps_only_its_window() {
     let want: Vec<(f64, f64)> = df.signal(&trace).unwrap().until(trace.t_last()).collect();
     assert_eq!(online, want);
 }
+
+/// Windows thousands of rows long (40 s over stamps 1 to 20 ms apart, as the bench's), for
+/// every kind of operator: the online monitor equals offline, and what it keeps stays
+/// within a window (not the trace).
+#[test]
+fn the_online_monitor_streams_long_windows() {
+    let x = |c: f64| gt(0, c);
+    let y = |c: f64| Formula::cmp(Expr::var(1), CmpOp::Lt, Expr::constant(c));
+    let ms = |a: usize, b: Option<usize>| iv(a, b);
+    let cases = [
+        Formula::always(ms(0, Some(40_000)), Formula::and(vec![x(-3.0), y(3.0)])),
+        Formula::eventually(ms(1_000, Some(40_000)), x(2.0)),
+        Formula::historically(ms(0, Some(40_000)), Formula::or(vec![x(-2.0), y(0.5)])),
+        Formula::once(ms(500, Some(40_000)), x(2.5)),
+        Formula::once(ms(500, None), x(2.5)),
+        Formula::since(ms(100, Some(40_000)), x(-2.0), y(-1.0)),
+        Formula::since(ms(0, None), x(-2.5), y(-1.0)),
+        Formula::until(ms(0, Some(2_000)), x(-2.0), y(-1.0)),
+        Formula::always(
+            ms(0, Some(40_000)),
+            Formula::implies(x(1.0), Formula::eventually(ms(100, Some(3_000)), y(0.0))),
+        ),
+        Formula::not(Formula::historically(
+            ms(0, Some(10_000)),
+            Formula::once(ms(0, Some(20_000)), x(2.9)),
+        )),
+    ];
+    // A deterministic walk with irregular stamps (whole milliseconds, in seconds) and
+    // empty cells.
+    let mut rows: Vec<(f64, Vec<Option<f64>>)> = Vec::new();
+    let (mut ms_total, mut state) = (0u64, 0x9e37_79b9_7f4a_7c15u64);
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let (mut xv, mut yv) = (0.0f64, 0.0f64);
+    for k in 0..30_000 {
+        xv = (xv + (next() % 5) as f64 * 0.1 - 0.2).clamp(-3.0, 3.0);
+        yv = (yv + (next() % 5) as f64 * 0.1 - 0.2).clamp(-3.0, 3.0);
+        let cells = if k == 0 {
+            vec![Some(xv), Some(yv)]
+        } else {
+            vec![(next() % 4 != 0).then_some(xv), (next() % 3 != 0).then_some(yv)]
+        };
+        rows.push((ms_total as f64 / 1000.0, cells));
+        ms_total += 1 + next() % 20;
+    }
+    let mut b = DenseTraceBuilder::new(2);
+    for (t, cells) in &rows {
+        b.push(*t, cells).unwrap();
+    }
+    let trace = b.build().unwrap();
+    for f in cases {
+        let df = DenseFormula::new(&f, TimeScale::decimals(3)).unwrap();
+        let want: Vec<(f64, f64)> = df.signal(&trace).unwrap().until(trace.t_last()).collect();
+        let mut m = DenseMonitor::new(&df, 2).unwrap();
+        let (mut got, mut most) = (Vec::new(), 0);
+        for (t, cells) in &rows {
+            got.extend(m.push(*t, cells).unwrap());
+            most = most.max(m.kept());
+        }
+        got.extend(m.finish().unwrap());
+        assert_eq!(got.len(), want.len(), "{f}");
+        assert!(
+            got.iter().zip(&want).all(|(g, w)| g.0 == w.0 && g.1.to_bits() == w.1.to_bits()),
+            "{f}"
+        );
+        // A 40 s window spans about 3,800 rows; the trace has 30,000.
+        assert!(most < 12_000, "{f}: kept {most}");
+    }
+}

@@ -147,6 +147,18 @@ proptest! {
         prop_assert!(same_points(&got, &want), "{}\n online  {:?}\n offline {:?}", f, got, want);
     }
 
+    /// Long traces (up to 400 rows, gaps of 0.01 to 0.08) under windows of up to 1.4, so a
+    /// window spans tens of rows and the streaming operators drop and refill their deques.
+    #[test]
+    fn online_equals_offline_on_long_windows(f in formula(10), rows in rows(0.01, 400)) {
+        let trace = build(&rows);
+        let df = DenseFormula::new(&f, scale()).expect("a dense formula");
+        let Ok(want) = df.signal(&trace) else { return Ok(()) };
+        let want = points(&want, trace.t_last());
+        let got = online(&df, &rows, 1);
+        prop_assert!(same_points(&got, &want), "{}\n online  {:?}\n offline {:?}", f, got, want);
+    }
+
     /// Per-variable sample lists merge into the rows a CSV with empty cells gives.
     #[test]
     fn per_variable_samples_merge_like_rows(rows in rows(0.25, 12)) {

@@ -31,7 +31,8 @@
 //! - [`DenseFormula::signal`] computes the whole signal offline, in time linear in the
 //!   number of change points whatever the windows' lengths;
 //! - [`DenseMonitor`] takes samples one at a time and gives each change point of the
-//!   signal once no later sample can change it.
+//!   signal once no later sample can change it, streaming: its work per row does not grow
+//!   with the windows' lengths (except for `until`, which re-evaluates its window).
 
 mod offline;
 mod online;

@@ -19,14 +19,14 @@ use crate::formula::{ExprId, Node};
 use std::collections::VecDeque;
 
 /// Which way a window looks.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Dir {
     Future,
     Past,
 }
 
 /// The extreme a window takes.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Ext {
     Max,
     Min,
@@ -34,7 +34,7 @@ pub(crate) enum Ext {
 
 impl Ext {
     #[inline]
-    fn identity(self) -> f64 {
+    pub(crate) fn identity(self) -> f64 {
         match self {
             Ext::Max => f64::NEG_INFINITY,
             Ext::Min => f64::INFINITY,
@@ -43,7 +43,7 @@ impl Ext {
 
     /// Whether `new` makes `old` useless in a monotone deque (`old` no better than `new`).
     #[inline]
-    fn dominates(self, new: f64, old: f64) -> bool {
+    pub(crate) fn dominates(self, new: f64, old: f64) -> bool {
         match self {
             Ext::Max => old <= new,
             Ext::Min => old >= new,
@@ -52,12 +52,12 @@ impl Ext {
 }
 
 #[inline]
-fn min(a: f64, b: f64) -> f64 {
+pub(crate) fn min(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
 }
 
 #[inline]
-fn max(a: f64, b: f64) -> f64 {
+pub(crate) fn max(a: f64, b: f64) -> f64 {
     if b > a { b } else { a }
 }
 

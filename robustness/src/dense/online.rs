@@ -1,42 +1,540 @@
 //! The online dense-time monitor: samples arrive one row at a time, change points of the
 //! robustness signal leave once no later sample can change them.
+//!
+//! Every node of the formula is a streaming operator: it takes its operands' new change
+//! points and how far they are final (a *frontier* `F`: every change point before `F` has
+//! been given, and the values before `F` are final), and gives its own new change points
+//! and frontier, in one pass over what is new:
+//! - a comparison gives a point at each row (final up to the row's stamp);
+//! - `!`, `&&`, `||` and `->` merge their operands' points up to the least of their
+//!   frontiers, as the offline evaluator merges whole signals;
+//! - `eventually`, `always`, `once` and `historically` run the offline sliding window (a
+//!   monotone deque over pieces) up to the time no piece still to come can reach: for a
+//!   future window `[a, b]` over an operand final up to `F`, a later piece starts at
+//!   `s - b >= F - b` and the last known piece ends at `s' - a >= F - a`, so every event
+//!   before `F - b` (one IEEE operation, as the window's own ends) is final; past windows
+//!   likewise up to `F + a`. The deque and the pieces kept span one window;
+//! - `since` (timed or not) is rtamt's decomposition (`once[a..=b] g && historically[0..=a]
+//!   (f since g)`) of streaming parts: untimed `since` is a forward recurrence;
+//! - `until` is the one operator not streamed: untimed `f until g` is a backward
+//!   recurrence from the end of the trace, so a timed `until` node keeps its operands'
+//!   points over its window and re-evaluates them (offline) at each step, deciding up to
+//!   `F - b` (less a few ulps). Its cost per row grows with its window's length; every other
+//!   operator's does not.
+//!
+//! Each operator computes the same values at the same breakpoints as the offline evaluator
+//! (the same IEEE operations in the same order), so the monitor's change points are
+//! [`DenseFormula::signal`]'s bit for bit.
 
-use super::offline::{self, Rows};
-use super::{DenseError, DenseFormula, DenseTraceBuilder};
+use super::offline::{self, Dir, Ext, max, min};
+use super::{DenseError, DenseFormula, DenseSignal, DenseTraceBuilder};
+use crate::formula::Node;
+use std::collections::VecDeque;
 
 /// Monitors a [`DenseFormula`] over rows of time-stamped samples pushed one at a time.
 ///
-/// After a row with stamp `X`, the signal is decided on `[t0, X - H)` where `H` is the
-/// formula's future reach ([`DenseFormula::future_reach`]), less a few ulps: a later sample
-/// starts after `X` and a value at `t` reads no further than `t + H`. [`DenseMonitor::push`]
-/// returns the change points that became decided (`(t, value)`: the value holds from `t`
-/// until the next change point); [`DenseMonitor::finish`] ends the trace and returns the
-/// rest up to the last stamp. Together they are exactly [`DenseFormula::signal`]'s change
-/// points up to the last stamp.
+/// [`DenseMonitor::push`] returns the change points that became final (`(t, value)`: the
+/// value holds from `t` until the next change point); [`DenseMonitor::finish`] ends the
+/// trace and returns the rest up to the last stamp. Together they are exactly
+/// [`DenseFormula::signal`]'s change points up to the last stamp. A change point at `t` is
+/// given once a row stamped after `t + H` has arrived (give or take a few ulps), `H` the
+/// formula's future reach ([`DenseFormula::future_reach`]), and never before a row stamped
+/// at or after `t` (past operators could tell earlier, but the trace may end first).
 ///
-/// The monitor keeps only the rows the undecided part reads: those within the future and
-/// past reaches of the decided frontier, so memory is bounded by the windows (an unbounded
-/// operator keeps every row, and an unbounded future operator decides nothing before the
-/// end). Each decision re-evaluates the kept rows; by default that happens at every push
-/// (verdicts as soon as they are decided), and [`DenseMonitor::set_batch`] trades delay for
-/// throughput (one evaluation per `n` rows).
+/// The monitor is incremental: each operator keeps only the pieces its window spans (see
+/// the module's source for how), so the work per row does not grow with the windows'
+/// lengths and memory is bounded by them, except for two cases:
+/// - `until` (timed or not) re-evaluates the points it keeps, its window's worth, at every
+///   row: its work per row grows with its window;
+/// - an unbounded future operator (`eventually[a..]`, `always`, untimed `until`) decides
+///   nothing before the end and keeps everything; an unbounded past one (`once[a..]`,
+///   `historically`) keeps only its running extreme.
 #[derive(Clone, Debug)]
 pub struct DenseMonitor {
     formula: DenseFormula,
     rows: DenseTraceBuilder,
     vars: usize,
-    /// Change points before this time have been returned.
-    decided: f64,
-    /// The last value returned.
-    last: Option<f64>,
-    batch: usize,
-    pending: usize,
+    ops: Vec<Op>,
+    /// Each expression node's value at the last row.
+    ev: Vec<f64>,
+    /// Each node's change points given in this step.
+    fresh: Vec<Vec<(f64, f64)>>,
+    /// Each node's frontier.
+    front: Vec<f64>,
+    /// The first stamp; NaN before the first row.
+    t0: f64,
+    /// The last stamp.
+    x: f64,
+    /// The root's final change points after the last stamp (given once a row reaches them).
+    held: VecDeque<(f64, f64)>,
 }
 
 /// `x` lowered by a relative margin of a few ulps (and a tiny absolute one), so a frontier
 /// computed in rounded arithmetic stays on the safe side.
 fn down(x: f64, scale: f64) -> f64 {
     x - (x.abs() + scale) * f64::EPSILON * 16.0 - f64::MIN_POSITIVE
+}
+
+const INF: f64 = f64::INFINITY;
+
+/// Drops a change point that repeats the last value, as [`DenseSignal`] does.
+#[derive(Clone, Debug, Default)]
+struct Dedup {
+    last: Option<f64>,
+}
+
+impl Dedup {
+    #[inline]
+    fn push(&mut self, out: &mut Vec<(f64, f64)>, t: f64, v: f64) {
+        if self.last != Some(v) {
+            out.push((t, v));
+            self.last = Some(v);
+        }
+    }
+}
+
+/// How a merge combines its operands' values.
+#[derive(Clone, Copy, Debug)]
+enum Fold {
+    Min,
+    Max,
+    /// `max(-a, b)`.
+    Implies,
+    /// Untimed `since`: `u = max(min(f, g), min(f, u_before))`.
+    Since,
+}
+
+/// Operands' points merged over the union of their change points, up to the least of the
+/// operands' frontiers.
+#[derive(Clone, Debug)]
+struct Merge {
+    fold: Fold,
+    queues: Vec<VecDeque<(f64, f64)>>,
+    cur: Vec<f64>,
+    /// `since`'s running value.
+    acc: f64,
+    out: Dedup,
+}
+
+impl Merge {
+    fn new(fold: Fold, n: usize) -> Merge {
+        Merge {
+            fold,
+            queues: vec![VecDeque::new(); n],
+            cur: vec![0.0; n],
+            acc: f64::NEG_INFINITY,
+            out: Dedup::default(),
+        }
+    }
+
+    fn feed(&mut self, k: usize, points: &[(f64, f64)]) {
+        self.queues[k].extend(points.iter().copied());
+    }
+
+    fn kept(&self) -> usize {
+        self.queues.iter().map(VecDeque::len).sum()
+    }
+
+    /// Every union time before `frontier` (the least of the operands' frontiers: each
+    /// operand's points before it have all been fed).
+    fn advance(&mut self, frontier: f64, out: &mut Vec<(f64, f64)>) {
+        loop {
+            let mut t: Option<f64> = None;
+            for q in &self.queues {
+                if let Some(&(x, _)) = q.front()
+                    && t.is_none_or(|t| x < t)
+                {
+                    t = Some(x);
+                }
+            }
+            let Some(t) = t else { break };
+            if t >= frontier {
+                break;
+            }
+            for (q, c) in self.queues.iter_mut().zip(&mut self.cur) {
+                if q.front().is_some_and(|p| p.0 == t) {
+                    *c = q.pop_front().map_or(*c, |p| p.1);
+                }
+            }
+            let c = &self.cur;
+            let v = match self.fold {
+                Fold::Min => c[1..].iter().fold(c[0], |acc, &x| min(acc, x)),
+                Fold::Max => c[1..].iter().fold(c[0], |acc, &x| max(acc, x)),
+                Fold::Implies => max(-c[0], c[1]),
+                Fold::Since => {
+                    self.acc = max(min(c[0], c[1]), min(c[0], self.acc));
+                    self.acc
+                }
+            };
+            self.out.push(out, t, v);
+        }
+    }
+}
+
+/// A window operator fed piece by piece: the offline sweep, run up to the time no piece
+/// still to come can change.
+#[derive(Clone, Debug)]
+struct Win {
+    dir: Dir,
+    a: f64,
+    b: f64,
+    ext: Ext,
+    /// Whether pieces ever leave the window (not for an unbounded past window).
+    ends: bool,
+    /// The pieces from `base` on: their start times and values.
+    times: VecDeque<f64>,
+    vals: VecDeque<f64>,
+    base: usize,
+    /// The next piece to enter and the next to leave (absolute indices).
+    i: usize,
+    j: usize,
+    dq: VecDeque<(usize, f64)>,
+    /// The last event swept, if any.
+    swept: Option<f64>,
+    out: Dedup,
+}
+
+impl Win {
+    fn new(dir: Dir, a: f64, b: f64, ext: Ext) -> Win {
+        Win {
+            dir,
+            a,
+            b,
+            ext,
+            ends: !(dir == Dir::Past && b == INF),
+            times: VecDeque::new(),
+            vals: VecDeque::new(),
+            base: 0,
+            i: 0,
+            j: 0,
+            dq: VecDeque::new(),
+            swept: None,
+            out: Dedup::default(),
+        }
+    }
+
+    fn feed(&mut self, points: &[(f64, f64)]) {
+        for &(t, v) in points {
+            self.times.push_back(t);
+            self.vals.push_back(v);
+        }
+    }
+
+    fn kept(&self) -> usize {
+        self.times.len() + self.dq.len()
+    }
+
+    fn received(&self) -> usize {
+        self.base + self.times.len()
+    }
+
+    /// When piece `k` starts meeting the window (as offline computes it).
+    #[inline]
+    fn start(&self, k: usize) -> f64 {
+        let s = self.times[k - self.base];
+        match self.dir {
+            Dir::Future => s - self.b,
+            Dir::Past => s + self.a,
+        }
+    }
+
+    /// When piece `k` stops meeting the window; `None` while its successor is unknown.
+    #[inline]
+    fn end(&self, k: usize, done: bool) -> Option<f64> {
+        if !self.ends {
+            return Some(INF);
+        }
+        match self.times.get(k + 1 - self.base) {
+            Some(&next) => Some(match self.dir {
+                Dir::Future => next - self.a,
+                Dir::Past => next + self.b,
+            }),
+            None => done.then_some(INF),
+        }
+    }
+
+    /// Sweeps every event before the operand's frontier allows; returns the output's
+    /// frontier.
+    fn advance(&mut self, t0: f64, operand: f64, out: &mut Vec<(f64, f64)>) -> f64 {
+        let done = operand == INF;
+        // A piece still to come starts at `s - b` (`s + a`) with `s >= operand`, and the
+        // last known one ends no sooner (rounding is monotone).
+        let limit = if done {
+            INF
+        } else {
+            match self.dir {
+                Dir::Future => operand - self.b,
+                Dir::Past => operand + self.a,
+            }
+        };
+        loop {
+            let t = match self.swept {
+                None => t0,
+                Some(_) => {
+                    let rec = self.received();
+                    let unknown = if done { INF } else { limit };
+                    let next_start = if self.i < rec { self.start(self.i) } else { unknown };
+                    let next_end = if self.j < rec {
+                        self.end(self.j, done).unwrap_or(unknown)
+                    } else {
+                        unknown
+                    };
+                    next_start.min(next_end)
+                }
+            };
+            if t >= limit {
+                break;
+            }
+            let rec = self.received();
+            while self.i < rec && self.start(self.i) <= t {
+                // A piece already past its end (an empty interval) never enters.
+                if self.i >= self.j {
+                    let v = self.vals[self.i - self.base];
+                    while self.dq.back().is_some_and(|&(_, q)| self.ext.dominates(v, q)) {
+                        self.dq.pop_back();
+                    }
+                    self.dq.push_back((self.i, v));
+                }
+                self.i += 1;
+            }
+            while self.j < rec && self.end(self.j, done).is_some_and(|e| e <= t) {
+                if self.dq.front().is_some_and(|q| q.0 == self.j) {
+                    self.dq.pop_front();
+                }
+                self.j += 1;
+            }
+            let v = self.dq.front().map_or(self.ext.identity(), |q| q.1);
+            self.out.push(out, t, v);
+            self.swept = Some(t);
+            // Pieces before the next to leave (to enter, when none leaves) are done with.
+            let keep = if self.ends { self.j } else { self.i };
+            while self.base < keep && !self.times.is_empty() {
+                self.times.pop_front();
+                self.vals.pop_front();
+                self.base += 1;
+            }
+        }
+        limit
+    }
+}
+
+/// `f since[a..=b] g` as rtamt decomposes it, of streaming parts.
+#[derive(Clone, Debug)]
+struct SinceNode {
+    b: f64,
+    untimed: Merge,
+    /// `once[a..=b] g`, `historically[0..=a] (f since g)` (for `a > 0`) and their `&&`;
+    /// none for `[0..]`.
+    reach: Option<Win>,
+    hold: Option<Win>,
+    both: Option<Merge>,
+}
+
+impl SinceNode {
+    fn new(a: f64, b: f64) -> SinceNode {
+        let untimed = a == 0.0 && b == INF;
+        SinceNode {
+            b,
+            untimed: Merge::new(Fold::Since, 2),
+            reach: (!untimed).then(|| Win::new(Dir::Past, a, b, Ext::Max)),
+            hold: (a != 0.0).then(|| Win::new(Dir::Past, 0.0, a, Ext::Min)),
+            both: (!untimed).then(|| Merge::new(Fold::Min, 2)),
+        }
+    }
+
+    fn kept(&self) -> usize {
+        self.untimed.kept()
+            + self.reach.as_ref().map_or(0, Win::kept)
+            + self.hold.as_ref().map_or(0, Win::kept)
+            + self.both.as_ref().map_or(0, Merge::kept)
+    }
+
+    fn advance(
+        &mut self,
+        t0: f64,
+        (ff, fp): (f64, &[(f64, f64)]),
+        (gf, gp): (f64, &[(f64, f64)]),
+        out: &mut Vec<(f64, f64)>,
+    ) -> f64 {
+        self.untimed.feed(0, fp);
+        self.untimed.feed(1, gp);
+        let uf = ff.min(gf);
+        let (Some(reach), Some(both)) = (&mut self.reach, &mut self.both) else {
+            self.untimed.advance(uf, out);
+            return uf;
+        };
+        let mut up = Vec::new();
+        self.untimed.advance(uf, &mut up);
+        reach.feed(gp);
+        let mut rp = Vec::new();
+        let rf = reach.advance(t0, gf, &mut rp);
+        let (hp, hf) = match &mut self.hold {
+            Some(hold) => {
+                hold.feed(&up);
+                let mut hp = Vec::new();
+                let hf = hold.advance(t0, uf, &mut hp);
+                (hp, hf)
+            }
+            None => (up, uf),
+        };
+        if self.b == INF {
+            both.feed(0, &hp);
+            both.feed(1, &rp);
+        } else {
+            both.feed(0, &rp);
+            both.feed(1, &hp);
+        }
+        let f = rf.min(hf);
+        both.advance(f, out);
+        f
+    }
+}
+
+/// `f until[a..=b] g`: not streamed (untimed `until` reads to the end of the trace). The
+/// operands' points over the window are kept and evaluated offline at each step, deciding
+/// up to `F - b` less a few ulps, `F` the operands' frontier: the value at `t` reads the
+/// operands on `[t, t + b]` only.
+#[derive(Clone, Debug)]
+struct UntilNode {
+    a: f64,
+    b: f64,
+    f: VecDeque<(f64, f64)>,
+    g: VecDeque<(f64, f64)>,
+    /// The node's frontier; `-inf` before the first step.
+    decided: f64,
+    out: Dedup,
+}
+
+impl UntilNode {
+    fn kept(&self) -> usize {
+        self.f.len() + self.g.len()
+    }
+
+    fn advance(
+        &mut self,
+        t0: f64,
+        (ff, fp): (f64, &[(f64, f64)]),
+        (gf, gp): (f64, &[(f64, f64)]),
+        out: &mut Vec<(f64, f64)>,
+    ) -> f64 {
+        self.f.extend(fp.iter().copied());
+        self.g.extend(gp.iter().copied());
+        if self.decided == f64::NEG_INFINITY {
+            self.decided = t0;
+        }
+        let fc = ff.min(gf);
+        let frontier = if fc == INF { INF } else { down(fc - self.b, self.b) };
+        let d = self.decided;
+        if frontier <= d || self.f.is_empty() || self.g.is_empty() {
+            return d;
+        }
+        // The kept points from `d` on: the first holds at `d` (see below), so it is moved
+        // to `d`, which changes no value from `d` on.
+        let signal = |q: &VecDeque<(f64, f64)>| {
+            let mut s = DenseSignal::with_capacity(q.len());
+            for (k, &(t, v)) in q.iter().enumerate() {
+                s.push(if k == 0 { d } else { t }, v);
+            }
+            s
+        };
+        let s = offline::timed_until(
+            &signal(&self.f),
+            &signal(&self.g),
+            d,
+            Dir::Future,
+            self.a,
+            self.b,
+        );
+        for (t, v) in s.points() {
+            if t >= frontier {
+                break;
+            }
+            if t >= d {
+                self.out.push(out, t, v);
+            }
+        }
+        self.decided = frontier;
+        // Keep the last point at or before the frontier (it holds there) and the rest.
+        for q in [&mut self.f, &mut self.g] {
+            while q.len() >= 2 && q[1].0 <= frontier {
+                q.pop_front();
+            }
+        }
+        frontier
+    }
+}
+
+/// One node's streaming state.
+#[derive(Clone, Debug)]
+enum Op {
+    /// An expression: a value per row.
+    Expr,
+    /// A comparison: a point per row.
+    Cmp(Dedup),
+    /// `true`, `false`, an empty `&&` or `||`: one point at the first stamp.
+    Constant(f64, Dedup),
+    Not(Dedup),
+    /// `&&` or `||` of one operand.
+    Copy,
+    Merge(Merge),
+    Win(Win),
+    Since(Box<SinceNode>),
+    Until(Box<UntilNode>),
+}
+
+impl Op {
+    fn kept(&self) -> usize {
+        match self {
+            Op::Merge(m) => m.kept(),
+            Op::Win(w) => w.kept(),
+            Op::Since(s) => s.kept(),
+            Op::Until(u) => u.kept(),
+            _ => 0,
+        }
+    }
+}
+
+fn ops(df: &DenseFormula) -> Vec<Op> {
+    let nodes = df.formula.nodes();
+    nodes
+        .iter()
+        .enumerate()
+        .map(|(i, node)| {
+            let (a, b) = df.bounds[i];
+            match node {
+                Node::Cmp { .. } => Op::Cmp(Dedup::default()),
+                Node::True => Op::Constant(INF, Dedup::default()),
+                Node::False => Op::Constant(f64::NEG_INFINITY, Dedup::default()),
+                Node::Not(_) => Op::Not(Dedup::default()),
+                Node::And(gs) | Node::Or(gs) => {
+                    let and = matches!(node, Node::And(_));
+                    match gs.len() {
+                        0 => Op::Constant(
+                            if and { INF } else { f64::NEG_INFINITY },
+                            Dedup::default(),
+                        ),
+                        1 => Op::Copy,
+                        n => Op::Merge(Merge::new(if and { Fold::Min } else { Fold::Max }, n)),
+                    }
+                }
+                Node::Implies(..) => Op::Merge(Merge::new(Fold::Implies, 2)),
+                Node::Eventually(..) => Op::Win(Win::new(Dir::Future, a, b, Ext::Max)),
+                Node::Always(..) => Op::Win(Win::new(Dir::Future, a, b, Ext::Min)),
+                Node::Once(..) => Op::Win(Win::new(Dir::Past, a, b, Ext::Max)),
+                Node::Historically(..) => Op::Win(Win::new(Dir::Past, a, b, Ext::Min)),
+                Node::Since(..) => Op::Since(Box::new(SinceNode::new(a, b))),
+                Node::Until(..) => Op::Until(Box::new(UntilNode {
+                    a,
+                    b,
+                    f: VecDeque::new(),
+                    g: VecDeque::new(),
+                    decided: f64::NEG_INFINITY,
+                    out: Dedup::default(),
+                })),
+                _ => Op::Expr,
+            }
+        })
+        .collect()
 }
 
 impl DenseMonitor {
@@ -47,34 +545,38 @@ impl DenseMonitor {
         {
             return Err(DenseError::MissingVar { var, vars });
         }
+        let n = formula.formula.nodes().len();
         Ok(DenseMonitor {
             formula: formula.clone(),
             rows: DenseTraceBuilder::new(vars),
             vars,
-            decided: f64::NEG_INFINITY,
-            last: None,
-            batch: 1,
-            pending: 0,
+            ops: ops(formula),
+            ev: vec![0.0; n],
+            fresh: vec![Vec::new(); n],
+            front: vec![f64::NEG_INFINITY; n],
+            t0: f64::NAN,
+            x: f64::NAN,
+            held: VecDeque::new(),
         })
     }
 
-    /// Evaluates once every `n` rows (at least 1) instead of at every row: verdicts come up
-    /// to `n` rows late, and the work per row drops from the window's length to about
-    /// `1 + window / n`.
+    /// Has no effect: kept for compatibility. (The monitor used to re-evaluate its window
+    /// at every row, and batching rows traded delay for throughput; it is now incremental.)
     pub fn set_batch(&mut self, n: usize) {
-        self.batch = n.max(1);
+        let _ = n;
     }
 
-    /// The number of rows kept.
+    /// The number of pieces and change points the monitor holds (its operators' windows'
+    /// worth), bounded by the windows' lengths for bounded windows.
     pub fn kept(&self) -> usize {
-        self.rows.rows().0.len()
+        self.ops.iter().map(Op::kept).sum::<usize>() + self.held.len() + 1
     }
 
     /// Appends a row with stamp `t` (`None`: no new sample of that variable) and returns
     /// the change points it decided.
     pub fn push(&mut self, t: f64, cells: &[Option<f64>]) -> Result<Vec<(f64, f64)>, DenseError> {
         self.rows.push(t, cells)?;
-        self.advance()
+        self.row()
     }
 
     /// [`DenseMonitor::push`] with a whole-number stamp (nanoseconds, say), taken relative
@@ -86,7 +588,7 @@ impl DenseMonitor {
         cells: &[Option<f64>],
     ) -> Result<Vec<(f64, f64)>, DenseError> {
         self.rows.push_int(stamp, cells)?;
-        self.advance()
+        self.row()
     }
 
     /// The first whole-number stamp, when rows have whole-number stamps.
@@ -94,77 +596,149 @@ impl DenseMonitor {
         self.rows.origin()
     }
 
-    fn advance(&mut self) -> Result<Vec<(f64, f64)>, DenseError> {
-        self.pending += 1;
+    /// The row just pushed: one step of every node.
+    fn row(&mut self) -> Result<Vec<(f64, f64)>, DenseError> {
         let (times, _) = self.rows.rows();
-        if self.decided == f64::NEG_INFINITY {
-            self.decided = times[0];
+        if times.len() > 1 {
+            // Only the last row is needed (it holds the values of empty cells).
+            self.rows.drop_front(times.len() - 1);
         }
-        let x = times[times.len() - 1];
-        let reach = self.formula.future_reach();
-        let frontier = down(x - reach, reach);
-        if self.pending < self.batch || frontier <= self.decided {
-            return Ok(Vec::new());
+        let (times, _) = self.rows.rows();
+        let t = times[times.len() - 1];
+        if self.t0.is_nan() {
+            self.t0 = t;
         }
-        self.pending = 0;
-        let out = self.emit(frontier, true)?;
-        self.forget();
-        Ok(out)
+        self.x = t;
+        self.step(Some(t))?;
+        Ok(self.release(t))
     }
 
-    /// Evaluates the kept rows and returns the new change points before `frontier` (up to
-    /// it, inclusive, when not `open`).
-    fn emit(&mut self, frontier: f64, open: bool) -> Result<Vec<(f64, f64)>, DenseError> {
-        let (times, columns) = self.rows.rows();
-        let rows = Rows { times, columns: columns.iter().map(Vec::as_slice).collect() };
-        let sig = offline::evaluate(&self.formula, &rows)?;
+    /// The root's points up to `upto`.
+    fn release(&mut self, upto: f64) -> Vec<(f64, f64)> {
         let mut out = Vec::new();
-        // The kept rows give the right values from `decided` on (see `forget`).
-        let from = sig.times.partition_point(|&s| s < self.decided);
-        for (&t, &v) in sig.times[from..].iter().zip(&sig.values[from..]) {
-            if if open { t >= frontier } else { t > frontier } {
+        while let Some(&(t, v)) = self.held.front() {
+            if t > upto {
                 break;
             }
-            if self.last != Some(v) {
-                out.push((t, v));
-                self.last = Some(v);
-            }
+            out.push((t, v));
+            self.held.pop_front();
         }
-        // A value decided at `decided` and unchanged since: nothing to emit, but the
-        // frontier moves on.
-        self.decided = frontier;
-        Ok(out)
+        out
     }
 
-    /// Drops the rows no undecided value reads: a value at `t >= decided` reads back no
-    /// further than `decided - past_reach`, so the last row at or before that is the first
-    /// one kept (it holds the values there).
-    fn forget(&mut self) {
-        let reach = self.formula.past_reach();
-        if reach == f64::INFINITY {
-            return;
+    /// Every node in order, on the last row (`Some(t)`) or at the end of the trace.
+    fn step(&mut self, row: Option<f64>) -> Result<(), DenseError> {
+        let DenseMonitor { formula, rows, ops, ev, fresh, front, t0, held, .. } = self;
+        let t0 = *t0;
+        let nodes = formula.formula.nodes();
+        let (_, columns) = rows.rows();
+        for f in fresh.iter_mut() {
+            f.clear();
         }
-        let keep_from = down(self.decided - reach, reach);
-        let (times, _) = self.rows.rows();
-        let k = times.partition_point(|&s| s <= keep_from);
-        // Dropping is a copy of what is kept: do it when it halves the rows at least.
-        if k > times.len() / 2 {
-            self.rows.drop_front(k - 1);
+        for (i, node) in nodes.iter().enumerate() {
+            let (done, rest) = fresh.split_at_mut(i);
+            let out = &mut rest[0];
+            let fr = |id: usize| (front[id], done[id].as_slice());
+            let new_front = match &mut ops[i] {
+                Op::Expr => {
+                    if row.is_some() {
+                        let e = |id: &crate::formula::ExprId| ev[id.index()];
+                        ev[i] = match node {
+                            Node::Const(c) => *c,
+                            Node::Var(j) => *columns[*j].last().expect("a row"),
+                            Node::Neg(a) => -e(a),
+                            Node::Abs(a) => e(a).abs(),
+                            Node::Sqrt(a) => e(a).sqrt(),
+                            Node::Add(a, b) => e(a) + e(b),
+                            Node::Sub(a, b) => e(a) - e(b),
+                            Node::Mul(a, b) => e(a) * e(b),
+                            Node::Div(a, b) => e(a) / e(b),
+                            _ => unreachable!("an expression node"),
+                        };
+                    }
+                    continue;
+                }
+                Op::Cmp(dd) => match row {
+                    Some(t) => {
+                        let Node::Cmp { lhs, op, rhs } = node else { unreachable!("a comparison") };
+                        let v = op.robustness(ev[lhs.index()], ev[rhs.index()]);
+                        if v.is_nan() {
+                            return Err(DenseError::Nan { time: t, atom: formula.atom_text(i) });
+                        }
+                        dd.push(out, t, v);
+                        t
+                    }
+                    None => INF,
+                },
+                Op::Constant(v, dd) => {
+                    dd.push(out, t0, *v);
+                    INF
+                }
+                Op::Not(dd) => {
+                    let Node::Not(a) = node else { unreachable!("a negation") };
+                    for &(t, v) in &done[a.index()] {
+                        dd.push(out, t, -v);
+                    }
+                    front[a.index()]
+                }
+                Op::Copy => {
+                    let (Node::And(gs) | Node::Or(gs)) = node else { unreachable!("and, or") };
+                    let c = gs[0].index();
+                    out.extend_from_slice(&done[c]);
+                    front[c]
+                }
+                Op::Merge(m) => {
+                    let mut f = INF;
+                    let mut feed = |k: usize, c: usize| {
+                        m.feed(k, &done[c]);
+                        f = f.min(front[c]);
+                    };
+                    match node {
+                        Node::And(gs) | Node::Or(gs) => {
+                            for (k, g) in gs.iter().enumerate() {
+                                feed(k, g.index());
+                            }
+                        }
+                        Node::Implies(a, b) => {
+                            feed(0, a.index());
+                            feed(1, b.index());
+                        }
+                        _ => unreachable!("a merge"),
+                    }
+                    m.advance(f, out);
+                    f
+                }
+                Op::Win(w) => {
+                    let c = node.children().next().expect("an operand");
+                    w.feed(&done[c]);
+                    w.advance(t0, front[c], out)
+                }
+                Op::Since(s) => {
+                    let Node::Since(_, f, g) = node else { unreachable!("since") };
+                    s.advance(t0, fr(f.index()), fr(g.index()), out)
+                }
+                Op::Until(u) => {
+                    let Node::Until(_, f, g) = node else { unreachable!("until") };
+                    u.advance(t0, fr(f.index()), fr(g.index()), out)
+                }
+            };
+            front[i] = new_front;
         }
+        let root = formula.formula.root().index();
+        held.extend(fresh[root].iter().copied());
+        Ok(())
     }
 
     /// Ends the trace: the change points not returned yet, up to the last stamp. The
     /// monitor is then ready for a new trace.
     pub fn finish(&mut self) -> Result<Vec<(f64, f64)>, DenseError> {
-        let (times, _) = self.rows.rows();
-        let out = match times.last() {
-            None => Vec::new(),
-            Some(&t_last) => self.emit(t_last, false)?,
-        };
-        self.rows = DenseTraceBuilder::new(self.vars);
-        self.decided = f64::NEG_INFINITY;
-        self.last = None;
-        self.pending = 0;
-        Ok(out)
+        if self.t0.is_nan() {
+            return Ok(Vec::new());
+        }
+        let result = self.step(None);
+        let x = self.x;
+        let out = self.release(x);
+        *self = DenseMonitor::new(&self.formula, self.vars)?;
+        result.map(|()| out)
     }
 }
