@@ -700,6 +700,32 @@ impl Splitter<'_, '_> {
                  `[{a}..{b}]` leaves out {b}"
             ));
         }
+        if found == ":" && expects("`..`") {
+            let number =
+                |j: usize| self.toks.get(j).filter(|t| t.kind == TokKind::Number).map(|_| text(j));
+            let (a, b) = (number(k.wrapping_sub(1)).flatten()?, number(k + 1).flatten()?);
+            return Some(format!(
+                "rtamt writes `[{a}:{b}]`; hstl writes `[{a}..={b}]` (the steps {a} to {b}), or \
+                 `[{a}..{b}]` to leave out {b}"
+            ));
+        }
+        // rtamt's and the textbooks' spellings, here or just before the error.
+        for j in [k, k.wrapping_sub(1)] {
+            let hint = match text(j) {
+                Some("and" | "&" | "AND") => "write `&&` for and",
+                Some("or" | "|" | "OR") => "write `||` for or",
+                Some("not" | "NOT" | "~") => "write `!` for not",
+                Some("implies" | "=>") => "write `->` for implies",
+                Some("G") => "write `always` for G (□): `always[0..=10] f`",
+                Some("F") => "write `eventually` for F (◇): `eventually[0..=10] f`",
+                Some("U") => "write `until` for U: `f until[0..=10] g`",
+                Some("H") => "write `historically` for H: `historically[0..=10] f`",
+                Some("O") => "write `once` for O: `once[0..=10] f`",
+                Some("S") => "write `since` for S: `f since[0..=10] g`",
+                _ => continue,
+            };
+            return Some(hint.into());
+        }
         // A word just before the error, or at it, that is a keyword misspelt.
         for j in [k.wrapping_sub(1), k] {
             let Some(t) = self.toks.get(j).filter(|t| t.kind == TokKind::Word) else { continue };
