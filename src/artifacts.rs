@@ -203,11 +203,15 @@ fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usi
     if agent.memory.is_none() || horizons.is_empty() {
         return vec![("options.svg".into(), "options policy".into(), horizons)];
     }
+    // A one-step window (a safety conjunct `always !S` is the region `!S` so) is kept where
+    // the state is: every map shows it kept, and none is drawn after it.
+    let kept_now: Vec<usize> = horizons.iter().map(|&n| if n == 1 { 0 } else { n }).collect();
     spec.regions
         .iter()
         .enumerate()
+        .filter(|(_, r)| r.horizon > 1)
         .map(|(j, r)| {
-            let mut tau = horizons.clone();
+            let mut tau = kept_now.clone();
             tau[j] = 1;
             (
                 format!("options_after_{}.svg", file_safe(&r.name)),

@@ -20,6 +20,9 @@ mod assembly {
 mod auto {
     hstl::hstl! { include "examples/specs/surveillance_auto.hstl" }
 }
+mod safe {
+    hstl::hstl! { include "examples/specs/surveillance_safe.hstl" }
+}
 mod reach_avoid {
     hstl::hstl! { include "examples/suite/field_reach_avoid.hstl" }
 }
@@ -40,7 +43,7 @@ fn lowered(path: &str) -> TaskSpec {
 fn macro_and_lowering_build_the_same_task_spec() {
     // The preset expands in the checker, so both paths see what it filled in (the entry
     // form, one option per region, memory, `avoid`).
-    let cases: [(&str, TaskSpec); 6] = [
+    let cases: [(&str, TaskSpec); 7] = [
         ("examples/specs/surveillance_ot1.hstl", ot1::surveillance::Surveillance.task_spec()),
         ("examples/specs/surveillance_ot2.hstl", ot2::surveillance::Surveillance.task_spec()),
         ("examples/specs/surveillance_entry.hstl", entry::surveillance::Surveillance.task_spec()),
@@ -48,6 +51,10 @@ fn macro_and_lowering_build_the_same_task_spec() {
         (
             "examples/specs/surveillance_auto.hstl",
             auto::surveillance_auto::SurveillanceAuto.task_spec(),
+        ),
+        (
+            "examples/specs/surveillance_safe.hstl",
+            safe::surveillance_safe::SurveillanceSafe.task_spec(),
         ),
         (
             "examples/suite/field_reach_avoid.hstl",

@@ -2099,8 +2099,11 @@ impl Cx<'_> {
         }
         // The regions before this index are reached by an option.
         let reached = regions.len();
+        // A safety conjunct's `!S` is no region to visit: `S` is checked as written.
         for c in out.persistent_conjuncts(self.src).unwrap_or_default() {
-            add_region(&c.region, &mut regions);
+            if !c.safety {
+                add_region(&c.region, &mut regions);
+            }
         }
         let present = |k: usize| mask.is_none_or(|m| m.present[k]);
         let np = out.primitives.len();
@@ -2728,6 +2731,9 @@ fn plan_missing(out: &CheckedSpec, src: &str) -> Option<&'static str> {
              `eventually[0..T] G && always !R`",
         );
     };
+    if regions.iter().any(|r| r.safety) {
+        return Some("a task without safety conjuncts `always !R` (the legs avoid them instead)");
+    }
     let l = &out.learn;
     if l.memory == 0 {
         return Some("`memory`");

@@ -487,6 +487,9 @@ pub struct PersistentConjunct {
     pub region: CFormula,
     /// Steps in the window: 40 for `[0..40]`, 41 for `[0..=40]`.
     pub steps: u64,
+    /// A safety conjunct `always[0..] !R` beside the persistent part, as the region `!R`
+    /// with a window of one step: it holds at a step exactly when `R` does not.
+    pub safety: bool,
 }
 
 impl CheckedSpec {
@@ -537,10 +540,44 @@ impl CheckedSpec {
     }
 
     /// For a task `always[0..] (eventually[0..N1] R1 && ... && eventually[0..Nk] Rk)` with
-    /// state formulas Rj, the conjuncts in order; `None` for any other task.
+    /// state formulas Rj, the conjuncts in order; `None` for any other task. Beside it, at
+    /// the top level, safety conjuncts `always[0..] !S` with `S` a state formula may stand
+    /// (`always[0..] (...) && always[0..] !S`, which is `always[0..] (... && !S)`): each is
+    /// one more conjunct, the region `!S` with a window of one step, after the others.
     pub fn persistent_conjuncts(&self, src: &str) -> Option<Vec<PersistentConjunct>> {
         let task = self.task.as_ref()?;
-        let CFormulaKind::Always(iv, body) = &task.formula.kind else { return None };
+        let (persistent, safety) = match &task.formula.kind {
+            CFormulaKind::And(parts) => {
+                let is_persistent = |f: &CFormula| self.persistent_part(f, src).is_some();
+                let mut found = parts.iter().filter(|f| is_persistent(f));
+                let (Some(p), None) = (found.next(), found.next()) else { return None };
+                let rest: Vec<&CFormula> = parts.iter().filter(|f| !std::ptr::eq(*f, p)).collect();
+                (p, rest)
+            }
+            _ => (&task.formula, Vec::new()),
+        };
+        let mut out = self.persistent_part(persistent, src)?;
+        for c in safety {
+            let CFormulaKind::Always(iv, body) = &c.kind else { return None };
+            let CFormulaKind::Not(r) = &body.kind else { return None };
+            if iv.start != 0 || iv.end != Bound::Unbounded || !self.is_state_formula(r) {
+                return None;
+            }
+            let name = src.get(body.range.clone()).unwrap_or("").trim().to_string();
+            out.push(PersistentConjunct {
+                name,
+                let_index: None,
+                region: (**body).clone(),
+                steps: 1,
+                safety: true,
+            });
+        }
+        Some(out)
+    }
+
+    /// The conjuncts of `always[0..] (eventually[0..N1] R1 && ...)`, or `None`.
+    fn persistent_part(&self, f: &CFormula, src: &str) -> Option<Vec<PersistentConjunct>> {
+        let CFormulaKind::Always(iv, body) = &f.kind else { return None };
         if iv.start != 0 || iv.end != Bound::Unbounded {
             return None;
         }
@@ -563,7 +600,13 @@ impl CheckedSpec {
                 CFormulaKind::Let(i) => (self.lets.get(i)?.name.clone(), Some(i)),
                 _ => (src.get(region.range.clone()).unwrap_or("").trim().to_string(), None),
             };
-            out.push(PersistentConjunct { name, let_index, region: (**region).clone(), steps });
+            out.push(PersistentConjunct {
+                name,
+                let_index,
+                region: (**region).clone(),
+                steps,
+                safety: false,
+            });
         }
         Some(out)
     }

@@ -129,13 +129,15 @@ pub fn covers(avoid: &CFormula, r: &CFormula, src: &str) -> bool {
     }
 }
 
-/// The memory buckets `B` for deadlines `horizons` over `k = horizons.len()` regions: one
-/// bucket per [`BUCKET_STEPS`] steps of the longest deadline, fewer when `(B + 1)^k` would
-/// exceed [`MAX_MEMORY_VALUES`], at least 1.
+/// The memory buckets `B` for deadlines `horizons` over `k` regions (those with a window
+/// longer than one step): one bucket per [`BUCKET_STEPS`] steps of the longest deadline,
+/// fewer when `(B + 1)^k` would exceed [`MAX_MEMORY_VALUES`], at least 1.
 pub fn memory_buckets(horizons: &[u64]) -> u64 {
     let longest = horizons.iter().copied().max().unwrap_or(1);
     let mut b = longest.div_ceil(BUCKET_STEPS).max(1);
-    let k = u32::try_from(horizons.len()).unwrap_or(u32::MAX);
+    // A one-step window (a safety conjunct's) takes two of its `B + 1` values only: kept
+    // or not. It does not make the others' buckets coarser.
+    let k = u32::try_from(horizons.iter().filter(|&&n| n > 1).count()).unwrap_or(u32::MAX);
     while b > 1 && (b + 1).checked_pow(k).is_none_or(|v| v > MAX_MEMORY_VALUES) {
         b -= 1;
     }
@@ -279,5 +281,8 @@ mod tests {
         // Short deadlines: one bucket per 5 steps, at least one.
         assert_eq!(memory_buckets(&[3]), 1);
         assert_eq!(memory_buckets(&[12, 7]), 3);
+        // A safety conjunct's one-step window does not make the others coarser.
+        assert_eq!(memory_buckets(&[40, 40, 40, 1]), 8);
+        assert_eq!(memory_buckets(&[40, 40, 40, 1, 1]), 8);
     }
 }

@@ -407,9 +407,32 @@ impl TaskSpec {
 }
 
 /// The conjuncts `(R_j, N_j)` of a task `always[0..] (eventually[0..N1] R1 && ...)` whose
-/// `R_j` are state formulas, or `None` for a task of another form.
+/// `R_j` are state formulas, or `None` for a task of another form. Safety conjuncts
+/// `always[0..] !S` (`S` a state formula) may stand beside it at the top level: each adds
+/// `(!S, 1)` after the others, since `always[0..] (P) && always[0..] !S` is `always[0..]
+/// (P && eventually[0..1] !S)`: its windows are kept at a step where `S` does not hold.
 pub fn persistent_regions(task: &Formula) -> Option<Vec<(Formula, usize)>> {
-    let Node::Always(outer, body) = task.root_node() else { return None };
+    let root = task.root_node();
+    let Node::And(parts) = root else { return persistent_part(task, task.root()) };
+    let mut persistent = parts.iter().filter(|&&p| persistent_part(task, p).is_some());
+    let (Some(&p), None) = (persistent.next(), persistent.next()) else {
+        return persistent_part(task, task.root());
+    };
+    let mut out = persistent_part(task, p)?;
+    for &c in parts.iter().filter(|&&c| c != p) {
+        let Node::Always(i, body) = &task[c] else { return None };
+        let Node::Not(s) = &task[*body] else { return None };
+        if *i != Interval::ALL || !task.is_state(*s) {
+            return None;
+        }
+        out.push((task.sub(*body), 1));
+    }
+    Some(out)
+}
+
+/// [`persistent_regions`] of the sub-formula at `at`, which must be `always[0..] (...)`.
+fn persistent_part(task: &Formula, at: NodeId) -> Option<Vec<(Formula, usize)>> {
+    let Node::Always(outer, body) = &task[at] else { return None };
     if *outer != Interval::ALL {
         return None;
     }

@@ -409,6 +409,34 @@ fn persistent_regions_are_read_off_the_task() {
             ),
             None,
         ),
+        // Safety conjuncts `always[0..] !S` beside it: each a one-step window of `!S`.
+        (
+            Formula::and(vec![
+                always(ev(0, Bound::Exclusive(40))),
+                always(Formula::not(common::cmp(1, CmpOp::Lt, 2.0))),
+                always(Formula::not(common::cmp(0, CmpOp::Lt, 1.0))),
+            ]),
+            Some(vec![40, 1, 1]),
+        ),
+        // ... but not bounded ones, nor two persistent parts, nor anything else beside it.
+        (
+            Formula::and(vec![
+                always(ev(0, Bound::Exclusive(40))),
+                Formula::always(
+                    Interval { start: 0, end: Bound::Exclusive(9) },
+                    Formula::not(common::cmp(1, CmpOp::Lt, 2.0)),
+                ),
+            ]),
+            None,
+        ),
+        (
+            Formula::and(vec![
+                always(ev(0, Bound::Exclusive(40))),
+                always(ev(0, Bound::Exclusive(9))),
+            ]),
+            None,
+        ),
+        (Formula::and(vec![always(ev(0, Bound::Exclusive(40))), r.clone()]), None),
     ];
     for (task, want) in cases {
         let got =
