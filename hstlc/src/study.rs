@@ -13,7 +13,7 @@ use hstl::artifacts::OutFile;
 use hstl::runtime::{GridWorld, Intra, Region, TaskSpec};
 use hstl::study::{self as facade, CurveSet, Keep, Kept, SeedRun, Stats, StudiedSpec};
 use hstl::world::AnyWorld;
-use hstl_outdir::{OutDir, Writer};
+use hstl_outdir::{OutDir, StudyDir, Writer};
 
 use crate::cli_error::CliError;
 use crate::output::outln;
@@ -51,6 +51,11 @@ pub struct StudyArgs {
     /// (`curves.svg`, with every seed's in `curves.csv`).
     #[arg(long, value_name = "DIR", default_value = "out/study")]
     pub out: PathBuf,
+    /// Replace files at the top of `--out` that no study wrote (`curves.csv`, `curves.svg`,
+    /// `summary.csv`), and remove other runs' folders there that this study does not write
+    /// (otherwise either refuses the run before any training).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The bytes of trained policies a study keeps in memory for the median seed's files; past
@@ -75,10 +80,11 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     }
     // Each spec's folder, taken before the long part: a folder another run holds is
     // refused at once, and two specs of one name get folders of their own.
-    let outs = facade::spec_dirs(&args.out, &args.specs)
-        .iter()
-        .map(|d| OutDir::lock(d, Writer::CLI))
-        .collect::<Result<Vec<_>, _>>()?;
+    // The study's own folder is held too, and its top files (written last) must describe
+    // every spec folder in it: another run's folder there, or a user's `summary.csv`, is
+    // refused now unless `--force`.
+    let spec_dirs = facade::spec_dirs(&args.out, &args.specs);
+    let (study_dir, outs) = StudyDir::take(&args.out, &spec_dirs, args.force, Writer::CLI)?;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
@@ -191,7 +197,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     }
     let mut files = facade::curves_files(&all_curves, seeds.len())?;
     files.push(OutFile::text("summary.csv", summary));
-    hstl_outdir::write_beside(&args.out, &files)?;
+    study_dir.write(&files, &spec_dirs)?;
     outln!()?;
     outln!(
         "wrote {} and {}: the learning curves of every spec; {}: each spec's measure",

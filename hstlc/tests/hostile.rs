@@ -358,7 +358,7 @@ fn output_folders_are_whole_or_nothing() {
     assert_eq!(run.status, Some(0), "{}", run.stderr);
     assert_eq!(
         listing(&d.join("st")),
-        [".spec-2.lock", ".spec.lock", "curves.csv", "curves.svg", "spec", "spec-2", "summary.csv"]
+        [".hstlc-study", "curves.csv", "curves.svg", "spec", "spec-2", "summary.csv"]
     );
     let curves = std::fs::read_to_string(d.join("st/curves.csv")).expect("curves.csv");
     assert!(curves.contains("a/spec.hstl") && curves.contains("b/spec.hstl"), "{curves}");
@@ -584,4 +584,77 @@ fn shared_and_deep_lets_run_in_linear_time() {
     let run = hstlc_in(d, &["check", "chain.hstl"], b"");
     assert_eq!((run.status, run.stdout.as_str()), (Some(0), "checked 1 file: no problems\n"));
     assert_eq!(monitor("chain.hstl", "C299"), want);
+}
+
+/// Hostile round 2: `study --out` never replaces a user's own files at the top of its folder
+/// without `--force`, and its top files describe every spec folder there: a second study
+/// into the folder of another is refused (or, with `--force`, removes the other's folders).
+#[test]
+fn a_study_keeps_a_users_files_and_describes_every_folder() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "a.hstl", SMALL);
+    write(d, "b.hstl", SMALL);
+    let study = |spec: &str, out: &str, force: bool| {
+        let mut args = vec!["study", spec, "--seeds", "1", "--no-optimum", "--out", out];
+        if force {
+            args.push("--force");
+        }
+        hstlc_in(d, &args, b"")
+    };
+    // A user's own summary.csv and curves.csv: refused before training, left as they were.
+    std::fs::create_dir(d.join("mine")).expect("folder");
+    write(d, "mine/summary.csv", "my,figures\n");
+    write(d, "mine/curves.csv", "my,curves\n");
+    write(d, "mine/notes.txt", "keep me");
+    let run = study("a.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("curves.csv` was not written by a study, and would be replaced"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.stderr.contains("--force"), "{}", run.stderr);
+    assert!(!run.stdout.contains("study:"), "refused before training: {}", run.stdout);
+    assert_eq!(listing(&d.join("mine")), ["curves.csv", "notes.txt", "summary.csv"]);
+    assert_eq!(std::fs::read_to_string(d.join("mine/summary.csv")).expect("read"), "my,figures\n");
+    assert!(!listing(d).iter().any(|f| f.ends_with(".lock")), "a lock left: {:?}", listing(d));
+    // With --force they are replaced; the user's other files stay.
+    let run = study("a.hstl", "mine", true);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let summary = std::fs::read_to_string(d.join("mine/summary.csv")).expect("read");
+    assert!(summary.contains("a.hstl"), "{summary}");
+    assert_eq!(std::fs::read_to_string(d.join("mine/notes.txt")).expect("read"), "keep me");
+    // A study's own files are replaced by the next study of the same specs.
+    let run = study("a.hstl", "mine", false);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+
+    // Two studies into one folder: the second would leave `a` undescribed, and is refused.
+    let run = study("b.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "holds `a`, another run's folder, which this study's summary would not describe"
+        ),
+        "{}",
+        run.stderr
+    );
+    assert!(listing(&d.join("mine")).contains(&"a".to_string()));
+    // With --force the other study's folder goes, and the summary describes what is there.
+    let run = study("b.hstl", "mine", true);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(
+        listing(&d.join("mine")),
+        [".hstlc-study", "b", "curves.csv", "curves.svg", "notes.txt", "summary.csv"]
+    );
+    let summary = std::fs::read_to_string(d.join("mine/summary.csv")).expect("read");
+    assert_eq!(summary.lines().count(), 2, "{summary}");
+    assert!(!summary.contains("a.hstl"), "{summary}");
+    // A train run's folder inside the study's folder is another run's folder too.
+    let run = hstlc_in(d, &["train", "a.hstl", "--out", "mine/trained"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let run = study("b.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(run.stderr.contains("holds `trained`"), "{}", run.stderr);
+    assert!(!listing(d).iter().any(|f| f.starts_with('.')), "left beside: {:?}", listing(d));
 }

@@ -263,6 +263,171 @@ fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
     ))
 }
 
+/// The file that marks a study's folder: the names of what a study wrote at its top, one a
+/// line (its own files and its specs' folders). A file at the top that it does not name is
+/// a user's, and is never replaced without `--force` (`force=True`).
+pub const STUDY_MARKER: &str = ".hstlc-study";
+
+/// The files a study writes at the top of its folder, beside its specs' folders.
+pub const STUDY_FILES: [&str; 3] = ["curves.svg", "curves.csv", "summary.csv"];
+
+/// A study's folder, held by this run (a [`Lock`] on it, beside it): its specs' folders
+/// ([`OutDir`]s, taken by [`StudyDir::take`]) and the files at its top, written last by
+/// [`StudyDir::write`].
+///
+/// The files at the top describe every spec folder in the study's folder, or the run is
+/// refused: a folder that another run wrote there (one holding [`MARKER`], or one the last
+/// study named) and that this study does not write would be left beside a summary that
+/// does not describe it. With `force` such folders are removed, and a user's files of the
+/// top files' names replaced; without it either is refused before any training, naming
+/// the file or folder and how to proceed. Anything else in the folder is left alone.
+#[derive(Debug)]
+pub struct StudyDir {
+    dir: PathBuf,
+    /// Held while this value lives.
+    _lock: Lock,
+}
+
+impl StudyDir {
+    /// Takes the study folder `dir` and its specs' folders `spec_dirs` (each one inside
+    /// `dir`), or refuses them (see [`StudyDir`]). Call it before the long work.
+    pub fn take(
+        dir: &Path,
+        spec_dirs: &[PathBuf],
+        force: bool,
+        writer: Writer,
+    ) -> Result<(StudyDir, Vec<OutDir>), Error> {
+        let write_err = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| Error::Write { path, source }
+        };
+        let dir = if dir.file_name().is_none() || dir.is_symlink() {
+            std::fs::canonicalize(dir).map_err(write_err(dir))?
+        } else {
+            dir.to_path_buf()
+        };
+        let ours: Vec<String> = spec_dirs
+            .iter()
+            .filter_map(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect();
+        // A target refused as it stands gets nothing beside it; checked again once held.
+        study_refusal(&dir, &ours, force, writer)?;
+        let parent = match dir.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&parent).map_err(write_err(&dir))?;
+        let lock = Lock::take(&dir, writer)?;
+        for stale in study_refusal(&dir, &ours, force, writer)? {
+            // Taken first, so that a folder another run is writing is refused, not removed.
+            let held = OutDir::lock(&stale, writer)?;
+            std::fs::remove_dir_all(&stale).map_err(write_err(&stale))?;
+            drop(held);
+        }
+        let study = StudyDir { dir: dir.clone(), _lock: lock };
+        let outs = spec_dirs
+            .iter()
+            .map(|d| OutDir::lock(&dir.join(d.file_name().unwrap_or_default()), writer))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((study, outs))
+    }
+
+    /// Writes the files at the top of the study's folder, each whole or not at all, after
+    /// the marker that names them and `spec_dirs`; the paths written.
+    pub fn write(self, files: &[OutFile], spec_dirs: &[PathBuf]) -> Result<Vec<PathBuf>, Error> {
+        let mut names: Vec<String> = files.iter().map(|f| f.name.clone()).collect();
+        names.extend(
+            spec_dirs.iter().filter_map(|d| d.file_name().map(|n| n.to_string_lossy().into())),
+        );
+        let marker = format!(
+            "# What an hstl study wrote in this folder; a later study replaces these.\n{}\n",
+            names.join("\n")
+        );
+        write_beside(&self.dir, &[OutFile::text(STUDY_MARKER, marker)])?;
+        write_beside(&self.dir, files)
+    }
+}
+
+/// Refuses a study folder whose top a study may not write (see [`StudyDir`]), or returns
+/// the folders of other runs to remove first (only with `force`).
+fn study_refusal(
+    dir: &Path,
+    ours: &[String],
+    force: bool,
+    writer: Writer,
+) -> Result<Vec<PathBuf>, Error> {
+    let meta = match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(source) => return Err(Error::Write { path: dir.to_path_buf(), source }),
+        Ok(meta) => meta,
+    };
+    if !meta.is_dir() {
+        return Err(refused(
+            format!("`{}` is a file, not a folder", dir.display()),
+            Some(format!("choose another {}", writer.option)),
+        ));
+    }
+    let listed: Vec<String> = std::fs::read_to_string(dir.join(STUDY_MARKER))
+        .map(|t| t.lines().filter(|l| !l.starts_with('#')).map(str::to_string).collect())
+        .unwrap_or_default();
+    let force_help = |what: &str| {
+        Some(format!(
+            "move it out of the folder, choose another {}, or {what} ({})",
+            writer.option,
+            if writer.program == "hstl" { "`force=True`" } else { "`--force`" }
+        ))
+    };
+    for name in STUDY_FILES {
+        let path = dir.join(name);
+        let Ok(meta) = std::fs::symlink_metadata(&path) else { continue };
+        if !meta.is_file() {
+            return Err(refused(
+                format!(
+                    "`{}` is in the way of a study's `{name}`: it is not a file",
+                    path.display()
+                ),
+                Some(format!("move it out of the folder, or choose another {}", writer.option)),
+            ));
+        }
+        if !force && !listed.iter().any(|l| l == name) {
+            return Err(refused(
+                format!("`{}` was not written by a study, and would be replaced", path.display()),
+                force_help("replace it"),
+            ));
+        }
+    }
+    let entries = std::fs::read_dir(dir)
+        .map_err(|source| Error::Write { path: dir.to_path_buf(), source })?;
+    let mut stale = Vec::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        // Hidden siblings of the specs' folders are their runs' (see `OutDir::lock`).
+        if name.starts_with('.')
+            || ours.iter().any(|o| o.eq_ignore_ascii_case(&name))
+            || !entry.file_type().is_ok_and(|t| t.is_dir())
+        {
+            continue;
+        }
+        let path = entry.path();
+        if path.join(MARKER).is_file() || listed.contains(&name) {
+            stale.push(path);
+        }
+    }
+    stale.sort();
+    if let Some(first) = stale.first().filter(|_| !force) {
+        return Err(refused(
+            format!(
+                "`{}` holds `{}`, another run's folder, which this study's summary would not \
+                 describe",
+                dir.display(),
+                first.file_name().unwrap_or_default().to_string_lossy()
+            ),
+            force_help("remove it"),
+        ));
+    }
+    Ok(stale)
+}
+
 /// Writes `files` into the folder `dir` (made if missing) beside what it holds, each file
 /// whole or not at all (written to a hidden temporary file, synced, renamed over the old
 /// one): for files such as a study's `curves.svg` that sit beside the runs' folders.

@@ -55,6 +55,7 @@ def study(
     num_cpus: Optional[int] = None,
     batch: Optional[int] = None,
     max_retries: int = 3,
+    force: bool = False,
 ) -> StudyResult:
     """Trains each spec for each seed and returns one dict per (spec, seed).
 
@@ -90,7 +91,10 @@ def study(
     median seed's policy and pictures, ``seeds.csv`` and ``curve.svg``; ``curves.svg`` and
     ``curves.csv`` beside them). The folders are taken before training starts (one another
     run holds is refused at once) and written only when every result is in, each whole or
-    not at all.
+    not at all. A file at the folder's top that no study wrote (a ``summary.csv`` of your
+    own), or another run's folder in it that this study would leave undescribed, is refused
+    then too (a ``ValueError``), unless ``force=True``, which replaces the file and removes
+    the folder, as ``hstlc study --force``.
     """
     return _study(
         specs,
@@ -104,6 +108,7 @@ def study(
         num_cpus=num_cpus,
         batch=batch,
         max_retries=max_retries,
+        force=force,
     )
 
 
@@ -120,6 +125,7 @@ def _study(
     num_cpus: Optional[int],
     batch: Optional[int],
     max_retries: int,
+    force: bool = False,
     before_batch: Optional[Callable[[List[int]], None]] = None,
 ) -> StudyResult:
     """``study``, with ``before_batch(seeds)`` called in each Ray task before it trains (the
@@ -141,7 +147,7 @@ def _study(
     # Every spec checked against the world here, before anything trains or is sent away.
     tasks = [_hstl._study_task(spec, world, episodes) for spec in spec_list]
     paths = [_path_of(spec) for spec in spec_list]
-    folder = _hstl._StudyOut(os.fspath(out), paths) if out is not None else None
+    folder = _hstl._StudyOut(os.fspath(out), paths, bool(force)) if out is not None else None
     # One W* per distinct set of regions, as hstlc study solves it.
     wanted = {}
     if optimum:

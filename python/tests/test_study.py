@@ -250,3 +250,14 @@ def test_tune_trials_report_w_and_w_over_w_star(cluster, tmp_path):
     assert own["training_iteration"] == 2 and own["episodes"] == 10
     assert (own["window_rate"], own["reward"], own["ratio"]) == (row["window_rate"], row["reward"], row["ratio"])
     assert by_alpha[0.6]["window_rate"] != own["window_rate"]
+
+
+def test_a_users_summary_is_kept_unless_force(tmp_path):
+    """Hostile round 2: `out=` replaced a user's own summary.csv without a word."""
+    (tmp_path / "summary.csv").write_text("mine\n")
+    with pytest.raises(ValueError, match=r"summary.csv` was not written by a study") as e:
+        hstl.study(SMALL, seeds=1, episodes=2, optimum=False, out=tmp_path)
+    assert "`force=True`" in str(e.value)
+    assert (tmp_path / "summary.csv").read_text() == "mine\n"
+    hstl.study(SMALL, seeds=1, episodes=2, optimum=False, out=tmp_path, force=True)
+    assert (tmp_path / "summary.csv").read_text().startswith("spec,measure")
