@@ -140,6 +140,9 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         // Rewards compare only under the same options-level reward.
         match &baseline {
             None => baseline = Some((label.clone(), reward, spec.learn.reward)),
+            Some((base, b, kind)) if *kind == spec.learn.reward && *b == 0.0 => {
+                outln!("  reward not compared with {base}: its mean reward per episode is 0")?
+            }
             Some((base, b, kind)) if *kind == spec.learn.reward => outln!(
                 "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
                 100.0 * (reward - b) / b.abs()
@@ -447,8 +450,10 @@ fn print_table(results: &[SeedRun], w_star: Option<f64>) -> Result<(), CliError>
     row("reward per episode (last 100)", s.reward, 2)?;
     if let Some(w) = s.window_rate {
         row("window rate W", w, 3)?;
-        if let (Some(r), Some(w)) = (s.ratio, w_star) {
-            row(&format!("W/W* (W* = {w:.4})"), r, 3)?;
+        match (s.ratio, w_star) {
+            (Some(r), Some(w)) => row(&format!("W/W* (W* = {w:.4})"), r, 3)?,
+            (None, Some(_)) => outln!("  {}", facade::RATIO_UNDEFINED)?,
+            _ => {}
         }
     }
     if let Some(p) = s.satisfaction {

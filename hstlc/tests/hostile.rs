@@ -658,3 +658,34 @@ fn a_study_keeps_a_users_files_and_describes_every_folder() {
     assert!(run.stderr.contains("holds `trained`"), "{}", run.stderr);
     assert!(!listing(d).iter().any(|f| f.starts_with('.')), "left beside: {:?}", listing(d));
 }
+
+/// Hostile round 2: when no policy can keep the task (W* = 0, `check` clean), `eval` and
+/// `study` say W/W* is undefined in words, and `summary.csv` leaves its cells empty: never
+/// NaN or inf.
+#[test]
+fn w_over_w_star_is_undefined_in_words_when_no_policy_keeps_the_task() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    // Two steps cannot take the agent from one corner to the other and back.
+    let zero = SMALL.replace("[0..40]", "[0..2]");
+    write(d, "zero.hstl", &zero);
+    let run = hstlc_in(d, &["check", "zero.hstl"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stdout);
+    let run = hstlc_in(d, &["train", "zero.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let undefined = "W/W* undefined (W* = 0: no policy keeps the task)";
+    let run = hstlc_in(d, &["eval", "run/policy.json", "--starts", "2", "--steps", "200"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains(undefined), "{}", run.stdout);
+    let run = hstlc_in(d, &["study", "zero.hstl", "zero.hstl", "--seeds", "2", "--out", "st"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(run.stdout.matches(undefined).count(), 2, "{}", run.stdout);
+    let summary = std::fs::read_to_string(d.join("st/summary.csv")).expect("summary.csv");
+    for line in summary.lines().skip(1) {
+        assert_eq!(line.split(',').collect::<Vec<_>>()[1..5], ["W/W*", "0", "", ""], "{summary}");
+    }
+    for text in [&run.stdout, &summary] {
+        let lower = text.to_lowercase();
+        assert!(!lower.contains("nan") && !lower.contains("inf"), "{text}");
+    }
+}

@@ -63,7 +63,9 @@ def study(
     parsed from text), ``seed``, ``window_rate`` (W of the greedy policy, for a persistent
     task; else None), ``optimum`` (W*, or None), ``ratio`` (W/W*, or None), ``reward``
     (per episode, the mean of the last 100 episodes), ``seconds`` (training time),
-    ``steps`` (primitive steps) and ``curve`` (reward per episode). The numbers are those
+    ``steps`` (primitive steps) and ``curve`` (reward per episode). ``ratio`` is None when
+    W* = 0 (no policy keeps the task: W/W* is undefined), and the summary then has no
+    ``ratio`` either. The numbers are those
     of ``hstlc study``, bit for bit, whatever the backend (training time excepted); the
     list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``).
 
@@ -185,7 +187,7 @@ def _study(
                     "seed": run["seed"],
                     "window_rate": w,
                     "optimum": w_star,
-                    "ratio": w / w_star if w is not None and w_star is not None else None,
+                    "ratio": _ratio(w, w_star),
                     "reward": run["reward"],
                     "seconds": run["seconds"],
                     "steps": run["steps"],
@@ -197,6 +199,18 @@ def _study(
     if folder is not None:
         folder.write(spec_list, world, runs, episodes, w_stars)
     return StudyResult(rows, summary)
+
+
+#: W* at or below this is 0: no policy keeps the task (the facade's ``MIN_OPTIMUM``).
+_MIN_OPTIMUM = 1e-9
+
+
+def _ratio(w: Optional[float], w_star: Optional[float]) -> Optional[float]:
+    """W/W*, or None when either is unknown or W* = 0 (no policy keeps the task: the
+    ratio is undefined, as ``hstlc study`` says)."""
+    if w is None or w_star is None or not w_star > _MIN_OPTIMUM:
+        return None
+    return w / w_star
 
 
 def _whole(n: Any, name: str, lo: int, hi: int) -> int:
