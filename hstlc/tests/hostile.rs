@@ -364,8 +364,9 @@ fn output_folders_are_whole_or_nothing() {
     assert!(curves.contains("a/spec.hstl") && curves.contains("b/spec.hstl"), "{curves}");
 }
 
-/// Class 7: `fmt --write` rewrites a file as the same file: its permissions, the symbolic
-/// link to it, its hard links and its byte order mark stay.
+/// Class 7: `fmt --write` rewrites a file whole, as the same file where a rename allows: its
+/// permissions, the symbolic link to it and its byte order mark stay; a hard-linked one
+/// becomes a file of its own, with a note.
 #[cfg(unix)]
 #[test]
 fn fmt_write_keeps_the_file() {
@@ -399,12 +400,25 @@ fn fmt_write_keeps_the_file() {
     assert!(std::fs::symlink_metadata(d.join("link.hstl")).expect("meta").file_type().is_symlink());
     assert_eq!(read("real/target.hstl"), tidy);
 
-    // Hard links: both names see the new text, still one file.
+    // Hostile round 2: a hard-linked file was rewritten in place, and a run killed mid-write
+    // left the new text followed by the old text's tail (the old text only in a hidden
+    // backup). Now it is replaced whole, by a rename, like any file: it becomes a file of
+    // its own, the other name keeps the old text, and a note says so.
     write(d, "one.hstl", messy);
     std::fs::hard_link(d.join("one.hstl"), d.join("two.hstl")).expect("hard link");
-    fmt_write("one.hstl");
-    assert_eq!((read("one.hstl"), read("two.hstl")), (tidy.clone(), tidy.clone()));
-    assert_eq!(std::fs::metadata(d.join("two.hstl")).expect("meta").nlink(), 2);
+    let inode = std::fs::metadata(d.join("one.hstl")).expect("meta").ino();
+    let run = hstlc_in(d, &["fmt", "--write", "one.hstl"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(
+        run.stderr,
+        "note: `one.hstl` had 1 other hard link: it is now a file of its own, and that name \
+         keeps the text before formatting (run `hstlc fmt --write` on it too)\n"
+    );
+    assert_eq!((read("one.hstl"), read("two.hstl")), (tidy.clone(), messy.to_string()));
+    let meta = std::fs::metadata(d.join("one.hstl")).expect("meta");
+    assert_ne!(meta.ino(), inode, "written in place, not whole");
+    let two = std::fs::metadata(d.join("two.hstl")).expect("meta");
+    assert_eq!((meta.nlink(), meta.permissions().mode()), (1, two.permissions().mode()));
 
     // A byte order mark stays; the fixed temporary name of old is left alone.
     write(d, "bom.hstl", format!("\u{feff}{messy}"));
@@ -412,7 +426,10 @@ fn fmt_write_keeps_the_file() {
     fmt_write("bom.hstl");
     assert_eq!(read("bom.hstl"), format!("\u{feff}{tidy}"));
     assert_eq!(read(".bom.hstl.hstlc-fmt.tmp"), "not mine");
-    let left: Vec<String> = listing(d).into_iter().filter(|f| f.contains("hstlc-fmt-")).collect();
+    let left: Vec<String> = listing(d)
+        .into_iter()
+        .filter(|f| f.contains("hstlc-fmt") && f != ".bom.hstl.hstlc-fmt.tmp")
+        .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
 
