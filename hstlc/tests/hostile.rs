@@ -706,3 +706,44 @@ fn w_over_w_star_is_undefined_in_words_when_no_policy_keeps_the_task() {
         assert!(!lower.contains("nan") && !lower.contains("inf"), "{text}");
     }
 }
+
+/// Hostile round 2: a named pipe called `*.csv` in a batch folder hung `monitor` forever,
+/// waiting for a writer. Only regular files are read from a folder; the others are skipped
+/// with a note.
+#[cfg(unix)]
+#[test]
+fn a_batch_folder_is_read_for_its_regular_files_only() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    std::fs::create_dir(d.join("traces")).expect("folder");
+    write(d, "traces/a.csv", "x,y\n1,1\n2,2\n");
+    let made = Command::new("mkfifo").arg(d.join("traces/b.csv")).status().expect("mkfifo runs");
+    assert!(made.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["monitor", "small.hstl", "--trace", "traces"])
+        .current_dir(d)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while child.try_wait().expect("waits").is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("monitor hangs on a named pipe in a batch folder");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().expect("hstlc ends");
+    let (stdout, stderr) =
+        (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stdout.contains("a.csv") && !stdout.contains("b.csv"), "{stdout}");
+    assert!(
+        stderr.contains("note: skipped `traces/b.csv`: a named pipe, not a regular file"),
+        "{stderr}"
+    );
+}
