@@ -236,7 +236,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
             .collect();
         let dir = out.path().to_path_buf();
         out.write(&files)?;
-        outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", dir.display())?;
+        outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", crate::output::shown(&dir))?;
     }
     Ok(Status::Clean)
 }

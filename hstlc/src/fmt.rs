@@ -62,7 +62,7 @@ pub fn run(args: &FmtArgs) -> CmdResult {
         let is_stdin = path.as_path() == Path::new("-");
         if args.check {
             if formatted != source {
-                outln!("{name}")?;
+                outln!("{}", hstl::load::escape_controls(&name))?;
                 status = Status::Errors;
             }
         } else if args.write && !is_stdin {
@@ -118,7 +118,7 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
         errln!(
             "note: `{}` had {} other hard link{}: it is now a file of its own, and {} the \
              text before formatting (run `hstlc fmt --write` on {} too)",
-            path.display(),
+            hstl::load::escape_controls(&path.display().to_string()),
             others,
             if others == 1 { "" } else { "s" },
             if others == 1 { "that name keeps" } else { "those names keep" },

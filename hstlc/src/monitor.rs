@@ -216,7 +216,11 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         }
         skipped.sort();
         for (p, what) in &skipped {
-            errln!("note: skipped `{}`: {what}, not a regular file", p.display());
+            let shown = p.display().to_string();
+            errln!(
+                "note: skipped `{}`: {what}, not a regular file",
+                hstl::load::escape_controls(&shown)
+            );
         }
         if found.is_empty() {
             return Err(CliError::new(
@@ -276,7 +280,8 @@ pub(crate) fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
     if ignored.is_empty() {
         return;
     }
-    let names: Vec<String> = ignored.iter().map(|n| format!("`{n}`")).collect();
+    let names: Vec<String> =
+        ignored.iter().map(|n| format!("`{}`", hstl::load::escape_controls(n))).collect();
     let (what, verb) = if names.len() == 1 {
         ("column", "is not a state variable")
     } else {

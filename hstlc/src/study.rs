@@ -189,7 +189,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             outln!("  {why}")?;
         }
         out.write(&files)?;
-        outln!("  wrote {}", dir.display())?;
+        outln!("  wrote {}", crate::output::shown(&dir))?;
         // The variant's curves follow the spec's in the figure.
         all_curves.push(CurveSet {
             label: label.clone(),
@@ -204,9 +204,9 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     outln!()?;
     outln!(
         "wrote {} and {}: the learning curves of every spec; {}: each spec's measure",
-        args.out.join("curves.svg").display(),
-        args.out.join("curves.csv").display(),
-        args.out.join("summary.csv").display()
+        crate::output::shown(&args.out.join("curves.svg")),
+        crate::output::shown(&args.out.join("curves.csv")),
+        crate::output::shown(&args.out.join("summary.csv"))
     )?;
     Ok(Status::Clean)
 }
@@ -372,7 +372,7 @@ fn continuous_spec(
         runs.len(),
         rates[median]
     )?;
-    outln!("  wrote {}", dir.display())?;
+    outln!("  wrote {}", crate::output::shown(&dir))?;
     let s = Stats::of(&rates);
     let line = format!(
         "{},{measure},,{},{},{}\n",

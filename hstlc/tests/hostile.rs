@@ -747,3 +747,45 @@ fn a_batch_folder_is_read_for_its_regular_files_only() {
         "{stderr}"
     );
 }
+
+/// Hostile round 2: names with control characters (a file name, a CSV column) reached the
+/// terminal raw, where an escape sequence can clear the screen or retitle the window. They
+/// are shown escaped (`\x1b`) in errors, diagnostics, notes and `fmt --check`'s list.
+#[cfg(unix)]
+#[test]
+fn control_characters_in_names_are_escaped() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let raw = |run: &Run| {
+        let all = format!("{}{}", run.stdout, run.stderr);
+        all.chars().any(|c| c.is_control() && c != '\n')
+    };
+    // A spec file whose name clears the screen, with a syntax error and messy layout.
+    let evil = "evil\x1b[2J\r.hstl";
+    write(d, evil, "spec S { state { x: int in 0..=9 } task x > 1 &&; }");
+    for args in [&["check", evil][..], &["fmt", evil], &["train", evil, "--out", "o"]] {
+        let run = hstlc_in(d, args, b"");
+        assert_eq!(run.status, Some(1), "{args:?}: {}", run.stderr);
+        assert!(!raw(&run), "{args:?}: {:?}", run.stderr);
+        let shown = format!("{}{}", run.stdout, run.stderr);
+        assert!(shown.contains("evil\\x1b[2J\\x0d.hstl"), "{args:?}: {shown}");
+    }
+    let run = hstlc_in(d, &["check", "--format", "concise", evil], b"");
+    assert!(!raw(&run) && run.stdout.contains("evil\\x1b[2J\\x0d.hstl:1:"), "{}", run.stdout);
+    // A missing file, and `fmt --check`'s list of files that would change.
+    let run = hstlc_in(d, &["check", "gone\x07.hstl"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(!raw(&run) && run.stderr.contains("cannot read `gone\\x07.hstl`"), "{}", run.stderr);
+    let messy = "messy\x1b]0;owned\x07.hstl";
+    write(d, messy, "spec  S {state{x:int in 0..=9} task x>1;}\n");
+    let run = hstlc_in(d, &["fmt", "--check", messy], b"");
+    assert_eq!(run.status, Some(1), "{}", run.stderr);
+    assert_eq!(run.stdout, "messy\\x1b]0;owned\\x07.hstl\n");
+    // A trace column the spec does not name.
+    write(d, "small.hstl", SMALL);
+    write(d, "t.csv", "x,y,\x1b[31mred\n1,1,0\n2,2,0\n");
+    let run = hstlc_in(d, &["monitor", "small.hstl", "--trace", "t.csv"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(!raw(&run), "{:?}", run.stderr);
+    assert!(run.stderr.contains("column `\\x1b[31mred` is not"), "{}", run.stderr);
+}
