@@ -156,7 +156,30 @@ impl std::error::Error for UnknownCode {}
 /// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
 /// "(os error N)" tail.
 pub fn read_error(path: &Path, error: &std::io::Error) -> String {
-    format!("cannot read `{}`: {}", path.display(), io_reason(error))
+    format!("cannot read `{}`: {}", escape_controls(&path.display().to_string()), io_reason(error))
+}
+
+/// `text` with its control characters (and the bidirectional controls, which reorder what
+/// a terminal shows) escaped as `\x1b` or `\u{202e}`: a name shown in a message cannot
+/// clear the screen, retitle the window, move the cursor or hide what follows. Other text,
+/// non-ASCII letters included, is shown as it is.
+pub fn escape_controls(text: &str) -> std::borrow::Cow<'_, str> {
+    let bidi = |c: char| matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    let unsafe_char = |c: char| c.is_control() || bidi(c);
+    if !text.chars().any(unsafe_char) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        match c {
+            c if (c as u32) < 0x80 && unsafe_char(c) => {
+                out.push_str(&format!("\\x{:02x}", c as u32))
+            }
+            c if unsafe_char(c) => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// The OS reason of an I/O error in lower case, without the "(os error N)" tail.

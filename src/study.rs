@@ -224,7 +224,21 @@ pub struct Summary {
     pub satisfaction_ratio: Option<(Stats, f64)>,
 }
 
-/// The figures of `runs`, W/W* against `optimum`.
+/// W* at or below this is 0: no policy keeps the task, and W/W* is undefined.
+pub const MIN_OPTIMUM: f64 = 1e-9;
+
+/// Whether W/W* is defined for the optimum `w_star`: at W* = 0 (no policy keeps the task)
+/// it is not, and every front end says so in [`RATIO_UNDEFINED`]'s words (an empty cell in
+/// CSV, `None` in Python), never NaN or infinity.
+pub fn ratio_defined(w_star: f64) -> bool {
+    w_star > MIN_OPTIMUM
+}
+
+/// What W/W* is when W* = 0.
+pub const RATIO_UNDEFINED: &str = "W/W* undefined (W* = 0: no policy keeps the task)";
+
+/// The figures of `runs`, W/W* against `optimum` (none when it is 0, see
+/// [`ratio_defined`]).
 pub fn summary(runs: &[SeedRun], optimum: Option<f64>) -> Summary {
     let of = |f: &dyn Fn(&SeedRun) -> f64| Stats::of(&runs.iter().map(f).collect::<Vec<_>>());
     let windows: Vec<f64> = runs.iter().filter_map(|r| r.window_rate).collect();
@@ -241,7 +255,7 @@ pub fn summary(runs: &[SeedRun], optimum: Option<f64>) -> Summary {
         reward: of(&|r| r.reward),
         window_rate: all.then(|| Stats::of(&windows)),
         ratio: optimum
-            .filter(|_| all)
+            .filter(|w| all && ratio_defined(*w))
             .map(|w| Stats::of(&windows.iter().map(|x| x / w).collect::<Vec<_>>())),
     }
 }
@@ -409,7 +423,8 @@ pub fn spec_files(
 pub const SUMMARY_HEADER: &str = "spec,measure,optimum,ratio_mean,ratio_min,train_secs_mean\n";
 
 /// One spec's line of `summary.csv`: the measure (`W/W*` for a persistent task, `P/P*` for
-/// a reach-avoid task), its mean and minimum over seeds, and the mean training time.
+/// a reach-avoid task), its mean and minimum over seeds (empty where undefined: W* = 0),
+/// and the mean training time.
 pub fn summary_line(label: &str, runs: &[SeedRun], w_star: Option<f64>) -> String {
     let s = summary(runs, w_star);
     let secs = s.seconds.mean;
@@ -417,6 +432,9 @@ pub fn summary_line(label: &str, runs: &[SeedRun], w_star: Option<f64>) -> Strin
         ("P/P*", best, ratio)
     } else if let (Some(ratio), Some(w)) = (s.ratio, w_star) {
         ("W/W*", w, ratio)
+    } else if let (Some(_), Some(w)) = (s.window_rate, w_star) {
+        // W* = 0: the ratio is undefined, its cells empty.
+        return format!("{},W/W*,{w},,,{secs}\n", csv_field(label));
     } else {
         return format!("{},,,,,{secs}\n", csv_field(label));
     };
@@ -606,6 +624,23 @@ mod tests {
         assert_eq!(Stats::of(&[5.0]).sd, 0.0);
         let none = Stats::of(&[]);
         assert_eq!((none.mean, none.min, none.max), (0.0, f64::INFINITY, f64::NEG_INFINITY));
+    }
+
+    #[test]
+    fn no_policy_keeps_the_task_and_the_ratio_is_undefined_not_nan() {
+        let run = |w: f64| SeedRun {
+            seed: 0,
+            window_rate: Some(w),
+            satisfaction: None,
+            reward: 0.0,
+            secs: 1.0,
+            steps: 1,
+            curve: vec![],
+        };
+        let runs = [run(0.0), run(0.0)];
+        assert_eq!(summary(&runs, Some(0.0)).ratio, None);
+        let line = summary_line("zero.hstl", &runs, Some(0.0));
+        assert_eq!(line, "zero.hstl,W/W*,0,,,1\n");
     }
 
     #[test]

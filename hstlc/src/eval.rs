@@ -139,14 +139,18 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         let optimum = evaluate::optimum(&replay, SolveConfig::default())
             .map_err(|p| CliError::new(p.message, Some(SKIP_OPTIMUM.into())))?;
         if let Some(optimum) = optimum {
+            let ratio = if hstl::study::ratio_defined(optimum.gain) {
+                format!("W/W* = {:.3}", report.rate / optimum.gain)
+            } else {
+                hstl::study::RATIO_UNDEFINED.to_string()
+            };
             outln!(
-                "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): W/W* = {:.3}",
-                optimum.gain,
-                optimum.lower,
-                optimum.upper,
+                "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): {ratio}",
+                optimum.gain.max(0.0),
+                optimum.lower.max(0.0),
+                optimum.upper.max(0.0),
                 start.elapsed().as_secs_f64(),
                 if optimum.converged { "" } else { ", not converged" },
-                report.rate / optimum.gain
             )?;
         }
     }
@@ -232,7 +236,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
             .collect();
         let dir = out.path().to_path_buf();
         out.write(&files)?;
-        outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", dir.display())?;
+        outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", crate::output::shown(&dir))?;
     }
     Ok(Status::Clean)
 }

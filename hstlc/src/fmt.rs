@@ -2,9 +2,10 @@
 //!
 //! Without flags it prints the formatted text of each input to standard output. `--check`
 //! prints nothing but the names of the files that would change and exits 1 when there
-//! is one; `--write` rewrites the files that change, whole or not at all, as the same
-//! files: a symbolic link's target is rewritten, permissions and hard links are kept (see
-//! `write_whole`), and a byte order mark stays.
+//! is one; `--write` rewrites the files that change, whole or not at all (a new file
+//! renamed over the old): a symbolic link's target is rewritten, permissions and a byte
+//! order mark are kept, and a hard-linked file becomes a file of its own, with a note (see
+//! `write_whole`).
 //! A file with syntax errors is left as it is: its errors go to standard error, rendered
 //! as `hstlc check` renders them, and the exit status is 1. An unreadable input stops the
 //! run before anything is printed (exit status 2).
@@ -16,7 +17,7 @@ use clap::Args;
 
 use crate::check::Checked;
 use crate::cli_error::CliError;
-use crate::output::{err, out, outln};
+use crate::output::{err, errln, out, outln};
 use crate::{CmdResult, Status, input, render};
 
 /// Arguments of `hstlc fmt`.
@@ -61,7 +62,7 @@ pub fn run(args: &FmtArgs) -> CmdResult {
         let is_stdin = path.as_path() == Path::new("-");
         if args.check {
             if formatted != source {
-                outln!("{name}")?;
+                outln!("{}", hstl::load::escape_controls(&name))?;
                 status = Status::Errors;
             }
         } else if args.write && !is_stdin {
@@ -79,14 +80,15 @@ pub fn run(args: &FmtArgs) -> CmdResult {
 }
 
 /// Rewrites the file `path` with `text` (after the byte order mark it had), whole or not at
-/// all, as the same file:
+/// all: the new text goes to a new temporary file beside it (created exclusively, under a
+/// name no other file has), synced, then renamed over it, so that a run killed at any point
+/// leaves the old text or the new, never a mix, and no backup to find. It stays the same
+/// file as far as one rename allows:
 /// - through a symbolic link the file it points to is rewritten, and the link stays;
 /// - the file keeps its permissions (and its owner and group, where that is allowed);
-/// - a file with one name gets the text in a new temporary file beside it (created
-///   exclusively, under a name no other file has), synced, then renamed over it;
-/// - a file with several hard links is rewritten in place, so that all its names see the
-///   new text; its old text waits in a hidden backup beside it until the new text is on
-///   disk, and the error names the backup if the rewrite fails.
+/// - a file with several hard links becomes a file of its own under the name given (no
+///   write in place can be whole or nothing); its other names keep the old text, and a
+///   note on standard error says so, naming the file.
 fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
     let fail = |source| CliError::Write { path: path.to_path_buf(), source };
     let real = std::fs::canonicalize(path).map_err(fail)?;
@@ -96,9 +98,6 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
         bytes.extend_from_slice("\u{feff}".as_bytes());
     }
     bytes.extend_from_slice(text.as_bytes());
-    if links(&meta) > 1 {
-        return rewrite_in_place(path, &real, &bytes);
-    }
     let (mut tmp, tmp_path) = create_beside(&real, "tmp").map_err(fail)?;
     let written = (|| {
         tmp.write_all(&bytes)?;
@@ -114,34 +113,19 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
     if let Some(dir) = real.parent() {
         hstl_outdir::sync_dir(dir);
     }
+    let others = links(&meta).saturating_sub(1);
+    if others > 0 {
+        errln!(
+            "note: `{}` had {} other hard link{}: it is now a file of its own, and {} the \
+             text before formatting (run `hstlc fmt --write` on {} too)",
+            hstl::load::escape_controls(&path.display().to_string()),
+            others,
+            if others == 1 { "" } else { "s" },
+            if others == 1 { "that name keeps" } else { "those names keep" },
+            if others == 1 { "it" } else { "them" },
+        );
+    }
     Ok(())
-}
-
-/// Overwrites a hard-linked file in place, its old text kept in a backup until done.
-fn rewrite_in_place(path: &Path, real: &Path, bytes: &[u8]) -> Result<(), CliError> {
-    let fail = |source| CliError::Write { path: path.to_path_buf(), source };
-    let old = std::fs::read(real).map_err(fail)?;
-    let (mut backup, backup_path) = create_beside(real, "orig").map_err(fail)?;
-    if let Err(source) = backup.write_all(&old).and_then(|()| backup.sync_all()) {
-        let _ = std::fs::remove_file(&backup_path);
-        return Err(fail(source));
-    }
-    let rewritten = (|| {
-        let mut file = std::fs::OpenOptions::new().write(true).open(real)?;
-        file.write_all(bytes)?;
-        file.set_len(bytes.len() as u64)?;
-        file.sync_all()
-    })();
-    match rewritten {
-        Ok(()) => {
-            let _ = std::fs::remove_file(&backup_path);
-            Ok(())
-        }
-        Err(source) => Err(CliError::new(
-            format!("cannot write `{}`: {source}", path.display()),
-            Some(format!("its text before formatting is in `{}`", backup_path.display())),
-        )),
-    }
 }
 
 /// A new file beside `real`, `.NAME.hstlc-fmt-<pid>-<n>.<ext>`, created exclusively (with

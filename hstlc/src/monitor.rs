@@ -184,7 +184,7 @@ pub fn run(args: &MonitorArgs) -> CmdResult {
 }
 
 /// The trace files to score: each `--trace` as given, a folder as its `.csv` files in name
-/// order.
+/// order, regular files only (the others skipped with a note).
 fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
     let mut paths = Vec::new();
     for path in given {
@@ -195,15 +195,32 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         let entries = std::fs::read_dir(path)
             .map_err(|source| CliError::Read { path: path.clone(), source })?;
         let mut found = Vec::new();
+        let mut skipped = Vec::new();
         for entry in entries {
             let entry = entry.map_err(|source| CliError::Read { path: path.clone(), source })?;
             let p = entry.path();
-            if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) && !p.is_dir() {
-                found.push(p);
+            if !p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) {
+                continue;
+            }
+            // Only regular files (or links to them): a named pipe would wait for a writer
+            // forever, a device would never end. A file that cannot be looked at is kept,
+            // for its read error.
+            match std::fs::metadata(&p) {
+                Ok(meta) if meta.is_dir() => {}
+                Ok(meta) if !meta.is_file() => skipped.push((p, not_regular(&meta))),
+                _ => found.push(p),
             }
             if found.len() > MAX_BATCH_TRACES {
                 break;
             }
+        }
+        skipped.sort();
+        for (p, what) in &skipped {
+            let shown = p.display().to_string();
+            errln!(
+                "note: skipped `{}`: {what}, not a regular file",
+                hstl::load::escape_controls(&shown)
+            );
         }
         if found.is_empty() {
             return Err(CliError::new(
@@ -221,6 +238,26 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         ));
     }
     Ok(paths)
+}
+
+/// What a file that is not a regular file (nor a folder) is, in words.
+fn not_regular(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a named pipe";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_block_device() || t.is_char_device() {
+            return "a device";
+        }
+    }
+    let _ = meta;
+    "a special file"
 }
 
 /// The CSV columns the spec's state variables need.
@@ -243,7 +280,8 @@ pub(crate) fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
     if ignored.is_empty() {
         return;
     }
-    let names: Vec<String> = ignored.iter().map(|n| format!("`{n}`")).collect();
+    let names: Vec<String> =
+        ignored.iter().map(|n| format!("`{}`", hstl::load::escape_controls(n))).collect();
     let (what, verb) = if names.len() == 1 {
         ("column", "is not a state variable")
     } else {

@@ -72,3 +72,9 @@ pub fn is_broken_pipe(e: &CliError) -> bool {
 }
 
 pub(crate) use {err, errln, out, outln};
+
+/// A path as messages show it: its control characters escaped (see
+/// [`hstl::load::escape_controls`]).
+pub fn shown(path: &std::path::Path) -> String {
+    hstl::load::escape_controls(&path.display().to_string()).into_owned()
+}

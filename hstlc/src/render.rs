@@ -35,7 +35,14 @@ pub fn full(files: &[Checked], colour: bool) -> String {
 /// The `concise` format: `path:line:col: CODE message`, the help (if any) indented on the
 /// next line, then a summary line.
 pub fn concise(files: &[Checked]) -> String {
-    hstl::lang::render_concise(&file_diagnostics(files))
+    let names: Vec<String> =
+        files.iter().map(|f| hstl::load::escape_controls(&f.name).into_owned()).collect();
+    let shown: Vec<FileDiagnostics<'_>> = files
+        .iter()
+        .zip(&names)
+        .map(|(f, name)| FileDiagnostics { name, source: &f.source, diagnostics: &f.diagnostics })
+        .collect();
+    hstl::lang::render_concise(&shown)
 }
 
 /// The `json` format: one array of flat objects, positions 1-based, end exclusive.
@@ -168,11 +175,17 @@ pub fn cli_error(e: &CliError) -> String {
     } else {
         out.push_str("error: ");
     }
-    out.push_str(&e.to_string());
+    out.push_str(&escape_lines(&e.to_string()));
     if let Some(help) = e.help() {
-        out.push_str(&format!("\n  help: {help}"));
+        out.push_str(&format!("\n  help: {}", escape_lines(&help)));
     }
     out
+}
+
+/// `text` with the control characters of each line escaped (its line ends kept): the names
+/// a message quotes reach the terminal as text, never as commands to it.
+pub fn escape_lines(text: &str) -> String {
+    text.split('\n').map(|l| hstl::load::escape_controls(l)).collect::<Vec<_>>().join("\n")
 }
 
 /// `checked 2 files: 1 error, 3 warnings`.
@@ -375,7 +388,8 @@ impl Excerpt {
         }
         let p = index.position(src, marks[0].0);
         let start = (p.line - 1, p.column - 1);
-        let mut excerpt = Excerpt { name: name.to_string(), text, lines, spans: Vec::new(), start };
+        let name = hstl::load::escape_controls(name).into_owned();
+        let mut excerpt = Excerpt { name, text, lines, spans: Vec::new(), start };
         excerpt.spans = marks
             .iter()
             .map(|&(s, e, _, _)| {

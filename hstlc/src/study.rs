@@ -13,7 +13,7 @@ use hstl::artifacts::OutFile;
 use hstl::runtime::{GridWorld, Intra, Region, TaskSpec};
 use hstl::study::{self as facade, CurveSet, Keep, Kept, SeedRun, Stats, StudiedSpec};
 use hstl::world::AnyWorld;
-use hstl_outdir::{OutDir, Writer};
+use hstl_outdir::{OutDir, StudyDir, Writer};
 
 use crate::cli_error::CliError;
 use crate::output::outln;
@@ -51,6 +51,11 @@ pub struct StudyArgs {
     /// (`curves.svg`, with every seed's in `curves.csv`).
     #[arg(long, value_name = "DIR", default_value = "out/study")]
     pub out: PathBuf,
+    /// Replace files at the top of `--out` that no study wrote (`curves.csv`, `curves.svg`,
+    /// `summary.csv`), and remove other runs' folders there that this study does not write
+    /// (otherwise either refuses the run before any training).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The bytes of trained policies a study keeps in memory for the median seed's files; past
@@ -75,10 +80,11 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     }
     // Each spec's folder, taken before the long part: a folder another run holds is
     // refused at once, and two specs of one name get folders of their own.
-    let outs = facade::spec_dirs(&args.out, &args.specs)
-        .iter()
-        .map(|d| OutDir::lock(d, Writer::CLI))
-        .collect::<Result<Vec<_>, _>>()?;
+    // The study's own folder is held too, and its top files (written last) must describe
+    // every spec folder in it: another run's folder there, or a user's `summary.csv`, is
+    // refused now unless `--force`.
+    let spec_dirs = facade::spec_dirs(&args.out, &args.specs);
+    let (study_dir, outs) = StudyDir::take(&args.out, &spec_dirs, args.force, Writer::CLI)?;
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
@@ -134,6 +140,9 @@ pub fn run(args: &StudyArgs) -> CmdResult {
         // Rewards compare only under the same options-level reward.
         match &baseline {
             None => baseline = Some((label.clone(), reward, spec.learn.reward)),
+            Some((base, b, kind)) if *kind == spec.learn.reward && *b == 0.0 => {
+                outln!("  reward not compared with {base}: its mean reward per episode is 0")?
+            }
             Some((base, b, kind)) if *kind == spec.learn.reward => outln!(
                 "  reward vs {base}: {:+.1}% (mean reward per episode, last 100 episodes)",
                 100.0 * (reward - b) / b.abs()
@@ -180,7 +189,7 @@ pub fn run(args: &StudyArgs) -> CmdResult {
             outln!("  {why}")?;
         }
         out.write(&files)?;
-        outln!("  wrote {}", dir.display())?;
+        outln!("  wrote {}", crate::output::shown(&dir))?;
         // The variant's curves follow the spec's in the figure.
         all_curves.push(CurveSet {
             label: label.clone(),
@@ -191,13 +200,13 @@ pub fn run(args: &StudyArgs) -> CmdResult {
     }
     let mut files = facade::curves_files(&all_curves, seeds.len())?;
     files.push(OutFile::text("summary.csv", summary));
-    hstl_outdir::write_beside(&args.out, &files)?;
+    study_dir.write(&files, &spec_dirs)?;
     outln!()?;
     outln!(
         "wrote {} and {}: the learning curves of every spec; {}: each spec's measure",
-        args.out.join("curves.svg").display(),
-        args.out.join("curves.csv").display(),
-        args.out.join("summary.csv").display()
+        crate::output::shown(&args.out.join("curves.svg")),
+        crate::output::shown(&args.out.join("curves.csv")),
+        crate::output::shown(&args.out.join("summary.csv"))
     )?;
     Ok(Status::Clean)
 }
@@ -363,7 +372,7 @@ fn continuous_spec(
         runs.len(),
         rates[median]
     )?;
-    outln!("  wrote {}", dir.display())?;
+    outln!("  wrote {}", crate::output::shown(&dir))?;
     let s = Stats::of(&rates);
     let line = format!(
         "{},{measure},,{},{},{}\n",
@@ -441,8 +450,10 @@ fn print_table(results: &[SeedRun], w_star: Option<f64>) -> Result<(), CliError>
     row("reward per episode (last 100)", s.reward, 2)?;
     if let Some(w) = s.window_rate {
         row("window rate W", w, 3)?;
-        if let (Some(r), Some(w)) = (s.ratio, w_star) {
-            row(&format!("W/W* (W* = {w:.4})"), r, 3)?;
+        match (s.ratio, w_star) {
+            (Some(r), Some(w)) => row(&format!("W/W* (W* = {w:.4})"), r, 3)?,
+            (None, Some(_)) => outln!("  {}", facade::RATIO_UNDEFINED)?,
+            _ => {}
         }
     }
     if let Some(p) = s.satisfaction {

@@ -134,7 +134,12 @@ pub fn run(args: &TrainArgs) -> CmdResult {
             WindowConfig::default().steps
         )?;
     }
-    outln!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files))?;
+    outln!(
+        "  wrote {} files to {}: {}",
+        written.len(),
+        crate::output::shown(&args.out),
+        names(&files)
+    )?;
     if let Some(why) = skipped {
         outln!("  {why}")?;
     }
@@ -214,7 +219,12 @@ fn run_continuous(
             c::task_steps(&spec)
         )?,
     }
-    outln!("  wrote {} files to {}: {}", written.len(), args.out.display(), names(&files))?;
+    outln!(
+        "  wrote {} files to {}: {}",
+        written.len(),
+        crate::output::shown(&args.out),
+        names(&files)
+    )?;
     Ok(Status::Clean)
 }
 

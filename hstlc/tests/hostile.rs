@@ -305,7 +305,7 @@ fn output_folders_are_whole_or_nothing() {
     assert!(!files.iter().any(|f| f.starts_with("options_after")), "old files stayed: {files:?}");
     assert!(files.contains(&"options.svg".to_string()), "{files:?}");
     let siblings: Vec<String> = listing(d).into_iter().filter(|f| f.starts_with(".run")).collect();
-    assert_eq!(siblings, [".run.lock"], "only the lock file stays beside the folder");
+    assert!(siblings.is_empty(), "nothing stays beside the folder: {siblings:?}");
 
     // A folder holding other files is not replaced.
     std::fs::create_dir(d.join("mine")).expect("folder");
@@ -314,6 +314,8 @@ fn output_folders_are_whole_or_nothing() {
     assert_eq!(run.status, Some(2));
     assert!(run.stderr.contains("holds `notes.txt`, which no hstlc run writes"), "{}", run.stderr);
     assert_eq!(listing(&d.join("mine")), ["notes.txt"]);
+    // Hostile round 2: and no lock file lands beside the refused folder.
+    assert!(!d.join(".mine.lock").exists(), "a lock beside a refused target");
 
     // Two runs into one folder: the second is refused while the first holds it; a killed
     // run leaves no lock behind.
@@ -356,14 +358,15 @@ fn output_folders_are_whole_or_nothing() {
     assert_eq!(run.status, Some(0), "{}", run.stderr);
     assert_eq!(
         listing(&d.join("st")),
-        [".spec-2.lock", ".spec.lock", "curves.csv", "curves.svg", "spec", "spec-2", "summary.csv"]
+        [".hstlc-study", "curves.csv", "curves.svg", "spec", "spec-2", "summary.csv"]
     );
     let curves = std::fs::read_to_string(d.join("st/curves.csv")).expect("curves.csv");
     assert!(curves.contains("a/spec.hstl") && curves.contains("b/spec.hstl"), "{curves}");
 }
 
-/// Class 7: `fmt --write` rewrites a file as the same file: its permissions, the symbolic
-/// link to it, its hard links and its byte order mark stay.
+/// Class 7: `fmt --write` rewrites a file whole, as the same file where a rename allows: its
+/// permissions, the symbolic link to it and its byte order mark stay; a hard-linked one
+/// becomes a file of its own, with a note.
 #[cfg(unix)]
 #[test]
 fn fmt_write_keeps_the_file() {
@@ -397,12 +400,25 @@ fn fmt_write_keeps_the_file() {
     assert!(std::fs::symlink_metadata(d.join("link.hstl")).expect("meta").file_type().is_symlink());
     assert_eq!(read("real/target.hstl"), tidy);
 
-    // Hard links: both names see the new text, still one file.
+    // Hostile round 2: a hard-linked file was rewritten in place, and a run killed mid-write
+    // left the new text followed by the old text's tail (the old text only in a hidden
+    // backup). Now it is replaced whole, by a rename, like any file: it becomes a file of
+    // its own, the other name keeps the old text, and a note says so.
     write(d, "one.hstl", messy);
     std::fs::hard_link(d.join("one.hstl"), d.join("two.hstl")).expect("hard link");
-    fmt_write("one.hstl");
-    assert_eq!((read("one.hstl"), read("two.hstl")), (tidy.clone(), tidy.clone()));
-    assert_eq!(std::fs::metadata(d.join("two.hstl")).expect("meta").nlink(), 2);
+    let inode = std::fs::metadata(d.join("one.hstl")).expect("meta").ino();
+    let run = hstlc_in(d, &["fmt", "--write", "one.hstl"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(
+        run.stderr,
+        "note: `one.hstl` had 1 other hard link: it is now a file of its own, and that name \
+         keeps the text before formatting (run `hstlc fmt --write` on it too)\n"
+    );
+    assert_eq!((read("one.hstl"), read("two.hstl")), (tidy.clone(), messy.to_string()));
+    let meta = std::fs::metadata(d.join("one.hstl")).expect("meta");
+    assert_ne!(meta.ino(), inode, "written in place, not whole");
+    let two = std::fs::metadata(d.join("two.hstl")).expect("meta");
+    assert_eq!((meta.nlink(), meta.permissions().mode()), (1, two.permissions().mode()));
 
     // A byte order mark stays; the fixed temporary name of old is left alone.
     write(d, "bom.hstl", format!("\u{feff}{messy}"));
@@ -410,7 +426,10 @@ fn fmt_write_keeps_the_file() {
     fmt_write("bom.hstl");
     assert_eq!(read("bom.hstl"), format!("\u{feff}{tidy}"));
     assert_eq!(read(".bom.hstl.hstlc-fmt.tmp"), "not mine");
-    let left: Vec<String> = listing(d).into_iter().filter(|f| f.contains("hstlc-fmt-")).collect();
+    let left: Vec<String> = listing(d)
+        .into_iter()
+        .filter(|f| f.contains("hstlc-fmt") && f != ".bom.hstl.hstlc-fmt.tmp")
+        .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
 
@@ -582,4 +601,191 @@ fn shared_and_deep_lets_run_in_linear_time() {
     let run = hstlc_in(d, &["check", "chain.hstl"], b"");
     assert_eq!((run.status, run.stdout.as_str()), (Some(0), "checked 1 file: no problems\n"));
     assert_eq!(monitor("chain.hstl", "C299"), want);
+}
+
+/// Hostile round 2: `study --out` never replaces a user's own files at the top of its folder
+/// without `--force`, and its top files describe every spec folder there: a second study
+/// into the folder of another is refused (or, with `--force`, removes the other's folders).
+#[test]
+fn a_study_keeps_a_users_files_and_describes_every_folder() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "a.hstl", SMALL);
+    write(d, "b.hstl", SMALL);
+    let study = |spec: &str, out: &str, force: bool| {
+        let mut args = vec!["study", spec, "--seeds", "1", "--no-optimum", "--out", out];
+        if force {
+            args.push("--force");
+        }
+        hstlc_in(d, &args, b"")
+    };
+    // A user's own summary.csv and curves.csv: refused before training, left as they were.
+    std::fs::create_dir(d.join("mine")).expect("folder");
+    write(d, "mine/summary.csv", "my,figures\n");
+    write(d, "mine/curves.csv", "my,curves\n");
+    write(d, "mine/notes.txt", "keep me");
+    let run = study("a.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("curves.csv` was not written by a study, and would be replaced"),
+        "{}",
+        run.stderr
+    );
+    assert!(run.stderr.contains("--force"), "{}", run.stderr);
+    assert!(!run.stdout.contains("study:"), "refused before training: {}", run.stdout);
+    assert_eq!(listing(&d.join("mine")), ["curves.csv", "notes.txt", "summary.csv"]);
+    assert_eq!(std::fs::read_to_string(d.join("mine/summary.csv")).expect("read"), "my,figures\n");
+    assert!(!listing(d).iter().any(|f| f.ends_with(".lock")), "a lock left: {:?}", listing(d));
+    // With --force they are replaced; the user's other files stay.
+    let run = study("a.hstl", "mine", true);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let summary = std::fs::read_to_string(d.join("mine/summary.csv")).expect("read");
+    assert!(summary.contains("a.hstl"), "{summary}");
+    assert_eq!(std::fs::read_to_string(d.join("mine/notes.txt")).expect("read"), "keep me");
+    // A study's own files are replaced by the next study of the same specs.
+    let run = study("a.hstl", "mine", false);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+
+    // Two studies into one folder: the second would leave `a` undescribed, and is refused.
+    let run = study("b.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains(
+            "holds `a`, another run's folder, which this study's summary would not describe"
+        ),
+        "{}",
+        run.stderr
+    );
+    assert!(listing(&d.join("mine")).contains(&"a".to_string()));
+    // With --force the other study's folder goes, and the summary describes what is there.
+    let run = study("b.hstl", "mine", true);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(
+        listing(&d.join("mine")),
+        [".hstlc-study", "b", "curves.csv", "curves.svg", "notes.txt", "summary.csv"]
+    );
+    let summary = std::fs::read_to_string(d.join("mine/summary.csv")).expect("read");
+    assert_eq!(summary.lines().count(), 2, "{summary}");
+    assert!(!summary.contains("a.hstl"), "{summary}");
+    // A train run's folder inside the study's folder is another run's folder too.
+    let run = hstlc_in(d, &["train", "a.hstl", "--out", "mine/trained"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let run = study("b.hstl", "mine", false);
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert!(run.stderr.contains("holds `trained`"), "{}", run.stderr);
+    assert!(!listing(d).iter().any(|f| f.starts_with('.')), "left beside: {:?}", listing(d));
+}
+
+/// Hostile round 2: when no policy can keep the task (W* = 0, `check` clean), `eval` and
+/// `study` say W/W* is undefined in words, and `summary.csv` leaves its cells empty: never
+/// NaN or inf.
+#[test]
+fn w_over_w_star_is_undefined_in_words_when_no_policy_keeps_the_task() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    // Two steps cannot take the agent from one corner to the other and back.
+    let zero = SMALL.replace("[0..40]", "[0..2]");
+    write(d, "zero.hstl", &zero);
+    let run = hstlc_in(d, &["check", "zero.hstl"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stdout);
+    let run = hstlc_in(d, &["train", "zero.hstl", "--out", "run"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let undefined = "W/W* undefined (W* = 0: no policy keeps the task)";
+    let run = hstlc_in(d, &["eval", "run/policy.json", "--starts", "2", "--steps", "200"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains(undefined), "{}", run.stdout);
+    let run = hstlc_in(d, &["study", "zero.hstl", "zero.hstl", "--seeds", "2", "--out", "st"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert_eq!(run.stdout.matches(undefined).count(), 2, "{}", run.stdout);
+    let summary = std::fs::read_to_string(d.join("st/summary.csv")).expect("summary.csv");
+    for line in summary.lines().skip(1) {
+        assert_eq!(line.split(',').collect::<Vec<_>>()[1..5], ["W/W*", "0", "", ""], "{summary}");
+    }
+    for text in [&run.stdout, &summary] {
+        let lower = text.to_lowercase();
+        assert!(!lower.contains("nan") && !lower.contains("inf"), "{text}");
+    }
+}
+
+/// Hostile round 2: a named pipe called `*.csv` in a batch folder hung `monitor` forever,
+/// waiting for a writer. Only regular files are read from a folder; the others are skipped
+/// with a note.
+#[cfg(unix)]
+#[test]
+fn a_batch_folder_is_read_for_its_regular_files_only() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    std::fs::create_dir(d.join("traces")).expect("folder");
+    write(d, "traces/a.csv", "x,y\n1,1\n2,2\n");
+    let made = Command::new("mkfifo").arg(d.join("traces/b.csv")).status().expect("mkfifo runs");
+    assert!(made.success());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["monitor", "small.hstl", "--trace", "traces"])
+        .current_dir(d)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("hstlc starts");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while child.try_wait().expect("waits").is_none() {
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("monitor hangs on a named pipe in a batch folder");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().expect("hstlc ends");
+    let (stdout, stderr) =
+        (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stdout.contains("a.csv") && !stdout.contains("b.csv"), "{stdout}");
+    assert!(
+        stderr.contains("note: skipped `traces/b.csv`: a named pipe, not a regular file"),
+        "{stderr}"
+    );
+}
+
+/// Hostile round 2: names with control characters (a file name, a CSV column) reached the
+/// terminal raw, where an escape sequence can clear the screen or retitle the window. They
+/// are shown escaped (`\x1b`) in errors, diagnostics, notes and `fmt --check`'s list.
+#[cfg(unix)]
+#[test]
+fn control_characters_in_names_are_escaped() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let raw = |run: &Run| {
+        let all = format!("{}{}", run.stdout, run.stderr);
+        all.chars().any(|c| c.is_control() && c != '\n')
+    };
+    // A spec file whose name clears the screen, with a syntax error and messy layout.
+    let evil = "evil\x1b[2J\r.hstl";
+    write(d, evil, "spec S { state { x: int in 0..=9 } task x > 1 &&; }");
+    for args in [&["check", evil][..], &["fmt", evil], &["train", evil, "--out", "o"]] {
+        let run = hstlc_in(d, args, b"");
+        assert_eq!(run.status, Some(1), "{args:?}: {}", run.stderr);
+        assert!(!raw(&run), "{args:?}: {:?}", run.stderr);
+        let shown = format!("{}{}", run.stdout, run.stderr);
+        assert!(shown.contains("evil\\x1b[2J\\x0d.hstl"), "{args:?}: {shown}");
+    }
+    let run = hstlc_in(d, &["check", "--format", "concise", evil], b"");
+    assert!(!raw(&run) && run.stdout.contains("evil\\x1b[2J\\x0d.hstl:1:"), "{}", run.stdout);
+    // A missing file, and `fmt --check`'s list of files that would change.
+    let run = hstlc_in(d, &["check", "gone\x07.hstl"], b"");
+    assert_eq!(run.status, Some(2));
+    assert!(!raw(&run) && run.stderr.contains("cannot read `gone\\x07.hstl`"), "{}", run.stderr);
+    let messy = "messy\x1b]0;owned\x07.hstl";
+    write(d, messy, "spec  S {state{x:int in 0..=9} task x>1;}\n");
+    let run = hstlc_in(d, &["fmt", "--check", messy], b"");
+    assert_eq!(run.status, Some(1), "{}", run.stderr);
+    assert_eq!(run.stdout, "messy\\x1b]0;owned\\x07.hstl\n");
+    // A trace column the spec does not name.
+    write(d, "small.hstl", SMALL);
+    write(d, "t.csv", "x,y,\x1b[31mred\n1,1,0\n2,2,0\n");
+    let run = hstlc_in(d, &["monitor", "small.hstl", "--trace", "t.csv"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(!raw(&run), "{:?}", run.stderr);
+    assert!(run.stderr.contains("column `\\x1b[31mred` is not"), "{}", run.stderr);
 }

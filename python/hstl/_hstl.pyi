@@ -311,7 +311,7 @@ def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> 
 class _StudyOut:
     """A study's output folder, each spec's folder locked from now on and written whole."""
 
-    def __init__(self, out: PathArg, paths: Sequence[PathArg]) -> None: ...
+    def __init__(self, out: PathArg, paths: Sequence[PathArg], force: bool = False) -> None: ...
     def write(
         self,
         specs: Sequence[Spec],

@@ -55,6 +55,7 @@ def study(
     num_cpus: Optional[int] = None,
     batch: Optional[int] = None,
     max_retries: int = 3,
+    force: bool = False,
 ) -> StudyResult:
     """Trains each spec for each seed and returns one dict per (spec, seed).
 
@@ -62,7 +63,9 @@ def study(
     parsed from text), ``seed``, ``window_rate`` (W of the greedy policy, for a persistent
     task; else None), ``optimum`` (W*, or None), ``ratio`` (W/W*, or None), ``reward``
     (per episode, the mean of the last 100 episodes), ``seconds`` (training time),
-    ``steps`` (primitive steps) and ``curve`` (reward per episode). The numbers are those
+    ``steps`` (primitive steps) and ``curve`` (reward per episode). ``ratio`` is None when
+    W* = 0 (no policy keeps the task: W/W* is undefined), and the summary then has no
+    ``ratio`` either. The numbers are those
     of ``hstlc study``, bit for bit, whatever the backend (training time excepted); the
     list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``).
 
@@ -90,7 +93,10 @@ def study(
     median seed's policy and pictures, ``seeds.csv`` and ``curve.svg``; ``curves.svg`` and
     ``curves.csv`` beside them). The folders are taken before training starts (one another
     run holds is refused at once) and written only when every result is in, each whole or
-    not at all.
+    not at all. A file at the folder's top that no study wrote (a ``summary.csv`` of your
+    own), or another run's folder in it that this study would leave undescribed, is refused
+    then too (a ``ValueError``), unless ``force=True``, which replaces the file and removes
+    the folder, as ``hstlc study --force``.
     """
     return _study(
         specs,
@@ -104,6 +110,7 @@ def study(
         num_cpus=num_cpus,
         batch=batch,
         max_retries=max_retries,
+        force=force,
     )
 
 
@@ -120,6 +127,7 @@ def _study(
     num_cpus: Optional[int],
     batch: Optional[int],
     max_retries: int,
+    force: bool = False,
     before_batch: Optional[Callable[[List[int]], None]] = None,
 ) -> StudyResult:
     """``study``, with ``before_batch(seeds)`` called in each Ray task before it trains (the
@@ -141,7 +149,7 @@ def _study(
     # Every spec checked against the world here, before anything trains or is sent away.
     tasks = [_hstl._study_task(spec, world, episodes) for spec in spec_list]
     paths = [_path_of(spec) for spec in spec_list]
-    folder = _hstl._StudyOut(os.fspath(out), paths) if out is not None else None
+    folder = _hstl._StudyOut(os.fspath(out), paths, bool(force)) if out is not None else None
     # One W* per distinct set of regions, as hstlc study solves it.
     wanted = {}
     if optimum:
@@ -179,7 +187,7 @@ def _study(
                     "seed": run["seed"],
                     "window_rate": w,
                     "optimum": w_star,
-                    "ratio": w / w_star if w is not None and w_star is not None else None,
+                    "ratio": _ratio(w, w_star),
                     "reward": run["reward"],
                     "seconds": run["seconds"],
                     "steps": run["steps"],
@@ -191,6 +199,18 @@ def _study(
     if folder is not None:
         folder.write(spec_list, world, runs, episodes, w_stars)
     return StudyResult(rows, summary)
+
+
+#: W* at or below this is 0: no policy keeps the task (the facade's ``MIN_OPTIMUM``).
+_MIN_OPTIMUM = 1e-9
+
+
+def _ratio(w: Optional[float], w_star: Optional[float]) -> Optional[float]:
+    """W/W*, or None when either is unknown or W* = 0 (no policy keeps the task: the
+    ratio is undefined, as ``hstlc study`` says)."""
+    if w is None or w_star is None or not w_star > _MIN_OPTIMUM:
+        return None
+    return w / w_star
 
 
 def _whole(n: Any, name: str, lo: int, hi: int) -> int:

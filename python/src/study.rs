@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use hstl::lang::budget::MAX_EPISODES;
 use hstl::runtime::TaskSpec;
 use hstl::study::{self as facade, CurveSet, SeedRun, Stats, StudiedSpec};
-use hstl_outdir::{OutDir, Writer};
+use hstl_outdir::{OutDir, StudyDir, Writer};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -232,23 +232,23 @@ pub fn _study_summary<'py>(
 /// training; written by `write` once every result is in, each folder whole or not at all.
 #[pyclass(module = "hstl._hstl")]
 pub struct _StudyOut {
-    out: PathBuf,
     paths: Vec<PathBuf>,
-    dirs: Option<Vec<OutDir>>,
+    spec_dirs: Vec<PathBuf>,
+    dirs: Option<(StudyDir, Vec<OutDir>)>,
 }
 
 #[pymethods]
 impl _StudyOut {
-    /// Takes `out`'s folder for each spec, named from `paths` (each spec's file, or a
-    /// name for a spec parsed from text) as `hstlc study` names them.
+    /// Takes `out` and its folder for each spec, named from `paths` (each spec's file, or a
+    /// name for a spec parsed from text) as `hstlc study` names them; a user's files at its
+    /// top, or another run's folder in it, are refused unless `force` (as `hstlc study
+    /// --force`).
     #[new]
-    fn new(out: PathBuf, paths: Vec<PathBuf>) -> PyResult<_StudyOut> {
-        let dirs = facade::spec_dirs(&out, &paths)
-            .iter()
-            .map(|d| OutDir::lock(d, Writer::PYTHON))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(outdir_error)?;
-        Ok(_StudyOut { out, paths, dirs: Some(dirs) })
+    #[pyo3(signature = (out, paths, force=false))]
+    fn new(out: PathBuf, paths: Vec<PathBuf>, force: bool) -> PyResult<_StudyOut> {
+        let spec_dirs = facade::spec_dirs(&out, &paths);
+        let dirs = StudyDir::take(&out, &spec_dirs, force, Writer::PYTHON).map_err(outdir_error)?;
+        Ok(_StudyOut { paths, spec_dirs, dirs: Some(dirs) })
     }
 
     /// Writes every spec's folder, then `curves.svg` and `curves.csv` beside them. `runs[i]`
@@ -265,7 +265,7 @@ impl _StudyOut {
         episodes: Option<usize>,
         optima: Option<Vec<Option<f64>>>,
     ) -> PyResult<Vec<PathBuf>> {
-        let Some(dirs) = self.dirs.take() else {
+        let Some((study_dir, dirs)) = self.dirs.take() else {
             return Err(value_error(
                 "this study's folder is written already",
                 Some("make a new one for another study".into()),
@@ -323,7 +323,7 @@ impl _StudyOut {
         let seeds = curves.first().map_or(0, |c| c.runs.len());
         let mut files = facade::curves_files(&curves, seeds).map_err(|p| problem_error(&p))?;
         files.push(hstl::artifacts::OutFile::text("summary.csv", summary));
-        written.extend(hstl_outdir::write_beside(&self.out, &files).map_err(outdir_error)?);
+        written.extend(study_dir.write(&files, &self.spec_dirs).map_err(outdir_error)?);
         Ok(written)
     }
 }

@@ -250,3 +250,40 @@ def test_tune_trials_report_w_and_w_over_w_star(cluster, tmp_path):
     assert own["training_iteration"] == 2 and own["episodes"] == 10
     assert (own["window_rate"], own["reward"], own["ratio"]) == (row["window_rate"], row["reward"], row["ratio"])
     assert by_alpha[0.6]["window_rate"] != own["window_rate"]
+
+
+ZERO = """spec Zero {
+    world "paper";
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let A = x < 3 && y < 3;
+    let B = x > 11 && y > 11;
+    task always[0..] (eventually[0..2] A && eventually[0..2] B);
+    option A;
+    option B;
+    learn { episodes: 5, choices: 5 }
+}
+"""
+
+
+def test_no_policy_keeps_the_task_and_w_over_w_star_is_undefined(tmp_path):
+    """Hostile round 2: W* = 0 raised ZeroDivisionError after training every seed."""
+    spec = tmp_path / "zero.hstl"
+    spec.write_text(ZERO)
+    rows = hstl.study(spec, seeds=2, out=tmp_path / "out")
+    assert [r["optimum"] for r in rows] == [0.0, 0.0]
+    assert [r["ratio"] for r in rows] == [None, None]
+    assert "ratio" not in rows.summary[0]
+    summary = (tmp_path / "out" / "summary.csv").read_text()
+    assert summary.splitlines()[1].split(",")[1:5] == ["W/W*", "0", "", ""], summary
+    assert "NaN" not in summary and "inf" not in summary
+
+
+def test_a_users_summary_is_kept_unless_force(tmp_path):
+    """Hostile round 2: `out=` replaced a user's own summary.csv without a word."""
+    (tmp_path / "summary.csv").write_text("mine\n")
+    with pytest.raises(ValueError, match=r"summary.csv` was not written by a study") as e:
+        hstl.study(SMALL, seeds=1, episodes=2, optimum=False, out=tmp_path)
+    assert "`force=True`" in str(e.value)
+    assert (tmp_path / "summary.csv").read_text() == "mine\n"
+    hstl.study(SMALL, seeds=1, episodes=2, optimum=False, out=tmp_path, force=True)
+    assert (tmp_path / "summary.csv").read_text().startswith("spec,measure")
