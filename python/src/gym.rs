@@ -4,9 +4,10 @@
 //! The learner (and a replay) only ever steps from the state the environment is in, after
 //! `reset`. Each `reset` seeds the Python environment with a seed drawn from the learner's
 //! one generator, so the same seed gives the same episodes and the same Q-tables whatever
-//! the environment did before. A step that reports `terminated` or `truncated` leaves the
-//! robot there: later steps stay in that state, without calling Python, until the
-//! learner's episode ends and it resets. The first Python exception (in `reset`, `step`,
+//! the environment did before. A step that reports `terminated` or `truncated` ends the
+//! learner's episode there ([`Env::episode_ended`]): the next one starts with a reset, so
+//! every step the learner counts is a call of `env.step`. (A replay that steps on leaves
+//! the robot in that state, without calling Python, until it resets.) The first Python exception (in `reset`, `step`,
 //! or a bad observation) stops the run: every later call returns at once, the caller
 //! stops at the end of the episode and raises it.
 
@@ -306,6 +307,10 @@ impl Env for PyEnv {
             Err(e) => self.fail(e),
         }
         self.current.get()
+    }
+
+    fn episode_ended(&self) -> bool {
+        self.absorbed.get()
     }
 
     fn step(&self, state: &usize, action: usize, _rng: &mut Rng) -> usize {

@@ -42,9 +42,11 @@ class Line(gymnasium.Env):
         self.action_space = spaces.Discrete(2, start=10)
         self.steps_after_end = 0
         self.calls = 0
+        self.resets = 0
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
+        self.resets += 1
         self.cell, self.ended = 0, False
         return 0, {}
 
@@ -83,11 +85,13 @@ def test_frozen_lake_trains_deterministically():
     assert a.q_tables["flat"]["Goal"].shape == (16, 4) and np.any(a.q_tables["flat"]["Goal"] != 0)
 
 
-def test_a_terminated_step_absorbs_until_the_learners_episode_ends():
+def test_a_terminated_step_ends_the_learners_episode_and_only_real_steps_count():
     env = Line()
     policy = hstl.train(LINE, env=env, valuation=lambda o: {"s": o}, seed=1)
-    # The learner never stepped past the end: after `terminated` it stayed put.
-    assert env.steps_after_end == 0 and env.calls < policy.steps
+    # The learner never stepped past the end; each of its episodes reset the environment,
+    # and every step it counts is a call of env.step.
+    assert env.steps_after_end == 0 and env.calls == policy.steps
+    assert env.resets == 15
     assert hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o}, seed=1) == policy
     # Actions are the environment's own (Discrete(2, start=10)).
     assert policy.actions == ["10", "11"]
@@ -95,6 +99,36 @@ def test_a_terminated_step_absorbs_until_the_learners_episode_ends():
     assert policy.act(0) in (10, 11) and policy.act({"s": 3}) in (10, 11)
     report = policy.evaluate(starts=4, steps=30, env=Line(), valuation=lambda o: {"s": o})
     assert len(report["robustness"]) == 4 and report["window_rate"] is None
+
+
+class Counted(gymnasium.Wrapper):
+    """Counts the steps and episodes of the environment it wraps, and the steps taken
+    after an episode ended without a reset between."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.steps = self.episodes = self.after_end = 0
+        self.ended = False
+
+    def reset(self, **kwargs):
+        self.episodes += 1
+        self.ended = False
+        return self.env.reset(**kwargs)
+
+    def step(self, action):
+        self.after_end += self.ended
+        self.steps += 1
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.ended = terminated or truncated
+        return obs, reward, terminated, truncated, info
+
+
+def test_frozen_lake_episodes_end_where_gymnasiums_do():
+    env = Counted(gymnasium.make("FrozenLake-v1"))
+    policy = hstl.train(LAKE, env=env, valuation=lake_state, seed=3, episodes=200)
+    assert env.after_end == 0 and env.steps == policy.steps and env.episodes == 200
+    # An episode is at most choices x max_steps = 120 steps, and most end in a hole sooner.
+    assert policy.steps < 200 * 40
 
 
 def test_a_saved_policy_loads_and_needs_its_environment_to_evaluate(tmp_path):

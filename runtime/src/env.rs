@@ -83,6 +83,14 @@ pub trait Env {
     /// The state after taking `action` in `state`. An action outside the set leaves the
     /// state unchanged.
     fn step(&self, state: &Self::State, action: usize, rng: &mut Rng) -> Self::State;
+    /// Whether the last [`Env::step`] ended the environment's own episode (a gymnasium
+    /// environment's `terminated` or `truncated`): the learner then ends its episode
+    /// there, and starts the next with [`Env::reset`], so every step it counts is one the
+    /// environment took. A world whose episodes never end (every built-in one) keeps the
+    /// default, `false`.
+    fn episode_ended(&self) -> bool {
+        false
+    }
 }
 
 impl<E: Env> World for E {

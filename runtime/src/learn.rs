@@ -174,6 +174,8 @@ struct Run {
     obs: Vec<usize>,
     /// `psi` at each position (empty without counters).
     psi: Vec<bool>,
+    /// The environment ended its episode during the option ([`Env::episode_ended`]).
+    ended: bool,
 }
 
 impl<'e, E: Env> Learner<'e, E> {
@@ -366,6 +368,10 @@ impl<'e, E: Env> Learner<'e, E> {
                 self.counterfactual_updates(o, run, rng);
             }
             s = *run.states.last().unwrap_or(&s);
+            if run.ended {
+                // The environment's episode is over: the next episode resets it.
+                break;
+            }
         }
         total
     }
@@ -417,12 +423,13 @@ impl<'e, E: Env> Learner<'e, E> {
         run.leg_starts.clear();
         run.obs.clear();
         run.psi.clear();
+        run.ended = false;
         run.states.push(s);
         run.obs.push(s * values + *code);
         if let Some(m) = memory {
             run.psi.push(m.kept(tau));
         }
-        for &p in &tables.legs[o] {
+        'legs: for &p in &tables.legs[o] {
             run.leg_starts.push(run.states.len() - 1);
             let term = &tables.term[p];
             for _ in 0..max_steps {
@@ -462,6 +469,10 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
                 run.obs.push(next * values + *code);
                 s = next;
+                if env.episode_ended() {
+                    run.ended = true;
+                    break 'legs;
+                }
                 if term[next] {
                     break;
                 }
