@@ -98,8 +98,8 @@ impl Env for Episodic {
         next
     }
 
-    fn episode_ended(&self) -> bool {
-        self.ended.get()
+    fn episode_end(&self) -> Option<hstl::runtime::EpisodeEnd> {
+        self.ended.get().then_some(hstl::runtime::EpisodeEnd::Terminated)
     }
 }
 

@@ -43,7 +43,8 @@ def train(
     of the learner starts with ``env.reset(seed=s)``, ``s`` drawn from the one generator;
     a step that is ``terminated`` or ``truncated`` ends the learner's episode there (its
     option and the rest of its ``choices``), and the next episode resets the environment,
-    so ``policy.steps`` counts only the ``env.step`` calls made. The actions of the policy
+    so ``policy.steps`` counts only the ``env.step`` calls made; a ``terminated`` state is
+    valued as one the robot never leaves (a ``truncated`` one as usual). The actions of the policy
     are the environment's (``policy.act`` returns one).
 
     ``progress``: a progress bar on standard error (tqdm's when it is installed); by default

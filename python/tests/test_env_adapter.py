@@ -191,3 +191,47 @@ def test_an_exception_in_the_environment_stops_training_and_is_raised():
 
     with pytest.raises(ValueError, match=r"env.step gave the observation 9, outside Discrete\(6, start=0\)"):
         hstl.train(LINE, env=OffTheLine(), valuation=lambda o: {"s": o})
+
+
+class Cliff(gymnasium.Env):
+    """Cells 0..n-1 on a line, from cell 1: cell 0 is a hole and cell n-1 the goal, both
+    terminal (action 1 moves right, 0 left; no slip). Every step earns robustness below 0
+    on the way, so a learner that valued a terminal state as neutral (its episode over)
+    would jump into the hole rather than walk to the goal."""
+
+    def __init__(self, n=12, limit=None):
+        self.n, self.limit = n, limit
+        self.observation_space = spaces.Discrete(n)
+        self.action_space = spaces.Discrete(2)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.cell, self.t = 1, 0
+        return 1, {}
+
+    def step(self, action):
+        self.t += 1
+        self.cell = min(self.n - 1, max(0, self.cell + (1 if action == 1 else -1)))
+        terminated = self.cell in (0, self.n - 1)
+        truncated = self.limit is not None and self.t >= self.limit
+        return self.cell, 0.0, terminated, truncated and not terminated, {}
+
+
+CLIFF = hstl.Spec.parse(
+    """spec Cliff {
+        state { s: int in 0..=11 }
+        let Goal = s > 10;
+        task eventually[0..40] Goal;
+        option Goal;
+        learn { episodes: 400, choices: 1, max_steps: 40 }
+    }"""
+)
+
+
+def test_a_terminal_state_is_valued_as_one_the_robot_never_leaves():
+    policy = hstl.train(CLIFF, env=Cliff(), valuation=lambda o: {"s": o}, seed=0)
+    q = policy.q_tables["flat"]["Goal"]
+    # Right (1) from every cell on the way: the hole at 0 is worse than the long walk.
+    assert q[1:11].argmax(axis=1).tolist() == [1] * 10, q
+    report = policy.evaluate(starts=3, steps=40, env=Cliff(), valuation=lambda o: {"s": o})
+    assert report["satisfied"] == 3
