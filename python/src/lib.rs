@@ -34,6 +34,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
+    m.add_function(wrap_pyfunction!(spec::formula, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
     m.add_class::<study::_StudyOut>()?;
