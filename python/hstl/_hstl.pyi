@@ -137,6 +137,8 @@ class OnlineMonitor:
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
+#: ``hstl.study`` measures the policy of seed ``s`` as ``policy.evaluate(seed=s ^ EVAL_SEED)``.
+EVAL_SEED: int
 #: The `learn` values `hstl.tune` takes from a config (see `hstl.tune.LEARN_KEYS`).
 LEARN_KEYS: list[str]
 

@@ -64,7 +64,11 @@ def study(
     (per episode, the mean of the last 100 episodes), ``seconds`` (training time),
     ``steps`` (primitive steps) and ``curve`` (reward per episode). The numbers are those
     of ``hstlc study``, bit for bit, whatever the backend (training time excepted); the
-    list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``).
+    list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``). The
+    policy of seed ``s`` (``hstl.train(spec, seed=s)``, the same bit for bit) is measured
+    on the runs of evaluation seed ``s ^ hstl.EVAL_SEED``, so
+    ``policy.evaluate(seed=s ^ hstl.EVAL_SEED)["window_rate"]`` is its ``window_rate``
+    (``policy.evaluate()`` alone uses seed 0, other runs).
 
     ``specs``: spec files' paths or ``hstl.Spec`` objects (one or a list); each is checked
     against ``world`` first (``hstl.SpecError`` with the diagnostics of ``hstlc check

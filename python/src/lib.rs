@@ -45,6 +45,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study::_train_chunks, m)?)?;
     m.add("LEARN_KEYS", hstl::train::LEARN_KEYS.to_vec())?;
     m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
+    m.add("EVAL_SEED", hstl::train::EVAL_SEED)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

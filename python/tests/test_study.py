@@ -250,3 +250,10 @@ def test_tune_trials_report_w_and_w_over_w_star(cluster, tmp_path):
     assert own["training_iteration"] == 2 and own["episodes"] == 10
     assert (own["window_rate"], own["reward"], own["ratio"]) == (row["window_rate"], row["reward"], row["ratio"])
     assert by_alpha[0.6]["window_rate"] != own["window_rate"]
+
+
+def test_a_seed_s_window_rate_is_evaluate_with_its_evaluation_seed(local):
+    row = next(r for r in local if r["spec"] == "Small" and r["seed"] == 5)
+    policy = hstl.train(SMALL, seed=5, episodes=10)
+    report = policy.evaluate(seed=5 ^ hstl.EVAL_SEED, optimum=False)
+    assert report["window_rate"] == row["window_rate"]
