@@ -100,7 +100,7 @@ class GridWorldEnv(gymnasium.Env):
         return np.array(self._cell, dtype=np.int64), {"state": state}
 
     def step(self, action: Any):
-        if self._state is None:
+        if self._state is None or self._generator is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a = int(action)
         if not 0 <= a < 4:
