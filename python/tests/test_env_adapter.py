@@ -235,3 +235,19 @@ def test_a_terminal_state_is_valued_as_one_the_robot_never_leaves():
     assert q[1:11].argmax(axis=1).tolist() == [1] * 10, q
     report = policy.evaluate(starts=3, steps=40, env=Cliff(), valuation=lambda o: {"s": o})
     assert report["satisfied"] == 3
+
+
+def test_the_examples_frozen_lake_spec_comes_within_a_tenth_of_the_optimum():
+    from conftest import REPO
+
+    source = (REPO / "examples" / "python" / "train.py").read_text()
+    # The example's lake spec, valuation and optimum, without its case study.
+    part = source[source.index("LAKE = ") : source.index("frozen = hstl.train")]
+    ns: dict = {"gymnasium": gymnasium, "hstl": hstl}
+    exec(part, ns)
+    best = ns["lake_optimum"](100)
+    assert 0.74 < best < 0.75
+    policy = hstl.train(hstl.Spec.parse(ns["LAKE"]), env=gymnasium.make("FrozenLake-v1"), valuation=ns["cell"], seed=0)
+    report = policy.evaluate(starts=500, steps=100, env=gymnasium.make("FrozenLake-v1"), valuation=ns["cell"])
+    assert report["satisfied"] / 500 >= 0.9 * best
+    assert policy.steps < 2000 * 100, "every counted step is a real one"
