@@ -109,6 +109,91 @@ pub fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loa
     Ok(Loaded { spec, diagnostics: checked.diagnostics })
 }
 
+/// The spec of one formula ([`formula`]): its source and the checked spec.
+#[derive(Clone, Debug)]
+pub struct FormulaSpec {
+    /// The spec text written for it: `spec Formula { state { ... } task FORMULA; }`.
+    pub source: String,
+    /// The checked spec, whose task is the formula.
+    pub loaded: Loaded,
+}
+
+/// The name of the spec [`formula`] writes.
+pub const FORMULA_SPEC: &str = "Formula";
+
+/// A spec whose task is the one formula `text` (`always[0..=10] x > 0.5`), its state
+/// variables every name the formula reads, as `float`s in the order they first appear.
+/// Diagnostics are positioned in `text`. A text that is not one formula (a `;`, `{` or
+/// `}`) or reads no state variable is refused with a diagnostic at its start.
+pub fn formula(text: &str) -> Result<FormulaSpec, LoadError> {
+    let refuse = |message: &str, help: &str| {
+        let mut d = Diagnostic::new("HSTL001", 0..0, message);
+        d.help = Some(help.to_string());
+        LoadError::Invalid(vec![d])
+    };
+    if let Some(c) = text.chars().find(|c| matches!(c, ';' | '{' | '}')) {
+        return Err(refuse(
+            &format!("a formula has no `{c}`: write one formula, such as `always[0..=10] x > 0.5`"),
+            "write a whole spec with `Spec.parse`",
+        ));
+    }
+    // The text on its own line, so that a `//` comment in it ends there.
+    let write = |vars: &[String]| {
+        let state = if vars.is_empty() {
+            "_: float".to_string()
+        } else {
+            vars.iter().map(|v| format!("{v}: float")).collect::<Vec<_>>().join(", ")
+        };
+        let prefix = format!("spec {FORMULA_SPEC} {{ state {{ {state} }} task\n");
+        let source = format!("{prefix}{text}\n;\n}}\n");
+        (prefix.len(), source)
+    };
+    // The names the formula reads are those the checker does not know without them.
+    let (start, probe) = write(&[]);
+    let mut vars: Vec<String> = Vec::new();
+    for d in hstl_lang::check(&probe).diagnostics {
+        let inside = d.range.start >= start && d.range.end <= start + text.len();
+        if d.code == "HSTL002" && inside {
+            let name = probe[d.range.clone()].to_string();
+            if !vars.contains(&name) {
+                vars.push(name);
+            }
+        }
+    }
+    let (start, source) = write(&vars);
+    let shift = |d: Diagnostic| {
+        let at = |i: usize| i.saturating_sub(start).min(text.len());
+        Diagnostic {
+            range: at(d.range.start)..at(d.range.end),
+            labels: d
+                .labels
+                .into_iter()
+                .map(|l| hstl_lang::diagnostic::Label {
+                    range: at(l.range.start)..at(l.range.end),
+                    ..l
+                })
+                .collect(),
+            ..d
+        }
+    };
+    let loaded = match load(&source, Some(FORMULA_SPEC)) {
+        Ok(loaded) => loaded,
+        Err(LoadError::Invalid(ds)) => {
+            return Err(LoadError::Invalid(ds.into_iter().map(shift).collect()));
+        }
+        Err(e) => return Err(e),
+    };
+    if vars.is_empty() {
+        return Err(refuse(
+            "the formula reads no state variable",
+            "name one, such as `x > 0.5`, or write a whole spec with `Spec.parse`",
+        ));
+    }
+    let loaded =
+        Loaded { diagnostics: loaded.diagnostics.into_iter().map(shift).collect(), ..loaded };
+    Ok(FormulaSpec { source, loaded })
+}
+
 /// Every diagnostic of `source` (errors, warnings and notes, in source order), as `hstlc
 /// check` reports them; the specs with options are also checked against `world` (its label
 /// naming it in messages) when one is given.

@@ -249,9 +249,22 @@ pub struct Online {
     inner: OnlineMonitor,
     /// The steps before the states `inner` was given: a restored monitor's.
     offset: usize,
-    /// Every state of the trace, row after row, for a formula with a past-time operator
-    /// (whose verdicts read states the monitor no longer holds): what a snapshot replays.
-    log: Option<Vec<f64>>,
+    /// The last states of the trace, for a formula with a past-time operator (whose
+    /// verdicts read states the monitor no longer holds): what a snapshot replays.
+    log: Option<History>,
+}
+
+/// The states a snapshot of a past-time formula replays: every state from the first whose
+/// values a verdict still to come can read (the formula's lookback before the first open
+/// step), or every state of the trace when that reach is unbounded.
+#[derive(Clone, Debug)]
+struct History {
+    /// States, row after row.
+    states: Vec<f64>,
+    /// The step of the first state in `states`.
+    first: usize,
+    /// How many states to keep; `None`: all.
+    keep: Option<usize>,
 }
 
 /// An online monitor's state as plain data ([`Online::snapshot`]): the states it replays
@@ -509,7 +522,15 @@ impl Monitor {
             nan_prone: self.nan_prone.clone(),
             inner: OnlineMonitor::new(&self.formula, self.vars.len()),
             offset: 0,
-            log: self.formula.has_past().then(Vec::new),
+            log: self.formula.has_past().then(|| History {
+                states: Vec::new(),
+                first: 0,
+                // The first open step is at most `H` back, and reads at most `lookback`
+                // before it.
+                keep: lookback(&self.formula)
+                    .zip(self.formula.horizon())
+                    .map(|(l, h)| l.saturating_add(h).saturating_add(1)),
+            }),
         }
     }
 
@@ -635,11 +656,13 @@ impl Online {
 
     /// The monitor's state as plain data: the states from the first step without a
     /// verdict on (at most `H` for a bounded formula; every state of the trace for an
-    /// unbounded one or one with a past-time operator) and how many steps came before.
-    /// [`Online::restore`] on a monitor of the same formula continues exactly from it.
+    /// unbounded one), or for a formula with a past-time operator also the states before
+    /// it that its past windows read (every state when they are unbounded), and how many
+    /// steps came before. [`Online::restore`] on a monitor of the same formula continues
+    /// exactly from it.
     pub fn snapshot(&self) -> OnlineState {
         if let Some(log) = &self.log {
-            return OnlineState { skipped: 0, states: log.clone() };
+            return OnlineState { skipped: log.first, states: log.states.clone() };
         }
         let columns = self.inner.open_columns();
         let open = columns.first().map_or(0, |c| c.len());
@@ -657,12 +680,16 @@ impl Online {
             return Err(TraceError::Layout { len: state.states.len(), width });
         }
         for row in state.states.chunks(width) {
+            // The verdicts of replayed steps were given before the snapshot.
             if let Err(e) = self.push(row) {
                 self.finish();
                 return Err(e);
             }
         }
         self.offset = state.skipped;
+        if let Some(log) = &mut self.log {
+            log.first = state.skipped;
+        }
         Ok(())
     }
 
@@ -692,7 +719,17 @@ impl Online {
             _ => TraceError::Width { vars: self.vars.clone(), found: state.len() },
         })?;
         if let Some(log) = &mut self.log {
-            log.extend_from_slice(state);
+            log.states.extend_from_slice(state);
+            let width = state.len().max(1);
+            let held = log.states.len() / width;
+            // Drop the oldest states now and then: amortised O(1), at most twice `keep`.
+            if let Some(keep) = log.keep
+                && held >= 2 * keep.max(32)
+            {
+                let drop = held - keep;
+                log.states.drain(..drop * width);
+                log.first += drop;
+            }
         }
         Ok(verdict.map(|v| Verdict { step: v.step + self.offset, ..v }))
     }
@@ -722,10 +759,35 @@ impl Online {
     fn new_trace(&mut self, out: Vec<Verdict>) -> Vec<Verdict> {
         let offset = std::mem::take(&mut self.offset);
         if let Some(log) = &mut self.log {
-            log.clear();
+            log.states.clear();
+            log.first = 0;
         }
         out.into_iter().map(|v| Verdict { step: v.step + offset, ..v }).collect()
     }
+}
+
+/// How many steps before `t` the robustness at `t` may read (`None`: unbounded): a past
+/// window `[a..b]` adds `b`, `prev` one step; a future operator's operands count as they
+/// are.
+fn lookback(f: &rob::Formula) -> Option<usize> {
+    use rob::{Bound, Node};
+    let mut back: Vec<Option<usize>> = Vec::with_capacity(f.nodes().len());
+    for node in f.nodes() {
+        let kids = node.children().try_fold(0usize, |a, k| back[k].map(|b| a.max(b)));
+        let reach = |i: &rob::Interval| match i.end {
+            Bound::Unbounded => None,
+            Bound::Inclusive(b) => Some(b),
+            Bound::Exclusive(b) => Some(b.saturating_sub(1)),
+        };
+        back.push(match node {
+            Node::Historically(i, _) | Node::Once(i, _) | Node::Since(i, _, _) => {
+                kids.zip(reach(i)).map(|(k, b)| k.saturating_add(b))
+            }
+            Node::Prev(_) => kids.map(|k| k.saturating_add(1)),
+            _ => kids,
+        });
+    }
+    back.last().copied().flatten()
 }
 
 impl NanProne {

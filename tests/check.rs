@@ -38,3 +38,38 @@ fn explain_gives_the_long_text_and_names_the_known_codes_otherwise() {
     assert_eq!(e.to_string(), "unknown diagnostic code `HSTL9999`");
     assert!(e.help().starts_with("known codes: HSTL001, "), "{}", e.help());
 }
+
+#[test]
+fn a_formula_alone_is_a_spec_over_the_names_it_reads() {
+    let f =
+        hstl::load::formula("always[0..=10] (x > 0.5 && eventually[0..3] y < speed * 2)").unwrap();
+    let vars: Vec<&str> = f.loaded.spec.state_vars.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(vars, ["x", "y", "speed"]);
+    assert_eq!(f.loaded.spec.name, "Formula");
+    assert!(f.loaded.diagnostics.is_empty(), "{:?}", f.loaded.diagnostics);
+    // The source is a spec that loads again, to the same task.
+    let again = load(&f.source, Some("Formula")).unwrap();
+    assert_eq!(again.spec.state_vars.len(), 3);
+    // A comment at the end does not swallow the rest.
+    assert!(hstl::load::formula("x > 1 // done").is_ok());
+}
+
+#[test]
+fn a_formula_that_does_not_check_is_refused_at_its_own_positions() {
+    let text = "always[0..=10] x >";
+    let Err(hstl::load::LoadError::Invalid(ds)) = hstl::load::formula(text) else {
+        panic!("not refused")
+    };
+    assert!(ds.iter().all(|d| d.range.end <= text.len()), "{ds:?}");
+    assert!(ds.iter().any(|d| d.is_error()));
+    for bad in ["x > 1; y > 2", "spec S { }"] {
+        let Err(hstl::load::LoadError::Invalid(ds)) = hstl::load::formula(bad) else {
+            panic!("{bad} not refused")
+        };
+        assert!(ds[0].message.starts_with("a formula has no `"), "{}", ds[0].message);
+    }
+    let Err(hstl::load::LoadError::Invalid(ds)) = hstl::load::formula("true") else {
+        panic!("not refused")
+    };
+    assert_eq!(ds[0].message, "the formula reads no state variable");
+}

@@ -506,3 +506,52 @@ fn windows_complete_pads_the_undetermined_steps_with_nan_alone_and_in_batches() 
     assert_eq!(e.to_string(), "unknown windows `full`");
     assert!(e.help().contains("\"clipped\""));
 }
+
+#[test]
+fn a_past_time_monitors_snapshot_holds_only_what_its_past_windows_read() {
+    let tasks = [
+        "once[0..=4] (x > 6) && historically[1..=3] (y >= 0)",
+        "always[0..=3] once[2..=5] (x > 6)",
+        "(x > 2) since[0..=6] (y > 7) || prev (x < 3)",
+        "eventually[0..=2] historically[0..=3] (x > 1)",
+        "once[0..] (x > 13)",
+    ];
+    let mut draws = 17u64;
+    let mut next = || {
+        draws = draws.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        ((draws >> 33) % 15) as f64
+    };
+    let x: Vec<f64> = (0..400).map(|_| next()).collect();
+    let y: Vec<f64> = (0..400).map(|_| next()).collect();
+    for task in tasks {
+        let m = case_monitor(task);
+        let mut whole = m.online();
+        let mut want = Vec::new();
+        for t in 0..x.len() {
+            want.extend(whole.push(&[x[t], y[t]]).unwrap());
+        }
+        want.extend(whole.finish());
+        for cut in [0, 1, 5, 63, 64, 65, 200, 399, 400] {
+            let mut first = m.online();
+            let mut got = Vec::new();
+            for t in 0..cut {
+                got.extend(first.push(&[x[t], y[t]]).unwrap());
+            }
+            let snapshot = first.snapshot();
+            if !task.contains("[0..]") {
+                assert!(snapshot.states.len() <= 2 * 64 * 2, "{task}: {}", snapshot.states.len());
+            }
+            // A copy of a copy, so the restored monitor's own snapshot is checked too.
+            let mut back = m.online();
+            back.restore(&snapshot).unwrap();
+            let mut again = m.online();
+            again.restore(&back.snapshot()).unwrap();
+            assert_eq!(again.steps(), cut, "{task}, cut {cut}");
+            for t in cut..x.len() {
+                got.extend(again.push(&[x[t], y[t]]).unwrap());
+            }
+            got.extend(again.finish());
+            assert_eq!(got, want, "{task}, cut {cut}");
+        }
+    }
+}

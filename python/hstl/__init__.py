@@ -11,7 +11,8 @@ worlds for gymnasium, and the hierarchical learner.
 >>> spec.robustness({"x": [0, 2, 4], "y": [1, 1, 1]})
 1.0
 
-``Spec.load(path)`` reads a spec file; ``spec.signal(trace)`` gives the robustness at every
+``hstl.formula("always[0..=10] x > 0.5")`` is a spec of one formula (its state variables
+inferred as floats). ``Spec.load(path)`` reads a spec file; ``spec.signal(trace)`` gives the robustness at every
 step as a numpy array, ``spec.signal_batch(traces)`` many traces' on every core, and
 ``spec.online()`` a monitor fed one state at a time. The values are those of
 ``hstlc monitor``, bit for bit. See ``help(hstl.Spec)``.
@@ -31,11 +32,12 @@ the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a cod
 """
 
 from ._errors import MissingVariableError, PolicyError, SpecError, SpecWarning, WorldError
-from ._hstl import MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain
+from ._hstl import EVAL_SEED, MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain, formula
 from ._study import StudyResult, study
 from ._train import train
 
 __all__ = [
+    "EVAL_SEED",
     "MAX_EPISODES",
     "Diagnostic",
     "MissingVariableError",
@@ -51,6 +53,7 @@ __all__ = [
     "__version__",
     "check",
     "explain",
+    "formula",
     "study",
     "train",
 ]

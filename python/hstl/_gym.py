@@ -3,13 +3,14 @@
 Importing ``hstl`` registers the built-in worlds with gymnasium (when it is installed):
 ``gymnasium.make("hstl/GridWorld-v0")`` is the paper's world and
 ``gymnasium.make("hstl/FourRooms-v0")`` the four rooms, each with
-``max_episode_steps=MAX_EPISODE_STEPS``.
+``max_episode_steps=MAX_EPISODE_STEPS``. Without ``import hstl`` first,
+``gymnasium.make("hstl:hstl/GridWorld-v0")`` imports it (gymnasium's ``module:id`` form).
 """
 
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Union
 
 import gymnasium
 import numpy as np
@@ -99,7 +100,7 @@ class GridWorldEnv(gymnasium.Env):
         return np.array(self._cell, dtype=np.int64), {"state": state}
 
     def step(self, action: Any):
-        if self._state is None:
+        if self._state is None or self._generator is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a = int(action)
         if not 0 <= a < 4:
@@ -183,7 +184,7 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         spec: Union[Spec, str, "os.PathLike[str]"],
         valuation: Valuation = None,
         formula: Optional[str] = None,
-        reward: str = "robustness",
+        reward: Literal["robustness", "increment", "window", "sparse"] = "robustness",
         offset: float = 0.0,
         scale: float = 1.0,
     ) -> None:

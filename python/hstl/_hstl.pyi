@@ -57,6 +57,11 @@ def check(
     against ``world`` too when one is given. A ``str`` with a newline or ``{`` is spec
     text, another ``str`` or an ``os.PathLike`` a path."""
 
+def formula(text: str) -> Spec:
+    """A spec whose task is the one formula ``text`` (``"always[0..=10] x > 0.5"``): its
+    state variables are the names the formula reads, floats in order of appearance; its
+    name ``Formula``, its filename ``<formula>``."""
+
 def explain(code: str) -> str:
     """The long explanation of a diagnostic code (``"HSTL150"``), as ``hstlc explain``
     prints it; ``ValueError`` for an unknown code."""
@@ -70,6 +75,8 @@ class Spec:
     def parse(text: str, filename: str = "<string>", name: Optional[str] = None) -> Spec: ...
     @staticmethod
     def _unpickle(text: str, filename: str, name: Optional[str]) -> Spec: ...
+    @staticmethod
+    def _unpickle_formula(text: str) -> Spec: ...
     @property
     def name(self) -> str: ...
     @property
@@ -130,6 +137,8 @@ class OnlineMonitor:
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
+#: ``hstl.study`` measures the policy of seed ``s`` as ``policy.evaluate(seed=s ^ EVAL_SEED)``.
+EVAL_SEED: int
 #: The `learn` values `hstl.tune` takes from a config (see `hstl.tune.LEARN_KEYS`).
 LEARN_KEYS: list[str]
 

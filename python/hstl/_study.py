@@ -67,7 +67,11 @@ def study(
     W* = 0 (no policy keeps the task: W/W* is undefined), and the summary then has no
     ``ratio`` either. The numbers are those
     of ``hstlc study``, bit for bit, whatever the backend (training time excepted); the
-    list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``).
+    list's ``summary`` holds each spec's mean, sd, min and max (see ``StudyResult``). The
+    policy of seed ``s`` (``hstl.train(spec, seed=s)``, the same bit for bit) is measured
+    on the runs of evaluation seed ``s ^ hstl.EVAL_SEED``, so
+    ``policy.evaluate(seed=s ^ hstl.EVAL_SEED)["window_rate"]`` is its ``window_rate``
+    (``policy.evaluate()`` alone uses seed 0, other runs).
 
     ``specs``: spec files' paths or ``hstl.Spec`` objects (one or a list); each is checked
     against ``world`` first (``hstl.SpecError`` with the diagnostics of ``hstlc check

@@ -41,9 +41,11 @@ def train(
     order; every observation its own values, each in its declared ``int`` range). Every
     step calls back into Python, so it is much slower than a native world. Each episode
     of the learner starts with ``env.reset(seed=s)``, ``s`` drawn from the one generator;
-    after a step that is ``terminated`` or ``truncated`` the learner stays in that state
-    (without calling ``env.step``) until its episode ends. The actions of the policy are the
-    environment's (``policy.act`` returns one).
+    a step that is ``terminated`` or ``truncated`` ends the learner's episode there (its
+    option and the rest of its ``choices``), and the next episode resets the environment,
+    so ``policy.steps`` counts only the ``env.step`` calls made; a ``terminated`` state is
+    valued as one the robot never leaves (a ``truncated`` one as usual). The actions of the policy
+    are the environment's (``policy.act`` returns one).
 
     ``progress``: a progress bar on standard error (tqdm's when it is installed); by default
     only when standard error is a terminal. The GIL is released while the learner runs;

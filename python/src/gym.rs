@@ -4,16 +4,18 @@
 //! The learner (and a replay) only ever steps from the state the environment is in, after
 //! `reset`. Each `reset` seeds the Python environment with a seed drawn from the learner's
 //! one generator, so the same seed gives the same episodes and the same Q-tables whatever
-//! the environment did before. A step that reports `terminated` or `truncated` leaves the
-//! robot there: later steps stay in that state, without calling Python, until the
-//! learner's episode ends and it resets. The first Python exception (in `reset`, `step`,
+//! the environment did before. A step that reports `terminated` or `truncated` ends the
+//! learner's episode there ([`Env::episode_end`]): the next one starts with a reset, so
+//! every step the learner counts is a call of `env.step`; a terminal state is valued as
+//! one the robot stays in, a truncated one as usual. (A replay that steps on leaves
+//! the robot in that state, without calling Python, until it resets.) The first Python exception (in `reset`, `step`,
 //! or a bad observation) stops the run: every later call returns at once, the caller
 //! stops at the end of the episode and raises it.
 
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 
-use hstl::runtime::{Env, Rng, RngExt, TaskSpec, Value, json};
+use hstl::runtime::{Env, EpisodeEnd, Rng, RngExt, TaskSpec, Value, json};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -50,6 +52,8 @@ pub struct PyEnv {
     current: Cell<usize>,
     /// The last step terminated or truncated: stay until the next reset.
     absorbed: Cell<bool>,
+    /// How the last step ended the episode, if it did.
+    end: Cell<Option<EpisodeEnd>>,
     error: RefCell<Option<PyErr>>,
 }
 
@@ -163,6 +167,7 @@ impl PyEnv {
             values,
             current: Cell::new(0),
             absorbed: Cell::new(false),
+            end: Cell::new(None),
             error: RefCell::new(None),
         })
     }
@@ -222,7 +227,7 @@ impl PyEnv {
         })
     }
 
-    fn call_step(&self, action: usize) -> PyResult<(usize, bool)> {
+    fn call_step(&self, action: usize) -> PyResult<(usize, Option<EpisodeEnd>)> {
         Python::attach(|py| {
             let action = self.spaces.action_start + action as i64;
             let out = self.env.bind(py).call_method1("step", (action,))?;
@@ -245,8 +250,14 @@ impl PyEnv {
                 ));
             }
             let next = self.index_of(&five.get_item(0)?, "step")?;
-            let ended = five.get_item(2)?.is_truthy()? || five.get_item(3)?.is_truthy()?;
-            Ok((next, ended))
+            let end = if five.get_item(2)?.is_truthy()? {
+                Some(EpisodeEnd::Terminated)
+            } else if five.get_item(3)?.is_truthy()? {
+                Some(EpisodeEnd::Truncated)
+            } else {
+                None
+            };
+            Ok((next, end))
         })
     }
 }
@@ -302,10 +313,15 @@ impl Env for PyEnv {
             Ok(s) => {
                 self.current.set(s);
                 self.absorbed.set(false);
+                self.end.set(None);
             }
             Err(e) => self.fail(e),
         }
         self.current.get()
+    }
+
+    fn episode_end(&self) -> Option<EpisodeEnd> {
+        self.end.get()
     }
 
     fn step(&self, state: &usize, action: usize, _rng: &mut Rng) -> usize {
@@ -323,9 +339,10 @@ impl Env for PyEnv {
             return *state;
         }
         match self.call_step(action) {
-            Ok((next, ended)) => {
+            Ok((next, end)) => {
                 self.current.set(next);
-                self.absorbed.set(ended);
+                self.absorbed.set(end.is_some());
+                self.end.set(end);
             }
             Err(e) => self.fail(e),
         }

@@ -34,6 +34,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
+    m.add_function(wrap_pyfunction!(spec::formula, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
     m.add_class::<study::_StudyOut>()?;
@@ -44,6 +45,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study::_train_chunks, m)?)?;
     m.add("LEARN_KEYS", hstl::train::LEARN_KEYS.to_vec())?;
     m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
+    m.add("EVAL_SEED", hstl::train::EVAL_SEED)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

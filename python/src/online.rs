@@ -24,7 +24,9 @@ use crate::trace::state_values;
 ///
 /// It pickles and copies mid-trace (for worker processes, `copy.deepcopy`): by its spec,
 /// formula and the states of the steps still open (at most `H`; every state of the trace
-/// for an unbounded formula or one with a past-time operator), which the copy replays.
+/// for an unbounded formula), with the states before them that its past-time operators
+/// read (every state when a past window is unbounded, such as `once[0..]`), which the
+/// copy replays.
 #[pyclass(module = "hstl")]
 pub struct OnlineMonitor {
     inner: Online,

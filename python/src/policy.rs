@@ -451,7 +451,10 @@ impl Policy {
     /// Replays the policy greedily as `hstlc eval` does and returns what it measured.
     ///
     /// `starts` runs of `steps` steps from random starts (the starts and slips drawn from
-    /// one generator seeded with `seed`). For a persistent task the dict holds
+    /// one generator seeded with `seed`). `hstl.study` and `hstlc study` measure the
+    /// policy trained from seed `s` on other runs, those of `seed=s ^ hstl.EVAL_SEED` (with
+    /// the defaults of `starts`, `steps` and `burn_in`): pass that seed to get their
+    /// figures; the default `seed=0` scores every policy on the same runs. For a persistent task the dict holds
     /// `window_rate` (pooled over the runs; the share of steps after `burn_in` whose
     /// windows visit every region), `window_rates` (per run), `baseline` (the hand-written
     /// nearest-cell cycle on the same starts and slips) and, with `optimum=True`,

@@ -30,6 +30,9 @@ pub struct Spec {
     pub(crate) source: String,
     pub(crate) filename: String,
     requested: Option<String>,
+    /// The formula text of a spec made by `hstl.formula` (its diagnostics are positioned
+    /// in it).
+    formula: Option<String>,
     pub(crate) spec: CheckedSpec,
     warnings: Vec<hstl::lang::Diagnostic>,
     /// Lowered monitors by formula name (`None`: the task), made on first use.
@@ -149,8 +152,30 @@ impl Spec {
             source,
             filename,
             requested: name,
+            formula: None,
             spec: loaded.spec,
             warnings: loaded.diagnostics,
+            monitors: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The spec of the one formula `text` (see `hstl.formula`); its warnings are issued
+    /// as `hstl.SpecWarning`s unless `quiet`.
+    pub(crate) fn from_formula(py: Python<'_>, text: String, quiet: bool) -> PyResult<Spec> {
+        let filename = "<formula>".to_string();
+        let made = py
+            .detach(|| hstl::load::formula(&text))
+            .map_err(|e| errors::load_error(py, &filename, &text, e))?;
+        if !quiet {
+            errors::warn_spec(py, &filename, &text, &made.loaded.diagnostics)?;
+        }
+        Ok(Spec {
+            source: made.source,
+            filename,
+            requested: Some(hstl::load::FORMULA_SPEC.to_string()),
+            formula: Some(text),
+            spec: made.loaded.spec,
+            warnings: made.loaded.diagnostics,
             monitors: Mutex::new(HashMap::new()),
         })
     }
@@ -173,6 +198,16 @@ impl Spec {
         monitors.insert(key, Arc::clone(&m));
         Ok(m)
     }
+}
+
+/// A spec whose task is the one formula `text`, such as `"always[0..=10] x > 0.5"`, with
+/// every method of a spec: its state variables are the names the formula reads, as floats
+/// in the order they first appear (`state_vars`); its name is `Formula`, its filename
+/// `<formula>`, and its `source` the spec text written for it. Raises `hstl.SpecError`
+/// (positioned in `text`) when the text is not one formula that checks.
+#[pyfunction]
+pub fn formula(py: Python<'_>, text: String) -> PyResult<Spec> {
+    Spec::from_formula(py, text, false)
 }
 
 /// The `windows=` choice, or a `ValueError` naming both.
@@ -209,6 +244,12 @@ impl Spec {
         name: Option<String>,
     ) -> PyResult<Spec> {
         Spec::from_source(py, text, filename, name, false)
+    }
+
+    /// `hstl.formula` without the warnings: how a spec made from a formula unpickles.
+    #[staticmethod]
+    fn _unpickle_formula(py: Python<'_>, text: String) -> PyResult<Spec> {
+        Spec::from_formula(py, text, true)
     }
 
     /// `parse` without the warnings, which the original already issued: how a spec
@@ -263,7 +304,11 @@ impl Spec {
     /// The file's warnings (a spec with errors does not load), as `hstl.Diagnostic`s.
     #[getter]
     fn diagnostics(&self) -> Vec<Diagnostic> {
-        diagnostics_of(&self.filename, &self.source, &self.warnings)
+        diagnostics_of(
+            &self.filename,
+            self.formula.as_ref().unwrap_or(&self.source),
+            &self.warnings,
+        )
     }
 
     /// The horizon `H` of the task (or of the `let` called `formula`): its value at step
@@ -371,6 +416,10 @@ impl Spec {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let py = slf.py();
         let this = slf.get();
+        if let Some(text) = &this.formula {
+            let args = PyTuple::new(py, [text.clone()])?;
+            return Ok((slf.get_type().getattr("_unpickle_formula")?, args));
+        }
         let parse = slf.get_type().getattr("_unpickle")?;
         let args = PyTuple::new(
             py,

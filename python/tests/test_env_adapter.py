@@ -42,9 +42,11 @@ class Line(gymnasium.Env):
         self.action_space = spaces.Discrete(2, start=10)
         self.steps_after_end = 0
         self.calls = 0
+        self.resets = 0
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
+        self.resets += 1
         self.cell, self.ended = 0, False
         return 0, {}
 
@@ -83,11 +85,13 @@ def test_frozen_lake_trains_deterministically():
     assert a.q_tables["flat"]["Goal"].shape == (16, 4) and np.any(a.q_tables["flat"]["Goal"] != 0)
 
 
-def test_a_terminated_step_absorbs_until_the_learners_episode_ends():
+def test_a_terminated_step_ends_the_learners_episode_and_only_real_steps_count():
     env = Line()
     policy = hstl.train(LINE, env=env, valuation=lambda o: {"s": o}, seed=1)
-    # The learner never stepped past the end: after `terminated` it stayed put.
-    assert env.steps_after_end == 0 and env.calls < policy.steps
+    # The learner never stepped past the end; each of its episodes reset the environment,
+    # and every step it counts is a call of env.step.
+    assert env.steps_after_end == 0 and env.calls == policy.steps
+    assert env.resets == 15
     assert hstl.train(LINE, env=Line(), valuation=lambda o: {"s": o}, seed=1) == policy
     # Actions are the environment's own (Discrete(2, start=10)).
     assert policy.actions == ["10", "11"]
@@ -95,6 +99,36 @@ def test_a_terminated_step_absorbs_until_the_learners_episode_ends():
     assert policy.act(0) in (10, 11) and policy.act({"s": 3}) in (10, 11)
     report = policy.evaluate(starts=4, steps=30, env=Line(), valuation=lambda o: {"s": o})
     assert len(report["robustness"]) == 4 and report["window_rate"] is None
+
+
+class Counted(gymnasium.Wrapper):
+    """Counts the steps and episodes of the environment it wraps, and the steps taken
+    after an episode ended without a reset between."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.steps = self.episodes = self.after_end = 0
+        self.ended = False
+
+    def reset(self, **kwargs):
+        self.episodes += 1
+        self.ended = False
+        return self.env.reset(**kwargs)
+
+    def step(self, action):
+        self.after_end += self.ended
+        self.steps += 1
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.ended = terminated or truncated
+        return obs, reward, terminated, truncated, info
+
+
+def test_frozen_lake_episodes_end_where_gymnasiums_do():
+    env = Counted(gymnasium.make("FrozenLake-v1"))
+    policy = hstl.train(LAKE, env=env, valuation=lake_state, seed=3, episodes=200)
+    assert env.after_end == 0 and env.steps == policy.steps and env.episodes == 200
+    # An episode is at most choices x max_steps = 120 steps, and most end in a hole sooner.
+    assert policy.steps < 200 * 40
 
 
 def test_a_saved_policy_loads_and_needs_its_environment_to_evaluate(tmp_path):
@@ -157,3 +191,63 @@ def test_an_exception_in_the_environment_stops_training_and_is_raised():
 
     with pytest.raises(ValueError, match=r"env.step gave the observation 9, outside Discrete\(6, start=0\)"):
         hstl.train(LINE, env=OffTheLine(), valuation=lambda o: {"s": o})
+
+
+class Cliff(gymnasium.Env):
+    """Cells 0..n-1 on a line, from cell 1: cell 0 is a hole and cell n-1 the goal, both
+    terminal (action 1 moves right, 0 left; no slip). Every step earns robustness below 0
+    on the way, so a learner that valued a terminal state as neutral (its episode over)
+    would jump into the hole rather than walk to the goal."""
+
+    def __init__(self, n=12, limit=None):
+        self.n, self.limit = n, limit
+        self.observation_space = spaces.Discrete(n)
+        self.action_space = spaces.Discrete(2)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.cell, self.t = 1, 0
+        return 1, {}
+
+    def step(self, action):
+        self.t += 1
+        self.cell = min(self.n - 1, max(0, self.cell + (1 if action == 1 else -1)))
+        terminated = self.cell in (0, self.n - 1)
+        truncated = self.limit is not None and self.t >= self.limit
+        return self.cell, 0.0, terminated, truncated and not terminated, {}
+
+
+CLIFF = hstl.Spec.parse(
+    """spec Cliff {
+        state { s: int in 0..=11 }
+        let Goal = s > 10;
+        task eventually[0..40] Goal;
+        option Goal;
+        learn { episodes: 400, choices: 1, max_steps: 40 }
+    }"""
+)
+
+
+def test_a_terminal_state_is_valued_as_one_the_robot_never_leaves():
+    policy = hstl.train(CLIFF, env=Cliff(), valuation=lambda o: {"s": o}, seed=0)
+    q = policy.q_tables["flat"]["Goal"]
+    # Right (1) from every cell on the way: the hole at 0 is worse than the long walk.
+    assert q[1:11].argmax(axis=1).tolist() == [1] * 10, q
+    report = policy.evaluate(starts=3, steps=40, env=Cliff(), valuation=lambda o: {"s": o})
+    assert report["satisfied"] == 3
+
+
+def test_the_examples_frozen_lake_spec_comes_within_a_tenth_of_the_optimum():
+    from conftest import REPO
+
+    source = (REPO / "examples" / "python" / "train.py").read_text()
+    # The example's lake spec, valuation and optimum, without its case study.
+    part = source[source.index("LAKE = ") : source.index("frozen = hstl.train")]
+    ns: dict = {"gymnasium": gymnasium, "hstl": hstl}
+    exec(part, ns)
+    best = ns["lake_optimum"](100)
+    assert 0.74 < best < 0.75
+    policy = hstl.train(hstl.Spec.parse(ns["LAKE"]), env=gymnasium.make("FrozenLake-v1"), valuation=ns["cell"], seed=0)
+    report = policy.evaluate(starts=500, steps=100, env=gymnasium.make("FrozenLake-v1"), valuation=ns["cell"])
+    assert report["satisfied"] / 500 >= 0.9 * best
+    assert policy.steps < 2000 * 100, "every counted step is a real one"

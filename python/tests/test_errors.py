@@ -651,3 +651,32 @@ def test_explain_gives_hstlc_explains_text(hstlc):
     assert text + "\n" == run_cli(hstlc, "explain", "HSTL150").stdout
     with pytest.raises(ValueError, match="unknown diagnostic code `HSTL9`\n  help: known codes: HSTL001, "):
         hstl.explain("HSTL9")
+
+
+def test_a_formula_alone_is_a_spec_with_every_method():
+    spec = hstl.formula("always[0..=2] (x > 0.5 && eventually[0..3] y < speed * 2)")
+    assert spec.state_vars == ["x", "y", "speed"] and spec.name == "Formula" and spec.filename == "<formula>"
+    trace = {"x": [1.0, 2.0, 0.7, 3.0], "y": [0.0, 1.0, 5.0, 1.0], "speed": [1.0, 1.0, 1.0, 1.0]}
+    whole = hstl.Spec.parse(
+        "spec W { state { x: float, y: float, speed: float } "
+        "task always[0..=2] (x > 0.5 && eventually[0..3] y < speed * 2); }"
+    )
+    assert spec.robustness(trace) == whole.robustness(trace)
+    assert spec.signal(trace).tolist() == whole.signal(trace).tolist()
+    online = spec.online()
+    for t in range(4):
+        online.update({k: v[t] for k, v in trace.items()})
+    assert [v for _, v in online.finish()] == whole.signal(trace).tolist()
+    back = pickle.loads(pickle.dumps(spec))
+    assert back == spec and back.state_vars == spec.state_vars
+
+
+def test_a_formula_that_does_not_check_says_where_in_it():
+    with pytest.raises(hstl.SpecError) as e:
+        hstl.formula("always[0..=10] x >")
+    assert str(e.value).startswith("<formula>:1:")
+    assert all(d.file == "<formula>" and d.line == 1 for d in e.value.diagnostics)
+    with pytest.raises(hstl.SpecError, match="a formula has no `;`"):
+        hstl.formula("x > 1; y > 2")
+    with pytest.raises(hstl.SpecError, match="reads no state variable"):
+        hstl.formula("true")

@@ -253,3 +253,12 @@ def test_reward_forms_that_do_not_fit_say_what_to_pick():
         hstl.STLReward(hstl.GridWorldEnv(), REACH, scale=0.0)
     with pytest.raises(ValueError, match="offset must be a finite number; got NaN"):
         hstl.STLReward(hstl.GridWorldEnv(), REACH, offset=float("nan"))
+
+
+def test_gymnasium_imports_hstl_itself_by_the_module_prefix():
+    import subprocess
+    import sys
+
+    code = "import gymnasium; env = gymnasium.make('hstl:hstl/FourRooms-v0'); print(env.unwrapped.world.name)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "four-rooms", out.stderr

@@ -171,3 +171,19 @@ def test_stl_reward_envs_run_in_a_vector_env():
     _, rewards, _, _, infos = envs.step(np.array([0, 3]))
     assert rewards.shape == (2,) and "task_robustness" in infos
     envs.close()
+
+
+def continue_episode(env):
+    return _steps(env, [0, 3, 3, 1, 2])
+
+
+def test_an_stl_reward_env_crosses_to_a_spawned_process_mid_episode():
+    gymnasium = pytest.importorskip("gymnasium")
+    env = hstl.STLReward(
+        gymnasium.make("hstl/GridWorld-v0"), CLI_FIXTURES / "surveillance.hstl", valuation={"x": 0, "y": 1}, reward="window"
+    )
+    env.reset(seed=8)
+    _steps(env, [0, 0, 3])
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        there = pool.map(continue_episode, [env])[0]
+    assert there == continue_episode(env)

@@ -287,3 +287,10 @@ def test_a_users_summary_is_kept_unless_force(tmp_path):
     assert (tmp_path / "summary.csv").read_text() == "mine\n"
     hstl.study(SMALL, seeds=1, episodes=2, optimum=False, out=tmp_path, force=True)
     assert (tmp_path / "summary.csv").read_text().startswith("spec,measure")
+
+
+def test_a_seed_s_window_rate_is_evaluate_with_its_evaluation_seed(local):
+    row = next(r for r in local if r["spec"] == "Small" and r["seed"] == 5)
+    policy = hstl.train(SMALL, seed=5, episodes=10)
+    report = policy.evaluate(seed=5 ^ hstl.EVAL_SEED, optimum=False)
+    assert report["window_rate"] == row["window_rate"]

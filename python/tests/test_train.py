@@ -271,5 +271,5 @@ def test_the_example_script_trains_evaluates_and_runs_in_gymnasium(tmp_path):
     result = subprocess.run(args, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     assert "window rate" in result.stdout and "FrozenLake" in result.stdout
-    assert hstl.Policy.load(out).spec_name == "Surveillance"
+    assert hstl.Policy.load(out).spec_name == "SurveillanceAuto"
     shutil.rmtree(tmp_path)

@@ -83,6 +83,24 @@ pub trait Env {
     /// The state after taking `action` in `state`. An action outside the set leaves the
     /// state unchanged.
     fn step(&self, state: &Self::State, action: usize, rng: &mut Rng) -> Self::State;
+    /// Whether the last [`Env::step`] ended the environment's own episode, and how (a
+    /// gymnasium environment's `terminated` or `truncated`): the learner then ends its
+    /// episode there, and starts the next with [`Env::reset`], so every step it counts is
+    /// one the environment took. A world whose episodes never end (every built-in one)
+    /// keeps the default, `None`.
+    fn episode_end(&self) -> Option<EpisodeEnd> {
+        None
+    }
+}
+
+/// How an environment's episode ended ([`Env::episode_end`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum EpisodeEnd {
+    /// In a terminal state (gymnasium's `terminated`): the robot would stay there, so the
+    /// learner values the state as one it never leaves.
+    Terminated,
+    /// Cut off (gymnasium's `truncated`, a time limit): the state is valued as usual.
+    Truncated,
 }
 
 impl<E: Env> World for E {

@@ -37,6 +37,7 @@ use std::ops::ControlFlow;
 use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
+use crate::env::EpisodeEnd;
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
 use crate::plan_reach::ReachPlanner;
@@ -174,6 +175,8 @@ struct Run {
     obs: Vec<usize>,
     /// `psi` at each position (empty without counters).
     psi: Vec<bool>,
+    /// The environment ended its episode during the option ([`Env::episode_ended`]).
+    ended: bool,
 }
 
 impl<'e, E: Env> Learner<'e, E> {
@@ -366,6 +369,10 @@ impl<'e, E: Env> Learner<'e, E> {
                 self.counterfactual_updates(o, run, rng);
             }
             s = *run.states.last().unwrap_or(&s);
+            if run.ended {
+                // The environment's episode is over: the next episode resets it.
+                break;
+            }
         }
         total
     }
@@ -417,12 +424,20 @@ impl<'e, E: Env> Learner<'e, E> {
         run.leg_starts.clear();
         run.obs.clear();
         run.psi.clear();
+        run.ended = false;
         run.states.push(s);
         run.obs.push(s * values + *code);
         if let Some(m) = memory {
             run.psi.push(m.kept(tau));
         }
-        for &p in &tables.legs[o] {
+        // The discounted count of the steps of a leg spent in one state: `sum gamma^k`
+        // over `k < max_steps`.
+        let stay_factor = if flat.gamma < 1.0 {
+            (1.0 - flat.gamma.powi(max_steps.min(i32::MAX as usize) as i32)) / (1.0 - flat.gamma)
+        } else {
+            max_steps as f64
+        };
+        'legs: for &p in &tables.legs[o] {
             run.leg_starts.push(run.states.len() - 1);
             let term = &tables.term[p];
             for _ in 0..max_steps {
@@ -445,6 +460,9 @@ impl<'e, E: Env> Learner<'e, E> {
                 if let Some((_, model)) = planning {
                     model.record(s, a, next);
                 }
+                let end = env.episode_end();
+                // A terminal state is one the robot would stay in for the rest of the leg.
+                let stay = (end == Some(EpisodeEnd::Terminated)).then_some(stay_factor);
                 update_flat(
                     &mut q.flat,
                     &tables.reach,
@@ -453,6 +471,7 @@ impl<'e, E: Env> Learner<'e, E> {
                     actions,
                     s * actions + a,
                     next,
+                    stay,
                 );
                 run.states.push(next);
                 if let Some(c) = counters {
@@ -462,6 +481,10 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
                 run.obs.push(next * values + *code);
                 s = next;
+                if end.is_some() {
+                    run.ended = true;
+                    break 'legs;
+                }
                 if term[next] {
                     break;
                 }
@@ -647,8 +670,11 @@ fn floor_from(level: &LevelParams) -> Option<u64> {
 /// The flat update of every primitive after the step from cell `cell` (state times
 /// actions plus action) into state `next`: each table bootstraps from its own best value at
 /// `next`, with reward `reach_p[next]`; a primitive whose avoided region holds `next` does
-/// not bootstrap: its reward there is already the whole value of entering.
+/// not bootstrap: its reward there is already the whole value of entering. `stay`: `next`
+/// is a terminal state of the environment, where the robot would stay, each step earning
+/// `reach_p[next]`; its value is that reward times `stay` (the discounted steps left).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn update_flat(
     tables: &mut [Vec<f64>],
     reach: &[Vec<f64>],
@@ -657,10 +683,15 @@ fn update_flat(
     actions: usize,
     cell: usize,
     next: usize,
+    stay: Option<f64>,
 ) {
     for ((q, reach), ends) in tables.iter_mut().zip(reach).zip(ends) {
         let ends = ends.as_ref().is_some_and(|a| a[next]);
-        let best = if ends { 0.0 } else { max_of(&q[next * actions..][..actions]) };
+        let best = match stay {
+            _ if ends => 0.0,
+            Some(stay) => reach[next] * stay,
+            None => max_of(&q[next * actions..][..actions]),
+        };
         let cell = &mut q[cell];
         *cell += flat.alpha * (reach[next] + flat.gamma * best - *cell);
     }

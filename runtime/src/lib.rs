@@ -44,7 +44,7 @@ pub mod spec;
 mod tables;
 pub mod world;
 
-pub use env::{Cell, Env, GridWorld, Tile, World};
+pub use env::{Cell, Env, EpisodeEnd, GridWorld, Tile, World};
 pub use error::Error;
 pub use hstl_robustness as robustness;
 pub use learn::{Learner, QTables, Trained};
