@@ -47,6 +47,32 @@ pub const DEFAULT_STEPS: usize = 2000;
 /// At most this many runs are written by `--runs`.
 pub const MAX_RUN_FILES: usize = 1000;
 
+/// The window rate's line: the rate, its range over the runs, and what a kept step is. A
+/// one-step window (a safety conjunct `always[0..] !S`, the region `!S`) holds at the step.
+fn window_line(
+    rate: f64,
+    (lo, hi): (f64, f64),
+    burn_in: usize,
+    regions: &[hstl::runtime::Region],
+) -> String {
+    let (visits, safe): (Vec<_>, Vec<_>) = regions.iter().partition(|r| r.horizon > 1);
+    let mut what = format!(
+        "whose windows visit {}",
+        visits
+            .iter()
+            .map(|r| format!("{} within {}", r.name, r.horizon))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if !safe.is_empty() {
+        let names: Vec<&str> = safe.iter().map(|r| r.name.as_str()).collect();
+        what.push_str(&format!(" and where {} holds", names.join(" and ")));
+    }
+    format!(
+        "  window rate {rate:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {burn_in}-step burn-in {what}"
+    )
+}
+
 /// A count flag from 1 to `max`.
 fn count(max: usize) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::new().range(1..=max as u64)
@@ -108,16 +134,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         Evaluation::Window { report } => report,
     };
     let Stats { min: lo, max: hi, .. } = Stats::of(&report.per_rollout);
-    outln!(
-        "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
-        report.rate,
-        args.burn_in,
-        spec.regions
-            .iter()
-            .map(|r| format!("{} within {}", r.name, r.horizon))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )?;
+    outln!("{}", window_line(report.rate, (lo, hi), args.burn_in, &spec.regions))?;
     print_robustness(&report.robustness, &report.complete)?;
     let shares: Vec<f64> = report.kept.iter().flatten().copied().collect();
     if !shares.is_empty() {
@@ -190,16 +207,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
     match c::evaluate(&replay, runs)? {
         c::Evaluation::Window(w) => {
             let Stats { min: lo, max: hi, .. } = Stats::of(&w.per_run);
-            outln!(
-                "  window rate {:.4} (runs {lo:.3}-{hi:.3}): share of the steps after a {}-step burn-in whose windows visit {}",
-                w.rate,
-                args.burn_in,
-                spec.regions
-                    .iter()
-                    .map(|r| format!("{} within {}", r.name, r.horizon))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )?;
+            outln!("{}", window_line(w.rate, (lo, hi), args.burn_in, &spec.regions))?;
             let Stats { mean, min: lo, max: hi, .. } = Stats::of(&w.robustness);
             outln!(
                 "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
