@@ -25,7 +25,8 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use hstl_robustness::{StateEval, Trace};
+use hstl_robustness::StateEval;
+use hstl_runtime::approx::task_robustness;
 use hstl_runtime::plane::{PlaneWorld, Point};
 use hstl_runtime::world::AnyWorld;
 use hstl_runtime::{MountainCar, Rng, TaskSpec, Terminate, World, seeded_rng};
@@ -371,15 +372,5 @@ impl Ord for Visit {
 impl PartialOrd for Visit {
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
-    }
-}
-
-/// `rho(task, 0)` over row-major valuations.
-fn task_robustness(spec: &TaskSpec, values: &[f64], vars: usize) -> f64 {
-    let columns =
-        (0..vars).map(|d| values.iter().skip(d).step_by(vars).copied().collect()).collect();
-    match Trace::from_columns(columns) {
-        Ok(trace) => hstl_robustness::offline::robustness(&spec.task, &trace),
-        Err(_) => f64::NAN,
     }
 }

@@ -220,8 +220,8 @@ impl ApproxAgent {
     }
 }
 
-/// `rho(task, 0)` over row-major valuations.
-fn task_robustness(spec: &TaskSpec, values: &[f64], vars: usize) -> f64 {
+/// `rho(task, 0)` over row-major valuations of `vars` variables (NaN for ragged ones).
+pub fn task_robustness(spec: &TaskSpec, values: &[f64], vars: usize) -> f64 {
     let columns =
         (0..vars).map(|d| values.iter().skip(d).step_by(vars).copied().collect()).collect();
     match Trace::from_columns(columns) {
