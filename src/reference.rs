@@ -55,8 +55,8 @@ pub struct Reference {
 enum Legs {
     /// One distance field per primitive option.
     Plane(Vec<Field>),
-    /// Energy pumping.
-    Car,
+    /// Energy pumping; per option, whether its region lies right of the valley's bottom.
+    Car(Vec<bool>),
 }
 
 /// Distances (in world units) to an option's stop region over a lattice.
@@ -82,7 +82,19 @@ impl Reference {
                 let points = (MAX_LATTICE / fields).min(MAX_PLAN_WORK / fields / per_point).max(4);
                 Legs::Plane(spec.primitives.iter().map(|o| Field::plan(p, o, points)).collect())
             }
-            AnyWorld::MountainCar(_) => Legs::Car,
+            AnyWorld::MountainCar(_) => {
+                let mut eval = StateEval::new();
+                let at = |eval: &mut StateEval, r, x| eval.value(r, &[x, 0.0]);
+                Legs::Car(
+                    spec.primitives
+                        .iter()
+                        .map(|o| {
+                            at(&mut eval, &o.reach, MountainCar::MAX_POSITION)
+                                > at(&mut eval, &o.reach, MountainCar::MIN_POSITION)
+                        })
+                        .collect(),
+                )
+            }
             AnyWorld::Grid(_) => {
                 return Err(Problem::new(
                     "the reference is for continuous worlds; a grid has an exact optimum",
@@ -229,11 +241,11 @@ impl Reference {
                 }
                 best.1
             }
-            (Legs::Car, _) => {
+            (Legs::Car(right_side), _) => {
                 // Along the velocity, towards the region at rest, and off the far wall
                 // (the right wall does not stop the car, which would rest against it).
                 let (at, v) = (x[0], x[1]);
-                let right = if self.right_of_centre(p) {
+                let right = if right_side[p] {
                     v >= 0.0 || at <= MountainCar::MIN_POSITION
                 } else {
                     v > 0.0 && at < MountainCar::MAX_POSITION
@@ -242,13 +254,6 @@ impl Reference {
             }
             _ => 0,
         }
-    }
-
-    /// Whether option `p`'s region lies right of the valley's bottom.
-    fn right_of_centre(&self, p: usize) -> bool {
-        let mut eval = StateEval::new();
-        eval.value(&self.spec.primitives[p].reach, &[MountainCar::MAX_POSITION, 0.0])
-            > eval.value(&self.spec.primitives[p].reach, &[MountainCar::MIN_POSITION, 0.0])
     }
 
     /// The states `0..steps` after `burn_in` whose windows all hold, the counters starting

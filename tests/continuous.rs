@@ -30,6 +30,22 @@ const PATROL: &str = "spec Patrol {
 }
 ";
 
+/// Both hill tops of `mountain-car` within every `window` steps, trained `episodes`.
+fn car(window: u32, episodes: u32) -> String {
+    format!(
+        "spec Car {{
+        world \"mountain-car\";
+        state {{ x: float in -1.2..=0.6, v: float in -0.07..=0.07 }}
+        let Left = x < -1.0;
+        let Right = x > 0.4;
+        task always[0..] (eventually[0..{window}] Left && eventually[0..{window}] Right);
+        option Left;
+        option Right;
+        learn {{ preset: auto, episodes: {episodes}, choices: 4 }}
+    }}"
+    )
+}
+
 fn lowered(src: &str, world: &AnyWorld) -> hstl::runtime::TaskSpec {
     let loaded = hstl::load::load(src, None).expect("the spec checks");
     let mut spec = hstl::train::trainable(&loaded.spec, src, "spec.hstl").expect("trainable");
@@ -171,16 +187,7 @@ fn greedy_runs_as_data_have_the_contract_s_columns() {
 #[test]
 fn mountain_car_trains_with_its_own_tiling() {
     let world = AnyWorld::builtin("mountain-car").expect("built in");
-    let src = "spec Car {
-        world \"mountain-car\";
-        state { x: float in -1.2..=0.6, v: float in -0.07..=0.07 }
-        let Left = x < -1.0;
-        let Right = x > 0.4;
-        task always[0..] (eventually[0..200] Left && eventually[0..200] Right);
-        option Left;
-        option Right;
-        learn { preset: auto, episodes: 3, choices: 4 }
-    }";
+    let src = &car(200, 3);
     let spec = lowered(src, &world);
     assert_eq!(spec.learn.tiles.as_ref().map(|t| t.bins.clone()), Some(vec![12, 12]));
     let t = c::train(&spec, &world, 0, |_, _| {}).expect("trains");
@@ -262,16 +269,7 @@ fn plane_pictures_are_named_as_the_grid_s_and_count_blocked_moves() {
 #[test]
 fn mountain_car_pictures_are_drawn_in_the_phase_plane() {
     let world = AnyWorld::builtin("mountain-car").expect("built in");
-    let src = "spec Car {
-        world \"mountain-car\";
-        state { x: float in -1.2..=0.6, v: float in -0.07..=0.07 }
-        let Left = x < -1.0;
-        let Right = x > 0.4;
-        task always[0..] (eventually[0..100] Left && eventually[0..100] Right);
-        option Left;
-        option Right;
-        learn { preset: auto, episodes: 2, choices: 4 }
-    }";
+    let src = &car(100, 2);
     let loaded = hstl::load::load(src, None).expect("the spec checks");
     let spec = lowered(src, &world);
     let t = c::train(&spec, &world, 0, |_, _| {}).expect("trains");
