@@ -181,18 +181,7 @@ impl WorldFacts {
         for (name, _, _) in wanted {
             if !spec.state_vars.iter().any(|v| v.name == name) {
                 fits = false;
-                let at = spec
-                    .state_vars
-                    .first()
-                    .map_or(spec.name_range.clone(), |v| v.name_range.start..v.range.end);
-                push(
-                    Diagnostic::new(
-                        "HSTL030",
-                        at,
-                        format!("the state has no variable `{name}`, which {} needs", self.label),
-                    )
-                    .with_help(help.clone()),
-                );
+                push(missing_variable(spec, name, &self.label, &help));
             }
         }
         if !fits {
@@ -264,19 +253,23 @@ impl BoxFacts {
         }
         for (name, _, _) in &self.vars {
             if !spec.state_vars.iter().any(|v| &v.name == name) {
-                let at = spec
-                    .state_vars
-                    .first()
-                    .map_or(spec.name_range.clone(), |v| v.name_range.start..v.range.end);
-                push(
-                    Diagnostic::new(
-                        "HSTL030",
-                        at,
-                        format!("the state has no variable `{name}`, which {} needs", self.label),
-                    )
-                    .with_help(help.clone()),
-                );
+                push(missing_variable(spec, name, &self.label, &help));
             }
         }
     }
+}
+
+/// `HSTL030` for a variable `name` that the world `label` needs and the spec's state lacks,
+/// at the state's variables (or the spec's name when it has none).
+fn missing_variable(spec: &CheckedSpec, name: &str, label: &str, help: &str) -> Diagnostic {
+    let at = spec
+        .state_vars
+        .first()
+        .map_or(spec.name_range.clone(), |v| v.name_range.start..v.range.end);
+    Diagnostic::new(
+        "HSTL030",
+        at,
+        format!("the state has no variable `{name}`, which {label} needs"),
+    )
+    .with_help(help.to_string())
 }
