@@ -526,8 +526,14 @@ pub fn plane_pictures(
     // The options policy, one map per memory slice.
     let names: Vec<String> = spec.options.iter().map(|o| o.name.clone()).collect();
     let horizons: Vec<usize> = m.horizons().collect();
-    let slices: Vec<(String, Vec<usize>)> = if m.buckets == 0 || horizons.is_empty() {
-        vec![(String::new(), horizons.clone())]
+    let slices: Vec<(String, Vec<usize>, usize)> = if let Some(progress) = &m.progress {
+        // A task with goals: before any is met, and once every one is.
+        vec![
+            ("before the goal".to_string(), horizons.clone(), 0),
+            ("once the goal is met".to_string(), horizons.clone(), progress.all_met()),
+        ]
+    } else if m.buckets == 0 || horizons.is_empty() {
+        vec![(String::new(), horizons.clone(), 0)]
     } else {
         spec.regions
             .iter()
@@ -535,14 +541,14 @@ pub fn plane_pictures(
             .map(|(j, r)| {
                 let mut tau = horizons.clone();
                 tau[j] = 1;
-                (format!("one step after {}", r.name), tau)
+                (format!("one step after {}", r.name), tau, 0)
             })
             .collect()
     };
     let (mut g, mut available) = (Vec::new(), Vec::new());
     let mut maps = Vec::with_capacity(slices.len());
-    for (label, tau) in &slices {
-        let code = m.code(tau);
+    for (label, tau, met) in &slices {
+        let code = m.code(tau, *met);
         let choices = pic::Raster::from_fn(columns, rows, |i, j| {
             let (x, y) = plane.centre(columns, rows, i, j);
             m.available(&mut eval, &[x, y], &mut available);
@@ -552,8 +558,11 @@ pub fn plane_pictures(
         .map_err(picture_error)?;
         maps.push(pic::PlaneSlice { label: label.clone(), choices });
     }
-    let what =
-        if maps.len() > 1 { "options policy by memory (others overdue)" } else { "options policy" };
+    let what = match (maps.len(), &m.progress) {
+        (1, _) => "options policy",
+        (_, Some(_)) => "options policy before and after the goal",
+        _ => "options policy by memory (others overdue)",
+    };
     let svg =
         pic::plane_options_policy(&plane, &title(what), &maps, &names).map_err(picture_error)?;
     out.push(OutFile::text("options.svg", svg));

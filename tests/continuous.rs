@@ -338,3 +338,59 @@ fn a_crowded_plane_plans_on_a_coarser_lattice_within_its_budget() {
     assert_eq!(values.len(), 51 * 2);
     assert!(values.chunks(2).any(|p| p != &values[..2]), "the robot never moved");
 }
+
+/// Reach A, then B, then C, each within 16 steps, never touching O over 150 steps: the
+/// goal is met in about 40, and the rest of the run must keep out of O. Exploration decays
+/// within the short training, so that its runs meet the goal too.
+const TIMED: &str = "spec Timed {
+    state { x: float in 0..=10, y: float in 0..=10 }
+    let A = x > 9 && y < 1;
+    let B = x > 9 && y > 9;
+    let C = x < 1 && y > 9;
+    let O = sqrt((x - 5) * (x - 5) + (y - 5) * (y - 5)) < 2;
+    task eventually[0..16] (A && eventually[0..16] (B && eventually[0..16] C)) && always[0..150] !O;
+    option A;
+    option B;
+    option C;
+    options { [A, B, C], C }
+    learn { preset: auto, episodes: 1000, flat: { gamma: 0.9, decay: 0.00001 } }
+}
+";
+
+#[test]
+fn once_the_goal_is_met_the_options_level_holds_instead_of_starting_again() {
+    let toml = "kind = \"plane\"\nx = [0.0, 10.0]\ny = [0.0, 10.0]\nstep = 1.0\nheadings = 8\n\
+                slip = 0.05\nnoise = 0.05\nstart = [0.0, 0.0, 1.0, 1.0]\n";
+    let world = AnyWorld::from_toml(toml, "field").expect("a valid world");
+    let spec = lowered(TIMED, &world);
+    let t = c::train(&spec, &world, 1, |_, _| {}).expect("trains");
+    let m = &t.agent.model;
+    assert_eq!(m.progress.as_ref().map(|p| p.goals()), Some(1), "the sequence is the goal");
+    let replay = c::Replay {
+        spec: spec.clone(),
+        world: world.clone(),
+        agent: t.agent.clone(),
+        source: String::new(),
+        seed: Some(1),
+    };
+    let (mut after, mut holding, mut satisfied) = (0, 0, 0);
+    let runs = c::greedy_runs(&replay, 50, 150, 5);
+    for run in &runs {
+        let at = |s: usize| &run.values[s * 2..s * 2 + 2];
+        let inside = |s: usize, f: fn(f64, f64) -> bool| f(at(s)[0], at(s)[1]);
+        let a = (0..=150).find(|&s| inside(s, |x, y| x > 9.0 && y < 1.0));
+        let b = a.and_then(|a| (a..=150).find(|&s| inside(s, |x, y| x > 9.0 && y > 9.0)));
+        let met = b.and_then(|b| (b..=150).find(|&s| inside(s, |x, y| x < 1.0 && y > 9.0)));
+        if let Some(met) = met {
+            after += run.options.len() - met;
+            holding += run.options[met..].iter().filter(|&&o| o == 1).count();
+        }
+        if hstl::runtime::approx::task_robustness(&spec, &run.values, 2) > 0.0 {
+            satisfied += 1;
+        }
+    }
+    // Starting [A, B, C] again from C crosses the field past O; C alone stays put.
+    assert!(after > 0, "no run met the goal");
+    assert!(holding as f64 >= 0.9 * after as f64, "{holding} of {after} steps held");
+    assert!(satisfied >= 45, "{satisfied} of 50 runs satisfied the task");
+}

@@ -2,11 +2,12 @@
 //! data, the window rate of a persistent task and the satisfaction rate of another, on any
 //! [`World`].
 //!
-//! A greedy run chooses the best available option (its memory code included), runs each
-//! of its legs with the leg's greedy action until the leg stops or `max_steps` pass, then
-//! chooses again; with `switch: step` the options policy's pick at every step replaces a
+//! A greedy run chooses the best available option (its memory code and the goals met
+//! included, the goals read where a leg ends, as in training), runs each of its legs with
+//! the leg's greedy action until the leg stops or `max_steps` pass, then chooses again; with `switch: step` the options policy's pick at every step replaces a
 //! running option of strictly lower value, as the tabular agent does.
 
+use hstl_robustness::offline::Evaluator;
 use hstl_robustness::{StateEval, Trace};
 
 use super::learn::{Model, Weights};
@@ -53,6 +54,12 @@ pub struct WindowSummary {
 struct Cursor {
     running: Option<(usize, usize, usize)>,
     tau: Vec<usize>,
+    /// The goals met so far and those given up; the run so far, one column per variable
+    /// (for a task with goals).
+    met: usize,
+    given_up: usize,
+    prefix: Vec<Vec<f64>>,
+    prefix_eval: Evaluator,
     f: Vec<usize>,
     g: Vec<usize>,
     q: Vec<f64>,
@@ -93,13 +100,15 @@ impl ApproxAgent {
         let mut x = Vec::with_capacity(vars);
         world.valuation(&state, &mut x);
         self.model.start_counters(&mut eval, &x, &mut cur.tau);
+        self.record(&mut cur, &x, true);
         out.values.extend_from_slice(&x);
         for _ in 0..steps {
             self.model.blocked(world, &state, &mut cur.blocked);
             let (action, option) = self.act(&mut eval, &mut cur, &x);
             state = world.step(&state, action, rng);
             world.valuation(&state, &mut x);
-            self.observe(&mut eval, &mut cur, &x);
+            let leg_ended = self.observe(&mut eval, &mut cur, &x);
+            self.record(&mut cur, &x, leg_ended);
             out.values.extend_from_slice(&x);
             out.actions.push(action);
             out.options.push(option);
@@ -112,7 +121,7 @@ impl ApproxAgent {
         let pick = |cur: &mut Cursor, eval: &mut StateEval| {
             m.available(eval, x, &mut cur.available);
             m.options_coder.features(x, &mut cur.g);
-            let code = m.code(&cur.tau);
+            let code = m.code(&cur.tau, cur.met);
             (m.best_option(&self.weights, code, &cur.g, &cur.available), code)
         };
         if self.switch == Switch::Step
@@ -137,18 +146,35 @@ impl ApproxAgent {
         (m.greedy_action(&self.weights, p, &cur.f, &cur.blocked, &mut cur.q), o)
     }
 
-    fn observe(&self, eval: &mut StateEval, cur: &mut Cursor, next: &[f64]) {
+    /// Moves the memory and the running option on to `next`; returns whether a leg ended.
+    fn observe(&self, eval: &mut StateEval, cur: &mut Cursor, next: &[f64]) -> bool {
         let m = &self.model;
         if m.is_persistent() {
             m.step_counters(eval, next, &mut cur.tau);
         }
-        let Some((o, leg, steps)) = cur.running else { return };
+        let Some((o, leg, steps)) = cur.running else { return false };
         let done = m.stops(eval, m.legs[o][leg], next);
-        cur.running = if done || steps + 1 >= m.max_steps {
+        let ended = done || steps + 1 >= m.max_steps;
+        cur.running = if ended {
             (leg + 1 < m.legs[o].len()).then_some((o, leg + 1, 0))
         } else {
             Some((o, leg, steps + 1))
         };
+        ended
+    }
+
+    /// Appends `x` to the run so far and, where a leg ended (or the run starts), adds the
+    /// goals met to `cur.met`.
+    fn record(&self, cur: &mut Cursor, x: &[f64], leg_ended: bool) {
+        let Some(progress) = &self.model.progress else { return };
+        cur.prefix.resize_with(x.len(), Vec::new);
+        for (column, &v) in cur.prefix.iter_mut().zip(x) {
+            column.push(v);
+        }
+        if leg_ended {
+            let columns: Vec<&[f64]> = cur.prefix.iter().map(Vec::as_slice).collect();
+            cur.met = progress.update(cur.met, &columns, &mut cur.prefix_eval, &mut cur.given_up);
+        }
     }
 
     /// The window rate over `runs` greedy runs of `steps` actions from the world's starts,

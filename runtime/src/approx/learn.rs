@@ -20,16 +20,23 @@
 //! reward plus `gamma^(k-j) max_{o' available at s_k} Q(obs_k, o')`, all bootstrapping from
 //! the values before this execution's updates, as the tabular learner does.
 //!
+//! **Progress.** For a task that is not persistent, the code also holds which of its
+//! goals the episode has met ([`Progress`]), read where a leg ends, and an execution is
+//! scored against the conjuncts still open: after `eventually (A && eventually B) &&
+//! always !O` is met, only `always !O` is left to keep.
+//!
 //! Exploration, episodes, `max_steps`, `reward: window` and `switch: step` (in the greedy
 //! agent) are the tabular learner's. Nothing here names a state index or a table: states
 //! are the world's own values, seen through [`World::valuation`].
 
 use std::ops::ControlFlow;
 
+use hstl_robustness::offline::Evaluator;
 use hstl_robustness::segment::SegmentScorer;
 use hstl_robustness::{Formula, StateEval, Trace};
 use rand::RngExt;
 
+use super::progress::Progress;
 use super::tiles::TileCoder;
 use crate::spec::{LevelParams, RewardKind, Terminate, TileParams};
 use crate::{Error, Rng, TaskSpec, World};
@@ -81,7 +88,10 @@ pub struct Model {
     regions: Vec<(Formula, usize)>,
     /// Memory buckets `B` (0: the options level sees no memory).
     pub buckets: usize,
-    /// Memory codes `(B + 1)^k` (1 without memory).
+    /// The goals of a task that is not persistent, if it has any.
+    pub progress: Option<Progress>,
+    /// Codes the options level tells apart: `(B + 1)^k` memory codes (1 without memory)
+    /// times `2^goals` progress codes.
     pub values: usize,
     /// Steps after which a leg is cut off.
     pub max_steps: usize,
@@ -151,11 +161,14 @@ impl Model {
             ));
         }
         let buckets = spec.learn.memory;
-        let values = if buckets == 0 {
+        let progress = if persistent { None } else { Progress::of_task(&spec.task) };
+        let memory_values = if buckets == 0 {
             Some(1)
         } else {
             u32::try_from(regions.len()).ok().and_then(|k| (buckets + 1).checked_pow(k))
         };
+        let values =
+            memory_values.and_then(|v| v.checked_mul(progress.as_ref().map_or(1, Progress::codes)));
         let legs: Vec<Vec<usize>> = spec.options.iter().map(|o| o.sequence.clone()).collect();
         let total = values.and_then(|v| {
             let flat = flat_coder.len().checked_mul(actions)?.checked_mul(reach.len())?;
@@ -189,6 +202,7 @@ impl Model {
             legs,
             regions,
             buckets,
+            progress,
             values,
             max_steps: spec.learn.max_steps,
         })
@@ -294,16 +308,19 @@ impl Model {
         kept
     }
 
-    /// The memory code of the counters (0 without buckets).
-    pub fn code(&self, tau: &[usize]) -> usize {
+    /// The options level's code of the counters `tau` and the goals met `met` (a
+    /// [`Progress`] mask; 0 for a task without goals).
+    pub fn code(&self, tau: &[usize], met: usize) -> usize {
+        let progress = self.progress.as_ref().map_or(1, Progress::codes);
         if self.buckets == 0 {
-            return 0;
+            return met;
         }
         let b = self.buckets;
-        tau.iter().zip(&self.regions).fold(0, |code, (&t, (_, n))| {
+        let memory = tau.iter().zip(&self.regions).fold(0, |code, (&t, (_, n))| {
             let bucket = if t >= *n { b } else { t * b / n };
             code * (b + 1) + bucket
-        })
+        });
+        memory * progress + met
     }
 
     /// `Q_p(x, a)` for every action, from the features `f` of `x`, into `out`.
@@ -414,8 +431,11 @@ pub struct ApproxLearner<'w, W: World> {
     spec: TaskSpec,
     model: Model,
     weights: Weights,
-    scorer: Option<SegmentScorer>,
+    /// `reward: segment`'s scorers, one per progress code (the whole task at 0; `None`
+    /// where nothing is left to keep); empty for `reward: window`.
+    scorers: Vec<Option<SegmentScorer>>,
     eval: StateEval,
+    prefix_eval: Evaluator,
     gamma_powers: Vec<f64>,
 }
 
@@ -432,6 +452,8 @@ struct Run<S> {
     codes: Vec<usize>,
     /// `psi` at each position (empty for a task without counters).
     psi: Vec<bool>,
+    /// The goals met at each position.
+    met: Vec<usize>,
 }
 
 impl<'w, W: World> ApproxLearner<'w, W> {
@@ -440,17 +462,19 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         spec.validate()?;
         let model = Model::new(spec, world)?;
         let weights = model.zero_weights();
-        let scorer = match spec.learn.reward {
-            RewardKind::Segment => Some(SegmentScorer::new(&spec.task)),
-            RewardKind::Window => None,
+        let scorers = match (spec.learn.reward, &model.progress) {
+            (RewardKind::Window, _) => Vec::new(),
+            (RewardKind::Segment, Some(progress)) => progress.scorers(),
+            (RewardKind::Segment, None) => vec![Some(SegmentScorer::new(&spec.task))],
         };
         Ok(ApproxLearner {
             world,
             spec: spec.clone(),
             model,
             weights,
-            scorer,
+            scorers,
             eval: StateEval::new(),
+            prefix_eval: Evaluator::new(),
             gamma_powers: vec![1.0],
         })
     }
@@ -513,13 +537,34 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         let mut state = self.world.reset(rng);
         self.world.valuation(&state, &mut s.x);
         self.model.start_counters(&mut self.eval, &s.x, &mut s.tau);
+        (s.met, s.given_up) = (0, 0);
+        if self.model.progress.is_some() {
+            s.prefix.resize_with(s.x.len(), Vec::new);
+            for (column, &v) in s.prefix.iter_mut().zip(&s.x) {
+                column.clear();
+                column.push(v);
+            }
+            self.update_progress(s);
+        }
         let mut total = 0.0;
-        for _ in 0..self.spec.learn.choices {
+        // Once every goal is met, the episode goes on to the task's horizon, as a greedy
+        // run does: the options level learns to keep the rest where the run then is.
+        let hold = match &self.model.progress {
+            Some(p) => self.spec.task.horizon().map(|h| (p.all_met(), h)),
+            None => None,
+        };
+        let mut steps = 0;
+        for choice in 0.. {
+            let holding = hold.is_some_and(|(all, h)| s.met == all && steps < h);
+            if choice >= self.spec.learn.choices && !holding {
+                break;
+            }
             let o = self.choose_option(rng, s);
             self.run_option(o, &state, rng, run, s);
-            self.suffix_rewards(run, &mut s.rewards);
+            self.suffix_rewards(run, &mut s.rewards, &mut s.other_rewards);
             total += s.rewards[0];
             self.update_options(o, run, s);
+            steps += run.states.len() - 1;
             state = run.states.last().cloned().unwrap_or(state);
             let vars = self.model.vars.len();
             s.x.clear();
@@ -536,8 +581,16 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             return s.available[rng.random_range(0..s.available.len())];
         }
         self.model.options_coder.features(&s.x, &mut s.g);
-        let code = self.model.code(&s.tau);
+        let code = self.model.code(&s.tau, s.met);
         self.model.best_option(&self.weights, code, &s.g, &s.available)
+    }
+
+    /// Adds the goals the episode so far meets to `s.met`.
+    fn update_progress(&mut self, s: &mut Scratch) {
+        if let Some(progress) = &self.model.progress {
+            let columns: Vec<&[f64]> = s.prefix.iter().map(Vec::as_slice).collect();
+            s.met = progress.update(s.met, &columns, &mut self.prefix_eval, &mut s.given_up);
+        }
     }
 
     fn run_option(
@@ -556,13 +609,15 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         run.options_features.clear();
         run.codes.clear();
         run.psi.clear();
+        run.met.clear();
         let mut state = start.clone();
         model.blocked(self.world, &state, &mut s.blocked);
         run.states.push(state.clone());
         run.values.extend_from_slice(&s.x);
         model.options_coder.features(&s.x, &mut s.g);
         run.options_features.extend_from_slice(&s.g);
-        run.codes.push(model.code(&s.tau));
+        run.codes.push(model.code(&s.tau, s.met));
+        run.met.push(s.met);
         if model.is_persistent() {
             run.psi.push(s.tau.iter().zip(&model.regions).all(|(t, (_, n))| t < n));
         }
@@ -595,7 +650,13 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 run.values.extend_from_slice(&s.x_next);
                 model.options_coder.features(&s.x_next, &mut s.g);
                 run.options_features.extend_from_slice(&s.g);
-                run.codes.push(model.code(&s.tau));
+                run.codes.push(model.code(&s.tau, s.met));
+                run.met.push(s.met);
+                if model.progress.is_some() {
+                    for (column, &v) in s.prefix.iter_mut().zip(&s.x_next) {
+                        column.push(v);
+                    }
+                }
                 state = next;
                 std::mem::swap(&mut s.f, &mut s.f_next);
                 std::mem::swap(&mut s.x, &mut s.x_next);
@@ -605,35 +666,56 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                     break;
                 }
             }
+            // A leg ends where a goal's region is entered: the code from here on says so.
+            if let Some(progress) = &model.progress {
+                let columns: Vec<&[f64]> = s.prefix.iter().map(Vec::as_slice).collect();
+                s.met = progress.update(s.met, &columns, &mut self.prefix_eval, &mut s.given_up);
+                if let (Some(m), Some(c)) = (run.met.last_mut(), run.codes.last_mut()) {
+                    (*m, *c) = (s.met, model.code(&s.tau, s.met));
+                }
+            }
         }
         debug_assert_eq!(run.values.len(), run.states.len() * vars);
     }
 
-    /// `out[j]`: the reward of the suffix of `run` from position `j`.
-    fn suffix_rewards(&mut self, run: &Run<W::State>, out: &mut Vec<f64>) {
+    /// `out[j]`: the reward of the suffix of `run` from position `j`, scored against what
+    /// is left of the task at `j` (`other` is a buffer).
+    fn suffix_rewards(&mut self, run: &Run<W::State>, out: &mut Vec<f64>, other: &mut Vec<f64>) {
         let k = run.states.len() - 1;
-        match &mut self.scorer {
-            Some(scorer) => {
-                let vars = self.model.vars.len();
-                let columns = (0..vars)
-                    .map(|d| run.values.iter().skip(d).step_by(vars).copied().collect())
-                    .collect();
-                match Trace::from_columns(columns) {
-                    Ok(trace) => scorer.suffix_rewards(&trace, out),
-                    Err(_) => {
-                        out.clear();
-                        out.resize(k + 1, 0.0);
-                    }
-                }
+        if self.scorers.is_empty() {
+            let gamma = self.spec.learn.options.gamma;
+            out.clear();
+            out.resize(k + 1, 0.0);
+            for j in (0..k).rev() {
+                out[j] = f64::from(u8::from(run.psi[j + 1])) + gamma * out[j + 1];
             }
-            None => {
-                let gamma = self.spec.learn.options.gamma;
-                out.clear();
-                out.resize(k + 1, 0.0);
-                for j in (0..k).rev() {
-                    out[j] = f64::from(u8::from(run.psi[j + 1])) + gamma * out[j + 1];
-                }
+            return;
+        }
+        let vars = self.model.vars.len();
+        let columns =
+            (0..vars).map(|d| run.values.iter().skip(d).step_by(vars).copied().collect()).collect();
+        let Ok(trace) = Trace::from_columns(columns) else {
+            out.clear();
+            out.resize(k + 1, 0.0);
+            return;
+        };
+        let mut score = |met: usize, into: &mut Vec<f64>| match self.scorers.get_mut(met) {
+            Some(Some(scorer)) => scorer.suffix_rewards(&trace, into),
+            _ => {
+                into.clear();
+                into.resize(k + 1, 0.0);
             }
+        };
+        let first = run.met.first().copied().unwrap_or(0);
+        score(first, out);
+        // Goals met along the run: the positions after score against the rest.
+        let mut j = 0;
+        while let Some(offset) = run.met[j..].iter().position(|&m| m != run.met[j]) {
+            j += offset;
+            let met = run.met[j];
+            score(met, other);
+            let until = run.met[j..].iter().position(|&m| m != met).map_or(k + 1, |e| j + e);
+            out[j..until].copy_from_slice(&other[j..until]);
         }
     }
 
@@ -677,6 +759,7 @@ impl<S> Default for Run<S> {
             options_features: Vec::new(),
             codes: Vec::new(),
             psi: Vec::new(),
+            met: Vec::new(),
         }
     }
 }
@@ -699,6 +782,13 @@ struct Scratch {
     tau: Vec<usize>,
     available: Vec<usize>,
     rewards: Vec<f64>,
+    /// The suffix rewards under another progress code.
+    other_rewards: Vec<f64>,
+    /// The goals met so far, and those given up (their horizon passed).
+    met: usize,
+    given_up: usize,
+    /// The episode so far, one column per variable (for a task with goals).
+    prefix: Vec<Vec<f64>>,
 }
 
 /// The flat update of every primitive after the step `x -a-> x_next` (features `f`,

@@ -1,0 +1,193 @@
+//! Task progress: which goals of a task that is not persistent an episode has already met.
+//!
+//! A task such as `eventually[0..k] (A && eventually[0..k] (B && ...)) && always[0..T] !O`
+//! is judged on the whole run from step 0. Once the run has met its goal (the first
+//! conjunct), the options level must still keep the rest (stay out of `O`) for the
+//! remaining steps; scored against the whole task, every later option execution looks
+//! alike (none of them reaches `A` from where the run now is), and the learned choice is to
+//! start the sequence again, through `O`. So the options level sees, beside the state,
+//! which goals are met, and an execution is scored against the conjuncts still open.
+//!
+//! A *goal* is a top-level conjunct of the task that, once a prefix of the run satisfies
+//! it, every longer run satisfies: made of state formulas, `&&`, `||` and `eventually`
+//! (windows clipped at the end of the prefix, so a longer prefix can only raise its
+//! robustness), with at least one `eventually`. Goals are checked where a leg of an option
+//! ends (a goal's regions are entered there), reading at most the goal's horizon.
+
+use hstl_robustness::offline::Evaluator;
+use hstl_robustness::segment::SegmentScorer;
+use hstl_robustness::{Formula, Node, NodeId};
+
+/// At most this many goals are tracked (the options level's weights double with each).
+pub const MAX_GOALS: usize = 4;
+
+/// The goals of a task and the rest of the task once some are met.
+#[derive(Clone, Debug)]
+pub struct Progress {
+    /// The goals, in conjunct order, each with its horizon (`None`: unbounded).
+    goals: Vec<(Formula, Option<usize>)>,
+    /// `rest[mask]`: the task's conjuncts other than the goals in `mask`, or `None` when
+    /// nothing is left to keep.
+    rest: Vec<Option<Formula>>,
+}
+
+impl Progress {
+    /// The progress of `task`, or `None` when it has no goal (a persistent task, a state
+    /// formula, a task whose conjuncts can still fail once met). At most [`MAX_GOALS`]
+    /// goals, the first in conjunct order; the others stay in the rest.
+    pub fn of_task(task: &Formula) -> Option<Progress> {
+        let parts: Vec<NodeId> = match task.root_node() {
+            Node::And(parts) => parts.clone(),
+            _ => vec![task.root()],
+        };
+        let mut goals = Vec::new();
+        let mut others = Vec::new();
+        for &p in &parts {
+            if goals.len() < MAX_GOALS && is_goal(task, p) {
+                goals.push((task.sub(p), task.horizon_of(p)));
+            } else {
+                others.push(task.sub(p));
+            }
+        }
+        if goals.is_empty() {
+            return None;
+        }
+        let rest = (0..1usize << goals.len())
+            .map(|mask| {
+                if mask == 0 {
+                    return Some(task.clone());
+                }
+                let open: Vec<Formula> = goals
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| mask & (1 << j) == 0)
+                    .map(|(_, (g, _))| g.clone())
+                    .chain(others.iter().cloned())
+                    .collect();
+                match open.len() {
+                    0 => None,
+                    1 => open.into_iter().next(),
+                    _ => Some(Formula::and(open)),
+                }
+            })
+            .collect();
+        Some(Progress { goals, rest })
+    }
+
+    /// The number of goals.
+    pub fn goals(&self) -> usize {
+        self.goals.len()
+    }
+
+    /// The number of progress codes, `2^goals`.
+    pub fn codes(&self) -> usize {
+        1 << self.goals.len()
+    }
+
+    /// The code with every goal met.
+    pub fn all_met(&self) -> usize {
+        self.codes() - 1
+    }
+
+    /// What is left of the task once the goals in `mask` are met (`None`: nothing).
+    pub fn rest(&self, mask: usize) -> Option<&Formula> {
+        self.rest.get(mask).and_then(Option::as_ref)
+    }
+
+    /// A segment scorer for each progress code.
+    pub fn scorers(&self) -> Vec<Option<SegmentScorer>> {
+        self.rest.iter().map(|r| r.as_ref().map(SegmentScorer::new)).collect()
+    }
+
+    /// `mask` with every goal the prefix `columns` (one column per variable, `len` samples)
+    /// meets added. A goal whose horizon the prefix has passed without meeting it stays
+    /// unmet for good, so it is not read again.
+    pub fn update(
+        &self,
+        mask: usize,
+        columns: &[&[f64]],
+        eval: &mut Evaluator,
+        checked: &mut usize,
+    ) -> usize {
+        let len = columns.first().map_or(0, |c| c.len());
+        let mut mask = mask;
+        for (j, (goal, horizon)) in self.goals.iter().enumerate() {
+            let bit = 1 << j;
+            if mask & bit != 0 || *checked & bit != 0 {
+                continue;
+            }
+            if eval.robustness_of_slices(goal, columns).is_ok_and(|v| v > 0.0) {
+                mask |= bit;
+            } else if horizon.is_some_and(|h| len > h) {
+                *checked |= bit;
+            }
+        }
+        mask
+    }
+}
+
+/// Whether the conjunct at `at` is a goal: monotone in the prefix, with an `eventually`.
+fn is_goal(task: &Formula, at: NodeId) -> bool {
+    let mut stack = vec![at];
+    let mut temporal = false;
+    while let Some(id) = stack.pop() {
+        if task.is_state(id) {
+            continue;
+        }
+        match &task[id] {
+            Node::And(fs) | Node::Or(fs) => stack.extend(fs.iter().copied()),
+            Node::Eventually(_, f) => {
+                temporal = true;
+                stack.push(*f);
+            }
+            _ => return false,
+        }
+    }
+    temporal
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hstl_robustness::{Bound, CmpOp, Expr, Interval};
+
+    fn above(var: usize, c: f64) -> Formula {
+        Formula::cmp(Expr::var(var), CmpOp::Gt, Expr::constant(c))
+    }
+
+    fn within(n: usize, f: Formula) -> Formula {
+        Formula::eventually(Interval { start: 0, end: Bound::Inclusive(n) }, f)
+    }
+
+    #[test]
+    fn a_sequence_with_a_safety_conjunct_has_one_goal_and_keeps_the_safety() {
+        let (a, b, o) = (above(0, 5.0), above(1, 5.0), above(0, 100.0));
+        let goal = within(10, Formula::and(vec![a, within(10, b)]));
+        let safe = Formula::always(
+            Interval { start: 0, end: Bound::Inclusive(30) },
+            Formula::not(o.clone()),
+        );
+        let task = Formula::and(vec![goal.clone(), safe.clone()]);
+        let p = Progress::of_task(&task).expect("a goal");
+        assert_eq!(p.goals(), 1);
+        assert_eq!(p.rest(0), Some(&task));
+        assert_eq!(p.rest(1), Some(&safe));
+        assert!(Progress::of_task(&safe).is_none(), "an always conjunct can fail once met");
+        assert!(Progress::of_task(&o).is_none(), "a state formula is decided at step 0");
+        assert_eq!(Progress::of_task(&goal).map(|p| p.rest(1).cloned()), Some(None));
+    }
+
+    #[test]
+    fn a_goal_is_met_once_a_prefix_satisfies_it_and_given_up_past_its_horizon() {
+        let goal = within(3, above(0, 5.0));
+        let p = Progress::of_task(&goal).unwrap();
+        let mut eval = Evaluator::new();
+        let mut checked = 0;
+        let x = [0.0, 1.0, 7.0, 0.0, 9.0, 9.0];
+        assert_eq!(p.update(0, &[&x[..2]], &mut eval, &mut checked), 0);
+        assert_eq!(p.update(0, &[&x[..3]], &mut eval, &mut checked), 1);
+        let late = [0.0, 0.0, 0.0, 0.0, 9.0];
+        assert_eq!(p.update(0, &[&late[..]], &mut eval, &mut checked), 0);
+        assert_eq!(checked, 1, "past its horizon the goal is not read again");
+    }
+}
