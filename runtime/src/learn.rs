@@ -822,7 +822,9 @@ mod tests {
                 // alpha (r_j + gamma^(4-j) * max_o Q(x=4, o) - 0), max = 2.
                 let want = 0.5 * ((1.0 - j as f64) + 0.9f64.powi(4 - j as i32) * 2.0);
                 let q = &learner.q().options;
-                assert_eq!(q[j * 2 + credited[j]], want, "{intra:?} suffix {j}");
+                // `powi` may round differently where the optimiser folds it (release).
+                let got = q[j * 2 + credited[j]];
+                assert!((got - want).abs() <= 1e-12 * want.abs(), "{intra:?} suffix {j}: {got}");
                 assert_eq!(q[j * 2 + 1 - credited[j]], 0.0, "{intra:?} suffix {j}");
             }
         }

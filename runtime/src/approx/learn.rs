@@ -548,10 +548,13 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         }
         let mut total = 0.0;
         // Once every goal is met, the episode goes on to the task's horizon, as a greedy
-        // run does: the options level learns to keep the rest where the run then is.
+        // run does: the options level learns to keep the rest where the run then is (with
+        // one option it has nothing to learn).
         let hold = match &self.model.progress {
-            Some(p) => self.spec.task.horizon().map(|h| (p.all_met(), h)),
-            None => None,
+            Some(p) if self.model.legs.len() > 1 => {
+                self.spec.task.horizon().map(|h| (p.all_met(), h))
+            }
+            _ => None,
         };
         let mut steps = 0;
         for choice in 0.. {
