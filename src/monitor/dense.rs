@@ -91,6 +91,29 @@ impl Dense {
         &self.vars
     }
 
+    /// Whether every interval bound is a whole number of the time column's unit, so that
+    /// whole-number stamps give whole-number change points (`s - b`, `s + a`).
+    pub fn whole_bounds(&self) -> bool {
+        use hstl_robustness::{Bound, Node};
+        let scale = self.formula.scale();
+        let whole = |n: usize| scale.bound(n).fract() == 0.0;
+        self.formula.formula().nodes().iter().all(|node| match node {
+            Node::Always(i, _)
+            | Node::Eventually(i, _)
+            | Node::Until(i, ..)
+            | Node::Once(i, _)
+            | Node::Historically(i, _)
+            | Node::Since(i, ..) => {
+                whole(i.start)
+                    && match i.end {
+                        Bound::Inclusive(b) | Bound::Exclusive(b) => whole(b),
+                        Bound::Unbounded => true,
+                    }
+            }
+            _ => true,
+        })
+    }
+
     /// The formula, checked for dense time, with its bounds' time scale.
     pub fn formula(&self) -> &DenseFormula {
         &self.formula
