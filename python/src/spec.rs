@@ -372,6 +372,13 @@ impl Spec {
         self.spec.state_vars.iter().map(|v| v.name.clone()).collect()
     }
 
+    /// The time variable of a dense-time spec (its trace column holds each row's stamp);
+    /// None for a discrete-time spec.
+    #[getter]
+    fn time_var(&self) -> Option<&str> {
+        self.spec.time.as_ref().map(|t| t.name.as_str())
+    }
+
     /// The names of the `let`s, in declaration order: what `formula=` can name.
     #[getter]
     fn lets(&self) -> Vec<String> {
