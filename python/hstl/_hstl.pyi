@@ -169,7 +169,7 @@ class OnlineMonitor:
     def time_var(self) -> Optional[str]:
         """The time variable of a dense-time monitor; None for a discrete-time one."""
     @overload
-    def update(self, state: State) -> Optional[Tuple[int, float]]:
+    def update(self, state: State, row: None = None) -> Optional[Tuple[int, float]]:
         """Discrete time: the verdict this state completes, ``(step, value)``, or None."""
     @overload
     def update(self, state: Stamp, row: DenseState) -> list[Tuple[Stamp, float]]:
