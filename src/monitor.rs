@@ -19,7 +19,11 @@ use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
 use crate::lower::{self, LowerError};
 
 mod dense;
-pub use dense::{Dense, DenseProblem, time_text};
+mod stamps;
+pub use dense::{Dense, DenseLive, DenseProblem, StampColumn, time_text};
+pub use stamps::{
+    MaxGap, Stamp, StampError, StampOrder, TimeAxis, decimal_difference, signal_rows,
+};
 
 /// The most threads [`Monitor::signal_batch`] starts, whatever it is asked for.
 pub const MAX_BATCH_THREADS: usize = 64;

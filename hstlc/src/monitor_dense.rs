@@ -12,7 +12,9 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 
 use hstl::lang::CheckedSpec;
-use hstl::monitor::{Dense, DenseProblem, time_text};
+use hstl::monitor::{
+    Dense, DenseProblem, MaxGap, TimeAxis, Windows as Semantics, signal_rows, time_text,
+};
 use hstl::robustness::dense::{DenseTrace, DenseTraceBuilder, DenseTraceError};
 
 use crate::cli_error::CliError;
@@ -32,16 +34,20 @@ struct DenseRead {
 
 /// Runs `hstlc monitor` for the dense-time spec `spec` (from the file `name`).
 pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf]) -> CmdResult {
-    if args.windows == Windows::Complete {
+    let windows = match args.windows {
+        Windows::Clipped => Semantics::Clipped,
+        Windows::Complete => Semantics::Complete,
+    };
+    if args.online && windows == Semantics::Complete {
         return Err(CliError::new(
             format!(
-                "{name}: `--windows complete` is not supported yet for dense-time specs (spec \
-                 `{}` has a `time` variable)",
+                "{name}: `--online` with `--windows complete` is not supported yet for \
+                 dense-time specs (spec `{}` has a `time` variable)",
                 spec.name
             ),
             Some(
-                "leave it out: a dense-time window is never cut at the end of the trace (after \
-                 the last stamp every variable keeps its last value)"
+                "leave out `--online` to score the recorded trace over complete windows, or \
+                 `--windows complete` to stream it"
                     .to_string(),
             ),
         ));
@@ -55,7 +61,11 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         };
         CliError::new(format!("{name}: {e}"), help)
     })?;
-    let gap = args.max_gap.as_deref().map(MaxGap::parse).transpose()?;
+    let gap = args
+        .max_gap
+        .as_deref()
+        .map(|text| MaxGap::parse(text, "--max-gap ").map_err(|p| CliError::new(p.message, p.help)))
+        .transpose()?;
     let mut cols = vec![Column { name: monitor.time_var(), kind: ColumnKind::Real }];
     cols.extend(columns(spec));
     let opts = Options { gap: gap.as_ref(), relative: args.relative };
@@ -65,6 +75,8 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
     let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
     let mut scored = Vec::with_capacity(traces.len());
     let mut ignored: Vec<String> = Vec::new();
+    // Traces with undetermined times (complete windows), and the times they start at.
+    let mut open: Vec<(String, Option<String>)> = Vec::new();
     for path in traces {
         let read = read_dense(path, &cols, &monitor, opts.gap)?;
         for n in &read.ignored {
@@ -72,17 +84,31 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
                 ignored.push(n.clone());
             }
         }
-        let signal = monitor.signal(&read.trace).map_err(|e| located(path, &read, e))?;
+        let (signal, end) =
+            monitor.signal_in(&read.trace, windows).map_err(|e| located(path, &read, e))?;
         let times =
-            Times { relative: opts.relative, origin: read.trace.origin(), t0: read.trace.t0() };
-        let rows: Vec<(String, f64)> = if args.signal {
-            signal.until(read.trace.t_last()).map(|(t, v)| (times.text(t), v)).collect()
+            TimeAxis { relative: opts.relative, origin: read.trace.origin(), t0: read.trace.t0() };
+        let (t0, t_last) = (read.trace.t0(), read.trace.t_last());
+        let cell = |v: Option<f64>| v.map_or_else(String::new, |v| v.to_string());
+        let rows: Vec<(String, String)> = if args.signal {
+            signal_rows(&signal, t0, t_last, end)
+                .into_iter()
+                .map(|(t, v)| (times.text(t), cell(v)))
+                .collect()
         } else {
-            vec![(String::new(), signal.first())]
+            let first = end.is_none_or(|e| e >= t0).then(|| signal.first());
+            vec![(
+                String::new(),
+                first.map_or_else(|| "undetermined".to_string(), |v| v.to_string()),
+            )]
         };
+        if let Some(end) = end.filter(|&e| e < t_last && (args.signal || e < t0)) {
+            open.push((trace_name(path), (end >= t0).then(|| times.text(end))));
+        }
         scored.push((path, rows));
     }
     note_ignored(&ignored, spec);
+    note_open(&open, batch);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let written = match (batch, args.signal) {
         (false, true) => writeln!(out, "t,robustness")
@@ -103,6 +129,35 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
     .and_then(|()| out.flush());
     written.map_err(crate::output::stdout_error)?;
     Ok(Status::Clean)
+}
+
+/// Says on standard error which times complete windows left undetermined: for each such
+/// trace, its name and the time after which they are (`None`: every time).
+fn note_open(open: &[(String, Option<String>)], batch: bool) {
+    let when = |end: &Option<String>| match end {
+        Some(e) => format!("the times after {e} are"),
+        None => "every time is".to_string(),
+    };
+    match open {
+        [] => {}
+        [(_, end)] if !batch => errln!(
+            "note: over complete windows, {} undetermined: their windows run past the last \
+             stamp",
+            when(end)
+        ),
+        _ => {
+            let list: Vec<String> =
+                open.iter().map(|(name, end)| format!("{name} ({})", when(end))).collect();
+            errln!(
+                "note: over complete windows, {} trace{} {} undetermined times, whose windows \
+                 run past the last stamp: {}",
+                open.len(),
+                if open.len() == 1 { "" } else { "s" },
+                if open.len() == 1 { "has" } else { "have" },
+                list.join(", ")
+            );
+        }
+    }
 }
 
 /// Opens a trace (standard input for `-`).
@@ -219,7 +274,7 @@ fn online(
     let mut cells = vec![None; cols.len() - 1];
     let mut count = 0usize;
     let mut gaps = Gaps::default();
-    let mut times = Times { relative: opts.relative, origin: None, t0: 0.0 };
+    let mut times = TimeAxis { relative: opts.relative, origin: None, t0: 0.0 };
     while let Some(row) =
         rows.next_dense_row(&mut cells, count == 0).map_err(|e| read_error(&name, e))?
     {
@@ -293,84 +348,6 @@ struct Options<'a> {
     relative: bool,
 }
 
-/// How the output's times print: in the time column's scale, or relative to the first
-/// stamp (`--relative`).
-struct Times {
-    relative: bool,
-    /// The first whole-number stamp, when stamps are whole numbers beyond 2^53 (the times
-    /// are then relative to it already, computed in integer arithmetic).
-    origin: Option<i128>,
-    /// The first stamp, when stamps are doubles.
-    t0: f64,
-}
-
-impl Times {
-    fn text(&self, t: f64) -> String {
-        match (self.relative, self.origin) {
-            (false, origin) => time_text(origin, t),
-            (true, Some(_)) => t.to_string(),
-            // Exact: the difference of the two times as they print.
-            (true, None) => decimal_difference(&t.to_string(), &self.t0.to_string()),
-        }
-    }
-}
-
-/// `--max-gap`: the bound exactly as written (`digits / 10^decimals`) and as the nearest
-/// double.
-struct MaxGap {
-    text: String,
-    digits: u128,
-    decimals: u32,
-    bound: f64,
-}
-
-impl MaxGap {
-    fn parse(text: &str) -> Result<MaxGap, CliError> {
-        let bad = || {
-            CliError::new(
-                format!("`--max-gap {text}` is not a time: give a number of 0 or more"),
-                Some(
-                    "the gap is in the time column's unit, such as `0.5` for stamps in \
-                     seconds or `500000000` for nanoseconds"
-                        .to_string(),
-                ),
-            )
-        };
-        let (digits, decimals) =
-            hstl::robustness::dense::TimeScale::parse_decimal(text).ok_or_else(bad)?;
-        let bound: f64 = text.trim().parse().map_err(|_| bad())?;
-        if !bound.is_finite() {
-            return Err(bad());
-        }
-        Ok(MaxGap { text: text.trim().to_string(), digits, decimals, bound })
-    }
-
-    /// Whether the gap from `prev` to `now` is larger than the bound, computed exactly;
-    /// with the gap as written.
-    fn exceeded(&self, prev: Stamp, now: Stamp) -> Option<String> {
-        match (prev, now) {
-            (Stamp::Int(p), Stamp::Int(s)) => {
-                let gap = u128::try_from(s - p).unwrap_or(0);
-                // gap > digits / 10^decimals, with no rounding (an overflow is larger).
-                let scaled = 10u128.checked_pow(self.decimals).and_then(|m| gap.checked_mul(m));
-                scaled.is_none_or(|g| g > self.digits).then(|| gap.to_string())
-            }
-            (Stamp::Real(p), Stamp::Real(s)) => {
-                // `d` is `s - p` rounded and `err` the rounding error (Knuth's two-sum):
-                // rounding is monotone, so the exact gap exceeds the bound exactly when
-                // `d` does, or `d` equals it and the error is positive.
-                let d = s - p;
-                let sv = d + p;
-                let err = (s - sv) + (-p - (d - sv));
-                (d > self.bound || d == self.bound && err > 0.0)
-                    .then(|| decimal_difference(&s.to_string(), &p.to_string()))
-            }
-            // A trace's stamps are all of one kind (`StampOrder`).
-            _ => None,
-        }
-    }
-}
-
 /// The previous row's stamp and line, for `--max-gap`.
 #[derive(Default)]
 struct Gaps {
@@ -392,142 +369,14 @@ impl Gaps {
         if let Some((prev, line)) = self.last
             && let Some(width) = gap.exceeded(prev, stamp)
         {
+            let at = format!(" (line {line})");
+            let p = gap.problem(&width, (prev, &at), stamp, time, "--max-gap ");
             return Err(CliError::new(
-                format!(
-                    "{name}:{}:{}: the time stamp {} in column `{time}` comes {width} after the \
-                     previous one, {} (line {line}): more than `--max-gap {}`",
-                    row.line,
-                    row.stamp_column,
-                    stamp_text(stamp),
-                    stamp_text(prev),
-                    gap.text
-                ),
-                Some(
-                    "each variable would keep its value across the gap: fill the gap with \
-                     samples, monitor the parts before and after it separately, or raise \
-                     `--max-gap`"
-                        .to_string(),
-                ),
+                format!("{name}:{}:{}: {}", row.line, row.stamp_column, p.message),
+                p.help,
             ));
         }
         self.last = Some((stamp, row.line));
         Ok(())
-    }
-}
-
-fn stamp_text(stamp: Stamp) -> String {
-    match stamp {
-        Stamp::Int(n) => n.to_string(),
-        Stamp::Real(t) => t.to_string(),
-    }
-}
-
-/// `a - b` for two decimals as Rust prints doubles (`-12.5`, `0.001`: no exponent),
-/// exactly, printed the same way.
-fn decimal_difference(a: &str, b: &str) -> String {
-    fn parts(x: &str) -> (bool, &str, &str) {
-        let (neg, x) = x.strip_prefix('-').map_or((false, x), |r| (true, r));
-        let (int, frac) = x.split_once('.').unwrap_or((x, ""));
-        (neg, int, frac)
-    }
-    let ((na, ia, fa), (nb, ib, fb)) = (parts(a), parts(b));
-    let scale = fa.len().max(fb.len());
-    // One more integer digit than either, for a carry.
-    let width = ia.len().max(ib.len()) + 1;
-    let digits = |int: &str, frac: &str| {
-        let mut v = vec![0u8; width - int.len()];
-        v.extend(int.bytes().chain(frac.bytes()).map(|c| c.wrapping_sub(b'0')));
-        v.resize(width + scale, 0);
-        v
-    };
-    let (da, db) = (digits(ia, fa), digits(ib, fb));
-    // `a - b` is `±(|a| + |b|)` for opposite signs, `±(|a| - |b|)` otherwise.
-    let (neg, mag) = if na != nb {
-        (na, add_digits(&da, &db))
-    } else if da >= db {
-        (na, sub_digits(&da, &db))
-    } else {
-        (!na, sub_digits(&db, &da))
-    };
-    let text = |d: &[u8]| d.iter().map(|&c| char::from(b'0' + c)).collect::<String>();
-    let int = text(&mag[..width]);
-    let int = int.trim_start_matches('0');
-    let frac = text(&mag[width..]);
-    let frac = frac.trim_end_matches('0');
-    if int.is_empty() && frac.is_empty() {
-        return "0".to_string();
-    }
-    let sign = if neg { "-" } else { "" };
-    let int = if int.is_empty() { "0" } else { int };
-    if frac.is_empty() { format!("{sign}{int}") } else { format!("{sign}{int}.{frac}") }
-}
-
-/// The sum of two equally long digit strings (most significant first; no overflow out of
-/// the first digit).
-fn add_digits(a: &[u8], b: &[u8]) -> Vec<u8> {
-    let mut out = vec![0u8; a.len()];
-    let mut carry = 0u8;
-    for k in (0..a.len()).rev() {
-        let s = a[k] + b[k] + carry;
-        out[k] = s % 10;
-        carry = s / 10;
-    }
-    out
-}
-
-/// `a - b` for two equally long digit strings with `a >= b`.
-fn sub_digits(a: &[u8], b: &[u8]) -> Vec<u8> {
-    let mut out = vec![0u8; a.len()];
-    let mut borrow = 0u8;
-    for k in (0..a.len()).rev() {
-        let (d, sub) = (a[k], b[k] + borrow);
-        if d >= sub {
-            out[k] = d - sub;
-            borrow = 0;
-        } else {
-            out[k] = d + 10 - sub;
-            borrow = 1;
-        }
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn decimal_differences_are_exact() {
-        assert_eq!(decimal_difference("0.3", "0.1"), "0.2");
-        assert_eq!(decimal_difference("1700000000.4", "1700000000"), "0.4");
-        assert_eq!(decimal_difference("5", "-2.25"), "7.25");
-        assert_eq!(decimal_difference("-2.25", "5"), "-7.25");
-        assert_eq!(decimal_difference("-1", "-3.5"), "2.5");
-        assert_eq!(decimal_difference("0.1", "0.3"), "-0.2");
-        assert_eq!(decimal_difference("99.99", "0.01"), "99.98");
-        assert_eq!(decimal_difference("99.99", "-0.01"), "100");
-        assert_eq!(decimal_difference("2", "2"), "0");
-        assert_eq!(decimal_difference("-0", "0"), "0");
-        assert_eq!(decimal_difference("0.30000000000000004", "0"), "0.30000000000000004");
-    }
-
-    #[test]
-    fn gaps_compare_exactly() {
-        let g = MaxGap::parse("0.1").expect("a time");
-        // 0.3 - 0.2 (as doubles) is exactly 0.0999999999999999778: below the double 0.1.
-        assert!(g.exceeded(Stamp::Real(0.2), Stamp::Real(0.3)).is_none());
-        assert!(g.exceeded(Stamp::Real(0.0), Stamp::Real(0.1)).is_none());
-        assert_eq!(g.exceeded(Stamp::Real(0.0), Stamp::Real(0.25)).as_deref(), Some("0.25"));
-        let ns = MaxGap::parse("0.5").expect("a time");
-        let t = 1_700_000_000_000_000_000i128;
-        assert!(ns.exceeded(Stamp::Int(t), Stamp::Int(t + 1)).is_some());
-        let ns = MaxGap::parse("500000000").expect("a time");
-        assert!(ns.exceeded(Stamp::Int(t), Stamp::Int(t + 500_000_000)).is_none());
-        assert_eq!(
-            ns.exceeded(Stamp::Int(t), Stamp::Int(t + 500_000_001)).as_deref(),
-            Some("500000001")
-        );
-        assert!(MaxGap::parse("-1").is_err());
-        assert!(MaxGap::parse("inf").is_err());
     }
 }

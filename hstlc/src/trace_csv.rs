@@ -145,13 +145,7 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
 
 /// A row's time stamp, as written: whole numbers are read as integers (never rounded
 /// through a double), anything else as the nearest double.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Stamp {
-    /// Digits, with an optional sign: nanoseconds since the epoch, say.
-    Int(i128),
-    /// A decimal number.
-    Real(f64),
-}
+pub use hstl::monitor::Stamp;
 
 /// One row of a dense-time trace: its line, its stamp (with the stamp's column) and one
 /// cell per variable, `None` where the cell is empty (no new sample).
@@ -165,72 +159,19 @@ pub struct DenseRow {
     pub stamp_column: usize,
 }
 
-/// Reads a trace's stamps in one of two ways, decided by the first: a whole number of
-/// magnitude 2^53 or more (nanoseconds since the epoch, say) starts integer stamps, which
-/// must all be whole numbers and are taken relative to the first in integer arithmetic;
-/// any other first stamp starts double stamps, each the nearest double (a whole number that
-/// no double holds exactly is an error, never rounded). Stamps must strictly increase.
+/// Reads a trace's stamps as the facade's [`hstl::monitor::StampOrder`] does, its
+/// errors at the stamp's line and column.
 #[derive(Clone, Debug, Default)]
 pub struct StampOrder {
-    last: Option<Stamp>,
+    order: hstl::monitor::StampOrder,
 }
-
-/// 2^53: every whole number of smaller magnitude is a double.
-const EXACT: i128 = 1 << 53;
 
 impl StampOrder {
     /// The next row's stamp as the trace takes it, or what is wrong with it.
     pub fn next(&mut self, row: &DenseRow, time: &str) -> Result<Stamp, CsvError> {
-        let at =
-            |message: String, help: &str| csv(row.line, row.stamp_column, message, help.into());
-        let stamp = match (self.last, row.stamp) {
-            (None, Stamp::Int(n)) if n.abs() >= EXACT => Stamp::Int(n),
-            (Some(Stamp::Int(_)), Stamp::Int(n)) => Stamp::Int(n),
-            (Some(Stamp::Int(_)), Stamp::Real(_)) => {
-                return Err(at(
-                    format!(
-                        "the time stamp in column `{time}` is a decimal, but the trace's stamps \
-                         are whole numbers (its first is beyond 2^53)"
-                    ),
-                    "write every stamp as a whole number (such as nanoseconds since the epoch)",
-                ));
-            }
-            (_, Stamp::Int(n)) => {
-                let t = n as f64;
-                if t as i128 != n {
-                    return Err(at(
-                        format!(
-                            "the time stamp {n} in column `{time}` is not exactly a double, and \
-                             the trace's stamps are read as doubles (its first is below 2^53)"
-                        ),
-                        "stamps are taken relative to the first in integer arithmetic only when \
-                         the first is a whole number of 2^53 or more: write the stamps in \
-                         a unit that keeps them below 2^53, or all as such whole numbers",
-                    ));
-                }
-                Stamp::Real(t)
-            }
-            (_, Stamp::Real(t)) => Stamp::Real(t),
-        };
-        let order = match (self.last, stamp) {
-            (Some(Stamp::Int(p)), Stamp::Int(s)) if s <= p => Some((p.to_string(), s.to_string())),
-            (Some(Stamp::Real(p)), Stamp::Real(s)) if s <= p => {
-                Some((p.to_string(), s.to_string()))
-            }
-            _ => None,
-        };
-        if let Some((previous, now)) = order {
-            let how = if previous == now { "repeats" } else { "goes back from" };
-            return Err(at(
-                format!(
-                    "the time stamp {now} in column `{time}` {how} the previous one, {previous}"
-                ),
-                "time stamps must strictly increase: sort the rows, and merge the rows of one \
-                 stamp into one (an empty cell keeps a variable's value)",
-            ));
-        }
-        self.last = Some(stamp);
-        Ok(stamp)
+        self.order
+            .next(row.stamp)
+            .map_err(|e| csv(row.line, row.stamp_column, e.message(time), e.help()))
     }
 }
 

@@ -234,7 +234,44 @@ const CASES: &[Case] = &[
     ),
     case(
         "monitor_dense_windows_complete",
-        &["monitor", "dense.hstl", "--trace", "dense.csv", "--windows", "complete"],
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--windows", "complete", "--signal"],
+    ),
+    case(
+        "monitor_dense_windows_complete_value",
+        &["monitor", "dense_complete.hstl", "--trace", "dense_dip.csv", "--windows", "complete"],
+    ),
+    case(
+        "monitor_dense_windows_clipped_value",
+        &["monitor", "dense_complete.hstl", "--trace", "dense_dip.csv", "--signal"],
+    ),
+    case(
+        "monitor_dense_windows_complete_batch",
+        &[
+            "monitor",
+            "dense.hstl",
+            "--trace",
+            "dense.csv",
+            "--trace",
+            "dense_irregular.csv",
+            "--windows",
+            "complete",
+        ],
+    ),
+    case(
+        "monitor_dense_windows_complete_nanoseconds",
+        &[
+            "monitor",
+            "dense_ns.hstl",
+            "--trace",
+            "dense_ns.csv",
+            "--signal",
+            "--windows",
+            "complete",
+        ],
+    ),
+    case(
+        "monitor_dense_windows_complete_online",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--windows", "complete", "--online"],
     ),
     case(
         "monitor_decimal_bound_discrete",

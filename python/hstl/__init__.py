@@ -32,13 +32,14 @@ the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a cod
 """
 
 from ._errors import MissingVariableError, PolicyError, SpecError, SpecWarning, WorldError
-from ._hstl import EVAL_SEED, MAX_EPISODES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain, formula
+from ._hstl import EVAL_SEED, MAX_EPISODES, MAX_ONLINE_VALUES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain, formula
 from ._study import StudyResult, study
 from ._train import train
 
 __all__ = [
     "EVAL_SEED",
     "MAX_EPISODES",
+    "MAX_ONLINE_VALUES",
     "Diagnostic",
     "MissingVariableError",
     "OnlineMonitor",

@@ -1,7 +1,7 @@
 """Type stubs of the native module ``hstl._hstl`` (re-exported by ``hstl``)."""
 
 from os import PathLike
-from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,22 @@ State = Union[Mapping[str, float], Sequence[float], npt.ArrayLike]
 #: How the windows at the end of a trace count: cut there (``"clipped"``, the default), or a
 #: step counts only if its windows lie inside the trace (``"complete"``; later steps NaN).
 Windows = Literal["clipped", "complete"]
+#: A dense-time signal: the change points' times (int64 nanoseconds-style whole numbers for
+#: whole-number stamps of 2^53 or more, float64 otherwise or with ``relative=True``) and
+#: the value from each until the next (float64; a last NaN over complete windows: the times
+#: from there on are undetermined).
+DenseSignal = Tuple[npt.NDArray[Union[np.int64, np.uint64, np.float64]], npt.NDArray[np.float64]]
+#: The largest gap allowed between consecutive stamps, in the time column's unit (a number,
+#: or its text such as ``"0.5"``); None: any.
+MaxGap = Union[int, float, str, None]
+#: A dense-time row's stamp: an int stays a whole number (never rounded), a float is a
+#: double.
+Stamp = Union[int, float]
+#: A dense-time row for ``OnlineMonitor.update(t, state)``: names to numbers (a variable
+#: left out, None or NaN has no new sample), or one number per state variable (NaN: none).
+DenseState = Union[Mapping[str, Optional[float]], Sequence[float]]
+#: The most values a dense-time ``OnlineMonitor`` holds (2^27, 1 GiB of doubles).
+MAX_ONLINE_VALUES: int
 #: What ``hstl.STLReward`` rewards a step with (see its docs).
 RewardForm = Literal["robustness", "increment", "window", "sparse"]
 
@@ -88,6 +104,10 @@ class Spec:
     @property
     def state_vars(self) -> list[str]: ...
     @property
+    def time_var(self) -> Optional[str]:
+        """The time variable of a dense-time spec (its trace column holds each row's
+        stamp); None for a discrete-time spec."""
+    @property
     def lets(self) -> list[str]: ...
     @property
     def diagnostics(self) -> list[Diagnostic]: ...
@@ -99,7 +119,11 @@ class Spec:
         *,
         columns: Optional[Sequence[str]] = None,
         windows: Windows = "clipped",
-    ) -> float: ...
+        max_gap: MaxGap = None,
+    ) -> float:
+        """The robustness at step 0 (a dense-time spec: at the first stamp); NaN when
+        undetermined over complete windows. ``max_gap`` (dense-time specs) refuses a gap
+        between consecutive stamps larger than it."""
     def signal(
         self,
         trace: Trace,
@@ -107,7 +131,12 @@ class Spec:
         *,
         columns: Optional[Sequence[str]] = None,
         windows: Windows = "clipped",
-    ) -> npt.NDArray[np.float64]: ...
+        max_gap: MaxGap = None,
+        relative: bool = False,
+    ) -> Union[npt.NDArray[np.float64], DenseSignal]:
+        """A discrete-time spec: one float64 value per step. A dense-time spec: the
+        ``(times, values)`` of the signal's change points, the rows of ``hstlc monitor
+        --signal`` (``relative=True``: times from the first stamp, ``--relative``)."""
     def signal_batch(
         self,
         traces: Batch,
@@ -116,12 +145,19 @@ class Spec:
         columns: Optional[Sequence[str]] = None,
         threads: Optional[int] = None,
         windows: Windows = "clipped",
-    ) -> npt.NDArray[np.float64]: ...
-    def online(self, formula: Optional[str] = None) -> OnlineMonitor: ...
+        max_gap: MaxGap = None,
+        relative: bool = False,
+    ) -> Union[npt.NDArray[np.float64], list[DenseSignal]]:
+        """A discrete-time spec: an array (traces, steps). A dense-time spec: a list of
+        traces in, a list of ``(times, values)`` out, as ``signal`` gives them."""
+    def online(
+        self, formula: Optional[str] = None, *, max_gap: MaxGap = None, relative: bool = False
+    ) -> OnlineMonitor:
+        """An online monitor; a dense-time spec's takes ``update(t, state)``."""
 
 class OnlineMonitor:
     """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``. It pickles
-    and deep-copies mid-trace."""
+    and deep-copies mid-trace (a dense-time one deep-copies but does not pickle yet)."""
 
     @property
     def horizon(self) -> Optional[int]: ...
@@ -129,9 +165,24 @@ class OnlineMonitor:
     def steps(self) -> int: ...
     @property
     def state_vars(self) -> list[str]: ...
-    def update(self, state: State) -> Optional[Tuple[int, float]]: ...
-    def provisional(self) -> Optional[float]: ...
-    def finish(self) -> list[Tuple[int, float]]: ...
+    @property
+    def time_var(self) -> Optional[str]:
+        """The time variable of a dense-time monitor; None for a discrete-time one."""
+    @overload
+    def update(self, state: State, row: None = None) -> Optional[Tuple[int, float]]:
+        """Discrete time: the verdict this state completes, ``(step, value)``, or None."""
+    @overload
+    def update(self, state: Stamp, row: DenseState) -> list[Tuple[Stamp, float]]:
+        """Dense time: ``update(t, state)`` appends the row stamped ``t`` and returns the
+        change points it decided, ``[(t, value), ...]``."""
+    def provisional(self) -> Optional[float]:
+        """Discrete time only: the value the first open step would have if the trace
+        ended now."""
+    def finish(self) -> list[Tuple[Any, float]]:
+        """Ends the trace: the verdicts still open (``(step, value)``; dense time: the
+        change points up to the last stamp, ``(t, value)``)."""
+    def __deepcopy__(self, memo: dict[int, Any]) -> OnlineMonitor: ...
+    def __copy__(self) -> OnlineMonitor: ...
     @staticmethod
     def _restore(spec: Spec, formula: Optional[str], skipped: int, states: Sequence[float]) -> OnlineMonitor: ...
 

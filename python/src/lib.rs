@@ -8,6 +8,7 @@
 //! the facade's errors into Python exceptions with the command line's words.
 
 mod check;
+mod dense;
 mod errors;
 mod files;
 mod gym;
@@ -46,6 +47,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LEARN_KEYS", hstl::train::LEARN_KEYS.to_vec())?;
     m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
     m.add("EVAL_SEED", hstl::train::EVAL_SEED)?;
+    m.add("MAX_ONLINE_VALUES", hstl::robustness::MAX_ONLINE_VALUES)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,11 +5,12 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use hstl::lang::{CheckedSpec, Location};
-use hstl::monitor::Monitor;
+use hstl::monitor::{Dense, Monitor};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
+use crate::dense;
 use crate::errors::{self, batch_error, diagnostics_of, lower_error, trace_error, value_error};
 use crate::online::OnlineMonitor;
 use crate::trace::{hold, hold_batch};
@@ -37,6 +38,8 @@ pub struct Spec {
     warnings: Vec<hstl::lang::Diagnostic>,
     /// Lowered monitors by formula name (`None`: the task), made on first use.
     monitors: Mutex<HashMap<Option<String>, Arc<Monitor>>>,
+    /// The same for a dense-time spec.
+    dense: Mutex<HashMap<Option<String>, Arc<Dense>>>,
 }
 
 /// One diagnostic of `hstlc check`, positioned as `hstlc check --format json` gives it:
@@ -156,6 +159,7 @@ impl Spec {
             spec: loaded.spec,
             warnings: loaded.diagnostics,
             monitors: Mutex::new(HashMap::new()),
+            dense: Mutex::new(HashMap::new()),
         })
     }
 
@@ -177,12 +181,37 @@ impl Spec {
             spec: made.loaded.spec,
             warnings: made.loaded.diagnostics,
             monitors: Mutex::new(HashMap::new()),
+            dense: Mutex::new(HashMap::new()),
         })
     }
 
     /// A new online monitor of the task or of the `let` called `formula`.
     pub(crate) fn online_of(&self, formula: Option<&str>) -> PyResult<hstl::monitor::Online> {
         Ok(self.monitor(formula)?.online())
+    }
+
+    /// The dense-time monitor of the task or of the `let` called `formula`, lowered once.
+    pub(crate) fn dense(&self, formula: Option<&str>) -> PyResult<Arc<Dense>> {
+        let key = formula.map(str::to_string);
+        let mut monitors = self.dense.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(m) = monitors.get(&key) {
+            return Ok(Arc::clone(m));
+        }
+        let m =
+            Arc::new(Dense::new(&self.spec, formula).map_err(|e| lower_error(&self.filename, &e))?);
+        monitors.insert(key, Arc::clone(&m));
+        Ok(m)
+    }
+
+    /// The error for a dense-only keyword given with a discrete-time spec.
+    fn discrete_only(&self, gap: Option<&Bound<'_, PyAny>>, relative: bool) -> PyResult<()> {
+        if gap.is_some_and(|g| !g.is_none()) {
+            return Err(dense::dense_only(&self.spec.name, "max_gap"));
+        }
+        if relative {
+            return Err(dense::dense_only(&self.spec.name, "relative"));
+        }
+        Ok(())
     }
 
     /// The monitor of the task or of the `let` called `formula`, lowered once.
@@ -197,6 +226,54 @@ impl Spec {
         );
         monitors.insert(key, Arc::clone(&m));
         Ok(m)
+    }
+}
+
+impl Spec {
+    /// `signal_batch` of a dense-time spec: a list of `(times, values)`.
+    #[allow(clippy::too_many_arguments)]
+    fn dense_batch<'py>(
+        &self,
+        py: Python<'py>,
+        traces: &Bound<'py, PyAny>,
+        formula: Option<&str>,
+        columns: Option<&Bound<'py, PyAny>>,
+        threads: usize,
+        windows: hstl::monitor::Windows,
+        max_gap: Option<&Bound<'py, PyAny>>,
+        relative: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let monitor = self.dense(formula)?;
+        let gap = dense::max_gap(max_gap)?;
+        if traces.is_instance_of::<pyo3::types::PyString>() || dense::is_one_trace(traces)? {
+            return Err(crate::errors::type_error(
+                "a batch is a list of traces",
+                Some("for one trace call `signal`".into()),
+            ));
+        }
+        let mut built = Vec::new();
+        for (i, item) in traces.try_iter()?.enumerate() {
+            let item = item?;
+            let held = dense::hold(&item, columns, &monitor)
+                .and_then(|h| dense::build(py, &h, &monitor, gap.as_ref()))
+                .map_err(|e| dense::prefixed(py, e, i))?;
+            built.push(held);
+        }
+        let results = py.detach(|| monitor.signal_batch(&built, threads, windows));
+        let list = pyo3::types::PyList::empty(py);
+        for (i, (result, trace)) in results.into_iter().zip(&built).enumerate() {
+            let (signal, end) = result.map_err(|p| {
+                let axis = hstl::monitor::TimeAxis {
+                    relative: false,
+                    origin: trace.origin(),
+                    t0: trace.t0(),
+                };
+                dense::prefixed(py, dense::problem_error(&p, &monitor, Some(&axis)), i)
+            })?;
+            let (times, values) = dense::arrays(py, &signal, end, trace, relative)?;
+            list.append(PyTuple::new(py, [times, values.into_any()])?)?;
+        }
+        Ok(list.into_any())
     }
 }
 
@@ -295,6 +372,13 @@ impl Spec {
         self.spec.state_vars.iter().map(|v| v.name.clone()).collect()
     }
 
+    /// The time variable of a dense-time spec (its trace column holds each row's stamp);
+    /// None for a discrete-time spec.
+    #[getter]
+    fn time_var(&self) -> Option<&str> {
+        self.spec.time.as_ref().map(|t| t.name.as_str())
+    }
+
     /// The names of the `let`s, in declaration order: what `formula=` can name.
     #[getter]
     fn lets(&self) -> Vec<String> {
@@ -327,7 +411,12 @@ impl Spec {
     /// `windows="complete"` counts a step only if every window its value needs lies
     /// inside the trace (`hstlc monitor --windows complete`): NaN when step 0 is
     /// undetermined (the trace is too short for its windows). The whole trace is read.
-    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
+    ///
+    /// A dense-time spec (one with a `time` variable) takes a mapping with the time column
+    /// (NaN in a variable's column: no new sample) and gives the robustness at the first
+    /// stamp; `max_gap` refuses a gap between consecutive stamps larger than it (in the
+    /// time column's unit), as `hstlc monitor --max-gap` does.
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped", max_gap=None))]
     fn robustness(
         &self,
         py: Python<'_>,
@@ -335,8 +424,25 @@ impl Spec {
         formula: Option<&str>,
         columns: Option<&Bound<'_, PyAny>>,
         windows: &str,
+        max_gap: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<f64> {
         let windows = windows_of(windows)?;
+        if self.spec.is_dense() {
+            let monitor = self.dense(formula)?;
+            let gap = dense::max_gap(max_gap)?;
+            let held = dense::hold(trace, columns, &monitor)?;
+            let trace = dense::build(py, &held, &monitor, gap.as_ref())?;
+            let value = py.detach(|| monitor.robustness_in(&trace, windows)).map_err(|p| {
+                let axis = hstl::monitor::TimeAxis {
+                    relative: false,
+                    origin: trace.origin(),
+                    t0: trace.t0(),
+                };
+                dense::problem_error(&p, &monitor, Some(&axis))
+            })?;
+            return Ok(value.unwrap_or(f64::NAN));
+        }
+        self.discrete_only(max_gap, false)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
@@ -349,7 +455,15 @@ impl Spec {
     /// `windows="complete"` counts a step only if every window its value needs lies
     /// inside the trace (`--windows complete`); the later steps, undetermined, are NaN
     /// (the empty fields of `--signal`).
-    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped"))]
+    ///
+    /// A dense-time spec gives `(times, values)` instead: the change points of the signal
+    /// (the rows of `hstlc monitor --signal`), each value holding from its time until the
+    /// next. Times are in the time column's scale: int64 for whole-number stamps of 2^53
+    /// or more (nanoseconds since the epoch), exact; float64 otherwise; float64 from the
+    /// first stamp with `relative=True` (`--relative`). Over complete windows the last
+    /// value may be NaN: the times from there on are undetermined.
+    #[pyo3(signature = (trace, formula=None, *, columns=None, windows="clipped", max_gap=None, relative=false))]
+    #[allow(clippy::too_many_arguments)]
     fn signal<'py>(
         &self,
         py: Python<'py>,
@@ -357,14 +471,33 @@ impl Spec {
         formula: Option<&str>,
         columns: Option<&Bound<'py, PyAny>>,
         windows: &str,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        max_gap: Option<&Bound<'py, PyAny>>,
+        relative: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let windows = windows_of(windows)?;
+        if self.spec.is_dense() {
+            let monitor = self.dense(formula)?;
+            let gap = dense::max_gap(max_gap)?;
+            let held = dense::hold(trace, columns, &monitor)?;
+            let trace = dense::build(py, &held, &monitor, gap.as_ref())?;
+            let (signal, end) = py.detach(|| monitor.signal_in(&trace, windows)).map_err(|p| {
+                let axis = hstl::monitor::TimeAxis {
+                    relative: false,
+                    origin: trace.origin(),
+                    t0: trace.t0(),
+                };
+                dense::problem_error(&p, &monitor, Some(&axis))
+            })?;
+            let (times, values) = dense::arrays(py, &signal, end, &trace, relative)?;
+            return Ok(PyTuple::new(py, [times, values.into_any()])?.into_any());
+        }
+        self.discrete_only(max_gap, relative)?;
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
         let signal =
             py.detach(|| monitor.signal_in(&samples, windows)).map_err(|e| trace_error(py, &e))?;
-        Ok(PyArray1::from_vec(py, signal))
+        Ok(PyArray1::from_vec(py, signal).into_any())
     }
 
     /// The robustness signals of many traces of one length, on `threads` threads (default:
@@ -375,7 +508,11 @@ impl Spec {
     /// (traces, steps, columns) whose columns `columns=` names, or a mapping from each
     /// state variable to a 2-D array of shape (traces, steps). `windows` is as for
     /// `signal`.
-    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None, windows="clipped"))]
+    ///
+    /// A dense-time spec takes a list of traces (as `signal` takes them, of any lengths)
+    /// and gives a list of `(times, values)`, one per trace, as `signal` gives them.
+    #[pyo3(signature = (traces, formula=None, *, columns=None, threads=None, windows="clipped", max_gap=None, relative=false))]
+    #[allow(clippy::too_many_arguments)]
     fn signal_batch<'py>(
         &self,
         py: Python<'py>,
@@ -384,6 +521,8 @@ impl Spec {
         columns: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
         windows: &str,
+        max_gap: Option<&Bound<'py, PyAny>>,
+        relative: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let windows = windows_of(windows)?;
         let threads = match threads {
@@ -391,6 +530,11 @@ impl Spec {
             Some(n) => n,
             None => std::thread::available_parallelism().map_or(1, |n| n.get()),
         };
+        if self.spec.is_dense() {
+            return self
+                .dense_batch(py, traces, formula, columns, threads, windows, max_gap, relative);
+        }
+        self.discrete_only(max_gap, relative)?;
         let monitor = self.monitor(formula)?;
         let held = hold_batch(traces, columns, &monitor)?;
         let samples = held.samples()?;
@@ -405,9 +549,32 @@ impl Spec {
 
     /// An online monitor of the task (or of the `let` called `formula`), fed one state at
     /// a time; see `hstl.OnlineMonitor`.
-    #[pyo3(signature = (formula=None))]
-    fn online(slf: &Bound<'_, Self>, formula: Option<&str>) -> PyResult<OnlineMonitor> {
-        let inner = slf.get().online_of(formula)?;
+    ///
+    /// For a dense-time spec it takes `update(t, state)` rows (see `hstl.OnlineMonitor`);
+    /// `max_gap` and `relative` are as for `signal`.
+    #[pyo3(signature = (formula=None, *, max_gap=None, relative=false))]
+    fn online(
+        slf: &Bound<'_, Self>,
+        formula: Option<&str>,
+        max_gap: Option<&Bound<'_, PyAny>>,
+        relative: bool,
+    ) -> PyResult<OnlineMonitor> {
+        let this = slf.get();
+        if this.spec.is_dense() {
+            let monitor = this.dense(formula)?;
+            let live = monitor
+                .live(dense::max_gap(max_gap)?, dense::GAP_FLAG)
+                .map_err(|p| dense::problem_error(&p, &monitor, None))?;
+            return Ok(OnlineMonitor::dense(
+                monitor,
+                live,
+                relative,
+                slf.clone().unbind(),
+                formula.map(String::from),
+            ));
+        }
+        this.discrete_only(max_gap, relative)?;
+        let inner = this.online_of(formula)?;
         Ok(OnlineMonitor::new(inner, slf.clone().unbind(), formula.map(String::from)))
     }
 

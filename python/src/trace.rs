@@ -362,7 +362,7 @@ fn missing(py: Python<'_>, var: &str, known: Option<Vec<String>>, vars: &[String
 }
 
 /// The names of a mapping's keys, as text; empty when it has none or they cannot be listed.
-fn keys(mapping: &Bound<'_, PyAny>) -> Vec<String> {
+pub fn keys(mapping: &Bound<'_, PyAny>) -> Vec<String> {
     let Ok(keys) = mapping.call_method0("keys").and_then(|k| k.try_iter()) else {
         return Vec::new();
     };
@@ -421,7 +421,10 @@ fn picks(
 
 /// `obj` as a float64 array contiguous in C or Fortran order: itself when it is one,
 /// otherwise converted by numpy once. Refuses anything but booleans, integers and floats.
-fn float_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+pub fn float_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>()
         && (a.is_c_contiguous() || a.is_fortran_contiguous())
     {
@@ -498,7 +501,7 @@ fn field_names(array: &Bound<'_, PyUntypedArray>) -> PyResult<Option<Vec<String>
     if names.is_none() { Ok(None) } else { Ok(Some(names.extract()?)) }
 }
 
-fn is_mapping(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+pub fn is_mapping(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     Ok(obj.hasattr("keys")? && obj.hasattr("__getitem__")? && !obj.is_instance_of::<PyString>())
 }
 
@@ -540,7 +543,7 @@ fn tuple(dims: &[usize]) -> String {
     }
 }
 
-fn type_name(obj: &Bound<'_, PyAny>) -> String {
+pub fn type_name(obj: &Bound<'_, PyAny>) -> String {
     obj.get_type().name().map_or_else(|_| "an object".into(), |n| n.to_string())
 }
 

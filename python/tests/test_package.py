@@ -63,7 +63,10 @@ def test_help_reads_well():
         doc = inspect.getdoc(getattr(hstl.Spec, method))
         assert doc and len(doc) > 40, method
     signature = str(inspect.signature(hstl.Spec.signal_batch))
-    assert signature == "(self, /, traces, formula=None, *, columns=None, threads=None, windows='clipped')"
+    assert signature == (
+        "(self, /, traces, formula=None, *, columns=None, threads=None, windows='clipped', "
+        "max_gap=None, relative=False)"
+    )
     assert "final" in inspect.getdoc(hstl.OnlineMonitor)
 
 

@@ -364,3 +364,43 @@ fn the_online_monitor_streams_long_windows() {
         assert!(most < 12_000, "{f}: kept {most}");
     }
 }
+
+/// Complete windows: a time counts only if its windows lie inside the trace; a bounded
+/// operator's value there is the ordinary one, an unbounded one ranges over its operand's
+/// complete part.
+#[test]
+fn complete_windows_cut_each_node_at_its_complete_end() {
+    let (_, trace) = read_csv(EXAMPLE);
+    let x = gt(0, 1.0);
+    let complete = |f: &Formula| {
+        let df = DenseFormula::new(f, TimeScale::decimals(1)).expect("a dense formula");
+        let (sig, end) = df.complete_signal(&trace).expect("a signal");
+        (sig.points().collect::<Vec<_>>(), end, df.signal(&trace).expect("a signal"))
+    };
+    // `always[0.5..=1.5] x > 1`: complete up to 5 - 1.5; there the ordinary values.
+    let (got, end, ordinary) = complete(&Formula::always(iv(5, Some(15)), x.clone()));
+    assert_eq!(end, 3.5);
+    assert_eq!(got, [(0.0, 0.0), (0.5, 1.0), (1.5, 2.0), (2.0, -0.5)]);
+    assert_eq!(got, ordinary.until(end).collect::<Vec<_>>());
+    // A comparison and a past operator are complete up to the last stamp.
+    let (got, end, ordinary) = complete(&Formula::once(iv(10, Some(20)), x.clone()));
+    assert_eq!(end, 5.0);
+    assert_eq!(got, ordinary.until(5.0).collect::<Vec<_>>());
+    // `always (eventually[0..=1] x > 1)`: the ordinary value reads `eventually` past the
+    // last stamp (the held 0.5 at 3.5 .. 5 is seen at 3.5 whichever way); complete windows
+    // read it up to 4 only, as if the trace ended there.
+    let nested = Formula::always(iv(0, None), Formula::eventually(iv(0, Some(10)), x.clone()));
+    let (got, end, _) = complete(&nested);
+    assert_eq!(end, 4.0);
+    assert_eq!(got, [(0.0, -0.5), (4.0, 3.0)]);
+    // Over a trace whose last sample dips, the difference shows at t0.
+    let (_, dip) = read_csv("t,x\n0,2\n1,2\n2,0.5\n");
+    let df = DenseFormula::new(&nested, TimeScale::decimals(1)).expect("a dense formula");
+    assert_eq!(df.signal(&dip).expect("a signal").first(), -0.5);
+    let (sig, end) = df.complete_signal(&dip).expect("a signal");
+    assert_eq!((sig.first(), end), (1.0, 1.0));
+    // Windows longer than the trace: nothing is complete.
+    let long = Formula::eventually(iv(0, Some(60)), x);
+    let (_, end, _) = complete(&long);
+    assert!(end < trace.t0());
+}

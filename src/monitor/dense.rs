@@ -6,10 +6,13 @@
 use std::fmt;
 
 use hstl_lang::CheckedSpec;
+use hstl_robustness::MAX_ONLINE_VALUES;
 use hstl_robustness::dense::{
-    DenseError, DenseFormula, DenseMonitor, DenseSignal, DenseTrace, TimeScale,
+    DenseError, DenseFormula, DenseMonitor, DenseSignal, DenseTrace, DenseTraceBuilder, TimeScale,
 };
 
+use super::stamps::{MaxGap, Stamp, StampError, StampOrder, TimeAxis};
+use super::{MAX_BATCH_THREADS, Windows};
 use crate::lower::{self, LowerError};
 
 /// The task of a dense-time spec, or one of its `let`s, ready to score time-stamped
@@ -88,6 +91,29 @@ impl Dense {
         &self.vars
     }
 
+    /// Whether every interval bound is a whole number of the time column's unit, so that
+    /// whole-number stamps give whole-number change points (`s - b`, `s + a`).
+    pub fn whole_bounds(&self) -> bool {
+        use hstl_robustness::{Bound, Node};
+        let scale = self.formula.scale();
+        let whole = |n: usize| scale.bound(n).fract() == 0.0;
+        self.formula.formula().nodes().iter().all(|node| match node {
+            Node::Always(i, _)
+            | Node::Eventually(i, _)
+            | Node::Until(i, ..)
+            | Node::Once(i, _)
+            | Node::Historically(i, _)
+            | Node::Since(i, ..) => {
+                whole(i.start)
+                    && match i.end {
+                        Bound::Inclusive(b) | Bound::Exclusive(b) => whole(b),
+                        Bound::Unbounded => true,
+                    }
+            }
+            _ => true,
+        })
+    }
+
     /// The formula, checked for dense time, with its bounds' time scale.
     pub fn formula(&self) -> &DenseFormula {
         &self.formula
@@ -104,10 +130,181 @@ impl Dense {
         Ok(self.signal(trace)?.first())
     }
 
+    /// The robustness over complete windows ([`DenseFormula::complete_signal`]): the
+    /// signal cut at its complete end, and that end (nothing is determined when it comes
+    /// before the first stamp).
+    pub fn complete_signal(&self, trace: &DenseTrace) -> Result<(DenseSignal, f64), DenseProblem> {
+        self.formula.complete_signal(trace).map_err(|e| self.problem(e))
+    }
+
+    /// The signal over `windows`, and the time up to which it is determined (`None` over
+    /// clipped windows, where every time is).
+    pub fn signal_in(
+        &self,
+        trace: &DenseTrace,
+        windows: Windows,
+    ) -> Result<(DenseSignal, Option<f64>), DenseProblem> {
+        match windows {
+            Windows::Clipped => Ok((self.signal(trace)?, None)),
+            Windows::Complete => {
+                let (signal, end) = self.complete_signal(trace)?;
+                Ok((signal, Some(end)))
+            }
+        }
+    }
+
+    /// The robustness at the first stamp over `windows`; `None` when it is undetermined
+    /// (complete windows that run past the last stamp).
+    pub fn robustness_in(
+        &self,
+        trace: &DenseTrace,
+        windows: Windows,
+    ) -> Result<Option<f64>, DenseProblem> {
+        let (signal, end) = self.signal_in(trace, windows)?;
+        Ok(end.is_none_or(|e| e >= trace.t0()).then(|| signal.first()))
+    }
+
+    /// [`Dense::signal_in`] of many traces, on up to `threads` threads (at most
+    /// [`MAX_BATCH_THREADS`]); one result per trace, in order.
+    pub fn signal_batch(
+        &self,
+        traces: &[DenseTrace],
+        threads: usize,
+        windows: Windows,
+    ) -> Vec<Result<(DenseSignal, Option<f64>), DenseProblem>> {
+        let workers = threads.clamp(1, MAX_BATCH_THREADS).min(traces.len().max(1));
+        let chunk = traces.len().div_ceil(workers).max(1);
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = traces
+                .chunks(chunk)
+                .map(|part| {
+                    scope.spawn(move || {
+                        part.iter().map(|t| self.signal_in(t, windows)).collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+                .collect()
+        })
+    }
+
     /// An online monitor: rows pushed one at a time, each change point returned once no
     /// later row can change it.
     pub fn online(&self) -> Result<DenseMonitor, DenseProblem> {
         DenseMonitor::new(&self.formula, self.vars.len()).map_err(|e| self.problem(e))
+    }
+
+    /// An online monitor that takes stamps as given (whole numbers or doubles, read by
+    /// [`StampOrder`]), refuses a gap larger than `gap` (worded with `flag`, such as
+    /// `max_gap=`), and holds at most [`MAX_ONLINE_VALUES`] values.
+    pub fn live(&self, gap: Option<MaxGap>, flag: &str) -> Result<DenseLive, DenseProblem> {
+        Ok(DenseLive {
+            monitor: self.online()?,
+            time: self.time.clone(),
+            vars: self.vars.len(),
+            order: StampOrder::default(),
+            gap,
+            flag: flag.to_string(),
+            rows: 0,
+            t0: 0.0,
+            bounded: self.formula.future_reach().is_finite(),
+            stopped: None,
+        })
+    }
+
+    /// The trace of a time column and one column per state variable (in
+    /// [`Dense::state_vars`]' order), all of one length: row `k` has stamp `time[k]`, and a
+    /// NaN in a variable's column is no new sample (the variable keeps its value), as an
+    /// empty CSV cell is. Stamps are read by [`StampOrder`]; a gap larger than `gap` (worded
+    /// with `flag`) is refused. Problems name the row (counted from 0) and the variable.
+    pub fn trace(
+        &self,
+        time: StampColumn<'_>,
+        columns: &[&[f64]],
+        gap: Option<&MaxGap>,
+        flag: &str,
+    ) -> Result<DenseTrace, DenseProblem> {
+        let n = time.len();
+        if columns.len() != self.vars.len() {
+            return Err(DenseProblem {
+                message: format!(
+                    "{} columns given for {} state variables",
+                    columns.len(),
+                    self.vars.len()
+                ),
+                help: None,
+                row: None,
+                var: None,
+                time: None,
+            });
+        }
+        if let Some(var) = columns.iter().position(|c| c.len() != n) {
+            return Err(DenseProblem {
+                message: format!(
+                    "`{}` has {} samples, but the time column `{}` has {n}",
+                    self.vars[var],
+                    columns[var].len(),
+                    self.time
+                ),
+                help: Some(
+                    "give one value per row (NaN where a variable has no new sample)".to_string(),
+                ),
+                row: None,
+                var: Some(var),
+                time: None,
+            });
+        }
+        if n == 0 {
+            return Err(
+                self.problem(DenseError::Trace(hstl_robustness::dense::DenseTraceError::Empty))
+            );
+        }
+        let mut order = StampOrder::default();
+        let mut builder = DenseTraceBuilder::new(self.vars.len());
+        let mut cells = vec![None; self.vars.len()];
+        let mut prev: Option<Stamp> = None;
+        for k in 0..n {
+            let stamp = order.next(time.get(k)).map_err(|e| self.stamp_problem(&e, k))?;
+            if let (Some(gap), Some(p)) = (gap, prev)
+                && let Some(width) = gap.exceeded(p, stamp)
+            {
+                return Err(self.gap_problem(gap, &width, p, stamp, k, flag));
+            }
+            prev = Some(stamp);
+            for (cell, col) in cells.iter_mut().zip(columns) {
+                let v = col[k];
+                *cell = (!v.is_nan()).then_some(v);
+            }
+            stamp.push(&mut builder, &cells).map_err(|e| self.problem(DenseError::Trace(e)))?;
+        }
+        builder.build().map_err(|e| self.problem(DenseError::Trace(e)))
+    }
+
+    /// A stamp [`StampOrder`] refused, at row `row`.
+    pub fn stamp_problem(&self, e: &StampError, row: usize) -> DenseProblem {
+        DenseProblem {
+            message: e.message(&self.time),
+            help: Some(e.help()),
+            row: Some(row),
+            var: None,
+            time: None,
+        }
+    }
+
+    fn gap_problem(
+        &self,
+        gap: &MaxGap,
+        width: &str,
+        prev: Stamp,
+        stamp: Stamp,
+        row: usize,
+        flag: &str,
+    ) -> DenseProblem {
+        let at = format!(" (row {})", row - 1);
+        let p = gap.problem(width, (prev, &at), stamp, &self.time, flag);
+        DenseProblem { message: p.message, help: p.help, row: Some(row), var: None, time: None }
     }
 
     /// The core's error in the spec's names.
@@ -207,6 +404,168 @@ impl Dense {
             i += c.len_utf8();
         }
         out
+    }
+}
+
+/// A time column: whole numbers (as integer numpy columns hold them) or doubles.
+#[derive(Clone, Copy, Debug)]
+pub enum StampColumn<'a> {
+    /// Signed whole numbers.
+    Int(&'a [i64]),
+    /// Unsigned whole numbers.
+    UInt(&'a [u64]),
+    /// Doubles.
+    Real(&'a [f64]),
+}
+
+impl StampColumn<'_> {
+    /// The number of stamps.
+    pub fn len(&self) -> usize {
+        match self {
+            StampColumn::Int(s) => s.len(),
+            StampColumn::UInt(s) => s.len(),
+            StampColumn::Real(s) => s.len(),
+        }
+    }
+
+    /// Whether there is no stamp.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Stamp `k`.
+    pub fn get(&self, k: usize) -> Stamp {
+        match self {
+            StampColumn::Int(s) => Stamp::Int(i128::from(s[k])),
+            StampColumn::UInt(s) => Stamp::Int(i128::from(s[k])),
+            StampColumn::Real(s) => Stamp::Real(s[k]),
+        }
+    }
+}
+
+/// A dense-time monitor fed rows as they arrive ([`Dense::live`]): stamps read by
+/// [`StampOrder`], gaps checked, memory bounded by [`MAX_ONLINE_VALUES`].
+#[derive(Clone, Debug)]
+pub struct DenseLive {
+    monitor: DenseMonitor,
+    time: String,
+    vars: usize,
+    order: StampOrder,
+    gap: Option<MaxGap>,
+    flag: String,
+    rows: usize,
+    t0: f64,
+    bounded: bool,
+    /// The row where a comparison computed NaN: the trace cannot go on.
+    stopped: Option<usize>,
+}
+
+impl DenseLive {
+    /// Appends a row (`None`: no new sample of that variable) and returns the change points
+    /// it decided, `(t, value)`, times relative to [`DenseLive::origin`] when set. A row
+    /// refused for its stamp or its cells changes nothing; a row on which a comparison
+    /// computes NaN stops the trace (until [`DenseLive::finish`]).
+    pub fn push(
+        &mut self,
+        dense: &Dense,
+        stamp: Stamp,
+        cells: &[Option<f64>],
+    ) -> Result<Vec<(f64, f64)>, DenseProblem> {
+        let row = self.rows;
+        if let Some(at) = self.stopped {
+            return Err(DenseProblem {
+                message: format!("the trace stopped at row {at}, where a comparison computed NaN"),
+                help: Some("call `finish()` to start a new trace".to_string()),
+                row: Some(row),
+                var: None,
+                time: None,
+            });
+        }
+        let prev = self.order.last();
+        let mut order = self.order.clone();
+        let stamp = order.next(stamp).map_err(|e| dense.stamp_problem(&e, row))?;
+        if let (Some(gap), Some(p)) = (&self.gap, prev)
+            && let Some(width) = gap.exceeded(p, stamp)
+        {
+            return Err(dense.gap_problem(gap, &width, p, stamp, row, &self.flag));
+        }
+        if self.monitor.kept().saturating_add(1).saturating_mul(self.vars + 1) > MAX_ONLINE_VALUES {
+            let why = if self.bounded {
+                "its windows read"
+            } else {
+                "until the trace ends (it has an unbounded future operator, such as `always`)"
+            };
+            return Err(DenseProblem {
+                message: format!(
+                    "the monitor holds more than {MAX_ONLINE_VALUES} values, and the formula \
+                     keeps every row {why}"
+                ),
+                help: Some(
+                    "monitor a formula with bounded windows (`formula=` with a `let`), or call \
+                     `finish()` sooner"
+                        .to_string(),
+                ),
+                row: Some(row),
+                var: None,
+                time: None,
+            });
+        }
+        // The core checks the cells before it takes the row: a refused row changes nothing.
+        let decided = match stamp {
+            Stamp::Int(s) => self.monitor.push_int(s, cells),
+            Stamp::Real(t) => self.monitor.push(t, cells),
+        }
+        .map_err(|e| {
+            if matches!(e, DenseError::Nan { .. }) {
+                self.stopped = Some(row);
+            }
+            let mut p = dense.problem(e);
+            p.row = p.row.map(|_| row);
+            p
+        })?;
+        if row == 0
+            && let Stamp::Real(t) = stamp
+        {
+            self.t0 = t;
+        }
+        self.order = order;
+        self.rows += 1;
+        Ok(decided)
+    }
+
+    /// Ends the trace: the change points not returned yet, up to the last stamp. The
+    /// monitor then starts a new trace.
+    pub fn finish(&mut self, dense: &Dense) -> Result<Vec<(f64, f64)>, DenseProblem> {
+        let out = self.monitor.finish().map_err(|e| dense.problem(e));
+        self.order = StampOrder::default();
+        self.rows = 0;
+        self.t0 = 0.0;
+        if self.stopped.take().is_some() {
+            // The operators stopped halfway through a row: start afresh.
+            self.monitor = dense.online()?;
+            return Ok(Vec::new());
+        }
+        out
+    }
+
+    /// The rows given since creation or the last [`DenseLive::finish`].
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// The first whole-number stamp, when stamps are whole numbers beyond 2^53.
+    pub fn origin(&self) -> Option<i128> {
+        self.monitor.origin()
+    }
+
+    /// How this trace's times are written (`relative`: from the first stamp).
+    pub fn axis(&self, relative: bool) -> TimeAxis {
+        TimeAxis { relative, origin: self.origin(), t0: self.t0 }
+    }
+
+    /// The time variable's name.
+    pub fn time_var(&self) -> &str {
+        &self.time
     }
 }
 

@@ -316,7 +316,28 @@ impl DenseFormula {
             times: trace.times(),
             columns: trace.columns().iter().map(Vec::as_slice).collect(),
         };
-        offline::evaluate(self, &rows)
+        Ok(offline::evaluate(self, &rows, false)?.0)
+    }
+
+    /// The robustness over complete windows (`hstlc monitor --windows complete`): the
+    /// signal at the times whose windows lie inside the trace, and the last such time,
+    /// `end` (the signal is determined on `[t0, end]`; nothing is when `end < t0`).
+    ///
+    /// Each node has a complete end: the last stamp for a comparison, `true` and `false`;
+    /// the least of its operands' for `!`, `&&`, `||`, `->` and the past operators; that
+    /// less `b` for `eventually[a..=b]`, `always[a..=b]` and `until[a..=b]` (less `a` for
+    /// `[a..]`), one IEEE subtraction as a breakpoint is. An operator reads its operands'
+    /// signals cut at their ends, each holding its value at its end after it, as if the
+    /// trace ended there: a bounded window of a complete time reads only complete times
+    /// (its value is the ordinary one), and an unbounded one ranges over its operand's
+    /// complete part. The returned signal is cut at `end` likewise.
+    pub fn complete_signal(&self, trace: &DenseTrace) -> Result<(DenseSignal, f64), DenseError> {
+        self.check_vars(trace.vars())?;
+        let rows = offline::Rows {
+            times: trace.times(),
+            columns: trace.columns().iter().map(Vec::as_slice).collect(),
+        };
+        offline::evaluate(self, &rows, true)
     }
 
     /// The robustness at the trace's first stamp.

@@ -76,10 +76,22 @@ enum Val {
 }
 
 /// Every node of `df`'s formula in order; returns the root's signal.
-pub(crate) fn evaluate(df: &DenseFormula, rows: &Rows<'_>) -> Result<DenseSignal, DenseError> {
+///
+/// With `complete`, every formula node's signal is cut at its complete end (see
+/// [`DenseFormula::complete_signal`]): its operands' signals are cut at theirs before it
+/// reads them, each holding its value at its end after it, as if the trace ended there.
+/// The root's complete end is returned beside it (the last stamp without `complete`).
+pub(crate) fn evaluate(
+    df: &DenseFormula,
+    rows: &Rows<'_>,
+    complete: bool,
+) -> Result<(DenseSignal, f64), DenseError> {
     let nodes = df.formula.nodes();
     let n = rows.times.len();
     let t0 = rows.times[0];
+    let t_last = rows.times[n - 1];
+    // Each formula node's complete end (unused for expressions).
+    let mut ends = vec![t_last; nodes.len()];
     // The last node reading each node, so signals are freed once read for the last time.
     let mut last_use = vec![0usize; nodes.len()];
     for (i, node) in nodes.iter().enumerate() {
@@ -170,6 +182,11 @@ pub(crate) fn evaluate(df: &DenseFormula, rows: &Rows<'_>) -> Result<DenseSignal
                 unreachable!("DenseFormula::new rejects prev and next")
             }
         };
+        let mut val = val;
+        if complete && let Val::Sig(sig) = &mut val {
+            ends[i] = complete_end(node, &ends, df.bounds[i], t_last);
+            sig.cut(ends[i]);
+        }
         vals.push(val);
         for c in node.children() {
             if last_use[c] == i {
@@ -177,9 +194,22 @@ pub(crate) fn evaluate(df: &DenseFormula, rows: &Rows<'_>) -> Result<DenseSignal
             }
         }
     }
+    let end = ends[nodes.len() - 1];
     match vals.pop() {
-        Some(Val::Sig(s)) => Ok(s),
+        Some(Val::Sig(s)) => Ok((s, end)),
         _ => unreachable!("the root is a formula"),
+    }
+}
+
+/// The complete end of formula node `node` (interval `(a, b)`), given its operands'
+/// `ends`: the last time whose windows lie inside them, each window end one IEEE
+/// subtraction as a breakpoint is.
+fn complete_end(node: &Node, ends: &[f64], (a, b): (f64, f64), t_last: f64) -> f64 {
+    let operands = node.children().map(|c| ends[c]).reduce(f64::min).unwrap_or(t_last);
+    let reach = if b == f64::INFINITY { a } else { b };
+    match node {
+        Node::Eventually(..) | Node::Always(..) | Node::Until(..) => operands - reach,
+        _ => operands,
     }
 }
 

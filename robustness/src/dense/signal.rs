@@ -40,6 +40,14 @@ impl DenseSignal {
         }
     }
 
+    /// Keeps the change points at or before `end` (the first one whatever `end`): the
+    /// signal then holds its value at `end` after it.
+    pub(crate) fn cut(&mut self, end: f64) {
+        let n = self.times.partition_point(|&s| s <= end).max(1.min(self.len()));
+        self.times.truncate(n);
+        self.values.truncate(n);
+    }
+
     /// The change points' times.
     pub fn times(&self) -> &[f64] {
         &self.times
