@@ -1,6 +1,8 @@
 """Gymnasium environments and wrappers: ``GridWorldEnv`` and ``STLReward``.
 
-Importing ``hstl`` registers the built-in worlds with gymnasium (when it is installed):
+``hstl`` loads this module on first use of ``hstl.GridWorldEnv`` or ``hstl.STLReward``, so
+that ``import hstl`` does not import gymnasium. ``import hstl`` registers the built-in
+worlds with gymnasium (when it is imported, or as soon as it is; see ``_registration``):
 ``gymnasium.make("hstl/GridWorld-v0")`` is the paper's world and
 ``gymnasium.make("hstl/FourRooms-v0")`` the four rooms, each with
 ``max_episode_steps=MAX_EPISODE_STEPS``. Without ``import hstl`` first,
@@ -17,13 +19,9 @@ import numpy as np
 from gymnasium import spaces
 
 from ._hstl import EpisodeMonitor, Generator, Spec, World
+from ._registration import MAX_EPISODE_STEPS, REGISTERED, register
 
-#: The episode length of the registered environments: the length of the greedy runs that
-#: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
-MAX_EPISODE_STEPS = 2000
-
-#: The ids registered for the built-in worlds, and the world each makes.
-REGISTERED = {"hstl/GridWorld-v0": "paper", "hstl/FourRooms-v0": "four-rooms"}
+__all__ = ["GridWorldEnv", "MAX_EPISODE_STEPS", "REGISTERED", "STLReward", "register"]
 
 _MAX_SEED = 2**64 - 1
 
@@ -275,16 +273,3 @@ def _missing(message: str, vars: Sequence[str]) -> Exception:
 
     return MissingVariableError(f"{message}\n  help: the spec's state variables are {', '.join(f'`{v}`' for v in vars)}")
 
-
-def register() -> None:
-    """Registers the built-in worlds' ids with gymnasium (done by ``import hstl``)."""
-    from gymnasium.envs.registration import registry
-
-    for env_id, world in REGISTERED.items():
-        if env_id not in registry:
-            gymnasium.register(
-                id=env_id,
-                entry_point="hstl._gym:GridWorldEnv",
-                kwargs={"world": world},
-                max_episode_steps=MAX_EPISODE_STEPS,
-            )

@@ -66,6 +66,11 @@ def explain(code: str) -> str:
     """The long explanation of a diagnostic code (``"HSTL150"``), as ``hstlc explain``
     prints it; ``ValueError`` for an unknown code."""
 
+def cli(argv: Sequence[str]) -> int:
+    """Runs the ``hstlc`` command line with ``argv`` (the program's name first) on this
+    process's standard input, output and error, and returns its exit status: the native
+    binary's own code (``hstlc::run``). The ``hstlc`` command of the wheel calls it."""
+
 class Spec:
     """A checked hstl spec, ready to monitor traces."""
 

@@ -8,6 +8,7 @@
 //! the facade's errors into Python exceptions with the command line's words.
 
 mod check;
+mod cli;
 mod errors;
 mod files;
 mod gym;
@@ -34,6 +35,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
+    m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
     m.add_function(wrap_pyfunction!(spec::formula, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
