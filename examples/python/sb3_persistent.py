@@ -44,15 +44,17 @@ SPEC = Path(__file__).resolve().parents[1] / "specs" / "surveillance_auto.hstl"
 STARTS, STEPS, BURN_IN = 100, 2000, 100  # policy.evaluate()'s defaults
 
 
-class Clocks(gymnasium.ObservationWrapper):  # type: ignore[type-arg]
+class Clocks(gymnasium.ObservationWrapper):
     """Adds to the cell, per region, the steps since the robot was last in it, capped at
     the region's window (the window rate's own counters): the observation is
     ``[x / (W-1), y / (H-1), c_1 / H_1, ...]`` in [0, 1]."""
 
-    def __init__(self, env: gymnasium.Env, regions: list[set[tuple[int, int]]], horizons: list[int]) -> None:  # type: ignore[type-arg]
+    def __init__(self, env: gymnasium.Env, regions: list[set[tuple[int, int]]], horizons: list[int]) -> None:
         super().__init__(env)
         self.regions, self.horizons = regions, np.array(horizons, dtype=np.float64)
-        world = env.unwrapped.world  # type: ignore[attr-defined]
+        unwrapped = env.unwrapped
+        assert isinstance(unwrapped, hstl.GridWorldEnv)
+        world = unwrapped.world
         self.scale = np.array([world.width - 1, world.height - 1], dtype=np.float64)
         self.observation_space = spaces.Box(0.0, 1.0, shape=(2 + len(regions),), dtype=np.float32)
         self.clocks = self.horizons.copy()
@@ -68,8 +70,8 @@ class Clocks(gymnasium.ObservationWrapper):  # type: ignore[type-arg]
         return np.concatenate([np.asarray(cell) / self.scale, self.clocks / self.horizons]).astype(np.float32)
 
 
-def make_env(spec: hstl.Spec, regions: list[set[tuple[int, int]]], horizons: list[int], limit: int | None) -> gymnasium.Env:  # type: ignore[type-arg]
-    env: gymnasium.Env = hstl.GridWorldEnv("paper")  # type: ignore[type-arg]
+def make_env(spec: hstl.Spec, regions: list[set[tuple[int, int]]], horizons: list[int], limit: int | None) -> gymnasium.Env:
+    env: gymnasium.Env = hstl.GridWorldEnv("paper")
     if limit is not None:
         env = gymnasium.wrappers.TimeLimit(env, max_episode_steps=limit)
     return Clocks(hstl.STLReward(env, spec, reward="window"), regions, horizons)

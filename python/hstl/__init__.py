@@ -32,6 +32,7 @@ the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a cod
 """
 
 from importlib.util import find_spec as _find_spec
+from typing import TYPE_CHECKING as _TYPE_CHECKING
 from typing import Any as _Any
 
 from . import _registration
@@ -74,19 +75,26 @@ if _find_spec("gymnasium") is not None:
     _registration.install()
 
 
-def __getattr__(name: str) -> _Any:
-    if name in _GYM:
-        try:
-            from . import _gym
-        except ImportError as e:
-            raise AttributeError(
-                f"hstl.{name} needs gymnasium, which cannot be imported ({e})\n"
-                '  help: install it with `pip install gymnasium` (or `pip install "./python[gymnasium]"`)'
-            ) from e
-        value = getattr(_gym, name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'hstl' has no attribute '{name}'")
+if _TYPE_CHECKING:
+    # Type checkers see the classes (and no `__getattr__`, which would make every unknown
+    # name `Any`).
+    from ._gym import GridWorldEnv as GridWorldEnv
+    from ._gym import STLReward as STLReward
+else:
+
+    def __getattr__(name: str) -> _Any:
+        if name in _GYM:
+            try:
+                from . import _gym
+            except ImportError as e:
+                raise AttributeError(
+                    f"hstl.{name} needs gymnasium, which cannot be imported ({e})\n"
+                    '  help: install it with `pip install gymnasium` (or `pip install "./python[gymnasium]"`)'
+                ) from e
+            value = getattr(_gym, name)
+            globals()[name] = value
+            return value
+        raise AttributeError(f"module 'hstl' has no attribute '{name}'")
 
 
 def __dir__() -> list[str]:

@@ -16,6 +16,7 @@ from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Union
 
 import gymnasium
 import numpy as np
+import numpy.typing as npt
 from gymnasium import spaces
 
 from ._hstl import EpisodeMonitor, Generator, Spec, World
@@ -78,7 +79,9 @@ class GridWorldEnv(gymnasium.Env):
         self._state: Optional[int] = None
         self._cell = (0, 0)
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
         super().reset(seed=seed)
         if seed is not None:
             self._generator = Generator(_seed_of(seed))
@@ -97,7 +100,7 @@ class GridWorldEnv(gymnasium.Env):
         self._state, self._cell = state, (x, y)
         return np.array(self._cell, dtype=np.int64), {"state": state}
 
-    def step(self, action: Any):
+    def step(self, action: Any) -> tuple[npt.NDArray[np.int64], float, bool, bool, dict[str, Any]]:
         if self._state is None or self._generator is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a = int(action)
@@ -199,7 +202,7 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
 
-    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict]:
+    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict[str, Any]]:
         reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
         info = dict(info)
         info["task_robustness"] = robustness
@@ -207,13 +210,13 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             info["window_kept"] = kept
         return reward, info
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[Any, dict[str, Any]]:
         obs, info = self.env.reset(seed=seed, options=options)
         self._monitor.reset()
         _, info = self._score(obs, info)
         return obs, info
 
-    def step(self, action: Any):
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         obs, env_reward, terminated, truncated, info = self.env.step(action)
         reward, info = self._score(obs, info, bool(terminated or truncated))
         info["env_reward"] = env_reward
@@ -264,7 +267,7 @@ class _Picks:
     def __init__(self, picks: Sequence[tuple[str, Any]]) -> None:
         self.picks = list(picks)
 
-    def __call__(self, obs: Any) -> dict:
+    def __call__(self, obs: Any) -> dict[str, Any]:
         return {v: obs[k] for v, k in self.picks}
 
 

@@ -296,7 +296,7 @@ def _train_env(
 
 #: One seed's figures: ``seed``, ``window_rate`` (or None), ``reward``, ``seconds``,
 #: ``steps`` and ``curve``.
-SeedRun = dict
+SeedRun = dict[str, Any]
 
 def _study_task(
     spec: Spec, world: World, episodes: Optional[int] = None
@@ -318,7 +318,7 @@ def _study_optimum(spec: Spec, world: World) -> Optional[float]:
     """W* of the spec's regions in the world, or None for a task without regions."""
     ...
 
-def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> dict:
+def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> dict[str, Any]:
     """Mean, sd, min and max of ``seconds``, ``reward``, ``window_rate`` and ``ratio``."""
     ...
 

@@ -61,7 +61,7 @@ class _RegisterAfterImport(importlib.abc.MetaPathFinder):
             sys.meta_path.remove(self)
         for finder in sys.meta_path:
             find = getattr(finder, "find_spec", None)
-            spec = find(fullname, path, target) if find is not None else None
+            spec: Optional[importlib.machinery.ModuleSpec] = find(fullname, path, target) if find is not None else None
             if spec is not None:
                 if spec.loader is not None and hasattr(spec.loader, "exec_module"):
                     spec.loader = _Loader(spec.loader)
