@@ -20,7 +20,7 @@ Needs torch and stable-baselines3 (``pip install -r examples/python/requirements
 then the hstl package with gymnasium); not run in CI. About 8 minutes on 2 cores with the
 defaults (3 seeds); ``--steps`` and ``--seeds`` change it.
 
-    python examples/python/sb3_persistent.py [--algo ppo|dqn] [--seeds 3] [--steps 300000]
+    python examples/python/sb3_persistent.py [--algo ppo|dqn] [--seeds 3] [--steps 600000] [--shaping 1]
 """
 
 from __future__ import annotations
@@ -44,12 +44,25 @@ SPEC = Path(__file__).resolve().parents[1] / "specs" / "surveillance_auto.hstl"
 STARTS, STEPS, BURN_IN = 100, 2000, 100  # policy.evaluate()'s defaults
 
 
-class Clocks(gymnasium.ObservationWrapper):
+class Clocks(gymnasium.Wrapper):
     """Adds to the cell, per region, the steps since the robot was last in it, capped at
     the region's window (the window rate's own counters): the observation is
-    ``[x / (W-1), y / (H-1), c_1 / H_1, ...]`` in [0, 1]."""
+    ``[x / (W-1), y / (H-1), c_1 / H_1, ...]`` in [0, 1].
 
-    def __init__(self, env: gymnasium.Env, regions: list[set[tuple[int, int]]], horizons: list[int]) -> None:
+    With ``shaping`` > 0 it also adds ``shaping * (gamma * phi(s') - phi(s))`` to the reward,
+    ``phi = -sum(c_j / H_j)``: potential-based shaping (Ng, Harada and Russell, 1999), which
+    leaves the best policy of the window reward unchanged but pays for reaching a region in
+    proportion to how long it has waited, so that the first windows are found at all.
+    """
+
+    def __init__(
+        self,
+        env: gymnasium.Env,
+        regions: list[set[tuple[int, int]]],
+        horizons: list[int],
+        shaping: float = 0.0,
+        gamma: float = 0.99,
+    ) -> None:
         super().__init__(env)
         self.regions, self.horizons = regions, np.array(horizons, dtype=np.float64)
         unwrapped = env.unwrapped
@@ -57,24 +70,38 @@ class Clocks(gymnasium.ObservationWrapper):
         world = unwrapped.world
         self.scale = np.array([world.width - 1, world.height - 1], dtype=np.float64)
         self.observation_space = spaces.Box(0.0, 1.0, shape=(2 + len(regions),), dtype=np.float32)
+        self.shaping, self.gamma = shaping, gamma
         self.clocks = self.horizons.copy()
 
-    def reset(self, **kwargs: Any) -> tuple[np.ndarray, dict[str, Any]]:
-        self.clocks = self.horizons.copy()  # nothing visited yet: every region is due
-        return super().reset(**kwargs)
-
-    def observation(self, observation: Any) -> np.ndarray:
+    def _observe(self, observation: Any) -> np.ndarray:
         cell = (int(observation[0]), int(observation[1]))
         for j, region in enumerate(self.regions):
             self.clocks[j] = 0.0 if cell in region else min(self.clocks[j] + 1.0, self.horizons[j])
         return np.concatenate([np.asarray(cell) / self.scale, self.clocks / self.horizons]).astype(np.float32)
 
+    def _potential(self) -> float:
+        return -float(np.sum(self.clocks / self.horizons))
 
-def make_env(spec: hstl.Spec, regions: list[set[tuple[int, int]]], horizons: list[int], limit: int | None) -> gymnasium.Env:
+    def reset(self, **kwargs: Any) -> tuple[np.ndarray, dict[str, Any]]:
+        observation, info = self.env.reset(**kwargs)
+        self.clocks = self.horizons.copy()  # nothing visited yet: every region is due
+        return self._observe(observation), info
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        before = self._potential()
+        observation, reward, terminated, truncated, info = self.env.step(action)
+        out = self._observe(observation)
+        shaped = float(reward) + self.shaping * (self.gamma * self._potential() - before)
+        return out, shaped, terminated, truncated, info
+
+
+def make_env(
+    spec: hstl.Spec, regions: list[set[tuple[int, int]]], horizons: list[int], limit: int | None, shaping: float = 0.0
+) -> gymnasium.Env:
     env: gymnasium.Env = hstl.GridWorldEnv("paper")
     if limit is not None:
         env = gymnasium.wrappers.TimeLimit(env, max_episode_steps=limit)
-    return Clocks(hstl.STLReward(env, spec, reward="window"), regions, horizons)
+    return Clocks(hstl.STLReward(env, spec, reward="window"), regions, horizons, shaping)
 
 
 def window_rate(model: Any, spec: hstl.Spec, regions: list[set[tuple[int, int]]], horizons: list[int], seed: int) -> float:
@@ -103,8 +130,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--algo", choices=["ppo", "dqn"], default="ppo")
     parser.add_argument("--seeds", type=int, default=3)
-    parser.add_argument("--steps", type=int, default=300_000, help="training steps per seed")
+    parser.add_argument("--steps", type=int, default=600_000, help="training steps per seed")
     parser.add_argument("--episode", type=int, default=500, help="training episode length")
+    parser.add_argument(
+        "--shaping", type=float, default=1.0, help="weight of the potential-based term (0: the window reward alone)"
+    )
     args = parser.parse_args()
     torch.set_num_threads(1)  # a small network: one thread per process is the fastest
 
@@ -123,7 +153,7 @@ def main() -> None:
         horizons = memory["horizons"]
 
         started = time.perf_counter()
-        vec = make_vec_env(lambda: make_env(spec, regions, horizons, args.episode), n_envs=8, seed=seed)
+        vec = make_vec_env(lambda: make_env(spec, regions, horizons, args.episode, args.shaping), n_envs=8, seed=seed)
         model: Any
         if args.algo == "ppo":
             model = PPO("MlpPolicy", vec, n_steps=256, batch_size=512, gamma=0.99, ent_coef=0.01, seed=seed, verbose=0)
@@ -136,28 +166,29 @@ def main() -> None:
         w = window_rate(model, spec, regions, horizons, seed)
         rows.append((seed, w, report["window_rate"], optimum, report["baseline"], sb3_seconds, hstl_seconds))
         print(
-            f"seed {seed}: {args.algo.upper()} W = {w:.3f} ({sb3_seconds:.0f} s, {args.steps} steps); "
+            f"seed {seed}: {args.algo.upper()} (shaping {args.shaping:g}) W = {w:.3f} ({sb3_seconds:.0f} s, {args.steps} steps); "
             f"hstl W = {report['window_rate']:.3f} ({hstl_seconds:.1f} s, {policy.steps} steps); "
             f"W* = {optimum:.3f}; nearest-cell cycle {report['baseline']:.3f}",
             flush=True,
         )
 
-    w_sb3 = np.mean([r[1] for r in rows])
-    w_hstl = np.mean([r[2] for r in rows])
-    optimum = rows[0][3]
+    name = args.algo.upper()
+    w_sb3, w_hstl = float(np.mean([r[1] for r in rows])), float(np.mean([r[2] for r in rows]))
+    optimum, baseline = rows[0][3], rows[0][4]
+    sb3_seconds, hstl_seconds = float(np.mean([r[5] for r in rows])), float(np.mean([r[6] for r in rows]))
     print(
-        f"\nmean over {len(rows)} seeds: {args.algo.upper()} W = {w_sb3:.3f} ({w_sb3 / optimum:.2f} of W* = {optimum:.3f}), "
-        f"hstl W = {w_hstl:.3f} ({w_hstl / optimum:.2f} of W*), hand-written nearest-cell cycle {rows[0][4]:.3f}"
+        f"\nmean over {len(rows)} seeds: {name} W = {w_sb3:.3f} ({w_sb3 / optimum:.2f} of W* = {optimum:.3f}) "
+        f"after {args.steps} steps, {sb3_seconds:.0f} s a seed; hstl W = {w_hstl:.3f} ({w_hstl / optimum:.2f} of W*), "
+        f"{hstl_seconds:.1f} s a seed; the hand-written nearest-cell cycle {baseline:.3f}"
     )
+    # What the figures show, read off them.
+    learned = "kept the windows better than" if w_sb3 > baseline else "did not reach"
+    versus = "above" if w_sb3 > w_hstl else "below"
     print(
-        "What it shows: the window reward and the region counters make the persistent task one a\n"
-        "general deep learner can learn; hstl's learner, which knows the regions and plans the\n"
-        "order of visits, gets closer to the optimum in a fraction of the steps and time."
-        if w_sb3 < w_hstl
-        else "What it shows: with the window reward and the region counters a general deep learner\n"
-        "matches hstl's own learner on this task, with many more steps and much more time."
+        f"What it shows: on the window reward with the regions' counters in its observation, {name} "
+        f"{learned} the hand-written cycle in this budget, {versus} hstl's learner, which plans the order "
+        f"of the regions from the task and trains in {hstl_seconds / sb3_seconds:.0%} of {name}'s time."
     )
-
 
 if __name__ == "__main__":
     main()
