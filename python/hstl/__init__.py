@@ -21,7 +21,12 @@ step as a numpy array, ``spec.signal_batch(traces)`` many traces' on every core,
 does (the same ``policy.json``, byte for byte); ``policy.evaluate()`` measures it as
 ``hstlc eval`` does. With gymnasium installed, ``hstl.GridWorldEnv`` is a grid world as a
 ``gymnasium.Env`` (``gymnasium.make("hstl/GridWorld-v0")``, ``"hstl/FourRooms-v0"``) and
-``hstl.STLReward`` rewards any environment by robustness.
+``hstl.STLReward`` rewards any environment by robustness; ``import hstl`` does not import
+gymnasium (the two classes load on first use, and the ids are registered once gymnasium is
+imported).
+
+``pip install`` also installs the ``hstlc`` command: the command line itself
+(``hstl._hstl.cli``), with the native binary's output and exit status.
 
 ``hstl.check(path_or_text)`` lists a spec's diagnostics (warnings included; loading issues
 the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a code.
