@@ -314,9 +314,10 @@ def test_the_ids_are_registered_whichever_is_imported_first(code):
     assert out.returncode == 0 and out.stdout == "ok\n", out.stderr
 
 
-def test_without_import_hstl_gymnasium_names_the_module_id_form():
+def test_without_import_hstl_gymnasium_does_not_know_the_ids():
     # gymnasium >= 1.0 has no plugin entry points (removed in 1.0; `load_plugin_envs` is
-    # gone), so nothing can register the ids before something imports hstl: gymnasium's own
-    # error, and the `hstl:` form the docs give, which works.
+    # gone), so nothing registers the ids before something imports hstl: gymnasium's own
+    # error (the `hstl:` form the docs give works: see the test above). This fails, as a
+    # reminder to register through the plugin, the day gymnasium finds them by itself.
     out = python("import gymnasium\ngymnasium.make('hstl/GridWorld-v0')")
     assert out.returncode != 0 and "NamespaceNotFound" in out.stderr, out.stderr
