@@ -8,6 +8,7 @@ Run it after installing the package (see README.md, "Python"):
 from pathlib import Path
 
 import numpy as np
+import numpy.typing as npt
 
 import hstl
 
@@ -18,7 +19,7 @@ spec = hstl.Spec.load(SPECS / "surveillance_ot1.hstl")
 print(f"{spec.name}: state {spec.state_vars}, lets {spec.lets}")
 
 
-def walk(steps, rng):
+def walk(steps: int, rng: np.random.Generator) -> npt.NDArray[np.float64]:
     """A random walk on the 15 x 15 grid, as an array of shape (steps, 2): columns x, y."""
     moves = rng.integers(-1, 2, size=(steps, 2))
     return np.clip(7 + np.cumsum(moves, axis=0), 0, 14).astype(np.float64)

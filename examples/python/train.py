@@ -8,6 +8,7 @@ Run it after installing the package (see README.md, "Python"):
 
 import argparse
 import tempfile
+from typing import Any
 from pathlib import Path
 
 import gymnasium
@@ -27,8 +28,10 @@ args = parser.parse_args()
 # the same policy.json, byte for byte, as `hstlc train examples/specs/surveillance_auto.hstl`.
 spec = hstl.Spec.load(SPECS / "surveillance_auto.hstl")
 policy = hstl.train(spec, world="paper", seed=0, episodes=args.episodes)
-tail = policy.curve[-100:].mean()
-print(f"trained `{policy.spec_name}` on {policy.env_name}: {len(policy.curve)} episodes, "
+curve = policy.curve
+assert curve is not None  # None only for a policy.json written before curves were kept
+tail = curve[-100:].mean()
+print(f"trained `{policy.spec_name}` on {policy.env_name}: {len(curve)} episodes, "
       f"{policy.steps} steps, reward per episode {tail:.1f} (last 100)")
 
 # What `hstlc eval` reports: the window rate of 100 greedy runs of 2000 steps, and W*.
@@ -74,14 +77,15 @@ LAKE = """spec Lake {
 }"""
 
 
-def cell(o: int) -> dict:
+def cell(o: int) -> dict[str, int]:
     return {"row": o // 4, "col": o % 4}
 
 
 def lake_optimum(steps: int) -> float:
     """The best chance of reaching the goal from the start within `steps` steps: value
     iteration on FrozenLake's known model (`env.unwrapped.P`)."""
-    model = gymnasium.make("FrozenLake-v1").unwrapped.P
+    lake: Any = gymnasium.make("FrozenLake-v1").unwrapped
+    model = lake.P
     value = [0.0] * 16
     for _ in range(steps):
         value = [

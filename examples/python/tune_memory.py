@@ -63,17 +63,21 @@ def main() -> None:
     results = tuner.fit()
     print(f"{len(results)} trials of `{spec.name}`, {episodes} episodes at most:")
     rows = sorted(
-        (r for r in results if r.metrics and "window_rate" in r.metrics),
-        key=lambda r: -r.metrics["window_rate"],
+        (
+            (r.config or {}, r.metrics)
+            for r in (results[i] for i in range(len(results)))
+            if r.metrics and "window_rate" in r.metrics
+        ),
+        key=lambda cm: -cm[1]["window_rate"],
     )
-    for r in rows:
-        c, m = r.config, r.metrics
+    for c, m in rows:
         print(
             f"  flat_alpha {c['flat_alpha']:.3f}  options_alpha {c['options_alpha']:.3f}:"
             f"  W {m['window_rate']:.3f}  W/W* {m.get('ratio', float('nan')):.3f}"
             f"  after {m['episodes']} episodes"
         )
     best = results.get_best_result().config
+    assert best is not None  # every trial has a config
     print(f"best: flat_alpha {best['flat_alpha']:.3f}, options_alpha {best['options_alpha']:.3f}")
 
     # surveillance_memory_tuned.hstl is this spec with `flat: { alpha: 0.05 }`, found by hand.

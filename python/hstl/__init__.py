@@ -21,7 +21,12 @@ step as a numpy array, ``spec.signal_batch(traces)`` many traces' on every core,
 does (the same ``policy.json``, byte for byte); ``policy.evaluate()`` measures it as
 ``hstlc eval`` does. With gymnasium installed, ``hstl.GridWorldEnv`` is a grid world as a
 ``gymnasium.Env`` (``gymnasium.make("hstl/GridWorld-v0")``, ``"hstl/FourRooms-v0"``) and
-``hstl.STLReward`` rewards any environment by robustness.
+``hstl.STLReward`` rewards any environment by robustness; ``import hstl`` does not import
+gymnasium (the two classes load on first use, and the ids are registered once gymnasium is
+imported).
+
+``pip install`` also installs the ``hstlc`` command: the command line itself
+(``hstl._hstl.cli``), with the native binary's output and exit status.
 
 ``hstl.check(path_or_text)`` lists a spec's diagnostics (warnings included; loading issues
 the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a code.
@@ -31,8 +36,14 @@ the warnings as ``hstl.SpecWarning``), and ``hstl.explain(code)`` explains a cod
 ``hstl.tune.trainable`` tunes a spec's ``learn`` values with Ray Tune.
 """
 
+from importlib.util import find_spec as _find_spec
+from typing import TYPE_CHECKING as _TYPE_CHECKING
+from typing import Any as _Any
+
+from . import _registration
 from ._errors import MissingVariableError, PolicyError, SpecError, SpecWarning, WorldError
 from ._hstl import EVAL_SEED, MAX_EPISODES, MAX_ONLINE_VALUES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain, formula
+from ._registration import MAX_EPISODE_STEPS
 from ._study import StudyResult, study
 from ._train import train
 
@@ -40,6 +51,7 @@ __all__ = [
     "EVAL_SEED",
     "MAX_EPISODES",
     "MAX_ONLINE_VALUES",
+    "MAX_EPISODE_STEPS",
     "Diagnostic",
     "MissingVariableError",
     "OnlineMonitor",
@@ -59,12 +71,37 @@ __all__ = [
     "train",
 ]
 
-try:
-    import gymnasium as _gymnasium  # noqa: F401
-except ImportError:  # gymnasium is optional: the monitors and training do not need it
-    pass
-else:
-    from ._gym import MAX_EPISODE_STEPS, GridWorldEnv, STLReward, register as _register
+# gymnasium is optional and costs about 150 ms to import: the gymnasium classes load on
+# first use (`__getattr__` below), and the ids are registered with gymnasium once it is
+# imported (`_registration`).
+_GYM = ("GridWorldEnv", "STLReward")
 
-    _register()
-    __all__ += ["GridWorldEnv", "MAX_EPISODE_STEPS", "STLReward"]
+if _find_spec("gymnasium") is not None:
+    __all__ += _GYM
+    _registration.install()
+
+
+if _TYPE_CHECKING:
+    # Type checkers see the classes (and no `__getattr__`, which would make every unknown
+    # name `Any`).
+    from ._gym import GridWorldEnv as GridWorldEnv
+    from ._gym import STLReward as STLReward
+else:
+
+    def __getattr__(name: str) -> _Any:
+        if name in _GYM:
+            try:
+                from . import _gym
+            except ImportError as e:
+                raise AttributeError(
+                    f"hstl.{name} needs gymnasium, which cannot be imported ({e})\n"
+                    '  help: install it with `pip install gymnasium` (or `pip install "./python[gymnasium]"`)'
+                ) from e
+            value = getattr(_gym, name)
+            globals()[name] = value
+            return value
+        raise AttributeError(f"module 'hstl' has no attribute '{name}'")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_GYM))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 if TYPE_CHECKING:
     from ._hstl import Diagnostic
@@ -24,7 +24,7 @@ class SpecError(ValueError):
         super().__init__(message)
         self.diagnostics = list(diagnostics)
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (self.args[0], self.diagnostics))
 
 
@@ -43,7 +43,7 @@ class SpecWarning(UserWarning):
         super().__init__(message)
         self.diagnostic = diagnostic
 
-    def __reduce__(self):
+    def __reduce__(self) -> tuple[Any, ...]:
         return (type(self), (self.args[0], self.diagnostic))
 
 

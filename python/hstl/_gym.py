@@ -1,6 +1,8 @@
 """Gymnasium environments and wrappers: ``GridWorldEnv`` and ``STLReward``.
 
-Importing ``hstl`` registers the built-in worlds with gymnasium (when it is installed):
+``hstl`` loads this module on first use of ``hstl.GridWorldEnv`` or ``hstl.STLReward``, so
+that ``import hstl`` does not import gymnasium. ``import hstl`` registers the built-in
+worlds with gymnasium (when it is imported, or as soon as it is; see ``_registration``):
 ``gymnasium.make("hstl/GridWorld-v0")`` is the paper's world and
 ``gymnasium.make("hstl/FourRooms-v0")`` the four rooms, each with
 ``max_episode_steps=MAX_EPISODE_STEPS``. Without ``import hstl`` first,
@@ -14,16 +16,13 @@ from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Union
 
 import gymnasium
 import numpy as np
+import numpy.typing as npt
 from gymnasium import spaces
 
 from ._hstl import EpisodeMonitor, Generator, Spec, World
+from ._registration import MAX_EPISODE_STEPS, REGISTERED, register
 
-#: The episode length of the registered environments: the length of the greedy runs that
-#: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
-MAX_EPISODE_STEPS = 2000
-
-#: The ids registered for the built-in worlds, and the world each makes.
-REGISTERED = {"hstl/GridWorld-v0": "paper", "hstl/FourRooms-v0": "four-rooms"}
+__all__ = ["GridWorldEnv", "MAX_EPISODE_STEPS", "REGISTERED", "STLReward", "register"]
 
 _MAX_SEED = 2**64 - 1
 
@@ -80,7 +79,9 @@ class GridWorldEnv(gymnasium.Env):
         self._state: Optional[int] = None
         self._cell = (0, 0)
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
         super().reset(seed=seed)
         if seed is not None:
             self._generator = Generator(_seed_of(seed))
@@ -99,7 +100,7 @@ class GridWorldEnv(gymnasium.Env):
         self._state, self._cell = state, (x, y)
         return np.array(self._cell, dtype=np.int64), {"state": state}
 
-    def step(self, action: Any):
+    def step(self, action: Any) -> tuple[npt.NDArray[np.int64], float, bool, bool, dict[str, Any]]:
         if self._state is None or self._generator is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
         a = int(action)
@@ -201,7 +202,7 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
 
-    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict]:
+    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict[str, Any]]:
         reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
         info = dict(info)
         info["task_robustness"] = robustness
@@ -209,13 +210,13 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
             info["window_kept"] = kept
         return reward, info
 
-    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[Any, dict[str, Any]]:
         obs, info = self.env.reset(seed=seed, options=options)
         self._monitor.reset()
         _, info = self._score(obs, info)
         return obs, info
 
-    def step(self, action: Any):
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         obs, env_reward, terminated, truncated, info = self.env.step(action)
         reward, info = self._score(obs, info, bool(terminated or truncated))
         info["env_reward"] = env_reward
@@ -266,7 +267,7 @@ class _Picks:
     def __init__(self, picks: Sequence[tuple[str, Any]]) -> None:
         self.picks = list(picks)
 
-    def __call__(self, obs: Any) -> dict:
+    def __call__(self, obs: Any) -> dict[str, Any]:
         return {v: obs[k] for v, k in self.picks}
 
 
@@ -275,16 +276,3 @@ def _missing(message: str, vars: Sequence[str]) -> Exception:
 
     return MissingVariableError(f"{message}\n  help: the spec's state variables are {', '.join(f'`{v}`' for v in vars)}")
 
-
-def register() -> None:
-    """Registers the built-in worlds' ids with gymnasium (done by ``import hstl``)."""
-    from gymnasium.envs.registration import registry
-
-    for env_id, world in REGISTERED.items():
-        if env_id not in registry:
-            gymnasium.register(
-                id=env_id,
-                entry_point="hstl._gym:GridWorldEnv",
-                kwargs={"world": world},
-                max_episode_steps=MAX_EPISODE_STEPS,
-            )

@@ -82,6 +82,11 @@ def explain(code: str) -> str:
     """The long explanation of a diagnostic code (``"HSTL150"``), as ``hstlc explain``
     prints it; ``ValueError`` for an unknown code."""
 
+def cli(argv: Sequence[str]) -> int:
+    """Runs the ``hstlc`` command line with ``argv`` (the program's name first) on this
+    process's standard input, output and error, and returns its exit status: the native
+    binary's own code (``hstlc::run``). The ``hstlc`` command of the wheel calls it."""
+
 class Spec:
     """A checked hstl spec, ready to monitor traces."""
 
@@ -342,7 +347,7 @@ def _train_env(
 
 #: One seed's figures: ``seed``, ``window_rate`` (or None), ``reward``, ``seconds``,
 #: ``steps`` and ``curve``.
-SeedRun = dict
+SeedRun = dict[str, Any]
 
 def _study_task(
     spec: Spec, world: World, episodes: Optional[int] = None
@@ -364,7 +369,7 @@ def _study_optimum(spec: Spec, world: World) -> Optional[float]:
     """W* of the spec's regions in the world, or None for a task without regions."""
     ...
 
-def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> dict:
+def _study_summary(runs: Sequence[SeedRun], optimum: Optional[float] = None) -> dict[str, Any]:
     """Mean, sd, min and max of ``seconds``, ``reward``, ``window_rate`` and ``ratio``."""
     ...
 

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Any, Callable, Iterable, List, Mapping, Optional, Sequence, Union
+import logging
+from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 from . import _hstl
 from ._hstl import Spec, World
@@ -25,20 +26,20 @@ _TASK_COST = 0.02
 _MAX_BATCH = 16
 
 
-class StudyResult(list):
+class StudyResult(List[Dict[str, Any]]):
     """The list ``hstl.study`` returns: one dict per (spec, seed), specs in the order given
     and seeds in the order asked, with ``summary``, one dict per spec (in the same order)
     with ``spec``, ``file``, ``optimum`` and the figures ``hstlc study`` prints over the
     seeds, each a dict of ``mean``, ``sd`` (sample), ``min`` and ``max``: ``seconds``,
     ``reward``, and where every seed has them ``window_rate`` and ``ratio`` (W/W*)."""
 
-    summary: List[dict]
+    summary: List[Dict[str, Any]]
 
-    def __init__(self, rows: Iterable[dict] = (), summary: Optional[List[dict]] = None):
+    def __init__(self, rows: Iterable[Dict[str, Any]] = (), summary: Optional[List[Dict[str, Any]]] = None) -> None:
         super().__init__(rows)
         self.summary = list(summary or [])
 
-    def __reduce__(self):
+    def __reduce__(self) -> Tuple[Any, ...]:
         return (StudyResult, (list(self), self.summary))
 
 
@@ -291,7 +292,7 @@ def _train_batch(
     seeds: List[int],
     episodes: Optional[int],
     before_batch: Optional[Callable[[List[int]], None]],
-) -> list:
+) -> List[Dict[str, Any]]:
     """One Ray task: a batch of seeds of one spec, on one thread (Ray runs a task per CPU)."""
     if before_batch is not None:
         before_batch(seeds)
@@ -314,7 +315,7 @@ def _on_ray(
     batch: Optional[int],
     max_retries: int,
     before_batch: Optional[Callable[[List[int]], None]],
-):
+) -> Tuple[List[List[Dict[str, Any]]], Dict[str, Optional[float]]]:
     try:
         import ray
     except ImportError:
@@ -328,11 +329,11 @@ def _on_ray(
             ray.init(
                 num_cpus=num_cpus,
                 include_dashboard=False,
-                logging_level="warning",
+                logging_level=logging.WARNING,
                 _node_ip_address="127.0.0.1",
             )
         else:
-            ray.init(address=address, logging_level="warning")
+            ray.init(address=address, logging_level=logging.WARNING)
         started = True
     try:
         cpus = int(ray.cluster_resources().get("CPU", 1))

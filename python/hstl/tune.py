@@ -50,7 +50,7 @@ def _report_function() -> Callable[[Dict[str, Any]], None]:
     else ``ray.train.report`` (the earlier Ray 2 releases)."""
     from ray import tune
 
-    report = getattr(tune, "report", None)
+    report: Optional[Callable[[Dict[str, Any]], None]] = getattr(tune, "report", None)
     if report is None:  # pragma: no cover - older Ray
         from ray import train
 

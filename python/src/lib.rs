@@ -9,6 +9,7 @@
 
 mod check;
 mod dense;
+mod cli;
 mod errors;
 mod files;
 mod gym;
@@ -35,6 +36,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
+    m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
     m.add_function(wrap_pyfunction!(spec::formula, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;

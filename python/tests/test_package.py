@@ -80,3 +80,26 @@ def test_the_example_script_runs():
     out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "robustness at step 0" in out.stdout
+
+
+def test_the_build_backend_stops_with_one_line_without_cargo(tmp_path):
+    # `pip install ./python` on a machine without Rust: the backend's first hook that needs
+    # cargo, run as pip runs it (in python/, with this interpreter), with no cargo on PATH.
+    code = (
+        "import sys; sys.path.insert(0, 'build_backend'); import hstl_build; "
+        f"hstl_build.prepare_metadata_for_build_wheel({str(tmp_path)!r})"
+    )
+    env = {"PATH": str(tmp_path), "HOME": str(tmp_path)}
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPO / "python", env=env, capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 1 and out.stdout == "", out
+    lines = out.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("hstl: cannot build: cargo is not on PATH"), out.stderr
+    assert "rustup.rs" in lines[0] and "scripts/wheel" in lines[0]
+    # And maturin's toolchain download is off unless asked for.
+    code = "import sys; sys.path.insert(0, 'build_backend'); import hstl_build; print(hstl_build.get_requires_for_build_wheel())"
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=REPO / "python", env=env, capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 0 and "puccinialin" not in out.stdout, out

@@ -1,0 +1,93 @@
+"""The gymnasium ids of the built-in worlds, registered without importing gymnasium first.
+
+``import hstl`` does not import gymnasium (it costs about 150 ms, and most uses of the
+monitors need none of it). The ids still work as gymnasium users expect: when gymnasium is
+already imported, ``import hstl`` registers them at once; otherwise ``install()`` puts a
+finder on ``sys.meta_path`` that registers them as soon as gymnasium's own import ends, and
+then leaves. Registering needs only strings (``entry_point="hstl._gym:GridWorldEnv"``), so
+``hstl._gym`` itself loads when an environment is first made.
+"""
+
+from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import sys
+import types
+import warnings
+from typing import Any, Optional, Sequence
+
+#: The episode length of the registered environments: the length of the greedy runs that
+#: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
+MAX_EPISODE_STEPS = 2000
+
+#: The ids registered for the built-in worlds, and the world each makes.
+REGISTERED = {"hstl/GridWorld-v0": "paper", "hstl/FourRooms-v0": "four-rooms"}
+
+
+def register() -> None:
+    """Registers the built-in worlds' ids with gymnasium (imports it; idempotent)."""
+    import gymnasium
+    from gymnasium.envs.registration import registry
+
+    for env_id, world in REGISTERED.items():
+        if env_id not in registry:
+            gymnasium.register(
+                id=env_id,
+                entry_point="hstl._gym:GridWorldEnv",
+                kwargs={"world": world},
+                max_episode_steps=MAX_EPISODE_STEPS,
+            )
+
+
+def install() -> None:
+    """Registers the ids now if gymnasium is imported, else once it is."""
+    if "gymnasium" in sys.modules:
+        register()
+    elif not any(isinstance(f, _RegisterAfterImport) for f in sys.meta_path):
+        sys.meta_path.insert(0, _RegisterAfterImport())
+
+
+class _RegisterAfterImport(importlib.abc.MetaPathFinder):
+    """Finds gymnasium as the other finders do, and wraps its loader so that the ids are
+    registered right after the package has run; removes itself once it has."""
+
+    def find_spec(
+        self, fullname: str, path: Optional[Sequence[str]], target: Optional[types.ModuleType] = None
+    ) -> Optional[importlib.machinery.ModuleSpec]:
+        if fullname != "gymnasium":
+            return None
+        if self in sys.meta_path:
+            sys.meta_path.remove(self)
+        for finder in sys.meta_path:
+            find = getattr(finder, "find_spec", None)
+            spec: Optional[importlib.machinery.ModuleSpec] = find(fullname, path, target) if find is not None else None
+            if spec is not None:
+                if spec.loader is not None and hasattr(spec.loader, "exec_module"):
+                    spec.loader = _Loader(spec.loader)
+                return spec
+        return None
+
+
+class _Loader(importlib.abc.Loader):
+    """gymnasium's own loader, then the registration."""
+
+    def __init__(self, loader: Any) -> None:
+        self._loader = loader
+
+    def create_module(self, spec: importlib.machinery.ModuleSpec) -> Optional[types.ModuleType]:
+        module: Optional[types.ModuleType] = self._loader.create_module(spec)
+        return module
+
+    def exec_module(self, module: types.ModuleType) -> None:
+        self._loader.exec_module(module)
+        try:
+            register()
+        except Exception as e:  # gymnasium itself imported; only the ids are missing
+            warnings.warn(f"hstl could not register its gymnasium ids: {e}", stacklevel=2)
+
+    def __getattr__(self, name: str) -> Any:
+        # What else importlib or a resource reader asks of the loader is gymnasium's.
+        if name == "_loader":
+            raise AttributeError(name)
+        return getattr(self._loader, name)
