@@ -26,6 +26,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from typing import Any, Callable
+
 import pandas as pd
 
 import hstl
@@ -46,11 +48,11 @@ spec BrakingNs {
 EPOCH_NS = 1_700_000_000_000_000_000  # 2023-11-14, as a ROS 2 clock would stamp
 
 
-def approach(brake_delay_s: float):
+def approach(brake_delay_s: float) -> list[tuple[float, str, float]]:
     """A robot that drives at 0.8 m/s towards an obstacle, comes near it at 0.6 s, and
     brakes `brake_delay_s` later: `(seconds, topic, value)` samples, each signal at its
     own rate."""
-    samples = []
+    samples: list[tuple[float, str, float]] = []
     for k in range(26):  # the range sensor, every 100 ms
         t = k * 0.1
         samples.append((t, "dist", round(max(0.3, 1.7 - 1.8 * t) if t < 1.6 else 0.3 + (t - 1.6), 3)))
@@ -61,7 +63,7 @@ def approach(brake_delay_s: float):
     return samples
 
 
-def write_ros2_bag(path: Path, samples) -> None:
+def write_ros2_bag(path: Path, samples: list[tuple[float, str, float]]) -> None:
     """A ROS 2 bag (sqlite3, format 9) with `std_msgs/msg/Float64` on `/dist` and `/speed`."""
     from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
@@ -91,13 +93,13 @@ def read_ros2_bag(path: Path) -> pd.DataFrame:
 
 
 # The CAN signal layout: frame id -> (signal, decode of the frame's data).
-CAN_LAYOUT = {
+CAN_LAYOUT: dict[int, tuple[str, Callable[[bytes], float]]] = {
     0x120: ("dist", lambda data: struct.unpack_from(">H", data)[0] / 1000.0),  # millimetres
     0x2A0: ("speed", lambda data: struct.unpack_from(">H", data)[0] / 100.0),  # 0.01 m/s
 }
 
 
-def write_can_log(path: Path, samples) -> None:
+def write_can_log(path: Path, samples: list[tuple[float, str, float]]) -> None:
     """An ASC log of the two frames (plus an unrelated one the layout ignores)."""
     import can
 
@@ -124,7 +126,7 @@ def read_can_log(path: Path) -> pd.DataFrame:
     return merge(rows)
 
 
-def merge(rows) -> pd.DataFrame:
+def merge(rows: list[Any]) -> pd.DataFrame:
     """Samples as one row per distinct stamp: the values given at that stamp, NaN for the
     rest (a DataFrame's `groupby(...).first()` skips NaN)."""
     df = pd.DataFrame(rows, columns=["t", "dist", "speed"])

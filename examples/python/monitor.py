@@ -31,12 +31,12 @@ trace = walk(2000, rng)
 # One trace: a 2-D array whose columns are the state variables in order (or a dict of
 # arrays, or a pandas DataFrame).
 print(f"robustness at step 0: {spec.robustness(trace)}")
-signal = spec.signal(trace, formula="A")  # the `let` A at every step
+signal = np.asarray(spec.signal(trace, formula="A"))  # the `let` A at every step
 print(f"A holds at {np.count_nonzero(signal > 0)} of {len(signal)} steps")
 
 # A batch: 200 rollouts of 500 steps, scored on every core.
 rollouts = np.stack([walk(500, rng) for _ in range(200)])
-scores = spec.signal_batch(rollouts)[:, 0]
+scores = np.asarray(spec.signal_batch(rollouts))[:, 0]
 print(f"best rollout: {int(np.argmax(scores))} with robustness {scores.max()}")
 
 # Online: one state at a time; a verdict for step t arrives once its window is complete.
