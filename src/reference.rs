@@ -278,8 +278,10 @@ impl Field {
     fn plan(world: &PlaneWorld, option: &hstl_runtime::PrimitiveOption, points: usize) -> Field {
         let ([x0, x1], [y0, y1]) = world.extent();
         let mut spacing = world.step_length() / 2.0;
-        let cells =
-            |s: f64| (((x1 - x0) / s).ceil() as usize + 1, ((y1 - y0) / s).ceil() as usize + 1);
+        // Lattice points along a width: a width of 1e300 steps saturates (a float cast
+        // does), and so must the point past it, or it wraps to no point at all.
+        let along = |w: f64, s: f64| ((w / s).ceil() as usize).saturating_add(1);
+        let cells = |s: f64| (along(x1 - x0, s), along(y1 - y0, s));
         while {
             let (nx, ny) = cells(spacing);
             nx.saturating_mul(ny) > points

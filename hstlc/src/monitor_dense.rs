@@ -328,7 +328,10 @@ impl MaxGap {
     fn parse(text: &str) -> Result<MaxGap, CliError> {
         let bad = || {
             CliError::new(
-                format!("`--max-gap {text}` is not a time: give a number of 0 or more"),
+                format!(
+                    "`--max-gap {text}` is not a time: give a decimal number of 0 or more, \
+                     without a sign or an exponent"
+                ),
                 Some(
                     "the gap is in the time column's unit, such as `0.5` for stamps in \
                      seconds or `500000000` for nanoseconds"
