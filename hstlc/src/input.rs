@@ -53,66 +53,27 @@ pub fn read_text(path: &Path, stdin_name: &str, limit: u64, what: &str) -> Resul
 }
 
 /// Reads the regular file `path` as [`read_text`] does, and refuses anything else (a named
-/// pipe, a device, a socket) before reading a byte: a world file that a spec names is read
-/// by `check` and by the language server on every keystroke, and opening a named pipe
-/// would wait for a writer forever.
+/// pipe, a device, a socket) before reading a byte ([`hstl::load::open_regular`]): a world
+/// file that a spec names is read by `check` and by the language server on every
+/// keystroke, and opening a named pipe would wait for a writer forever.
 pub fn read_regular_text(path: &Path, limit: u64, what: &str) -> Result<Input, CliError> {
     let name = path.display().to_string();
     let read_err = |source| CliError::Read { path: path.to_path_buf(), source };
-    let file = open_without_waiting(path).map_err(read_err)?;
-    let meta = file.metadata().map_err(read_err)?;
-    if meta.is_dir() {
-        let source = std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a folder");
-        return Err(read_err(source));
-    }
-    if !meta.is_file() {
-        return Err(CliError::new(
-            format!(
-                "`{}` is {}, not a regular file",
-                hstl::load::escape_controls(&name),
-                file_kind(&meta)
-            ),
-            Some(format!(
-                "a {what} is read only from a regular file: save it as one and name that file"
-            )),
-        ));
-    }
-    let bytes =
-        if meta.len() > limit { None } else { read_capped(file, limit).map_err(read_err)? };
+    let file = hstl::load::open_regular(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::InvalidInput {
+            CliError::new(
+                format!("`{}` is {e}", hstl::load::escape_controls(&name)),
+                Some(format!(
+                    "a {what} is read only from a regular file: save it as one and name that file"
+                )),
+            )
+        } else {
+            read_err(e)
+        }
+    })?;
+    let len = file.metadata().map_err(read_err)?.len();
+    let bytes = if len > limit { None } else { read_capped(file, limit).map_err(read_err)? };
     decode(name, bytes, limit, what)
-}
-
-/// Opens `path` for reading without waiting for a writer when it is a named pipe.
-#[cfg(unix)]
-fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
-    use std::os::unix::fs::OpenOptionsExt;
-    std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path)
-}
-
-/// Opens `path` for reading.
-#[cfg(not(unix))]
-fn open_without_waiting(path: &Path) -> std::io::Result<std::fs::File> {
-    std::fs::File::open(path)
-}
-
-/// What kind of file that is not a regular file or a folder `meta` describes.
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
-        if t.is_fifo() {
-            return "a named pipe";
-        }
-        if t.is_char_device() || t.is_block_device() {
-            return "a device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    let _ = meta;
-    "a special file"
 }
 
 /// The text of `bytes` read from `name` (`None`: more than `limit` bytes).

@@ -201,6 +201,17 @@ fn extreme_plane_worlds_train_and_are_described_in_short_numbers() {
     let run = hstlc(d, &["train", "tiny.hstl", "--out", "tiny", "--episodes", "1"]);
     assert_eq!(run.status, Some(0), "{}", run.stderr);
     assert!(run.stdout.contains("plane 14 x 14, step 1e-300, 4 headings"), "{}", run.stdout);
+    // The planned reference's lattice: its point count overflowed past 2^64 points (a panic
+    // in a debug build, a lattice of no points in a release one), and half of a step of
+    // 5e-324 is 0, which no doubling thins out (a loop without end).
+    write(d, "least.toml", plane("[0.0, 14.0]", "5e-324", ""));
+    write(d, "least.hstl", spec("least.toml", "0..=14"));
+    let run = hstlc(d, &["train", "least.hstl", "--out", "least", "--episodes", "1"]);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let args = ["eval", "least/policy.json", "--starts", "2", "--steps", "150"];
+    let run = hstlc_within(d, &args, Duration::from_secs(120));
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains("planned reference: window rate"), "{}", run.stdout);
 }
 
 /// An edit of a document.
