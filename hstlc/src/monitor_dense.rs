@@ -328,10 +328,7 @@ impl MaxGap {
     fn parse(text: &str) -> Result<MaxGap, CliError> {
         let bad = || {
             CliError::new(
-                format!(
-                    "`--max-gap {text}` is not a time: give a decimal number of 0 or more, \
-                     without a sign or an exponent"
-                ),
+                format!("`--max-gap {text}` is not a time: give a number of 0 or more"),
                 Some(
                     "the gap is in the time column's unit, such as `0.5` for stamps in \
                      seconds or `500000000` for nanoseconds"
@@ -339,12 +336,26 @@ impl MaxGap {
                 ),
             )
         };
-        let (digits, decimals) =
-            hstl::robustness::dense::TimeScale::parse_decimal(text).ok_or_else(bad)?;
         let bound: f64 = text.trim().parse().map_err(|_| bad())?;
-        if !bound.is_finite() {
+        if !(bound.is_finite() && bound >= 0.0) {
             return Err(bad());
         }
+        // A number, but one whose exact value has more digits than the exact comparison of
+        // gaps holds (`1e300`, 39 digits and more).
+        let (digits, decimals) = hstl::robustness::dense::TimeScale::parse_decimal(text)
+            .ok_or_else(|| {
+                CliError::new(
+                    format!(
+                        "`--max-gap {text}` has more digits than a gap is compared with \
+                         exactly: at most 38 in all, with the zeros an exponent stands for"
+                    ),
+                    Some(
+                        "write the gap with at most 38 digits, such as `1e37`, or leave \
+                         `--max-gap` out"
+                            .to_string(),
+                    ),
+                )
+            })?;
         Ok(MaxGap { text: text.trim().to_string(), digits, decimals, bound })
     }
 
