@@ -123,9 +123,7 @@ pub fn policy_json(
     source: &str,
     seed: u64,
 ) -> Result<String, Error> {
-    let m = &agent.model;
     let w = &agent.weights;
-    let actions: Vec<String> = with_world!(world, wd => Ok(hstl_runtime::World::actions(wd)))?;
     let sparse = |v: &[f64]| -> Vec<Value> {
         // Each weight as the 16 hex digits of its bits, as `q_tables` holds Q-values, so
         // that the document loads back to the same bits (`-0.0` included).
@@ -141,6 +139,32 @@ pub fn policy_json(
         .zip(&w.flat)
         .map(|(p, v)| (p.name.clone(), Value::Array(sparse(v))))
         .collect();
+    let mut doc = header(spec, world, &agent.model)?;
+    doc.insert(
+        "weights".into(),
+        json!({
+            "flat_len": w.flat.first().map_or(0, Vec::len),
+            "options_len": w.options.len(),
+            "flat": flat,
+            "options": sparse(&w.options),
+        }),
+    );
+    doc.insert("steps".into(), json!(w.steps));
+    doc.insert("choices".into(), json!(w.choices));
+    doc.insert("spec_source".into(), json!(source));
+    doc.insert("seed".into(), json!(seed));
+    serde_json::to_string_pretty(&Value::Object(doc)).map_err(|e| Error::Config(e.to_string()))
+}
+
+/// The entries of a learned function's `policy.json` that its spec, world and model
+/// determine: everything but the weights, the counts of training and the source. A replay
+/// requires each of them as written.
+fn header(
+    spec: &TaskSpec,
+    world: &AnyWorld,
+    m: &hstl_runtime::approx::Model,
+) -> Result<serde_json::Map<String, Value>, Error> {
+    let actions: Vec<String> = with_world!(world, wd => Ok(hstl_runtime::World::actions(wd)))?;
     let options: Vec<Value> = spec
         .options
         .iter()
@@ -150,41 +174,36 @@ pub fn policy_json(
             json!({"name": o.name, "sequence": seq})
         })
         .collect();
-    let mut doc = json!({
-        "spec": spec.name,
-        "env": {"name": world.name(), "params": world.params()},
-        "state_vars": m.vars,
-        "actions": actions,
-        "options": options,
-        "learner": "tiles",
-        "tiles": {
+    let mut doc = serde_json::Map::new();
+    doc.insert("spec".into(), json!(spec.name));
+    doc.insert("env".into(), json!({"name": world.name(), "params": world.params()}));
+    doc.insert("state_vars".into(), json!(m.vars));
+    doc.insert("actions".into(), json!(actions));
+    doc.insert("options".into(), json!(options));
+    doc.insert("learner".into(), json!("tiles"));
+    doc.insert(
+        "tiles".into(),
+        json!({
             "tilings": m.flat_coder.tilings(),
             "bins": m.flat_coder.bins(),
             "lo": m.flat_coder.lo(),
             "hi": m.flat_coder.hi(),
             "options_tilings": m.options_coder.tilings(),
             "options_bins": m.options_coder.bins(),
-        },
-        "weights": {
-            "flat_len": w.flat.first().map_or(0, Vec::len),
-            "options_len": w.options.len(),
-            "flat": flat,
-            "options": sparse(&w.options),
-        },
-        "steps": w.steps,
-        "choices": w.choices,
-        "spec_source": source,
-        "seed": seed,
-    });
+        }),
+    );
     if m.is_persistent() {
         let regions: Vec<&str> = spec.regions.iter().map(|r| r.name.as_str()).collect();
         let horizons: Vec<usize> = m.horizons().collect();
-        doc["memory"] = json!({"regions": regions, "horizons": horizons, "buckets": m.buckets});
+        doc.insert(
+            "memory".into(),
+            json!({"regions": regions, "horizons": horizons, "buckets": m.buckets}),
+        );
     }
     if spec.learn.switch == hstl_runtime::Switch::Step {
-        doc["switch"] = json!("step");
+        doc.insert("switch".into(), json!("step"));
     }
-    serde_json::to_string_pretty(&doc).map_err(|e| Error::Config(e.to_string()))
+    Ok(doc)
 }
 
 /// Whether a `policy.json` (already parsed) holds a learned function.
@@ -194,30 +213,37 @@ pub fn is_learned_function(doc: &Value) -> bool {
 
 /// [`is_learned_function`] of a `policy.json`'s text, read in one pass that keeps nothing
 /// but the top-level `learner` entry: a tabular policy is then parsed once, by its own
-/// typed reader, not also as a generic document (16 bytes of memory per byte of text).
+/// typed reader, not also as a generic document (16 bytes of memory per byte of text). A
+/// document that says `"learner": "tiles"` before it breaks off is one too, so that its
+/// error is the learned function's reader's (where it breaks off), not the tables'.
 pub fn is_learned_function_text(text: &str) -> bool {
     use serde::de::{Deserializer, IgnoredAny, MapAccess, Visitor};
-    struct Learner;
-    impl<'de> Visitor<'de> for Learner {
-        type Value = bool;
+    struct Learner<'a>(&'a std::cell::Cell<bool>);
+    impl<'de> Visitor<'de> for Learner<'_> {
+        type Value = ();
         fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
             f.write_str("a JSON object")
         }
-        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<bool, A::Error> {
-            let mut tiles = false;
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
             while let Some(key) = map.next_key::<std::borrow::Cow<'de, str>>()? {
                 if key == "learner" {
-                    tiles =
+                    let tiles =
                         map.next_value::<std::borrow::Cow<'de, str>>().is_ok_and(|v| v == "tiles");
+                    self.0.set(tiles);
+                    if tiles {
+                        return Ok(());
+                    }
                 } else {
                     map.next_value::<IgnoredAny>()?;
                 }
             }
-            Ok(tiles)
+            Ok(())
         }
     }
+    let tiles = std::cell::Cell::new(false);
     let mut de = serde_json::Deserializer::from_str(text);
-    de.deserialize_map(Learner).unwrap_or(false)
+    let _ = de.deserialize_map(Learner(&tiles));
+    tiles.get()
 }
 
 /// A `policy.json` of a learned function, checked whole against its spec and world.
@@ -294,7 +320,39 @@ fn entry(e: &Value) -> Option<(u64, u64)> {
     Some((pair[0].as_u64()?, u64::from_str_radix(h, 16).ok()?))
 }
 
-/// Reads the top level of a `policy.json`: `weights` as [`SparseWeights`], the rest kept.
+/// The most JSON values (numbers, strings, lists, objects) that the entries of a learned
+/// function's `policy.json` other than its weights may hold together: the world's 1,024
+/// obstacles take about 6,000, so a document past this is no `policy.json` `hstlc train`
+/// wrote, and is refused while it is read, before it takes memory.
+pub const MAX_HEADER_VALUES: usize = 1 << 20;
+
+/// The most options `weights.flat` may name (a spec has far fewer primitive options).
+const MAX_FLAT_NAMES: usize = 1 << 16;
+
+/// The most JSON values one weight entry `[INDEX, "16 hex digits"]` may hold (it holds 3).
+const MAX_ENTRY_VALUES: usize = 8;
+
+/// The top-level entries a learned function's `policy.json` has besides `weights`; any
+/// other is skipped as it is read.
+const HEADER_KEYS: [&str; 13] = [
+    "spec",
+    "env",
+    "state_vars",
+    "actions",
+    "options",
+    "learner",
+    "tiles",
+    "memory",
+    "switch",
+    "steps",
+    "choices",
+    "spec_source",
+    "seed",
+];
+
+/// Reads the top level of a `policy.json`: `weights` as [`SparseWeights`], the entries of
+/// [`HEADER_KEYS`] kept within [`MAX_HEADER_VALUES`], any other skipped; a key given twice
+/// is an error.
 struct TopLevel;
 
 impl<'de> serde::de::Visitor<'de> for TopLevel {
@@ -304,29 +362,130 @@ impl<'de> serde::de::Visitor<'de> for TopLevel {
     }
     fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
         let (mut doc, mut weights) = (serde_json::Map::new(), None);
+        let left = std::cell::Cell::new(MAX_HEADER_VALUES);
+        let mut seen: Vec<String> = Vec::new();
         while let Some(key) = map.next_key::<String>()? {
-            if key == "weights" {
-                weights = Some(map.next_value_seed(WeightsSeed)?);
-            } else {
-                let v = map.next_value::<Value>()?;
-                doc.insert(key, v);
+            if seen.contains(&key) {
+                return Err(serde::de::Error::custom(format_args!(
+                    "the entry `{}` is given twice",
+                    crate::load::escape_controls(&key)
+                )));
             }
+            if key == "weights" {
+                weights = Some(map.next_value_seed(WeightsSeed { left: &left })?);
+            } else if HEADER_KEYS.contains(&key.as_str()) {
+                let v = map.next_value_seed(Bounded { left: &left, what: "the document" })?;
+                doc.insert(key.clone(), v);
+            } else {
+                map.next_value::<serde::de::IgnoredAny>()?;
+                continue;
+            }
+            seen.push(key);
         }
         Ok((Value::Object(doc), weights))
     }
 }
 
-/// Reads `weights`: its lengths, and its lists entry by entry.
-struct WeightsSeed;
+/// Reads one JSON value, counting it and everything in it against `left`: past the budget,
+/// an error naming `what`, so that no part of a document takes more memory than its
+/// budget allows, whatever it holds.
+struct Bounded<'a> {
+    left: &'a std::cell::Cell<usize>,
+    what: &'static str,
+}
 
-impl<'de> serde::de::DeserializeSeed<'de> for WeightsSeed {
+impl Bounded<'_> {
+    fn take<E: serde::de::Error>(&self) -> Result<(), E> {
+        match self.left.get().checked_sub(1) {
+            Some(left) => {
+                self.left.set(left);
+                Ok(())
+            }
+            None => Err(E::custom(format_args!(
+                "{} holds more values than a policy.json `hstlc train` writes",
+                self.what
+            ))),
+        }
+    }
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for Bounded<'_> {
+    type Value = Value;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<Value, D::Error> {
+        d.deserialize_any(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for Bounded<'_> {
+    type Value = Value;
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E: serde::de::Error>(self, v: bool) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::Bool(v))
+    }
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::from(v))
+    }
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::from(v))
+    }
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Value, E> {
+        self.take()?;
+        Ok(serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number))
+    }
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::String(v.to_string()))
+    }
+    fn visit_string<E: serde::de::Error>(self, v: String) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::String(v))
+    }
+    fn visit_unit<E: serde::de::Error>(self) -> Result<Value, E> {
+        self.take()?;
+        Ok(Value::Null)
+    }
+    fn visit_none<E: serde::de::Error>(self) -> Result<Value, E> {
+        self.visit_unit()
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Value, A::Error> {
+        self.take()?;
+        let mut out = Vec::new();
+        while let Some(v) = seq.next_element_seed(Bounded { left: self.left, what: self.what })? {
+            out.push(v);
+        }
+        Ok(Value::Array(out))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Value, A::Error> {
+        self.take()?;
+        let mut out = serde_json::Map::new();
+        while let Some(k) = map.next_key::<String>()? {
+            self.take()?;
+            let v = map.next_value_seed(Bounded { left: self.left, what: self.what })?;
+            out.insert(k, v);
+        }
+        Ok(Value::Object(out))
+    }
+}
+
+/// Reads `weights`: its lengths, and its lists entry by entry; anything but the lists counts
+/// against `left`.
+struct WeightsSeed<'a> {
+    left: &'a std::cell::Cell<usize>,
+}
+
+impl<'de> serde::de::DeserializeSeed<'de> for WeightsSeed<'_> {
     type Value = SparseWeights;
     fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<SparseWeights, D::Error> {
         d.deserialize_any(self)
     }
 }
 
-impl<'de> serde::de::Visitor<'de> for WeightsSeed {
+impl<'de> serde::de::Visitor<'de> for WeightsSeed<'_> {
     type Value = SparseWeights;
     fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("the weights object")
@@ -338,8 +497,14 @@ impl<'de> serde::de::Visitor<'de> for WeightsSeed {
         let mut out = SparseWeights::default();
         while let Some(key) = map.next_key::<String>()? {
             match key.as_str() {
-                "flat_len" => out.flat_len = map.next_value::<Value>()?.as_u64(),
-                "options_len" => out.options_len = map.next_value::<Value>()?.as_u64(),
+                "flat_len" => {
+                    let v = map.next_value_seed(Bounded { left: self.left, what: "`weights`" })?;
+                    out.flat_len = v.as_u64();
+                }
+                "options_len" => {
+                    let v = map.next_value_seed(Bounded { left: self.left, what: "`weights`" })?;
+                    out.options_len = v.as_u64();
+                }
                 "options" => out.options = Some(map.next_value_seed(EntriesSeed)?),
                 "flat" => out.flat = map.next_value_seed(FlatSeed)?,
                 _ => {
@@ -420,8 +585,12 @@ impl<'de> serde::de::Visitor<'de> for EntriesOrMap {
     }
     fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Lists, A::Error> {
         let mut out = Vec::new();
-        // One small entry at a time: only its compact form stays.
-        while let Some(e) = seq.next_element::<Value>()? {
+        // One small entry at a time: only its compact form stays, and an entry that holds
+        // more than an entry does is refused as it is read.
+        loop {
+            let left = std::cell::Cell::new(MAX_ENTRY_VALUES);
+            let seed = Bounded { left: &left, what: "an entry of `weights`" };
+            let Some(e) = seq.next_element_seed(seed)? else { break };
             out.push(entry(&e));
         }
         Ok(Lists::List(out))
@@ -429,6 +598,11 @@ impl<'de> serde::de::Visitor<'de> for EntriesOrMap {
     fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Lists, A::Error> {
         let mut out = Vec::new();
         while let Some(key) = map.next_key::<String>()? {
+            if out.len() == MAX_FLAT_NAMES {
+                return Err(serde::de::Error::custom(format_args!(
+                    "`weights.flat` names more than {MAX_FLAT_NAMES} options"
+                )));
+            }
             out.push((key, map.next_value_seed(EntriesSeed)?));
         }
         Ok(Lists::Map(out))
@@ -506,21 +680,38 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
             .map_err(|e| {
                 Problem::new(format!("it does not fit its spec and world: {e}"), retrain())
             })?;
-    let m = &agent0.model;
-    let tiles = field("tiles")?;
-    let same = tiles.get("tilings").and_then(Value::as_u64) == Some(m.flat_coder.tilings() as u64)
-        && tiles.get("bins") == Some(&json!(m.flat_coder.bins()))
-        && tiles.get("lo") == Some(&json!(m.flat_coder.lo()))
-        && tiles.get("hi") == Some(&json!(m.flat_coder.hi()))
-        && tiles.get("options_tilings").and_then(Value::as_u64)
-            == Some(m.options_coder.tilings() as u64)
-        && tiles.get("options_bins") == Some(&json!(m.options_coder.bins()));
-    if !same {
-        return Err(Problem::new(
-            "its `tiles` are not the tiling its spec and world give",
-            edited(),
-        ));
+    // Every entry the spec, the world and the model determine must be as `policy_json`
+    // writes it: the tiling, the world whole, the names of the variables, actions and
+    // options, the memory and the switch.
+    let expected = header(&spec, &world, &agent0.model)
+        .map_err(|e| Problem::new(format!("it does not fit its spec and world: {e}"), retrain()))?;
+    field("tiles")?;
+    for (key, want) in &expected {
+        if doc.get(key) != Some(want) {
+            let message = match key.as_str() {
+                "tiles" => "its `tiles` are not the tiling its spec and world give".to_string(),
+                "env" => "its `env` is not the world as `hstlc train` writes it".to_string(),
+                "memory" | "switch" if doc.get(key).is_none() => {
+                    format!("it has no `{key}` entry, which its spec gives")
+                }
+                _ => format!("its `{key}` is not what its spec and world give"),
+            };
+            return Err(Problem::new(message, edited()));
+        }
     }
+    for key in ["memory", "switch"] {
+        if doc.get(key).is_some() && !expected.contains_key(key) {
+            let message = format!("it has a `{key}` entry, which its spec does not give");
+            return Err(Problem::new(message, edited()));
+        }
+    }
+    let count = |key: &str| match doc.get(key) {
+        None => Ok(0),
+        Some(v) => v
+            .as_u64()
+            .ok_or_else(|| Problem::new(format!("its `{key}` is not a whole number"), edited())),
+    };
+    let (steps, choices) = (count("steps")?, count("choices")?);
     let weights_doc =
         weights_doc.ok_or_else(|| Problem::new("it has no `weights` entry", edited()))?;
     let mut weights = agent0.weights.clone();
@@ -562,8 +753,8 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
         .ok_or_else(|| Problem::new("it has no `weights.options`", edited()))?;
     fill(&mut weights.options, options.as_deref(), "weights.options")
         .map_err(|m| Problem::new(m, edited()))?;
-    weights.steps = doc.get("steps").and_then(Value::as_u64).unwrap_or(0);
-    weights.choices = doc.get("choices").and_then(Value::as_u64).unwrap_or(0);
+    weights.steps = steps;
+    weights.choices = choices;
     let agent = ApproxAgent { weights, ..agent0 };
     Ok(Replay { spec, world, agent, source, seed })
 }

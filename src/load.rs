@@ -238,6 +238,49 @@ impl fmt::Display for UnknownCode {
 
 impl std::error::Error for UnknownCode {}
 
+/// Opens `path` for reading when it is a regular file. A folder is an error of kind
+/// `IsADirectory`; a named pipe, a device or a socket one of kind `InvalidInput` whose
+/// message says what it is ("a named pipe, not a regular file"), before a byte is read: a
+/// file that a spec names (its `world` item) is read by `check` and by the language server
+/// on every keystroke, and opening a named pipe for reading waits for a writer, forever if
+/// none comes. The file is opened without waiting and then looked at.
+pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
+    #[cfg(unix)]
+    let file = {
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path)?
+    };
+    #[cfg(not(unix))]
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if meta.is_dir() {
+        return Err(std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a folder"));
+    }
+    if meta.is_file() {
+        return Ok(file);
+    }
+    #[cfg(unix)]
+    let kind = {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            "a named pipe"
+        } else if t.is_char_device() || t.is_block_device() {
+            "a device"
+        } else if t.is_socket() {
+            "a socket"
+        } else {
+            "a special file"
+        }
+    };
+    #[cfg(not(unix))]
+    let kind = "a special file";
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("{kind}, not a regular file"),
+    ))
+}
+
 /// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
 /// "(os error N)" tail.
 pub fn read_error(path: &Path, error: &std::io::Error) -> String {

@@ -277,9 +277,13 @@ impl Field {
     /// The field of `option`'s stop region on a lattice of at most `points` points.
     fn plan(world: &PlaneWorld, option: &hstl_runtime::PrimitiveOption, points: usize) -> Field {
         let ([x0, x1], [y0, y1]) = world.extent();
-        let mut spacing = world.step_length() / 2.0;
-        let cells =
-            |s: f64| (((x1 - x0) / s).ceil() as usize + 1, ((y1 - y0) / s).ceil() as usize + 1);
+        // Half a step, or the least normal double for a step so small that half of it is
+        // zero (doubling zero would never thin the lattice out).
+        let mut spacing = (world.step_length() / 2.0).max(f64::MIN_POSITIVE);
+        // Lattice points along a width: a width of 1e300 steps saturates (a float cast
+        // does), and so must the point past it, or it wraps to no point at all.
+        let along = |w: f64, s: f64| ((w / s).ceil() as usize).saturating_add(1);
+        let cells = |s: f64| (along(x1 - x0, s), along(y1 - y0, s));
         while {
             let (nx, ny) = cells(spacing);
             nx.saturating_mul(ny) > points

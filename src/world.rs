@@ -112,7 +112,15 @@ pub fn words(world: &AnyWorld, file: Option<&str>) -> String {
     let from = file.map_or(String::new(), |f| format!("{f}; "));
     let name = world.name();
     // Nine decimals: a `policy.json` written before worlds stores p, and 1 - 0.7 is not 0.3.
-    let round = |v: f64| (v * 1e9).round() / 1e9;
+    // A plane's numbers may be anything finite: past moderate magnitudes, with an exponent.
+    let round = |v: f64| {
+        let a = v.abs();
+        if a == 0.0 || (1e-5..1e16).contains(&a) {
+            ((v * 1e9).round() / 1e9).to_string()
+        } else {
+            hstl_runtime::plane::num(v)
+        }
+    };
     match world {
         AnyWorld::Grid(g) => {
             let cells = g.width() * g.height();
@@ -130,6 +138,14 @@ pub fn words(world: &AnyWorld, file: Option<&str>) -> String {
         }
         AnyWorld::Plane(p) => {
             let ([x0, x1], [y0, y1]) = p.extent();
+            // A width past the largest double is shown as its extent.
+            let size = |lo: f64, hi: f64| {
+                if (hi - lo).is_finite() {
+                    round(hi - lo)
+                } else {
+                    format!("[{}, {}]", hstl_runtime::plane::num(lo), hstl_runtime::plane::num(hi))
+                }
+            };
             let obstacles = match p.obstacles().len() {
                 0 => String::new(),
                 1 => ", 1 obstacle".into(),
@@ -137,12 +153,12 @@ pub fn words(world: &AnyWorld, file: Option<&str>) -> String {
             };
             format!(
                 "world `{name}` ({from}plane {} x {}, step {}, {} headings, slip {}, noise {}{obstacles})",
-                round(x1 - x0),
-                round(y1 - y0),
-                p.step_length(),
+                size(x0, x1),
+                size(y0, y1),
+                hstl_runtime::plane::num(p.step_length()),
                 p.headings(),
                 round(p.slip()),
-                p.noise()
+                hstl_runtime::plane::num(p.noise())
             )
         }
         AnyWorld::MountainCar(_) => {

@@ -100,7 +100,10 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
     assert!(!c::is_learned_function_text(r#"{"spec": "S", "learner": 3, "flat_policies": {}}"#));
     assert!(!c::is_learned_function_text(r#"{"learner": "table"}"#));
     assert!(!c::is_learned_function_text("[1, 2]"));
-    assert!(!c::is_learned_function_text("{\"learner\": \"tiles\""));
+    // A document cut off after `"learner": "tiles"` is one, so that its error says where
+    // it breaks off rather than what a table lacks.
+    assert!(c::is_learned_function_text("{\"learner\": \"tiles\""));
+    assert!(!c::is_learned_function_text("{\"learner\": \"til"));
     let replay = c::replay(&doc).expect("loads");
     assert_eq!(replay.seed, Some(2));
     // Read from the text in one pass (the weights straight into pairs), the same agent.
@@ -144,8 +147,7 @@ fn policy_json_loads_back_to_the_same_bits_and_edits_are_refused() {
     });
     assert!(msg.contains("primitive"), "{msg}");
     let msg = edit(&|d| {
-        d["env"] =
-            serde_json::json!({"name": "paper", "params": {"slip": 0.3, "map": ["..", ".."]}})
+        d["env"] = serde_json::json!({"name": "tiny", "params": {"slip": 0.3, "map": ["..", ".."]}})
     });
     assert!(msg.contains("grid"), "{msg}");
     // Weights of the wrong type anywhere, and text that is not a whole document.

@@ -209,8 +209,11 @@ impl WorldFacts {
 impl BoxFacts {
     /// The state block a spec needs for this world.
     fn declaration(&self) -> String {
-        let vars: Vec<String> =
-            self.vars.iter().map(|(n, lo, hi)| format!("{n}: float in {lo}..={hi}")).collect();
+        let vars: Vec<String> = self
+            .vars
+            .iter()
+            .map(|(n, lo, hi)| format!("{n}: float in {}..={}", literal(*lo), literal(*hi)))
+            .collect();
         format!("`{}`", vars.join(", "))
     }
 
@@ -243,8 +246,11 @@ impl BoxFacts {
                         "HSTL030",
                         v.name_range.start..v.range.end,
                         format!(
-                            "state variable `{}` must be `float in {lo}..={hi}`: the range of {}",
-                            v.name, self.label
+                            "state variable `{}` must be `float in {}..={}`: the range of {}",
+                            v.name,
+                            literal(*lo),
+                            literal(*hi),
+                            self.label
                         ),
                     )
                     .with_help(help.clone()),
@@ -257,6 +263,14 @@ impl BoxFacts {
             }
         }
     }
+}
+
+/// A bound as a spec writes it, read back to the same double: plain for moderate
+/// magnitudes (`0`, `14`, `-2.5`), with an exponent past them (`1e300`, `5e-324`), so that
+/// no message spells out three hundred digits.
+fn literal(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 || (1e-5..1e16).contains(&a) { v.to_string() } else { format!("{v:e}") }
 }
 
 /// `HSTL030` for a variable `name` that the world `label` needs and the spec's state lacks,

@@ -210,7 +210,10 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
             outln!("{}", window_line(w.rate, (lo, hi), args.burn_in, &spec.regions))?;
             let Stats { mean, min: lo, max: hi, .. } = Stats::of(&w.robustness);
             outln!(
-                "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
+                "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
+                figure(mean),
+                figure(lo),
+                figure(hi)
             )?;
         }
         c::Evaluation::Satisfaction { rate } => {
@@ -249,13 +252,23 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
     Ok(Status::Clean)
 }
 
+/// A robustness figure: three decimals, or three significant digits and an exponent past a
+/// million (a world 1e300 wide has robustness values of that size; three decimals of them
+/// are three hundred digits).
+fn figure(v: f64) -> String {
+    if v.is_finite() && v.abs() >= 1e6 { format!("{v:.3e}") } else { format!("{v:.3}") }
+}
+
 /// The task's robustness over each run, windows clipped and complete; satisfaction is
 /// counted over complete windows, since clipped ones fail a persistent task at the end of
 /// nearly every finite run.
 fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
     let Stats { mean, min: lo, max: hi, .. } = Stats::of(values);
     outln!(
-        "  task robustness over each run (windows clipped at the run's end): mean {mean:.3}, min {lo:.3}, max {hi:.3}"
+        "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
+        figure(mean),
+        figure(lo),
+        figure(hi)
     )?;
     let determined: Vec<f64> = complete.iter().flatten().copied().collect();
     let satisfied = evaluate::satisfied(values, complete);
@@ -263,7 +276,7 @@ fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliE
         "no run is long enough for one".to_string()
     } else {
         let Stats { mean, min: lo, max: hi, .. } = Stats::of(&determined);
-        format!("mean {mean:.3}, min {lo:.3}, max {hi:.3}")
+        format!("mean {}, min {}, max {}", figure(mean), figure(lo), figure(hi))
     };
     let short = complete.len() - determined.len();
     let short = match short {

@@ -49,6 +49,35 @@ pub fn read_text(path: &Path, stdin_name: &str, limit: u64, what: &str) -> Resul
             read(path).map_err(|source| CliError::Read { path: path.to_path_buf(), source })?;
         (name, bytes)
     };
+    decode(name, bytes, limit, what)
+}
+
+/// Reads the regular file `path` as [`read_text`] does, and refuses anything else (a named
+/// pipe, a device, a socket) before reading a byte ([`hstl::load::open_regular`]): a world
+/// file that a spec names is read by `check` and by the language server on every
+/// keystroke, and opening a named pipe would wait for a writer forever.
+pub fn read_regular_text(path: &Path, limit: u64, what: &str) -> Result<Input, CliError> {
+    let name = path.display().to_string();
+    let read_err = |source| CliError::Read { path: path.to_path_buf(), source };
+    let file = hstl::load::open_regular(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::InvalidInput {
+            CliError::new(
+                format!("`{}` is {e}", hstl::load::escape_controls(&name)),
+                Some(format!(
+                    "a {what} is read only from a regular file: save it as one and name that file"
+                )),
+            )
+        } else {
+            read_err(e)
+        }
+    })?;
+    let len = file.metadata().map_err(read_err)?.len();
+    let bytes = if len > limit { None } else { read_capped(file, limit).map_err(read_err)? };
+    decode(name, bytes, limit, what)
+}
+
+/// The text of `bytes` read from `name` (`None`: more than `limit` bytes).
+fn decode(name: String, bytes: Option<Vec<u8>>, limit: u64, what: &str) -> Result<Input, CliError> {
     let Some(mut bytes) = bytes else {
         return Err(too_large(&name, limit, what));
     };

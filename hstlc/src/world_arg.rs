@@ -56,7 +56,7 @@ impl LoadedWorld {
         // A file that cannot be read stays `CliError::Read`, so each caller says how to fix
         // it (too large or not UTF-8 say so already).
         let input::Input { name: file, text, .. } =
-            input::read_text(path, "<stdin>", hstl::world::MAX_WORLD_BYTES as u64, "world file")?;
+            input::read_regular_text(path, hstl::world::MAX_WORLD_BYTES as u64, "world file")?;
         let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
         let world = hstl::world::any_from_file(&text, &file, &stem)
             .map_err(|p| CliError::new(p.message, p.help))?;

@@ -226,6 +226,16 @@ const CASES: &[Case] = &[
         ],
         stdin: "t,x,y\n-1.5,1,5\n-0.5,2,\n0,,6\n0.5,3,\n2,0.5,\n2.5,,-1\n3.5,4,\n",
     },
+    // issue 30's campaign: stamps 2^64 units apart (no help before), a gap with an exponent
+    // (refused as "not a number of 0 or more" before)
+    case(
+        "monitor_dense_stamp_span",
+        &["monitor", "dense_ns.hstl", "--trace", "dense_stamp_span.csv", "--signal"],
+    ),
+    case(
+        "monitor_dense_max_gap_exponent",
+        &["monitor", "dense.hstl", "--trace", "dense.csv", "--max-gap", "1e300"],
+    ),
     case("monitor_dense_bad_stamp", &["monitor", "dense.hstl", "--trace", "dense_bad_stamp.csv"]),
     case("monitor_dense_bad_cell", &["monitor", "dense.hstl", "--trace", "dense_bad_cell.csv"]),
     case(

@@ -224,8 +224,9 @@ pub(crate) const START_HELP: &str = "write the start rectangle as `start = [x0, 
 const FREE_HELP: &str = "move the start rectangle (`start = [x0, y0, x1, y1]`) to where the \
                          obstacles leave room, or make the obstacles smaller";
 
-/// A number as messages show it: plain for moderate magnitudes, with an exponent beyond.
-pub(crate) fn num(v: f64) -> String {
+/// A number as messages show it: plain for moderate magnitudes, with an exponent beyond
+/// (`1e300`, `5e-324`), read back to the same double either way.
+pub fn num(v: f64) -> String {
     let a = v.abs();
     if v.is_finite() && a != 0.0 && !(1e-5..1e16).contains(&a) {
         format!("{v:e}")
@@ -260,6 +261,16 @@ impl PlaneWorld {
                 let message = format!(
                     "{axis} = {}: the lower bound must be less than the upper",
                     list(&[lo, hi])
+                );
+                return err(field(None), message, EXTENT_HELP);
+            }
+            // Every length in the world (tiles, pictures, distances) is a difference of
+            // positions: the widest must be a double too.
+            if !(hi - lo).is_finite() {
+                let message = format!(
+                    "{axis} = {}: the extent is wider than the largest number, {}",
+                    list(&[lo, hi]),
+                    num(f64::MAX)
                 );
                 return err(field(None), message, EXTENT_HELP);
             }

@@ -194,7 +194,10 @@ impl AnyWorld {
     /// [`World::params`] wrote. `"kind": "plane"` is a plane world; no `kind` (or
     /// `"grid"`) a grid world, also one written before worlds existed.
     pub fn from_params(name: &str, params: &Value) -> Result<AnyWorld, Error> {
-        match params.get("kind") {
+        if let Some(problem) = name_problem(name) {
+            return Err(Error::Env(problem));
+        }
+        let world = match params.get("kind") {
             None => GridWorld::from_params(name, params).map(AnyWorld::Grid),
             Some(Value::String(k)) if k == "grid" => {
                 GridWorld::from_params(name, params).map(AnyWorld::Grid)
@@ -208,7 +211,16 @@ impl AnyWorld {
             Some(_) => {
                 Err(Error::Env("the world's `kind` is neither \"grid\" nor \"plane\"".into()))
             }
+        }?;
+        // A built-in world's name stands for that world: another world under it is not it.
+        if let Some(builtin) = AnyWorld::builtin(name)
+            && builtin != world
+        {
+            return Err(Error::Env(format!(
+                "the world is named `{name}`, a built-in world, but its parameters are not `{name}`'s"
+            )));
         }
+        Ok(world)
     }
 
     /// The world's name.
@@ -301,8 +313,37 @@ fn document(text: &str) -> Result<Document<'_>, WorldError> {
             SIZE_HELP,
         ));
     }
+    // And so is the number of values: the parser keeps about a hundred bytes per value.
+    if let Some(at) = past_value_budget(text) {
+        return Err(WorldError::new(
+            format!(
+                "the world file holds more than {} values (numbers, strings, lists, tables)",
+                grouped(MAX_WORLD_VALUES)
+            ),
+            Some(at..at + 1),
+            SIZE_HELP,
+        ));
+    }
     let table = DeTable::parse(text).map_err(|e| {
         let message = e.message().trim_end_matches(['\n', '.']).replace('\n', "; ");
+        if message == "recursion limit" {
+            // The parser's limit on dotted keys comes without a place: the first line with
+            // that many dots is it.
+            let at = text
+                .lines()
+                .scan(0, |start, line| {
+                    let here = *start;
+                    *start += line.len() + 1;
+                    Some((here, line))
+                })
+                .find(|(_, line)| line.matches('.').count() >= DOTTED_LIMIT - 1)
+                .map(|(at, line)| at..at + line.len());
+            return WorldError::new(
+                format!("a key has more than {} dotted parts", DOTTED_LIMIT - 1),
+                at.or(e.span()),
+                "write the world's keys as the world file format names them, such as `x = [0.0, 20.0]`; no world key is nested",
+            );
+        }
         WorldError::new(message, e.span(), TOML_HELP)
     })?;
     let kind = match table.get_ref().get("kind") {
@@ -331,6 +372,57 @@ fn document(text: &str) -> Result<Document<'_>, WorldError> {
         }
     };
     Ok((table, kind))
+}
+
+/// The most values (numbers, strings, lists, tables, keys) a world file may hold: a
+/// plane's [`crate::plane::MAX_OBSTACLES`] obstacles take about 6,000, a grid's map is one.
+pub const MAX_WORLD_VALUES: usize = 1 << 16;
+
+/// The TOML parser's limit on the parts of a dotted key.
+const DOTTED_LIMIT: usize = 80;
+
+/// Where a world file's text passes [`MAX_WORLD_VALUES`], if it does, counted before it is
+/// parsed: each value but the first follows one of `[ { , = .` outside strings and comments
+/// (a dot in a number counts too, which only over-counts).
+fn past_value_budget(text: &str) -> Option<usize> {
+    let b = text.as_bytes();
+    let mut count = 0usize;
+    let mut i = 0;
+    // Skips a string opened at `i` by `quote` (`"` with escapes, `'` without), one line or
+    // three quotes long; returns where it ends.
+    let skip = |i: usize, quote: u8| -> usize {
+        let triple = b.len() >= i + 3 && b[i + 1] == quote && b[i + 2] == quote;
+        let mut j = if triple { i + 3 } else { i + 1 };
+        while j < b.len() {
+            match b[j] {
+                b'\\' if quote == b'"' => j += 2,
+                c if c == quote && !triple => return j + 1,
+                c if c == quote && b.len() >= j + 3 && b[j + 1] == quote && b[j + 2] == quote => {
+                    return j + 3;
+                }
+                b'\n' if !triple => return j + 1,
+                _ => j += 1,
+            }
+        }
+        b.len()
+    };
+    while i < b.len() {
+        match b[i] {
+            b'#' => {
+                i = b[i..].iter().position(|&c| c == b'\n').map_or(b.len(), |n| i + n + 1);
+            }
+            q @ (b'"' | b'\'') => i = skip(i, q),
+            b'[' | b'{' | b',' | b'=' | b'.' => {
+                count += 1;
+                if count > MAX_WORLD_VALUES {
+                    return Some(i);
+                }
+                i += 1;
+            }
+            _ => i += 1,
+        }
+    }
+    None
 }
 
 /// The most bytes a world file may have: a map of [`crate::grid::MAX_GRID_CELLS`] cells,
@@ -381,14 +473,29 @@ fn world_name(
     default_name: &str,
 ) -> Result<String, WorldError> {
     match name {
-        Some((n, span)) if n.trim().is_empty() || n.len() > 200 => Err(WorldError::new(
-            "the world's name must hold 1 to 200 characters",
-            Some(span),
-            NAME_HELP,
-        )),
-        Some((n, _)) => Ok(n.to_string()),
+        Some((n, span)) => match name_problem(n) {
+            Some(problem) => Err(WorldError::new(problem, Some(span), NAME_HELP)),
+            None => Ok(n.to_string()),
+        },
         None => Ok(default_name.to_string()),
     }
+}
+
+/// What is wrong with a world's name, if anything: it holds 1 to 200 bytes, not all white
+/// space, and no control character (a name is shown in messages, written into
+/// `policy.json` and drawn into pictures, so none may move a terminal's cursor or hide what
+/// follows it).
+pub fn name_problem(name: &str) -> Option<String> {
+    if name.trim().is_empty() || name.len() > 200 {
+        return Some("the world's name must hold 1 to 200 characters".into());
+    }
+    let bidi = |c: char| matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    name.chars().find(|&c| c.is_control() || bidi(c)).map(|c| {
+        format!(
+            "the world's name holds the control character U+{:04X}; a name is plain text",
+            u32::from(c)
+        )
+    })
 }
 
 /// Reads a grid world from the file's table (without `kind`).
@@ -529,7 +636,7 @@ impl Locator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Env;
+    use crate::{Env, World};
 
     /// A file of line ends only cost the TOML parser tens of bytes a line (a 63 MiB one took
     /// 3.1 GB and 12 s): past the limits it is refused before parsing, the line named.
@@ -545,6 +652,80 @@ mod tests {
         // A tall map, 65,536 rows of one cell, still reads.
         let tall = format!("map = \"\"\"\n{}\"\"\"\n", ".\n".repeat(1 << 16));
         assert!(AnyWorld::from_toml(&tall, "tall").is_ok());
+    }
+
+    /// Issue 30 (the campaign on world files): 400,000 obstacles fit in the 8 MiB a world
+    /// file may have, and the parser took 796 MB for them before the count refused them.
+    #[test]
+    fn the_values_of_a_world_file_are_counted_before_it_is_parsed() {
+        let head = "kind = \"plane\"\nx = [0.0, 9.0]\ny = [0.0, 9.0]\nstep = 1.0\nheadings = 4\n";
+        let many = format!("{head}obstacles = [\n{}]\n", "{circle=[1,1,1]},\n".repeat(400_000));
+        assert!(many.len() < MAX_WORLD_BYTES);
+        let e = AnyWorld::from_toml(&many, "w").expect_err("too many values");
+        assert_eq!(
+            e.message,
+            "the world file holds more than 65,536 values (numbers, strings, lists, tables)"
+        );
+        let at = e.span.expect("placed").start;
+        assert!(many[..at].starts_with(head) && at < many.len() / 2, "{at}");
+        // Strings and comments are not counted: a map full of commas and brackets is one
+        // value, and so is a comment.
+        let map = format!(
+            "# {}\nname = \"{}\"\nmap = \"\"\"\n{}\"\"\"\n",
+            ",".repeat(100_000),
+            "a",
+            "..\n".repeat(1_000)
+        );
+        assert_eq!(past_value_budget(&map), None);
+        let quoted = format!("a = '{}'\nb = \"\\\"{}\"\n", "[".repeat(70_000), ",".repeat(70_000));
+        assert_eq!(past_value_budget(&quoted), None);
+        // The largest world a file may describe is far inside the budget.
+        let obstacles = "{ rect = [1.5, 1.5, 2.5, 2.5] },\n".repeat(MAX_OBSTACLES);
+        let full = format!("{head}obstacles = [\n{obstacles}]\n");
+        assert_eq!(past_value_budget(&full), None);
+    }
+
+    /// Issue 30: an extent of finite bounds whose width overflows was accepted, trained
+    /// with every state in one tile, and failed only when its pictures were drawn.
+    #[test]
+    fn an_extent_wider_than_the_largest_double_is_refused() {
+        let text = "kind = \"plane\"\nx = [-1.7976931348623157e308, 1.7976931348623157e308]\n\
+                    y = [0.0, 1.0]\nstep = 1.0\nheadings = 4\n";
+        let e = AnyWorld::from_toml(text, "w").expect_err("too wide");
+        assert!(e.message.contains("the extent is wider than the largest number"), "{}", e.message);
+        assert_eq!(e.span.map(|s| s.start), text.find('['));
+        let lo = [-f64::MAX, 0.0];
+        let e = crate::approx::tiles::TileCoder::new(&lo, &[f64::MAX, 1.0], &[4, 4], 2)
+            .expect_err("a tiling of an infinite width");
+        assert!(e.contains("finite width") && e.contains("-1.7976931348623157e308"), "{e}");
+    }
+
+    /// Issue 30: a dotted key past the parser's depth was "recursion limit", with no place.
+    #[test]
+    fn a_key_with_too_many_dotted_parts_is_placed() {
+        let text = format!("kind = \"plane\"\n[{}]\nb = 1\n", vec!["a"; 100].join("."));
+        let e = AnyWorld::from_toml(&text, "w").expect_err("too deep");
+        assert_eq!(e.message, "a key has more than 79 dotted parts");
+        assert_eq!(e.span.map(|s| s.start), Some(15));
+    }
+
+    /// Issue 30: a world's name reaches terminals, `policy.json` and pictures; one with a
+    /// control character (an escape sequence) was shown raw.
+    #[test]
+    fn a_world_name_with_a_control_character_is_refused() {
+        let text = "name = \"a\\u001b[31mred\"\nmap = \"\"\"\n..\n\"\"\"\n";
+        let e = AnyWorld::from_toml(text, "w").expect_err("a control character");
+        assert!(e.message.contains("control character U+001B"), "{}", e.message);
+        let grid = builtin("paper").expect("paper");
+        let e = AnyWorld::from_params("a\u{202e}b", &World::params(&grid)).expect_err("bidi");
+        assert!(e.to_string().contains("U+202E"), "{e}");
+        // A built-in world's name on other parameters is not that world.
+        let four = builtin("four-rooms").expect("four-rooms");
+        let e = AnyWorld::from_params("paper", &World::params(&four)).expect_err("not paper");
+        assert!(e.to_string().contains("built-in world"), "{e}");
+        assert!(AnyWorld::from_params("paper", &World::params(&grid)).is_ok());
+        let plane = AnyWorld::builtin("paper-plane").expect("paper-plane");
+        assert_eq!(AnyWorld::from_params("paper-plane", &plane.params()).ok(), Some(plane));
     }
 
     #[test]

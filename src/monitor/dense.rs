@@ -368,7 +368,23 @@ impl Dense {
                     time: None,
                 },
                 T::Inexact { row, .. } | T::MixedStamps { row } | T::BadStamp { row, .. } => {
-                    DenseProblem { row: Some(row), ..plain(strip_row(&t.to_string())) }
+                    let help = match t {
+                        T::Inexact { .. } => {
+                            "whole-number stamps are taken relative to the first, within 2^53 \
+                             units of it: monitor the parts of the trace before and after the \
+                             jump separately, or write the stamps in a coarser unit"
+                        }
+                        T::MixedStamps { .. } => {
+                            "write every stamp of a trace as a whole number, or every one as a \
+                             decimal"
+                        }
+                        _ => "write each row's stamp as a finite number, such as `0.02`",
+                    };
+                    DenseProblem {
+                        row: Some(row),
+                        help: Some(help.to_string()),
+                        ..plain(strip_row(&t.to_string()))
+                    }
                 }
                 T::Empty | T::RowWidth { .. } => plain(t.to_string()),
             },

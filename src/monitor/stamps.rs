@@ -192,11 +192,24 @@ impl MaxGap {
                 ),
             )
         };
-        let (digits, decimals) = TimeScale::parse_decimal(text).ok_or_else(bad)?;
         let bound: f64 = text.trim().parse().map_err(|_| bad())?;
-        if !bound.is_finite() {
+        if !(bound.is_finite() && bound >= 0.0) {
             return Err(bad());
         }
+        // A number, but one whose exact value has more digits than the exact comparison of
+        // gaps holds (`1e300`, 39 digits and more).
+        let (digits, decimals) = TimeScale::parse_decimal(text).ok_or_else(|| {
+            Problem::new(
+                format!(
+                    "`{flag}{text}` has more digits than a gap is compared with exactly: at \
+                     most 38 in all, with the zeros an exponent stands for"
+                ),
+                Some(format!(
+                    "write the gap with at most 38 digits, such as `1e37`, or leave `{}` out",
+                    flag.trim_end_matches(['=', ' '])
+                )),
+            )
+        })?;
         Ok(MaxGap { text: text.trim().to_string(), digits, decimals, bound })
     }
 

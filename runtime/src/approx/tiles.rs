@@ -61,13 +61,17 @@ impl TileCoder {
             return Err(format!("tilings = {tilings} is not in 1..={MAX_TILINGS}"));
         }
         for d in 0..dims {
-            if !(lo[d].is_finite() && hi[d].is_finite() && lo[d] < hi[d]) {
+            if !(lo[d].is_finite()
+                && hi[d].is_finite()
+                && lo[d] < hi[d]
+                && (hi[d] - lo[d]).is_finite())
+            {
                 return Err(format!(
                     "variable {} has the range [{}, {}]; a tiling needs finite bounds, the lower \
-                     below the upper",
+                     below the upper, and a finite width",
                     d + 1,
-                    lo[d],
-                    hi[d]
+                    crate::plane::num(lo[d]),
+                    crate::plane::num(hi[d])
                 ));
             }
             if !(1..=MAX_BINS).contains(&bins[d]) {
