@@ -14,6 +14,7 @@
 //!   their operands' change points, and timed ones are decomposed as rtamt decomposes them
 //!   (see [`crate::dense`]).
 
+use super::until::{BoundedUntil, Pieces};
 use super::{DenseError, DenseFormula, DenseSignal};
 use crate::formula::{ExprId, Node};
 use std::collections::VecDeque;
@@ -175,8 +176,13 @@ pub(crate) fn evaluate(
             }
             Node::Until(_, f, g) | Node::Since(_, f, g) => {
                 let (a, b) = df.bounds[i];
-                let dir = if matches!(node, Node::Until(..)) { Dir::Future } else { Dir::Past };
-                Val::Sig(timed_until(s(f.index()), s(g.index()), t0, dir, a, b))
+                let (f, g) = (s(f.index()), s(g.index()));
+                match node {
+                    // Bounded until: the streaming sweep, the online monitor's.
+                    Node::Until(..) if b < f64::INFINITY => Val::Sig(bounded_until(f, g, t0, a, b)),
+                    Node::Until(..) => Val::Sig(timed_until(f, g, t0, Dir::Future, a, b)),
+                    _ => Val::Sig(timed_until(f, g, t0, Dir::Past, a, b)),
+                }
             }
             Node::Prev(_) | Node::Next(_) => {
                 unreachable!("DenseFormula::new rejects prev and next")
@@ -321,6 +327,22 @@ pub(crate) fn window(
             break;
         }
         t = next;
+    }
+    out
+}
+
+/// `f until[a..=b] g`, `b` finite, by the sweep of [`super::until`]: the same values as
+/// [`timed_until`] at every time, and the same operations as the online monitor.
+fn bounded_until(f: &DenseSignal, g: &DenseSignal, t0: f64, a: f64, b: f64) -> DenseSignal {
+    let mut pieces = Pieces::default();
+    pieces.feed(&f.points().collect::<Vec<_>>(), &g.points().collect::<Vec<_>>());
+    let mut u = BoundedUntil::new(a, b);
+    pieces.advance(f64::INFINITY, &mut u);
+    let mut points = Vec::new();
+    u.advance(t0, f64::INFINITY, &mut points);
+    let mut out = DenseSignal::with_capacity(points.len());
+    for (t, v) in points {
+        out.push(t, v);
     }
     out
 }
