@@ -14,7 +14,7 @@
 //!   their operands' change points, and timed ones are decomposed as rtamt decomposes them
 //!   (see [`crate::dense`]).
 
-use super::until::{BoundedUntil, Pieces};
+use super::until::BoundedUntil;
 use super::{DenseError, DenseFormula, DenseSignal};
 use crate::formula::{ExprId, Node};
 use std::collections::VecDeque;
@@ -334,11 +334,30 @@ pub(crate) fn window(
 /// `f until[a..=b] g`, `b` finite, by the sweep of [`super::until`]: the same values as
 /// [`timed_until`] at every time, and the same operations as the online monitor.
 fn bounded_until(f: &DenseSignal, g: &DenseSignal, t0: f64, a: f64, b: f64) -> DenseSignal {
-    let mut pieces = Pieces::default();
-    pieces.feed(&f.points().collect::<Vec<_>>(), &g.points().collect::<Vec<_>>());
     let mut u = BoundedUntil::new(a, b);
-    pieces.advance(f64::INFINITY, &mut u);
     let mut points = Vec::new();
+    let (mut i, mut j, mut fed) = (0usize, 0usize, 0usize);
+    loop {
+        let t = match (f.times.get(i), g.times.get(j)) {
+            (Some(&x), Some(&y)) => x.min(y),
+            (Some(&x), None) => x,
+            (None, Some(&y)) => y,
+            (None, None) => break,
+        };
+        // Every piece before `t` is in: sweep now and then, so that the sweep keeps a
+        // window's pieces rather than the trace's.
+        if fed % 512 == 511 {
+            u.advance(t0, t, &mut points);
+        }
+        if f.times.get(i) == Some(&t) {
+            i += 1;
+        }
+        if g.times.get(j) == Some(&t) {
+            j += 1;
+        }
+        u.feed(t, f.values[i.max(1) - 1], g.values[j.max(1) - 1]);
+        fed += 1;
+    }
     u.advance(t0, f64::INFINITY, &mut points);
     let mut out = DenseSignal::with_capacity(points.len());
     for (t, v) in points {

@@ -87,9 +87,7 @@ pub(crate) struct BoundedUntil {
     a: f64,
     b: f64,
     /// Pieces from `base` on: start, `f`, `g`.
-    s: VecDeque<f64>,
-    f: VecDeque<f64>,
-    g: VecDeque<f64>,
+    p: VecDeque<(f64, f64, f64)>,
     base: usize,
     /// How many pieces have `s_k - b <= t` (`M + 1`), `s_k - a <= t` (`L + 1`), `s_k <= t`
     /// (`m + 1`), at the last time swept.
@@ -113,9 +111,7 @@ impl BoundedUntil {
         BoundedUntil {
             a,
             b,
-            s: VecDeque::new(),
-            f: VecDeque::new(),
-            g: VecDeque::new(),
+            p: VecDeque::new(),
             base: 0,
             ne: 0,
             nl: 0,
@@ -132,95 +128,81 @@ impl BoundedUntil {
     /// The next piece: from `t` on, `f` is `fv` and `g` is `gv`.
     #[inline]
     pub(crate) fn feed(&mut self, t: f64, fv: f64, gv: f64) {
-        self.s.push_back(t);
-        self.f.push_back(fv);
-        self.g.push_back(gv);
+        self.p.push_back((t, fv, gv));
     }
 
     pub(crate) fn kept(&self) -> usize {
-        self.s.len() + self.minf.len() + self.front.len()
+        self.p.len() + self.minf.len() + self.front.len()
     }
 
     fn received(&self) -> usize {
-        self.base + self.s.len()
+        self.base + self.p.len()
     }
 
     #[inline]
     fn at(&self, k: usize) -> (f64, f64, f64) {
-        let i = k - self.base;
-        (self.s[i], self.f[i], self.g[i])
+        self.p[k - self.base]
     }
 
     /// Sweeps every breakpoint before the pieces' frontier (`INF`: every piece is in)
     /// allows, pushing the change points into `out`; returns the output's frontier.
     pub(crate) fn advance(&mut self, t0: f64, pieces: f64, out: &mut Vec<(f64, f64)>) -> f64 {
-        if self.received() == 0 {
+        let rec = self.received();
+        if rec == 0 {
             // Operands start at the first stamp: none yet means nothing is final.
             return f64::NEG_INFINITY;
         }
-        let done = pieces == INF;
         // A piece still to come starts at `s >= pieces`: its breakpoints are no sooner
         // than `pieces - b` (rounding is monotone).
-        let limit = if done { INF } else { pieces - self.b };
-        loop {
-            let t = if self.swept {
-                let rec = self.received();
-                let unknown = if done { INF } else { limit };
-                let next = |n: usize, d: f64| {
-                    if n < rec { self.at(n).0 - d } else { unknown }
-                };
-                next(self.ne, self.b).min(next(self.nl, self.a)).min(next(self.nm, 0.0))
-            } else {
-                t0
-            };
-            if t >= limit {
-                break;
+        let limit = if pieces == INF { INF } else { pieces - self.b };
+        // Where `M`, `L` and `m` move next (each one IEEE subtraction).
+        let next = |this: &Self, n: usize, d: f64| if n < rec { this.at(n).0 - d } else { limit };
+        let (mut te, mut tl, mut tm) =
+            (next(self, self.ne, self.b), next(self, self.nl, self.a), next(self, self.nm, 0.0));
+        let mut t = if self.swept { te.min(tl).min(tm) } else { t0 };
+        // `M`, `L`, `m` move in that order, so `m <= L <= M` stays true.
+        while t < limit {
+            while te <= t {
+                let (_, fv, gv) = self.at(self.ne);
+                self.back = join(self.back, piece(fv, gv));
+                self.ne += 1;
+                te = next(self, self.ne, self.b);
             }
-            self.sweep(t);
+            while tl <= t {
+                if self.nl > 0 {
+                    // Piece `L` leaves the until for the min of `f`.
+                    let k = self.nl - 1;
+                    self.pop_front(k);
+                    let fv = self.at(k).1;
+                    while self.minf.back().is_some_and(|&(_, q)| q >= fv) {
+                        self.minf.pop_back();
+                    }
+                    self.minf.push_back((k, fv));
+                }
+                self.nl += 1;
+                tl = next(self, self.nl, self.a);
+            }
+            while tm <= t {
+                if self.nm > 0 && self.minf.front().is_some_and(|q| q.0 == self.nm - 1) {
+                    self.minf.pop_front();
+                }
+                self.nm += 1;
+                tm = next(self, self.nm, 0.0);
+            }
+            // Pieces before `m` are done with.
+            while self.base + 1 < self.nm {
+                self.p.pop_front();
+                self.base += 1;
+            }
             let v = self.value();
             if self.last != Some(v) {
                 out.push((t, v));
                 self.last = Some(v);
             }
             self.swept = true;
+            t = te.min(tl).min(tm);
         }
         limit
-    }
-
-    /// Moves `M`, `L` and `m` to time `t` (in that order: `m <= L <= M` stays true).
-    fn sweep(&mut self, t: f64) {
-        let rec = self.received();
-        while self.ne < rec && self.at(self.ne).0 - self.b <= t {
-            let (_, fv, gv) = self.at(self.ne);
-            self.back = join(self.back, piece(fv, gv));
-            self.ne += 1;
-        }
-        while self.nl < rec && self.at(self.nl).0 - self.a <= t {
-            if self.nl > 0 {
-                // Piece `L` leaves the until for the min of `f`.
-                let k = self.nl - 1;
-                self.pop_front(k);
-                let fv = self.at(k).1;
-                while self.minf.back().is_some_and(|&(_, q)| q >= fv) {
-                    self.minf.pop_back();
-                }
-                self.minf.push_back((k, fv));
-            }
-            self.nl += 1;
-        }
-        while self.nm < rec && self.at(self.nm).0 <= t {
-            if self.nm > 0 && self.minf.front().is_some_and(|q| q.0 == self.nm - 1) {
-                self.minf.pop_front();
-            }
-            self.nm += 1;
-        }
-        // Pieces before `m` are done with.
-        while self.base + 1 < self.nm {
-            self.s.pop_front();
-            self.f.pop_front();
-            self.g.pop_front();
-            self.base += 1;
-        }
     }
 
     /// Drops piece `k`, the queue's first, folding the back into suffixes if needed.
