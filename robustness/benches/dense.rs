@@ -58,14 +58,10 @@ fn cases() -> Vec<(&'static str, Formula)> {
 fn trace(steps: usize) -> (Vec<f64>, DenseTrace) {
     let mut rng = walk::SplitMix64(walk::SEED);
     let w = walk::walk(steps, &mut rng);
+    let stamps = walk::stamps(steps, &mut rng);
     let mut b = DenseTraceBuilder::new(2);
-    let mut stamps = Vec::with_capacity(steps);
-    let mut ms_total = 0u64;
-    for k in 0..steps {
-        let t = ms_total as f64 / 1000.0;
-        stamps.push(t);
+    for (k, &t) in stamps.iter().enumerate() {
         b.push(t, &[Some(w.column(0)[k]), Some(w.column(1)[k])]).expect("increasing");
-        ms_total += 1 + rng.next_u64() % 20;
     }
     (stamps, b.build().expect("a trace"))
 }

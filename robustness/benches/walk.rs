@@ -1,5 +1,5 @@
 //! The benchmark data: a random walk on the 15 x 15 grid world, shared by the benches and
-//! the `walk` example (which writes it to CSV for the peers' script).
+//! the `walk` and `dense_walk` examples (which write it to CSV for the peers' script).
 
 use hstl_robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace};
 
@@ -43,6 +43,18 @@ pub fn walk(steps: usize, rng: &mut SplitMix64) -> Trace {
         }
     }
     Trace::from_columns(vec![xs, ys]).expect("two columns of equal length")
+}
+
+/// Dense-time stamps for `steps` rows, in seconds: row `k` at the sum of `k` gaps of 1 to
+/// 20 ms (uniform, drawn from `rng` after the walk), each the double nearest `ms / 1000`.
+pub fn stamps(steps: usize, rng: &mut SplitMix64) -> Vec<f64> {
+    let mut out = Vec::with_capacity(steps);
+    let mut ms = 0u64;
+    for _ in 0..steps {
+        out.push(ms as f64 / 1000.0);
+        ms += 1 + rng.next_u64() % 20;
+    }
+    out
 }
 
 fn cmp(lhs: Expr, op: CmpOp, rhs: Expr) -> Formula {

@@ -309,6 +309,13 @@ fn the_online_monitor_streams_long_windows() {
         Formula::since(ms(100, Some(40_000)), x(-2.0), y(-1.0)),
         Formula::since(ms(0, None), x(-2.5), y(-1.0)),
         Formula::until(ms(0, Some(2_000)), x(-2.0), y(-1.0)),
+        Formula::until(ms(0, Some(40_000)), x(-2.5), y(-2.0)),
+        Formula::until(ms(1_500, Some(40_000)), x(-2.8), Formula::or(vec![y(-2.5), x(2.5)])),
+        Formula::until(ms(20_000, Some(20_000)), x(-2.9), y(-1.5)),
+        Formula::always(
+            ms(0, Some(10_000)),
+            Formula::until(ms(500, Some(30_000)), Formula::not(y(-2.9)), x(2.0)),
+        ),
         Formula::always(
             ms(0, Some(40_000)),
             Formula::implies(x(1.0), Formula::eventually(ms(100, Some(3_000)), y(0.0))),
@@ -353,6 +360,13 @@ fn the_online_monitor_streams_long_windows() {
         for (t, cells) in &rows {
             got.extend(m.push(*t, cells).unwrap());
             most = most.max(m.kept());
+        }
+        // Bounded formulas decide as they go: only the last horizon's points wait for the
+        // end.
+        let early = got.len();
+        if df.future_reach().is_finite() {
+            let late = want.iter().filter(|p| p.0 > trace.t_last() - df.future_reach() - 1.0);
+            assert!(early + late.count() >= want.len(), "{f}: {early} of {} early", want.len());
         }
         got.extend(m.finish().unwrap());
         assert_eq!(got.len(), want.len(), "{f}");

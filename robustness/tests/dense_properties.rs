@@ -159,6 +159,55 @@ proptest! {
         prop_assert!(same_points(&got, &want), "{}\n online  {:?}\n offline {:?}", f, got, want);
     }
 
+    /// Bounded `until` (streamed by a sweep over pieces) with windows of up to 4.5, about a
+    /// hundred rows, over random operands, at the root or under a window operator: online
+    /// equals offline, and offline equals the literal reference.
+    #[test]
+    fn until_with_long_windows(
+        f in formula(10),
+        g in formula(10),
+        a in 0usize..=150,
+        len in 0usize..=300,
+        outer in 0usize..3,
+        rows in rows(0.01, 400),
+    ) {
+        let u = Formula::until(Interval { start: a, end: Bound::Inclusive(a + len) }, f, g);
+        let u = match outer {
+            0 => u,
+            1 => Formula::always(Interval { start: 0, end: Bound::Inclusive(50) }, u),
+            _ => Formula::not(Formula::eventually(Interval { start: 10, end: Bound::Inclusive(70) }, u)),
+        };
+        let trace = build(&rows);
+        let df = DenseFormula::new(&u, scale()).expect("a dense formula");
+        let Ok(want) = df.signal(&trace) else { return Ok(()) };
+        let want = points(&want, trace.t_last());
+        let got = online(&df, &rows, 1);
+        prop_assert!(same_points(&got, &want), "{}\n online  {:?}\n offline {:?}", u, got, want);
+    }
+
+    /// The same on quarters, where the reference's literal reading is exact (hundredths
+    /// round, which the reference does not follow): windows up to 15 over gaps of 0.25 to 2.
+    #[test]
+    fn until_with_long_windows_equals_reference(
+        f in formula(25),
+        g in formula(25),
+        a in 0usize..=20,
+        len in 0usize..=40,
+        rows in rows(0.25, 60),
+    ) {
+        let u = Formula::until(Interval { start: a * 25, end: Bound::Inclusive((a + len) * 25) }, f, g);
+        let trace = build(&rows);
+        let df = DenseFormula::new(&u, scale()).expect("a dense formula");
+        let Ok(got) = df.signal(&trace) else { return Ok(()) };
+        let want = reference::signal(&u, scale(), &trace);
+        prop_assert!(
+            same_points(&got.points().collect::<Vec<_>>(), &want.points().collect::<Vec<_>>()),
+            "{}\n got  {:?}\n want {:?}", u, got, want
+        );
+        let got = points(&got, trace.t_last());
+        prop_assert!(same_points(&online(&df, &rows, 1), &got), "{}", u);
+    }
+
     /// Per-variable sample lists merge into the rows a CSV with empty cells gives.
     #[test]
     fn per_variable_samples_merge_like_rows(rows in rows(0.25, 12)) {

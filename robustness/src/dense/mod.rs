@@ -23,21 +23,24 @@
 //! Interval bounds are [`Formula`] bounds (whole numbers) read through a [`TimeScale`]:
 //! with `TimeScale::decimals(1)` the bound `25` means `2.5`, read as the nearest double.
 //! Every breakpoint is computed as rtamt computes it, one IEEE operation per window end
-//! (`s_k - b`, `s_k + a`), so results match rtamt's bit for bit; bounded `until` and
-//! `since` follow rtamt's decomposition (`eventually[a..=b] g && always[0..=a] (f until
-//! g)`, and so on). The full statement, with where rtamt is wrong and hstl is not, is
+//! (`s_k - b`, `s_k + a`), so results match rtamt's bit for bit. Timed `until` and `since`
+//! take the values of rtamt's decomposition (`eventually[a..=b] g && always[0..=a] (f until
+//! g)`, and so on); bounded `until` computes them by a sweep over pieces that reads no
+//! further than its window and equals the decomposition value for value at every time
+//! (the sign of a zero aside, which is not pinned). The full statement, with where rtamt is wrong and hstl is not, is
 //! `docs/DENSE-TIME-DEVIATIONS.md` in the repository.
 //!
 //! - [`DenseFormula::signal`] computes the whole signal offline, in time linear in the
 //!   number of change points whatever the windows' lengths;
 //! - [`DenseMonitor`] takes samples one at a time and gives each change point of the
 //!   signal once no later sample can change it, streaming: its work per row does not grow
-//!   with the windows' lengths (except for `until`, which re-evaluates its window).
+//!   with the windows' lengths.
 
 mod offline;
 mod online;
 mod signal;
 mod trace;
+mod until;
 
 pub use online::DenseMonitor;
 pub use signal::DenseSignal;

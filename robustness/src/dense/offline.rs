@@ -14,6 +14,7 @@
 //!   their operands' change points, and timed ones are decomposed as rtamt decomposes them
 //!   (see [`crate::dense`]).
 
+use super::until::BoundedUntil;
 use super::{DenseError, DenseFormula, DenseSignal};
 use crate::formula::{ExprId, Node};
 use std::collections::VecDeque;
@@ -175,8 +176,13 @@ pub(crate) fn evaluate(
             }
             Node::Until(_, f, g) | Node::Since(_, f, g) => {
                 let (a, b) = df.bounds[i];
-                let dir = if matches!(node, Node::Until(..)) { Dir::Future } else { Dir::Past };
-                Val::Sig(timed_until(s(f.index()), s(g.index()), t0, dir, a, b))
+                let (f, g) = (s(f.index()), s(g.index()));
+                match node {
+                    // Bounded until: the streaming sweep, the online monitor's.
+                    Node::Until(..) if b < f64::INFINITY => Val::Sig(bounded_until(f, g, t0, a, b)),
+                    Node::Until(..) => Val::Sig(timed_until(f, g, t0, Dir::Future, a, b)),
+                    _ => Val::Sig(timed_until(f, g, t0, Dir::Past, a, b)),
+                }
             }
             Node::Prev(_) | Node::Next(_) => {
                 unreachable!("DenseFormula::new rejects prev and next")
@@ -321,6 +327,41 @@ pub(crate) fn window(
             break;
         }
         t = next;
+    }
+    out
+}
+
+/// `f until[a..=b] g`, `b` finite, by the sweep of [`super::until`]: the same values as
+/// [`timed_until`] at every time, and the same operations as the online monitor.
+fn bounded_until(f: &DenseSignal, g: &DenseSignal, t0: f64, a: f64, b: f64) -> DenseSignal {
+    let mut u = BoundedUntil::new(a, b);
+    let mut points = Vec::new();
+    let (mut i, mut j, mut fed) = (0usize, 0usize, 0usize);
+    loop {
+        let t = match (f.times.get(i), g.times.get(j)) {
+            (Some(&x), Some(&y)) => x.min(y),
+            (Some(&x), None) => x,
+            (None, Some(&y)) => y,
+            (None, None) => break,
+        };
+        // Every piece before `t` is in: sweep now and then, so that the sweep keeps a
+        // window's pieces rather than the trace's.
+        if fed % 512 == 511 {
+            u.advance(t0, t, &mut points);
+        }
+        if f.times.get(i) == Some(&t) {
+            i += 1;
+        }
+        if g.times.get(j) == Some(&t) {
+            j += 1;
+        }
+        u.feed(t, f.values[i.max(1) - 1], g.values[j.max(1) - 1]);
+        fed += 1;
+    }
+    u.advance(t0, f64::INFINITY, &mut points);
+    let mut out = DenseSignal::with_capacity(points.len());
+    for (t, v) in points {
+        out.push(t, v);
     }
     out
 }

@@ -16,17 +16,18 @@
 //!   likewise up to `F + a`. The deque and the pieces kept span one window;
 //! - `since` (timed or not) is rtamt's decomposition (`once[a..=b] g && historically[0..=a]
 //!   (f since g)`) of streaming parts: untimed `since` is a forward recurrence;
-//! - `until` is the one operator not streamed: untimed `f until g` is a backward
-//!   recurrence from the end of the trace, so a timed `until` node keeps its operands'
-//!   points over its window and re-evaluates them (offline) at each step, deciding up to
-//!   `F - b` (less a few ulps). Its cost per row grows with its window's length; every other
-//!   operator's does not.
+//! - bounded `until[a..=b]` is a sweep over the union of its operands' pieces (a monotone
+//!   deque and a two-stack queue, see `super::until`), decided up to `F - b` like a window;
+//!   the offline evaluator runs the same sweep;
+//! - unbounded `until` (`[a..]`, untimed) is a backward recurrence from the end of the
+//!   trace: its node keeps its operands' points and evaluates them offline at the end.
 //!
 //! Each operator computes the same values at the same breakpoints as the offline evaluator
 //! (the same IEEE operations in the same order), so the monitor's change points are
 //! [`DenseFormula::signal`]'s bit for bit.
 
 use super::offline::{self, Dir, Ext, max, min};
+use super::until::{BoundedUntil, Pieces};
 use super::{DenseError, DenseFormula, DenseSignal, DenseTraceBuilder};
 use crate::formula::Node;
 use std::collections::VecDeque;
@@ -43,12 +44,10 @@ use std::collections::VecDeque;
 ///
 /// The monitor is incremental: each operator keeps only the pieces its window spans (see
 /// the module's source for how), so the work per row does not grow with the windows'
-/// lengths and memory is bounded by them, except for two cases:
-/// - `until` (timed or not) re-evaluates the points it keeps, its window's worth, at every
-///   row: its work per row grows with its window;
-/// - an unbounded future operator (`eventually[a..]`, `always`, untimed `until`) decides
-///   nothing before the end and keeps everything; an unbounded past one (`once[a..]`,
-///   `historically`) keeps only its running extreme.
+/// lengths and memory is bounded by them, bounded `until` included. An unbounded future
+/// operator (`eventually[a..]`, `always`, `until[a..]`) decides nothing before the end and
+/// keeps everything; an unbounded past one (`once[a..]`, `historically`) keeps only its
+/// running extreme.
 #[derive(Clone, Debug)]
 pub struct DenseMonitor {
     formula: DenseFormula,
@@ -390,10 +389,8 @@ impl SinceNode {
     }
 }
 
-/// `f until[a..=b] g`: not streamed (untimed `until` reads to the end of the trace). The
-/// operands' points over the window are kept and evaluated offline at each step, deciding
-/// up to `F - b` less a few ulps, `F` the operands' frontier: the value at `t` reads the
-/// operands on `[t, t + b]` only.
+/// `f until[a..] g` (unbounded; bounded ones are [`BoundedUntil`]): the operands' points
+/// are kept and evaluated offline once the trace ends (`F` is infinite only then).
 #[derive(Clone, Debug)]
 struct UntilNode {
     a: f64,
@@ -479,6 +476,9 @@ enum Op {
     Merge(Merge),
     Win(Win),
     Since(Box<SinceNode>),
+    /// Bounded `until`: the sweep of `super::until`.
+    Bounded(Box<(Pieces, BoundedUntil)>),
+    /// Unbounded `until`: kept and evaluated at the end.
     Until(Box<UntilNode>),
 }
 
@@ -488,6 +488,7 @@ impl Op {
             Op::Merge(m) => m.kept(),
             Op::Win(w) => w.kept(),
             Op::Since(s) => s.kept(),
+            Op::Bounded(p) => p.0.kept() + p.1.kept(),
             Op::Until(u) => u.kept(),
             _ => 0,
         }
@@ -523,6 +524,9 @@ fn ops(df: &DenseFormula) -> Vec<Op> {
                 Node::Once(..) => Op::Win(Win::new(Dir::Past, a, b, Ext::Max)),
                 Node::Historically(..) => Op::Win(Win::new(Dir::Past, a, b, Ext::Min)),
                 Node::Since(..) => Op::Since(Box::new(SinceNode::new(a, b))),
+                Node::Until(..) if b < INF => {
+                    Op::Bounded(Box::new((Pieces::default(), BoundedUntil::new(a, b))))
+                }
                 Node::Until(..) => Op::Until(Box::new(UntilNode {
                     a,
                     b,
@@ -716,6 +720,14 @@ impl DenseMonitor {
                 Op::Since(s) => {
                     let Node::Since(_, f, g) = node else { unreachable!("since") };
                     s.advance(t0, fr(f.index()), fr(g.index()), out)
+                }
+                Op::Bounded(p) => {
+                    let Node::Until(_, f, g) = node else { unreachable!("until") };
+                    let (pieces, until) = &mut **p;
+                    let operands = front[f.index()].min(front[g.index()]);
+                    pieces.feed(&done[f.index()], &done[g.index()]);
+                    pieces.advance(operands, until);
+                    until.advance(t0, operands, out)
                 }
                 Op::Until(u) => {
                     let Node::Until(_, f, g) = node else { unreachable!("until") };
