@@ -8,8 +8,8 @@
 //! the facade's errors into Python exceptions with the command line's words.
 
 mod check;
-mod dense;
 mod cli;
+mod dense;
 mod errors;
 mod files;
 mod gym;

@@ -3,6 +3,8 @@
 //! `cargo bench -p hstl-robustness --bench robustness -- --warm-up-time 1 --measurement-time 3`
 
 #[path = "walk.rs"]
+// Shared with the dense bench, which alone uses its stamps.
+#[allow(dead_code)]
 mod walk;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
