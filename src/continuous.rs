@@ -854,9 +854,10 @@ pub fn runs_after_training(spec: &TaskSpec, seed: u64) -> Runs {
 }
 
 /// The steps a run of a task that is not persistent needs: its horizon and one, at most
-/// 100,000 (an unbounded task gets 2,000).
+/// [`MAX_RUN_STEPS`](hstl_runtime::approx::progress::MAX_RUN_STEPS) (an unbounded task gets
+/// 2,000).
 pub fn task_steps(spec: &TaskSpec) -> usize {
-    spec.task.horizon().map_or(2000, |h| h.saturating_add(1).min(100_000))
+    hstl_runtime::approx::progress::run_steps(&spec.task).unwrap_or(2000)
 }
 
 /// `DIR/run_K.csv` of greedy runs (the contract "greedy runs as data"): `t,VAR...,action,

@@ -7,10 +7,10 @@
 //! the leg's greedy action until the leg stops or `max_steps` pass, then chooses again; with `switch: step` the options policy's pick at every step replaces a
 //! running option of strictly lower value, as the tabular agent does.
 
-use hstl_robustness::offline::Evaluator;
 use hstl_robustness::{StateEval, Trace};
 
 use super::learn::{Model, Weights};
+use super::progress::GoalTracker;
 use crate::spec::Switch;
 use crate::{Error, Rng, TaskSpec, World};
 
@@ -54,12 +54,8 @@ pub struct WindowSummary {
 struct Cursor {
     running: Option<(usize, usize, usize)>,
     tau: Vec<usize>,
-    /// The goals met so far and those given up; the run so far, one column per variable
-    /// (for a task with goals).
-    met: usize,
-    given_up: usize,
-    prefix: Vec<Vec<f64>>,
-    prefix_eval: Evaluator,
+    /// The run so far and the goals it has met (for a task with goals).
+    goals: GoalTracker,
     f: Vec<usize>,
     g: Vec<usize>,
     q: Vec<f64>,
@@ -100,7 +96,10 @@ impl ApproxAgent {
         let mut x = Vec::with_capacity(vars);
         world.valuation(&state, &mut x);
         self.model.start_counters(&mut eval, &x, &mut cur.tau);
-        self.record(&mut cur, &x, true);
+        cur.goals.start(&x);
+        if let Some(progress) = &self.model.progress {
+            cur.goals.read(progress);
+        }
         out.values.extend_from_slice(&x);
         for _ in 0..steps {
             self.model.blocked(world, &state, &mut cur.blocked);
@@ -121,7 +120,7 @@ impl ApproxAgent {
         let pick = |cur: &mut Cursor, eval: &mut StateEval| {
             m.available(eval, x, &mut cur.available);
             m.options_coder.features(x, &mut cur.g);
-            let code = m.code(&cur.tau, cur.met);
+            let code = m.code(&cur.tau, cur.goals.met());
             (m.best_option(&self.weights, code, &cur.g, &cur.available), code)
         };
         if self.switch == Switch::Step
@@ -163,17 +162,12 @@ impl ApproxAgent {
         ended
     }
 
-    /// Appends `x` to the run so far and, where a leg ended (or the run starts), adds the
-    /// goals met to `cur.met`.
+    /// Appends `x` to the run so far and, where a leg ended, reads the goals met.
     fn record(&self, cur: &mut Cursor, x: &[f64], leg_ended: bool) {
         let Some(progress) = &self.model.progress else { return };
-        cur.prefix.resize_with(x.len(), Vec::new);
-        for (column, &v) in cur.prefix.iter_mut().zip(x) {
-            column.push(v);
-        }
+        cur.goals.push(x);
         if leg_ended {
-            let columns: Vec<&[f64]> = cur.prefix.iter().map(Vec::as_slice).collect();
-            cur.met = progress.update(cur.met, &columns, &mut cur.prefix_eval, &mut cur.given_up);
+            cur.goals.read(progress);
         }
     }
 

@@ -31,12 +31,11 @@
 
 use std::ops::ControlFlow;
 
-use hstl_robustness::offline::Evaluator;
 use hstl_robustness::segment::SegmentScorer;
 use hstl_robustness::{Formula, StateEval, Trace};
 use rand::RngExt;
 
-use super::progress::Progress;
+use super::progress::{GoalTracker, Progress};
 use super::tiles::TileCoder;
 use crate::spec::{LevelParams, RewardKind, Terminate, TileParams};
 use crate::{Error, Rng, TaskSpec, World};
@@ -435,7 +434,6 @@ pub struct ApproxLearner<'w, W: World> {
     /// where nothing is left to keep); empty for `reward: window`.
     scorers: Vec<Option<SegmentScorer>>,
     eval: StateEval,
-    prefix_eval: Evaluator,
     gamma_powers: Vec<f64>,
 }
 
@@ -474,7 +472,6 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             weights,
             scorers,
             eval: StateEval::new(),
-            prefix_eval: Evaluator::new(),
             gamma_powers: vec![1.0],
         })
     }
@@ -537,14 +534,9 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         let mut state = self.world.reset(rng);
         self.world.valuation(&state, &mut s.x);
         self.model.start_counters(&mut self.eval, &s.x, &mut s.tau);
-        (s.met, s.given_up) = (0, 0);
-        if self.model.progress.is_some() {
-            s.prefix.resize_with(s.x.len(), Vec::new);
-            for (column, &v) in s.prefix.iter_mut().zip(&s.x) {
-                column.clear();
-                column.push(v);
-            }
-            self.update_progress(s);
+        s.goals.start(&s.x);
+        if let Some(progress) = &self.model.progress {
+            s.goals.read(progress);
         }
         let mut total = 0.0;
         // Once every goal is met, the episode goes on to the task's horizon, as a greedy
@@ -552,13 +544,13 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         // one option it has nothing to learn).
         let hold = match &self.model.progress {
             Some(p) if self.model.legs.len() > 1 => {
-                self.spec.task.horizon().map(|h| (p.all_met(), h))
+                super::progress::run_steps(&self.spec.task).map(|n| (p.all_met(), n - 1))
             }
             _ => None,
         };
         let mut steps = 0;
         for choice in 0.. {
-            let holding = hold.is_some_and(|(all, h)| s.met == all && steps < h);
+            let holding = hold.is_some_and(|(all, h)| s.goals.met() == all && steps < h);
             if choice >= self.spec.learn.choices && !holding {
                 break;
             }
@@ -584,16 +576,8 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             return s.available[rng.random_range(0..s.available.len())];
         }
         self.model.options_coder.features(&s.x, &mut s.g);
-        let code = self.model.code(&s.tau, s.met);
+        let code = self.model.code(&s.tau, s.goals.met());
         self.model.best_option(&self.weights, code, &s.g, &s.available)
-    }
-
-    /// Adds the goals the episode so far meets to `s.met`.
-    fn update_progress(&mut self, s: &mut Scratch) {
-        if let Some(progress) = &self.model.progress {
-            let columns: Vec<&[f64]> = s.prefix.iter().map(Vec::as_slice).collect();
-            s.met = progress.update(s.met, &columns, &mut self.prefix_eval, &mut s.given_up);
-        }
     }
 
     fn run_option(
@@ -619,8 +603,8 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         run.values.extend_from_slice(&s.x);
         model.options_coder.features(&s.x, &mut s.g);
         run.options_features.extend_from_slice(&s.g);
-        run.codes.push(model.code(&s.tau, s.met));
-        run.met.push(s.met);
+        run.codes.push(model.code(&s.tau, s.goals.met()));
+        run.met.push(s.goals.met());
         if model.is_persistent() {
             run.psi.push(s.tau.iter().zip(&model.regions).all(|(t, (_, n))| t < n));
         }
@@ -653,12 +637,10 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 run.values.extend_from_slice(&s.x_next);
                 model.options_coder.features(&s.x_next, &mut s.g);
                 run.options_features.extend_from_slice(&s.g);
-                run.codes.push(model.code(&s.tau, s.met));
-                run.met.push(s.met);
+                run.codes.push(model.code(&s.tau, s.goals.met()));
+                run.met.push(s.goals.met());
                 if model.progress.is_some() {
-                    for (column, &v) in s.prefix.iter_mut().zip(&s.x_next) {
-                        column.push(v);
-                    }
+                    s.goals.push(&s.x_next);
                 }
                 state = next;
                 std::mem::swap(&mut s.f, &mut s.f_next);
@@ -671,10 +653,9 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             }
             // A leg ends where a goal's region is entered: the code from here on says so.
             if let Some(progress) = &model.progress {
-                let columns: Vec<&[f64]> = s.prefix.iter().map(Vec::as_slice).collect();
-                s.met = progress.update(s.met, &columns, &mut self.prefix_eval, &mut s.given_up);
+                let met = s.goals.read(progress);
                 if let (Some(m), Some(c)) = (run.met.last_mut(), run.codes.last_mut()) {
-                    (*m, *c) = (s.met, model.code(&s.tau, s.met));
+                    (*m, *c) = (met, model.code(&s.tau, met));
                 }
             }
         }
@@ -787,11 +768,8 @@ struct Scratch {
     rewards: Vec<f64>,
     /// The suffix rewards under another progress code.
     other_rewards: Vec<f64>,
-    /// The goals met so far, and those given up (their horizon passed).
-    met: usize,
-    given_up: usize,
-    /// The episode so far, one column per variable (for a task with goals).
-    prefix: Vec<Vec<f64>>,
+    /// The episode so far and the goals it has met.
+    goals: GoalTracker,
 }
 
 /// The flat update of every primitive after the step `x -a-> x_next` (features `f`,

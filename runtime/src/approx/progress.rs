@@ -21,6 +21,16 @@ use hstl_robustness::{Formula, Node, NodeId};
 /// At most this many goals are tracked (the options level's weights double with each).
 pub const MAX_GOALS: usize = 4;
 
+/// A greedy run of a task that is not persistent lasts its horizon and one step, at most
+/// this many (what `eval` and `study` judge it over, and what training holds to).
+pub const MAX_RUN_STEPS: usize = 100_000;
+
+/// The steps a greedy run of `task` (not persistent) lasts: its horizon and one, at most
+/// [`MAX_RUN_STEPS`]; `None` for an unbounded task.
+pub fn run_steps(task: &Formula) -> Option<usize> {
+    task.horizon().map(|h| h.saturating_add(1).min(MAX_RUN_STEPS))
+}
+
 /// The goals of a task and the rest of the task once some are met.
 #[derive(Clone, Debug)]
 pub struct Progress {
@@ -99,30 +109,72 @@ impl Progress {
         self.rest.iter().map(|r| r.as_ref().map(SegmentScorer::new)).collect()
     }
 
-    /// `mask` with every goal the prefix `columns` (one column per variable, `len` samples)
-    /// meets added. A goal whose horizon the prefix has passed without meeting it stays
-    /// unmet for good, so it is not read again.
-    pub fn update(
+    /// `mask` with every goal the prefix `columns` (one column per variable) meets added.
+    /// A goal whose horizon the prefix has passed without meeting it stays unmet for good:
+    /// it joins `given_up` and is not read again.
+    fn update(
         &self,
         mask: usize,
         columns: &[&[f64]],
         eval: &mut Evaluator,
-        checked: &mut usize,
+        given_up: &mut usize,
     ) -> usize {
         let len = columns.first().map_or(0, |c| c.len());
         let mut mask = mask;
         for (j, (goal, horizon)) in self.goals.iter().enumerate() {
             let bit = 1 << j;
-            if mask & bit != 0 || *checked & bit != 0 {
+            if mask & bit != 0 || *given_up & bit != 0 {
                 continue;
             }
             if eval.robustness_of_slices(goal, columns).is_ok_and(|v| v > 0.0) {
                 mask |= bit;
             } else if horizon.is_some_and(|h| len > h) {
-                *checked |= bit;
+                *given_up |= bit;
             }
         }
         mask
+    }
+}
+
+/// A run so far and the goals it has met, read where asked (where a leg ends): what the
+/// learner and the greedy agent keep alike.
+#[derive(Clone, Debug, Default)]
+pub struct GoalTracker {
+    /// The run's valuations, one column per variable.
+    columns: Vec<Vec<f64>>,
+    met: usize,
+    given_up: usize,
+    eval: Evaluator,
+}
+
+impl GoalTracker {
+    /// Starts a run in the valuation `x`: no goal met yet.
+    pub fn start(&mut self, x: &[f64]) {
+        self.columns.resize_with(x.len(), Vec::new);
+        for (column, &v) in self.columns.iter_mut().zip(x) {
+            column.clear();
+            column.push(v);
+        }
+        (self.met, self.given_up) = (0, 0);
+    }
+
+    /// Appends the valuation `x` to the run.
+    pub fn push(&mut self, x: &[f64]) {
+        for (column, &v) in self.columns.iter_mut().zip(x) {
+            column.push(v);
+        }
+    }
+
+    /// Adds the goals of `progress` the run so far meets; returns the goals met.
+    pub fn read(&mut self, progress: &Progress) -> usize {
+        let columns: Vec<&[f64]> = self.columns.iter().map(Vec::as_slice).collect();
+        self.met = progress.update(self.met, &columns, &mut self.eval, &mut self.given_up);
+        self.met
+    }
+
+    /// The goals met when last read (a [`Progress`] mask).
+    pub fn met(&self) -> usize {
+        self.met
     }
 }
 
@@ -181,13 +233,19 @@ mod tests {
     fn a_goal_is_met_once_a_prefix_satisfies_it_and_given_up_past_its_horizon() {
         let goal = within(3, above(0, 5.0));
         let p = Progress::of_task(&goal).unwrap();
-        let mut eval = Evaluator::new();
-        let mut checked = 0;
-        let x = [0.0, 1.0, 7.0, 0.0, 9.0, 9.0];
-        assert_eq!(p.update(0, &[&x[..2]], &mut eval, &mut checked), 0);
-        assert_eq!(p.update(0, &[&x[..3]], &mut eval, &mut checked), 1);
-        let late = [0.0, 0.0, 0.0, 0.0, 9.0];
-        assert_eq!(p.update(0, &[&late[..]], &mut eval, &mut checked), 0);
-        assert_eq!(checked, 1, "past its horizon the goal is not read again");
+        let mut run = GoalTracker::default();
+        run.start(&[0.0]);
+        run.push(&[1.0]);
+        assert_eq!(run.read(&p), 0);
+        run.push(&[7.0]);
+        assert_eq!(run.read(&p), 1);
+        run.push(&[0.0]);
+        assert_eq!(run.read(&p), 1, "a met goal stays met");
+        run.start(&[0.0]);
+        for v in [0.0, 0.0, 0.0, 9.0] {
+            run.push(&[v]);
+        }
+        assert_eq!(run.read(&p), 0, "9 comes past the window");
+        assert_eq!(run.given_up, 1, "past its horizon the goal is not read again");
     }
 }
