@@ -191,7 +191,7 @@ pub fn replay_in<E: Env>(
             "the file was edited or damaged: train the policy again with `hstlc train`".to_string(),
         )
     })?;
-    let agent = policy.agent(&env).map_err(|e| {
+    let agent = policy.agent_for(&spec, &env).map_err(|e| {
         Problem::new(e.to_string(), "the policy does not fit its world".to_string())
     })?;
     Ok(Replay { policy, spec, env, agent, source, seed })

@@ -530,7 +530,7 @@ impl Policy {
                     ));
                 }
                 let pyenv = PyEnv::new(env, valuation, given, &listed.spec)?;
-                let agent = listed.policy.agent(&pyenv).map_err(|e| {
+                let agent = listed.policy.agent_for(&listed.spec, &pyenv).map_err(|e| {
                     value_error(
                         e.to_string(),
                         Some("pass the environment and valuation it was trained with".into()),

@@ -10,7 +10,7 @@
 use hstl_robustness::{StateEval, Trace};
 
 use super::learn::{Model, Weights};
-use super::progress::GoalTracker;
+use crate::progress::GoalTracker;
 use crate::spec::Switch;
 use crate::{Error, Rng, TaskSpec, World};
 
