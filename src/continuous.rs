@@ -855,9 +855,9 @@ pub fn runs_after_training(spec: &TaskSpec, seed: u64) -> Runs {
 
 /// The steps a run of a task that is not persistent needs: its horizon and one, at most
 /// [`MAX_RUN_STEPS`](hstl_runtime::progress::MAX_RUN_STEPS) (an unbounded task gets
-/// 2,000).
+/// [`UNBOUNDED_RUN_STEPS`](hstl_runtime::progress::UNBOUNDED_RUN_STEPS)).
 pub fn task_steps(spec: &TaskSpec) -> usize {
-    hstl_runtime::progress::run_steps(&spec.task).unwrap_or(2000)
+    hstl_runtime::progress::run_steps(&spec.task)
 }
 
 /// `DIR/run_K.csv` of greedy runs (the contract "greedy runs as data"): `t,VAR...,action,

@@ -137,7 +137,7 @@ pub const MAX_ENTRY_CYCLE_DISTANCES: usize = 1 << 26;
 impl Default for WindowConfig {
     /// 100 rollouts of 2000 steps, the first 100 not counted.
     fn default() -> WindowConfig {
-        WindowConfig { starts: 100, steps: 2000, burn_in: 100 }
+        WindowConfig { starts: 100, steps: crate::progress::UNBOUNDED_RUN_STEPS, burn_in: 100 }
     }
 }
 

@@ -403,7 +403,7 @@ impl<'e, E: Env> Learner<'e, E> {
         // one option it has nothing to learn).
         let hold = match &self.goals {
             Some(g) if self.tables.legs.len() > 1 => {
-                run_steps(&self.spec.task).map(|n| (g.progress.all_met(), n - 1))
+                Some((g.progress.all_met(), run_steps(&self.spec.task) - 1))
             }
             _ => None,
         };

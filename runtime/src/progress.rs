@@ -25,10 +25,14 @@ pub const MAX_GOALS: usize = 4;
 /// this many (what `eval` and `study` judge it over, and what training holds to).
 pub const MAX_RUN_STEPS: usize = 100_000;
 
+/// The steps a greedy run of a task without a horizon (`always !R`) lasts, as a persistent
+/// task's runs do ([`crate::eval::WindowConfig`]'s default).
+pub const UNBOUNDED_RUN_STEPS: usize = 2000;
+
 /// The steps a greedy run of `task` (not persistent) lasts: its horizon and one, at most
-/// [`MAX_RUN_STEPS`]; `None` for an unbounded task.
-pub fn run_steps(task: &Formula) -> Option<usize> {
-    task.horizon().map(|h| h.saturating_add(1).min(MAX_RUN_STEPS))
+/// [`MAX_RUN_STEPS`]; [`UNBOUNDED_RUN_STEPS`] for an unbounded task.
+pub fn run_steps(task: &Formula) -> usize {
+    task.horizon().map_or(UNBOUNDED_RUN_STEPS, |h| h.saturating_add(1).min(MAX_RUN_STEPS))
 }
 
 /// The goals of a task and the rest of the task once some are met.

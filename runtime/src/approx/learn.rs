@@ -544,7 +544,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         // one option it has nothing to learn).
         let hold = match &self.model.progress {
             Some(p) if self.model.legs.len() > 1 => {
-                crate::progress::run_steps(&self.spec.task).map(|n| (p.all_met(), n - 1))
+                Some((p.all_met(), crate::progress::run_steps(&self.spec.task) - 1))
             }
             _ => None,
         };
