@@ -100,6 +100,12 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
     runs.check_burn_in(spec, flag)?;
+    // Decide what can be written before anything is printed.
+    let out = args
+        .runs
+        .as_ref()
+        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
+        .transpose()?;
     outln!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
@@ -129,6 +135,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                     r.optimum
                 )?;
             }
+            write_runs(out, &replay, args.starts, runs)?;
             return Ok(Status::Clean);
         }
         Evaluation::Window { report } => report,
@@ -171,7 +178,24 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             )?;
         }
     }
+    write_runs(out, &replay, args.starts, runs)?;
     Ok(Status::Clean)
+}
+
+/// With `--runs DIR`, writes the first [`MAX_RUN_FILES`] greedy runs of a grid policy.
+fn write_runs(
+    out: Option<hstl_outdir::OutDir>,
+    replay: &evaluate::Replay<hstl::runtime::GridWorld>,
+    starts: usize,
+    runs: hstl::evaluate::Runs,
+) -> Result<(), CliError> {
+    let Some(out) = out else { return Ok(()) };
+    let n = starts.min(MAX_RUN_FILES);
+    let files = evaluate::greedy_run_files(replay, n, runs)?;
+    let dir = out.path().to_path_buf();
+    out.write(&files)?;
+    outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", crate::output::shown(&dir))?;
+    Ok(())
 }
 
 /// `hstlc eval` of a learned function (a continuous world): the window rate of a
