@@ -396,3 +396,35 @@ fn once_the_goal_is_met_the_options_level_holds_instead_of_starting_again() {
     assert!(holding as f64 >= 0.9 * after as f64, "{holding} of {after} steps held");
     assert!(satisfied >= 45, "{satisfied} of 50 runs satisfied the task");
 }
+
+/// A greedy run driven one step at a time from outside (`ApproxAgent::stepper`, what
+/// `hstl.Policy.act` runs) takes the actions and options the agent's own run takes.
+#[test]
+fn a_run_stepped_from_outside_takes_the_agent_s_own_actions() {
+    use hstl::runtime::World;
+    let toml = "kind = \"plane\"\nx = [0.0, 10.0]\ny = [0.0, 10.0]\nstep = 1.0\nheadings = 8\n\
+                slip = 0.05\nnoise = 0.05\nobstacles = [{ circle = [5.0, 5.0, 1.5] }]\n";
+    let field = AnyWorld::from_toml(toml, "field").expect("a valid world");
+    for (src, world) in [(PATROL, plane()), (TIMED, field)] {
+        let spec = lowered(src, &world);
+        let t = c::train(&spec, &world, 3, |_, _| {}).expect("trains");
+        let AnyWorld::Plane(w) = &world else { unreachable!() };
+        let mut rng = hstl::runtime::seeded_rng(8);
+        for _ in 0..5 {
+            let start = w.reset(&mut rng);
+            let mut replay_rng = rng.clone();
+            let run = t.agent.run(w, start, 200, &mut rng);
+            let mut stepper = t.agent.stepper();
+            let (mut state, mut x, mut blocked) = (start, Vec::new(), Vec::new());
+            for k in 0..200 {
+                w.valuation(&state, &mut x);
+                assert_eq!(x[..], run.values[k * 2..k * 2 + 2]);
+                blocked.clear();
+                blocked.extend((0..w.actions().len()).map(|a| w.blocked(&state, a)));
+                let (a, o) = stepper.act(&t.agent, &x, &blocked);
+                assert_eq!((a, o), (run.actions[k], run.options[k]), "step {k}");
+                state = w.step(&state, a, &mut replay_rng);
+            }
+        }
+    }
+}

@@ -22,7 +22,7 @@ pub mod learn;
 pub mod progress;
 pub mod tiles;
 
-pub use agent::{ApproxAgent, GreedyRun, WindowSummary, task_robustness};
+pub use agent::{ApproxAgent, GreedyRun, Stepper, WindowSummary, task_robustness};
 pub use learn::{ApproxLearner, Model, Weights};
 pub use progress::Progress;
 pub use tiles::TileCoder;
