@@ -90,7 +90,7 @@ def train(
             return _hstl._train_world(spec, resolved, seed, episodes, bar.callback)
         if world is not None:
             raise TypeError("pass either world= or env=, not both")
-        if _is_box(env):
+        if _is_box(env) and spec.is_continuous:
             return _hstl._train_box(
                 spec, env, _box_valuation(valuation, spec), seed, *_box_spaces(env), episodes, bar.callback
             )
@@ -200,7 +200,9 @@ def _discrete(env: Any, name: str) -> Any:
         kind = type(space).__name__
         raise TypeError(
             f"train(env=...) needs a `Discrete` {name.replace('_', ' ')}; this environment's is {kind}\n"
-            "  help: the learner is tabular: wrap the environment so that it numbers its states and actions"
+            "  help: the tabular learner needs numbered states: wrap the environment so that it numbers its states "
+            "and actions, or for a `Box` observation space declare the spec's state variables as `float` ranges "
+            "(the approximate learner tiles them)"
         )
     return space
 
