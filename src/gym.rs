@@ -83,7 +83,7 @@ pub fn step(
 }
 
 /// Which of the world's actions its state `values` blocks (see
-/// [`World::blocked`](hstl_runtime::World::blocked)): what a greedy agent never chooses.
+/// [`World::blocked`]): what a greedy agent never chooses.
 pub fn blocked(world: &AnyWorld, values: &[f64]) -> Vec<bool> {
     match world {
         AnyWorld::Plane(p) if values.len() == 2 => {
