@@ -514,9 +514,12 @@ impl Policy {
     /// action led to; call `reset()` at the start of every episode.
     ///
     /// `state` is an observation of the environment the policy was trained in (a grid
-    /// world's `(x, y)`, a gymnasium environment's integer) or a mapping from the state
-    /// variables to values. Returns the action's index (for a gymnasium environment, the
-    /// action itself).
+    /// world's `(x, y)`, a gymnasium environment's integer, a continuous world's `(x, y)`
+    /// or `(x, v)` array) or a mapping from the state variables to values; for a policy
+    /// trained on a `Box` environment with a `valuation`, the valuation's result. A
+    /// learned function's state must lie in its world (or the ranges its spec declares):
+    /// NaN, infinite or outside values are refused. Returns the action's index (for a
+    /// gymnasium environment, the action itself).
     fn act(&self, state: &Bound<'_, PyAny>) -> PyResult<i64> {
         if let Some((agent, start)) = self.replayed.tiles() {
             let vars = self.replayed.state_vars();

@@ -224,3 +224,29 @@ def test_the_continuous_example_script_runs(tmp_path):
     result = subprocess.run([sys.executable, str(script), "--episodes", "5"], capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stderr
     assert "window rate W =" in result.stdout and "hstl/MountainCarPatrol-v0:" in result.stdout
+
+
+class Ending(Scripted):
+    """Terminates every episode after 3 steps, never in a region, and counts the steps it
+    is asked for."""
+
+    def __init__(self):
+        super().__init__([[0.5, 0.5], [0.6, 0.5], [0.4, 0.5], [0.5, 0.5]])
+        self.calls = []
+
+    def reset(self, *, seed=None, options=None):
+        self.calls.append(0)
+        return super().reset(seed=seed, options=options)
+
+    def step(self, action):
+        self.calls[-1] += 1
+        obs, reward, _, truncated, info = super().step(action)
+        return obs, reward, self.t == 3, truncated, info
+
+
+def test_a_terminated_step_holds_the_learner_there_until_it_resets():
+    env = Ending()
+    policy = hstl.train(UNIT, env=env, seed=1)
+    # One reset per learner episode, never a step past the end of an episode.
+    assert env.calls == [3, 3]
+    assert policy.steps > sum(env.calls), "the learner's steps in the held state call nothing"
