@@ -889,17 +889,29 @@ impl Policy {
 
 /// Checks a learned function's state against the ranges its spec declares (the tiling's).
 fn in_ranges(spec: &TaskSpec, vars: &[String], values: &[f64]) -> PyResult<()> {
+    if values.len() != vars.len() {
+        return Err(value_error(
+            format!(
+                "a state of the policy has {} numbers ({}), not {}",
+                vars.len(),
+                vars.join(", "),
+                values.len()
+            ),
+            Some("give the state variables' values in order, or a dict of them".into()),
+        ));
+    }
     let Some(t) = &spec.learn.tiles else { return Ok(()) };
     for (i, &x) in values.iter().enumerate() {
-        if !(x >= t.lo[i] && x <= t.hi[i]) {
+        let (Some(&lo), Some(&hi)) = (t.lo.get(i), t.hi.get(i)) else { continue };
+        if !(x >= lo && x <= hi) {
             let num = hstl::runtime::plane::num;
             return Err(value_error(
                 format!(
                     "`{}` = {} is outside its declared range {}..={}",
                     vars[i],
                     num(x),
-                    num(t.lo[i]),
-                    num(t.hi[i])
+                    num(lo),
+                    num(hi)
                 ),
                 Some("give a state the policy was trained on".into()),
             ));

@@ -210,7 +210,12 @@ def test_a_box_env_with_the_wrong_spaces_or_spec_is_refused():
         policy.evaluate(env=Scripted([[0.5, 0.5]], high=2.0), starts=1, steps=150)
     with pytest.raises(ValueError, match="the observation space is unbounded: component 1 lies in"):
         policy.evaluate(env=gymnasium.make("CartPole-v1").unwrapped, starts=1, steps=150)
-    for state, words in [([0.5, float("nan")], "`b` = NaN is outside its declared range"), ([1.5, 0.5], "`a` = 1.5")]:
+    for state, words in [
+        ([0.5, float("nan")], "`b` = NaN is outside its declared range"),
+        ([1.5, 0.5], "`a` = 1.5"),
+        ([0.5, 0.5, 0.5], "a state of the policy has 2 numbers (a, b), not 3"),
+        ([0.5], "not 1"),
+    ]:
         with pytest.raises(ValueError) as e:
             policy.act(state)
         assert words in str(e.value)
