@@ -28,6 +28,7 @@
 pub mod artifacts;
 pub mod continuous;
 pub mod evaluate;
+pub mod gym;
 pub mod load;
 pub mod lower;
 pub mod monitor;

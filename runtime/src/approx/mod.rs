@@ -21,6 +21,6 @@ pub mod agent;
 pub mod learn;
 pub mod tiles;
 
-pub use agent::{ApproxAgent, GreedyRun, WindowSummary, task_robustness};
+pub use agent::{ApproxAgent, GreedyRun, Stepper, WindowSummary, task_robustness};
 pub use learn::{ApproxLearner, Model, Weights};
 pub use tiles::TileCoder;
