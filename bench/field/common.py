@@ -64,7 +64,11 @@ def torch_one_thread() -> None:
     import torch
 
     torch.set_num_threads(1)
-    torch.set_num_interop_threads(1)
+    if torch.get_num_interop_threads() != 1:
+        try:
+            torch.set_num_interop_threads(1)
+        except RuntimeError:  # only before any parallel work; set once per process
+            pass
 
 
 def band_plot(path: pathlib.Path, series: dict[str, list[list[tuple[float, float]]]], xlabel: str, ylabel: str,

@@ -53,6 +53,43 @@ class Columns:
         return obs[self.columns]
 
 
+class Passthrough(gymnasium.Wrapper):
+    """A wrapper that does nothing: the floor of any Python wrapper's cost per step."""
+
+    def step(self, action):
+        return self.env.step(action)
+
+
+def push_alone(spec, columns, observations):
+    """CPU seconds per step of the monitor alone (`EpisodeMonitor.push`, what STLReward calls
+    into Rust) on recorded observations."""
+    from hstl._hstl import EpisodeMonitor
+
+    monitor = EpisodeMonitor(spec)
+    pick = Columns(columns)
+    t0 = time.process_time()
+    for o in observations:
+        monitor.push(pick(o))
+    return (time.process_time() - t0) / len(observations)
+
+
+def run_manual(env, actions, steps, episode, spec, columns):
+    """The bare step and the monitor's push, no wrapper: what the push costs between MuJoCo
+    steps (more than alone: the two share the core's caches)."""
+    from hstl._hstl import EpisodeMonitor
+
+    monitor = EpisodeMonitor(spec)
+    pick = Columns(columns)
+    env.reset(seed=0)
+    t0 = time.process_time()
+    for i in range(steps):
+        monitor.push(pick(env.step(actions[i])[0]))
+        if (i + 1) % episode == 0:
+            env.reset()
+            monitor.reset()
+    return (time.process_time() - t0) / steps
+
+
 def rtamt_monitor(formula: str, names: list[str]):
     import rtamt
 
@@ -101,24 +138,33 @@ def main() -> None:
     args = ap.parse_args()
     print(f"machine: {machine()}; {args.steps} random steps a repeat, median of {args.repeats} repeats, "
           f"episodes of {args.episode_steps} steps\n")
-    print("| environment | bare, us/step | + STLReward, us/step | STLReward adds | + rtamt online monitor, us/step | rtamt adds | goal <= 2% |")
-    print("|---|---|---|---|---|---|---|")
+    print("| environment | bare, us/step | + STLReward, us/step | STLReward adds | + rtamt online monitor, us/step | rtamt adds | goal <= 2% | an empty wrapper adds | the monitor's push alone, us | push between bare steps adds, us |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for env_id in args.envs.split(","):
         file, picks, rtamt_formula = TASKS[env_id]
         spec = hstl.Spec.load(SPECS / file)
         bare = gymnasium.make(env_id, max_episode_steps=None).unwrapped
-        wrapped = hstl.STLReward(gymnasium.make(env_id).unwrapped, spec, valuation=Columns(list(picks.values())))
+        columns = list(picks.values())
+        wrapped = hstl.STLReward(gymnasium.make(env_id).unwrapped, spec, valuation=Columns(columns))
         rng = np.random.default_rng(0)
         space = bare.action_space
-        actions = rng.uniform(space.low, space.high, size=(args.steps,) + space.shape).astype(space.dtype)
+        actions = rng.uniform(space.low, space.high, size=(max(args.steps, 5000),) + space.shape).astype(space.dtype)
         # Warm up each (imports, caches).
         run_bare(bare, actions, 1000, args.episode_steps)
         run_bare(wrapped, actions, 1000, args.episode_steps)
-        times = {"bare": [], "stl": [], "rtamt": []}
+        empty = Passthrough(gymnasium.make(env_id).unwrapped)
+        recorded = []
+        bare.reset(seed=0)
+        for a in actions[:5000]:
+            recorded.append(bare.step(a)[0])
+        times = {"bare": [], "stl": [], "rtamt": [], "empty": [], "push": [], "manual": []}
         for _ in range(args.repeats):
             times["bare"].append(run_bare(bare, actions, args.steps, args.episode_steps))
             times["stl"].append(run_bare(wrapped, actions, args.steps, args.episode_steps))
+            times["empty"].append(run_bare(empty, actions, args.steps, args.episode_steps))
+            times["push"].append(push_alone(spec, columns, recorded))
+            times["manual"].append(run_manual(bare, actions, args.steps, args.episode_steps, spec, columns))
             if not args.no_rtamt:
                 times["rtamt"].append(run_rtamt(bare, actions, args.steps, args.episode_steps, rtamt_formula, picks))
         med = {k: statistics.median(v) * 1e6 for k, v in times.items() if v}
@@ -127,14 +173,15 @@ def main() -> None:
         added = statistics.median(paired)
         r_added = statistics.median([r / b - 1 for r, b in zip(times["rtamt"], times["bare"])]) if times["rtamt"] else float("nan")
         met = "met" if added <= 0.02 else "not met"
+        e_added = statistics.median([e / b - 1 for e, b in zip(times["empty"], times["bare"])])
         print(f"| {env_id} | {med['bare']:.1f} | {med['stl']:.1f} | {100 * added:+.1f}% (repeats {min(paired) * 100:+.1f}% to {max(paired) * 100:+.1f}%) "
-              f"| {med.get('rtamt', float('nan')):.1f} | {100 * r_added:+.0f}% | {met} |", flush=True)
+              f"| {med.get('rtamt', float('nan')):.1f} | {100 * r_added:+.0f}% | {met} | {100 * e_added:+.1f}% | {med['push']:.2f} | {med['manual'] - med['bare']:.1f} |", flush=True)
         rows.append([env_id, args.steps, args.repeats, med["bare"], med["stl"], added, min(paired), max(paired),
-                     med.get("rtamt", float("nan")), r_added, machine()])
+                     med.get("rtamt", float("nan")), r_added, e_added, med["push"], med["manual"] - med["bare"], machine()])
         bare.close()
         wrapped.close()
     write_csv(OUT / "physics.csv", ["env", "steps", "repeats", "bare_us", "stlreward_us", "stlreward_added",
-                                     "added_min", "added_max", "rtamt_us", "rtamt_added", "machine"], rows)
+                                     "added_min", "added_max", "rtamt_us", "rtamt_added", "empty_wrapper_added", "push_us", "push_between_steps_us", "machine"], rows)
     print(f"\nwrote {OUT / 'physics.csv'}")
 
 
