@@ -79,6 +79,7 @@ def band_plot(path: pathlib.Path, series: dict[str, list[list[tuple[float, float
     import matplotlib
 
     matplotlib.use("Agg")
+    import matplotlib.ticker
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4.2))
@@ -90,10 +91,13 @@ def band_plot(path: pathlib.Path, series: dict[str, list[list[tuple[float, float
         xs = [statistics.fmean(c[i][0] for c in curves) for i in range(n)]
         ys = [[c[i][1] for c in curves] for i in range(n)]
         mean = [statistics.fmean(y) for y in ys]
-        (line,) = ax.plot(xs, mean, marker="o", ms=3, label=f"{name} (n={len(curves)})")
+        published = "TGPO" in name
+        label = name if published else f"{name} (n={len(curves)})"
+        (line,) = ax.plot(xs, mean, marker="o", ms=3, label=label, linestyle="--" if published else "-")
         ax.fill_between(xs, [min(y) for y in ys], [max(y) for y in ys], color=line.get_color(), alpha=0.2)
     if logx:
         ax.set_xscale("log")
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     if ylim:
         ax.set_ylim(*ylim)
     ax.set_xlabel(xlabel)

@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
+import statistics
 import subprocess
 import sys
 import time
@@ -289,7 +290,63 @@ def plot(task: Task) -> None:
               "window rate W (100 greedy runs x 2000 steps)", title, logx=True)
     band_plot(folder / "wall.png", {k: list(v.values()) for k, v in series_secs.items()}, "training wall clock, s (one core)",
               "window rate W", title, logx=True)
-    print(f"wrote {folder / 'curves.csv'}, steps.png, wall.png")
+    print(f"wrote {folder / 'curves.csv'}, steps.png, wall.png\n")
+    table(task, rows)
+
+
+def table(task: Task, rows: list[dict[str, str]]) -> None:
+    """The Markdown tables: each method's last checkpoint (mean ± sd, min-max over seeds),
+    hstl at equal environment steps and at equal wall clock with each SB3 method, and the
+    time to each method's plateau."""
+    from common import fmt_spread, spread
+
+    runs: dict[str, dict[str, list[dict[str, str]]]] = {}
+    for r in rows:
+        runs.setdefault(r["method"], {}).setdefault(r["seed"], []).append(r)
+    lines = [f"machine: {machine()}", "",
+             "| method | reward | seeds | env steps (mean) | training s (mean) | W at the end, mean ± sd (min-max) |",
+             "|---|---|---|---|---|---|"]
+    for method, seeds in runs.items():
+        last = [s_[-1] for s_ in seeds.values()]
+        if any(r["W"] in ("", "nan") for r in last):
+            lines.append(f"| {method} | {last[0]['reward']} | {len(last)} | | | pending |")
+            continue
+        lines.append(f"| {method} | {last[0]['reward']} | {len(last)} | {spread([float(r['steps']) for r in last])[0]:,.0f} "
+                     f"| {spread([float(r['train_secs']) for r in last])[0]:.1f} | {fmt_spread([float(r['W']) for r in last])} |")
+    hstl_runs = runs.get("hstl", {})
+    if hstl_runs and all(r["W"] not in ("", "nan") for v in hstl_runs.values() for r in v):
+        lines += ["", "| SB3 method | its steps, s and W (mean) | hstl at equal steps: W (its rungs with at most those steps, best) | hstl at equal wall clock: W | hstl's time to its plateau, s (mean) | SB3's time to its own best, s (mean) |",
+                  "|---|---|---|---|---|---|"]
+
+        def plateau_secs(seed_rows: list[dict[str, str]]) -> float:
+            best = max(float(r["W"]) for r in seed_rows)
+            return next(float(r["train_secs"]) for r in seed_rows if float(r["W"]) >= 0.95 * best)
+
+        h_plateau = statistics.fmean(plateau_secs(v) for v in hstl_runs.values())
+        for method, seeds in runs.items():
+            if method == "hstl":
+                continue
+            last = [v[-1] for v in seeds.values()]
+            steps = statistics.fmean(float(r["steps"]) for r in last)
+            secs = statistics.fmean(float(r["train_secs"]) for r in last)
+            w = statistics.fmean(float(r["W"]) for r in last)
+
+            def best_within(key: str, limit: float) -> list[float]:
+                out = []
+                for v in hstl_runs.values():
+                    ok = [float(r["W"]) for r in v if float(r[key]) <= limit]
+                    out.append(max(ok) if ok else math.nan)
+                return out
+
+            at_steps = best_within("steps", steps)
+            at_secs = best_within("train_secs", secs)
+            fmt = lambda xs: ("no rung that small" if any(math.isnan(x) for x in xs) else fmt_spread(xs))  # noqa: E731
+            sb3_plateau = statistics.fmean(plateau_secs(v) for v in seeds.values())
+            lines.append(f"| {method} | {steps:,.0f} steps, {secs:.0f} s, W {w:.3f} | {fmt(at_steps)} | {fmt(at_secs)} "
+                         f"| {h_plateau:.1f} | {sb3_plateau:.1f} |")
+    text = "\n".join(lines) + "\n"
+    (OUT / "patrol" / task.name / "table.md").write_text(text)
+    print(text)
 
 
 if __name__ == "__main__":
