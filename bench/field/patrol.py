@@ -287,7 +287,7 @@ def plot(task: Task) -> None:
     title = {"mountain_car": "MountainCar patrol (both hill tops every 200 steps)",
              "cartpole": "CartPole patrol (balance; each end of the track every 200 steps)"}[task.name]
     band_plot(folder / "steps.png", {k: list(v.values()) for k, v in series_steps.items()}, "environment steps",
-              "window rate W (100 greedy runs x 2000 steps)", title, logx=True)
+              "window rate W (greedy runs of 2000 steps)", title, logx=True)
     band_plot(folder / "wall.png", {k: list(v.values()) for k, v in series_secs.items()}, "training wall clock, s (one core)",
               "window rate W", title, logx=True)
     print(f"wrote {folder / 'curves.csv'}, steps.png, wall.png\n")
