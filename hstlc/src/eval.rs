@@ -47,6 +47,26 @@ pub const DEFAULT_STEPS: usize = 2000;
 /// At most this many runs are written by `--runs`.
 pub const MAX_RUN_FILES: usize = 1000;
 
+/// At most this many rows in all, over the runs `--runs` writes (they are built in memory
+/// before the folder is written whole).
+pub const MAX_RUN_ROWS: usize = 10_000_000;
+
+/// Refuses a `--runs` that would write more than [`MAX_RUN_ROWS`] rows, before anything runs.
+fn check_run_rows(args: &EvalArgs, steps: usize) -> Result<(), CliError> {
+    let rows = args.starts.min(MAX_RUN_FILES).saturating_mul(steps.saturating_add(1));
+    if args.runs.is_some() && rows > MAX_RUN_ROWS {
+        return Err(CliError::new(
+            format!(
+                "--runs would write {rows} rows ({} runs of {} states), more than {MAX_RUN_ROWS}",
+                args.starts.min(MAX_RUN_FILES),
+                steps.saturating_add(1)
+            ),
+            Some("lower --starts or --steps, or leave out --runs".to_string()),
+        ));
+    }
+    Ok(())
+}
+
 /// The window rate's line: the rate, its range over the runs, and what a kept step is. A
 /// one-step window (a safety conjunct `always[0..] !S`, the region `!S`) holds at the step.
 fn window_line(
@@ -101,6 +121,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let (spec, env) = (&replay.spec, &replay.env);
     runs.check_burn_in(spec, flag)?;
     // Decide what can be written before anything is printed.
+    check_run_rows(args, runs.steps)?;
     let out = args
         .runs
         .as_ref()
@@ -213,6 +234,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
     let runs = Runs { steps, ..runs };
     runs.check_burn_in(spec, flag)?;
     // Decide what can be written before anything is printed.
+    check_run_rows(args, runs.steps)?;
     let out = args
         .runs
         .as_ref()

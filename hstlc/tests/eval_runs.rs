@@ -65,5 +65,12 @@ fn eval_writes_the_greedy_runs_of_a_grid_policy() {
         assert_eq!(refused.status.code(), Some(2), "{spec}");
         assert!(refused.stdout.is_empty(), "decided before printing");
         assert_eq!(std::fs::read_to_string(mine.join("notes.txt")).expect("kept"), "mine");
+        // Runs too large to write are refused before anything runs or is printed.
+        let huge = dir.path().join("huge");
+        let big = ["eval", path(&policy), "--starts", "1000", "--steps", "100000", "--no-optimum"];
+        let refused = hstlc(&[&big[..], &["--runs", path(&huge)]].concat());
+        assert_eq!(refused.status.code(), Some(2), "{spec}");
+        assert!(String::from_utf8_lossy(&refused.stderr).contains("lower --starts or --steps"));
+        assert!(refused.stdout.is_empty() && !huge.exists());
     }
 }
