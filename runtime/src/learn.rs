@@ -46,7 +46,7 @@ use rand::RngExt;
 use crate::env::EpisodeEnd;
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
-use crate::plan_reach::ReachPlanner;
+use crate::plan_reach::{OptionsLayout, ReachPlanner};
 use crate::progress::{GoalTracker, StateGoals, run_steps};
 use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
@@ -382,7 +382,18 @@ impl<'e, E: Env> Learner<'e, E> {
             }
             (Plans::Reach(planner), _) => {
                 let flat = planner.legs(&self.tables, &self.q.flat, &moves, model.starts());
-                (flat, self.q.options.clone())
+                let options = match &self.goals {
+                    Some(g) => {
+                        let layout = OptionsLayout {
+                            values: self.values,
+                            codes: self.codes,
+                            all_met: g.progress.all_met(),
+                        };
+                        planner.options(&self.tables, &flat, &moves, &self.q.options, layout)
+                    }
+                    None => self.q.options.clone(),
+                };
+                (flat, options)
             }
             (Plans::Options(_), None) => return,
         };

@@ -17,7 +17,12 @@
 //! where nothing is known keeps its learned values.
 //!
 //! With several goals each leg is planned against its own deadline from the starts of
-//! training; the options level stays Q-learned.
+//! training; the options level stays Q-learned, but for a hold: a leg that enters no goal
+//! and keeps out of exactly the task's avoided states (`keep_clear`, which `preset: auto`
+//! adds). Once every goal is met only the avoidance is left, so the hold's leg is planned
+//! to keep out longest, and the options values of those observations become the
+//! probability of keeping out over the next [`TAIL_STEPS`] steps if each option's first leg
+//! were followed throughout; before then the hold enters no goal, so it is never chosen.
 
 use crate::plan::UNTRIED;
 use crate::reach_avoid::ReachAvoid;
@@ -39,6 +44,19 @@ pub(crate) struct ReachPlanner {
     /// `goal_of[p]`: the goal (0 for the first, `1 + j` for `also[j]`) primitive `p` stops
     /// on entering, if any.
     goal_of: Vec<Option<usize>>,
+    /// `hold[p]`: primitive `p` enters no goal and keeps out of exactly the task's avoided
+    /// states.
+    hold: Vec<bool>,
+}
+
+/// Where the options values are in their table: `options[obs * n + o]`, the observation of
+/// state `s`, memory value `v` and goals met `m` being `(s * values + v) * codes + m`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct OptionsLayout {
+    pub values: usize,
+    pub codes: usize,
+    /// The code of every goal met.
+    pub all_met: usize,
 }
 
 impl ReachPlanner {
@@ -62,8 +80,17 @@ impl ReachPlanner {
                     .collect();
                 goals.iter().position(|g| **g == stops && g.iter().any(|&x| x))
             })
+            .collect::<Vec<_>>();
+        let hold = (0..tables.term.len())
+            .map(|p| goal_of[p].is_none() && tables.ends[p].as_ref() == Some(&task.avoid))
             .collect();
-        Ok(Some(ReachPlanner { task, goal_of }))
+        Ok(Some(ReachPlanner { task, goal_of, hold }))
+    }
+
+    /// The steps a hold leg is planned to keep out over: the avoidance's, at most
+    /// [`TAIL_STEPS`].
+    fn hold_steps(&self) -> usize {
+        self.task.avoid_through.clamp(1, TAIL_STEPS)
     }
 
     /// The flat tables with every leg that enters a goal planned under `moves` (the
@@ -82,6 +109,23 @@ impl ReachPlanner {
             return out;
         }
         let start: Vec<f64> = starts.iter().map(|&c| f64::from(c) / total).collect();
+        if self.hold.iter().any(|&h| h) {
+            let leg = LegTask {
+                goal: &self.task.goal,
+                avoid: &self.task.avoid,
+                reach_by: 0,
+                avoid_through: self.task.avoid_through,
+            };
+            let (_, rows) = leg.safety(tables.states, tables.actions, moves, self.hold_steps());
+            for p in (0..self.hold.len()).filter(|&p| self.hold[p]) {
+                for s in 0..tables.states {
+                    let row = &rows[s * tables.actions..][..tables.actions];
+                    if row.iter().any(|&v| v > UNTRIED) {
+                        out[p][s * tables.actions..][..tables.actions].copy_from_slice(row);
+                    }
+                }
+            }
+        }
         for (p, goal) in self.goal_of.iter().enumerate() {
             let Some(j) = *goal else { continue };
             let (goal, by) = match j {
@@ -99,6 +143,70 @@ impl ReachPlanner {
                     let row = &table[s * tables.actions..][..tables.actions];
                     if row.iter().any(|&v| v > UNTRIED) {
                         out[p][s * tables.actions..][..tables.actions].copy_from_slice(row);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// The options values `options` (laid out as `layout` says) with the holds planned:
+    /// where every goal is met, each option's value is the probability under `moves` of
+    /// keeping out of the avoided states over the next steps if its first leg's greedy
+    /// actions in `flat` were followed throughout (0 from a state with no known action);
+    /// before then a hold option is worth [`UNTRIED`]. Unchanged without a hold option.
+    pub fn options(
+        &self,
+        tables: &Tables,
+        flat: &[Vec<f64>],
+        moves: &[Vec<(usize, f64)>],
+        options: &[f64],
+        layout: OptionsLayout,
+    ) -> Vec<f64> {
+        let mut out = options.to_vec();
+        let n = tables.legs.len();
+        let is_hold = |o: usize| tables.legs[o].first().is_some_and(|&p| self.hold[p]);
+        if !(0..n).any(is_hold) {
+            return out;
+        }
+        let (states, actions) = (tables.states, tables.actions);
+        // survive[o][s]: the probability of keeping out from `s` under option `o`'s first leg.
+        let survive: Vec<Vec<f64>> = (0..n)
+            .map(|o| {
+                let p = tables.legs[o][0];
+                let step: Vec<Option<usize>> = (0..states)
+                    .map(|s| {
+                        let row = &flat[p][s * actions..][..actions];
+                        let a = crate::learn::argmax(row);
+                        (!moves[s * actions + a].is_empty()).then_some(a)
+                    })
+                    .collect();
+                let mut w: Vec<f64> =
+                    (0..states).map(|s| if self.task.avoid[s] { 0.0 } else { 1.0 }).collect();
+                for _ in 0..self.hold_steps() {
+                    w = (0..states)
+                        .map(|s| match step[s] {
+                            Some(a) if !self.task.avoid[s] => {
+                                moves[s * actions + a].iter().map(|&(t, q)| q * w[t]).sum()
+                            }
+                            _ => 0.0,
+                        })
+                        .collect();
+                }
+                w
+            })
+            .collect();
+        let OptionsLayout { values, codes, all_met } = layout;
+        for s in 0..states {
+            for v in 0..values {
+                for met in 0..codes {
+                    let row = &mut out[((s * values + v) * codes + met) * n..][..n];
+                    for (o, value) in row.iter_mut().enumerate() {
+                        if met == all_met {
+                            *value = survive[o][s];
+                        } else if is_hold(o) {
+                            *value = UNTRIED;
+                        }
                     }
                 }
             }
