@@ -389,7 +389,14 @@ impl<'e, E: Env> Learner<'e, E> {
                             codes: self.codes,
                             all_met: g.progress.all_met(),
                         };
-                        planner.options(&self.tables, &flat, &moves, &self.q.options, layout)
+                        planner.options(
+                            &self.tables,
+                            &flat,
+                            &moves,
+                            model.starts(),
+                            &self.q.options,
+                            layout,
+                        )
                     }
                     None => self.q.options.clone(),
                 };

@@ -24,6 +24,8 @@
 //! probability of keeping out over the next [`TAIL_STEPS`] steps if each option's first leg
 //! were followed throughout; before then the hold enters no goal, so it is never chosen.
 
+mod choices;
+
 use crate::plan::UNTRIED;
 use crate::reach_avoid::ReachAvoid;
 use crate::tables::Tables;
@@ -150,12 +152,36 @@ impl ReachPlanner {
         out
     }
 
-    /// The options values `options` (laid out as `layout` says) with the holds planned:
-    /// where every goal is met, each option's value is the probability under `moves` of
-    /// keeping out of the avoided states over the next steps if its first leg's greedy
-    /// actions in `flat` were followed throughout (0 from a state with no known action);
-    /// before then a hold option is worth [`UNTRIED`]. Unchanged without a hold option.
+    /// The options values `options` (laid out as `layout` says) planned with the legs
+    /// `flat` under `moves`, from the episode starts `starts` (counts per state): the holds
+    /// first ([`ReachPlanner::holds`]), then, without memory, the choices improved on the
+    /// whole task's success probability (`choices`).
     pub fn options(
+        &self,
+        tables: &Tables,
+        flat: &[Vec<f64>],
+        moves: &[Vec<(usize, f64)>],
+        starts: &[u32],
+        options: &[f64],
+        layout: OptionsLayout,
+    ) -> Vec<f64> {
+        let out = self.holds(tables, flat, moves, options, layout);
+        let total: f64 = starts.iter().map(|&c| f64::from(c)).sum();
+        if layout.values != 1 || total == 0.0 {
+            return out;
+        }
+        let start: Vec<f64> = starts.iter().map(|&c| f64::from(c) / total).collect();
+        choices::Hierarchy::new(&self.task, tables, flat, moves, layout.codes)
+            .and_then(|h| h.improve(&out, &start))
+            .unwrap_or(out)
+    }
+
+    /// The options values `options` with the holds planned: where every goal is met, each
+    /// option's value is the probability under `moves` of keeping out of the avoided states
+    /// over the next steps if its first leg's greedy actions in `flat` were followed
+    /// throughout (0 from a state with no known action); before then a hold option is worth
+    /// [`UNTRIED`]. Unchanged without a hold option.
+    fn holds(
         &self,
         tables: &Tables,
         flat: &[Vec<f64>],
