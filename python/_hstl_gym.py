@@ -1,21 +1,31 @@
-"""The gymnasium ids of the built-in worlds, registered without importing gymnasium first.
+"""hstl's gymnasium ids, registered without importing gymnasium or hstl first.
+
+This module is top-level (not in the ``hstl`` package) so that the wheel's
+``hstl-gymnasium.pth`` can import it at every interpreter start without loading hstl's
+extension: gymnasium 1.x has no plugin entry points, and this is how
+``gymnasium.make("hstl/GridWorld-v0")`` works without ``import hstl`` (setuptools and
+coverage start the same way). It costs well under a millisecond; ``HSTL_NO_GYMNASIUM_IDS=1``
+turns it off. ``import hstl`` calls ``install()`` too, for installs without the ``.pth``.
 
 ``import hstl`` does not import gymnasium (it costs about 150 ms, and most uses of the
 monitors need none of it). The ids still work as gymnasium users expect: when gymnasium is
-already imported, ``import hstl`` registers them at once; otherwise ``install()`` puts a
-finder on ``sys.meta_path`` that registers them as soon as gymnasium's own import ends, and
-then leaves. Registering needs only strings (``entry_point="hstl._gym:GridWorldEnv"``), so
+already imported, ``install()`` registers them at once; otherwise it puts a finder on
+``sys.meta_path`` that registers them as soon as gymnasium's own import ends, and then
+leaves. Registering needs only strings (``entry_point="hstl._gym:GridWorldEnv"``), so
 ``hstl._gym`` itself loads when an environment is first made.
 """
 
 from __future__ import annotations
 
-import importlib.abc
-import importlib.machinery
 import sys
-import types
-import warnings
-from typing import Any, Optional, Sequence
+
+# Only what the interpreter has loaded anyway is imported at startup: `importlib.abc` alone
+# took about 20 ms, so the finder and loader are the protocols, not subclasses.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    import importlib.machinery
+    import types
+    from typing import Any, Optional, Sequence
 
 #: The episode length of the registered environments: the length of the greedy runs that
 #: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
@@ -50,6 +60,15 @@ def register() -> None:
             )
 
 
+def startup() -> None:
+    """What ``hstl-gymnasium.pth`` runs at interpreter start: ``install()``, unless the
+    environment sets ``HSTL_NO_GYMNASIUM_IDS`` to anything but ``""`` or ``0``."""
+    import os
+
+    if os.environ.get("HSTL_NO_GYMNASIUM_IDS", "") in ("", "0"):
+        install()
+
+
 def install() -> None:
     """Registers the ids now if gymnasium is imported, else once it is."""
     if "gymnasium" in sys.modules:
@@ -58,7 +77,7 @@ def install() -> None:
         sys.meta_path.insert(0, _RegisterAfterImport())
 
 
-class _RegisterAfterImport(importlib.abc.MetaPathFinder):
+class _RegisterAfterImport:
     """Finds gymnasium as the other finders do, and wraps its loader so that the ids are
     registered right after the package has run; removes itself once it has."""
 
@@ -74,12 +93,13 @@ class _RegisterAfterImport(importlib.abc.MetaPathFinder):
             spec: Optional[importlib.machinery.ModuleSpec] = find(fullname, path, target) if find is not None else None
             if spec is not None:
                 if spec.loader is not None and hasattr(spec.loader, "exec_module"):
-                    spec.loader = _Loader(spec.loader)
+                    # A loader by its methods, not its class (see the imports above).
+                    spec.loader = _Loader(spec.loader)  # type: ignore[assignment]
                 return spec
         return None
 
 
-class _Loader(importlib.abc.Loader):
+class _Loader:
     """gymnasium's own loader, then the registration."""
 
     def __init__(self, loader: Any) -> None:
@@ -94,6 +114,8 @@ class _Loader(importlib.abc.Loader):
         try:
             register()
         except Exception as e:  # gymnasium itself imported; only the ids are missing
+            import warnings
+
             warnings.warn(f"hstl could not register its gymnasium ids: {e}", stacklevel=2)
 
     def __getattr__(self, name: str) -> Any:

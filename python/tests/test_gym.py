@@ -314,10 +314,34 @@ def test_the_ids_are_registered_whichever_is_imported_first(code):
     assert out.returncode == 0 and out.stdout == "ok\n", out.stderr
 
 
-def test_without_import_hstl_gymnasium_does_not_know_the_ids():
-    # gymnasium >= 1.0 has no plugin entry points (removed in 1.0; `load_plugin_envs` is
-    # gone), so nothing registers the ids before something imports hstl: gymnasium's own
-    # error (the `hstl:` form the docs give works: see the test above). This fails, as a
-    # reminder to register through the plugin, the day gymnasium finds them by itself.
-    out = python("import gymnasium\ngymnasium.make('hstl/GridWorld-v0')")
+def python_env(code: str, **env: str) -> subprocess.CompletedProcess:
+    """`python(code)` with `env` added to the environment."""
+    import os
+
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env={**os.environ, **env}
+    )
+
+
+def test_gymnasium_knows_the_ids_without_import_hstl():
+    # gymnasium >= 1.0 has no plugin entry points: the wheel's `hstl-gymnasium.pth` imports
+    # the top-level `_hstl_gym` at interpreter start, which waits for gymnasium's import
+    # without importing hstl (its extension loads only when an environment is made).
+    out = python(
+        "import sys\n"
+        "assert '_hstl_gym' in sys.modules, 'hstl-gymnasium.pth did not run'\n"
+        "assert 'hstl' not in sys.modules and 'gymnasium' not in sys.modules\n"
+        "import gymnasium\n"
+        "assert 'hstl' not in sys.modules, 'registering imported hstl'\n"
+        "env = gymnasium.make('hstl/FourRooms-v0')\n"
+        "print(env.unwrapped.world.name)"
+    )
+    assert out.returncode == 0 and out.stdout == "four-rooms\n", out.stderr
+
+
+def test_the_startup_registration_can_be_turned_off():
+    out = python_env("import gymnasium\ngymnasium.make('hstl/GridWorld-v0')", HSTL_NO_GYMNASIUM_IDS="1")
     assert out.returncode != 0 and "NamespaceNotFound" in out.stderr, out.stderr
+    # `import hstl` registers them all the same.
+    out = python_env("import hstl, gymnasium\nprint(gymnasium.make('hstl/GridWorld-v0').unwrapped.world.name)", HSTL_NO_GYMNASIUM_IDS="1")
+    assert out.returncode == 0 and out.stdout == "paper\n", out.stderr
