@@ -382,25 +382,25 @@ impl<'e, E: Env> Learner<'e, E> {
             }
             (Plans::Reach(planner), _) => {
                 let flat = planner.legs(&self.tables, &self.q.flat, &moves, model.starts());
-                let options = match &self.goals {
+                match &self.goals {
                     Some(g) => {
                         let layout = OptionsLayout {
                             values: self.values,
                             codes: self.codes,
                             all_met: g.progress.all_met(),
                         };
-                        planner.options(
+                        planner.hierarchy(
                             &self.tables,
-                            &flat,
+                            &self.q.flat,
+                            flat,
                             &moves,
                             model.starts(),
                             &self.q.options,
                             layout,
                         )
                     }
-                    None => self.q.options.clone(),
-                };
-                (flat, options)
+                    None => (flat, self.q.options.clone()),
+                }
             }
             (Plans::Options(_), None) => return,
         };

@@ -31,8 +31,8 @@ pub(super) struct Hierarchy<'a> {
     step: Vec<Vec<Option<usize>>>,
     /// `in_goal[s]`: the goals (bits) whose region holds at `s`.
     in_goal: Vec<usize>,
-    /// `deadline[j]`: the last step goal `j` may be entered.
-    deadline: Vec<usize>,
+    /// `due[t]`: the goals (bits) that may still be entered at step `t`.
+    due: Vec<usize>,
     /// The last step judged: the deadlines, and past them the avoidance for at most
     /// [`TAIL_STEPS`] more.
     last: usize,
@@ -98,7 +98,12 @@ impl<'a> Hierarchy<'a> {
         let in_goal = (0..states)
             .map(|s| goals.iter().enumerate().filter(|(_, g)| g.0[s]).map(|(j, _)| 1 << j).sum())
             .collect();
-        Some(Hierarchy { task, tables, moves, step, in_goal, deadline, last, codes, slot, running })
+        let due = (0..=last)
+            .map(|t| {
+                deadline.iter().enumerate().filter(|(_, d)| t <= **d).map(|(j, _)| 1 << j).sum()
+            })
+            .collect();
+        Some(Hierarchy { task, tables, moves, step, in_goal, due, last, codes, slot, running })
     }
 
     /// The options values `table` (`options[(s * codes + met) * n + o]`, one memory value)
@@ -135,6 +140,11 @@ impl<'a> Hierarchy<'a> {
         best.map(|(_, table)| table)
     }
 
+    /// The success probability from `start` of the choices greedy on `table`.
+    pub fn success(&self, table: &[f64], start: &[f64]) -> f64 {
+        self.backward(&self.choices(table), start, None).success
+    }
+
     /// The option greedy on `table` at each `(state, goals met)`, among those available.
     fn choices(&self, table: &[f64]) -> Vec<usize> {
         let n = self.tables.legs.len();
@@ -151,18 +161,24 @@ impl<'a> Hierarchy<'a> {
         if self.task.avoid[s] && t <= self.task.avoid_through {
             return None;
         }
-        let due: usize =
-            self.deadline.iter().enumerate().filter(|(_, d)| t <= **d).map(|(j, _)| 1 << j).sum();
+        let due = self.due[t];
         let met = met | (self.in_goal[s] & due);
-        let late = self.deadline.iter().enumerate().any(|(j, &d)| t > d && met & (1 << j) == 0);
+        // A goal that can no longer be entered and was not is lost.
+        let late = !due & (self.codes - 1) & !met != 0;
         (!late).then_some(met)
     }
 
     /// One forward and one backward pass under `choices`.
     fn round(&self, choices: &[usize], start: &[f64]) -> Round {
+        let reached = self.forward(choices, start);
+        self.backward(choices, start, Some(&reached))
+    }
+
+    /// How often each decision point is reached at each step under `choices`:
+    /// `reached[(t * states + s) * codes + met]`.
+    fn forward(&self, choices: &[usize], start: &[f64]) -> Vec<f64> {
         let (states, actions, codes) = (self.tables.states, self.tables.actions, self.codes);
-        let (n, k) = (self.tables.legs.len(), self.running.len());
-        let all = codes - 1;
+        let k = self.running.len();
         // Forward: how often each decision point is reached at each step.
         let mut reached = vec![0.0f64; (self.last + 1) * states * codes];
         let mut mass = vec![0.0f64; states * codes * k];
@@ -199,40 +215,67 @@ impl<'a> Hierarchy<'a> {
             }
             mass = after;
         }
+        reached
+    }
+
+    /// The probability of success from each running leg under `choices`, summed into each
+    /// option's value where `reached` says a decision point is reached (without it, the
+    /// success probability alone).
+    fn backward(&self, choices: &[usize], start: &[f64], reached: Option<&[f64]>) -> Round {
+        let (states, actions, codes) = (self.tables.states, self.tables.actions, self.codes);
+        let (n, k) = (self.tables.legs.len(), self.running.len());
+        let all = codes - 1;
         // Backward: the probability of success from each running leg, summed into each
         // option's value where a decision point is reached.
-        let mut value = vec![0.0f64; states * codes * n];
-        let mut times = vec![0.0f64; states * codes];
+        let sums = if reached.is_some() { states * codes } else { 0 };
+        let mut value = vec![0.0f64; sums * n];
+        let mut times = vec![0.0f64; sums];
         let mut later = vec![0.0f64; states * codes * k];
         let mut decide = vec![0.0f64; states * codes];
+        let mut here = vec![0.0f64; states * codes * k];
         for t in (0..self.last).rev() {
-            let mut here = vec![0.0f64; states * codes * k];
-            for (i, v) in here.iter_mut().enumerate() {
-                let (point, r) = (i / k, i % k);
-                let (s, met) = (point / codes, point % codes);
-                let (o, l) = self.running[r];
-                let p = self.tables.legs[o][l];
-                let Some(a) = self.step[p][s] else { continue };
-                *v = self.moves[s * actions + a]
-                    .iter()
-                    .map(|&(next, w)| {
-                        let Some(met) = self.enter(next, t + 1, met) else { return 0.0 };
-                        let to = next * codes + met;
-                        w * if t + 1 == self.last {
-                            f64::from(u8::from(met == all))
-                        } else if !self.tables.term[p][next] {
-                            later[to * k + r]
-                        } else if l + 1 < self.tables.legs[o].len() {
-                            later[to * k + r + 1]
-                        } else {
-                            decide[to]
+            here.fill(0.0);
+            // A run at step `t` has met every goal past its deadline: other rows stay 0
+            // (past the last deadline, only the row of every goal met is computed).
+            let lost = !self.due[t] & all;
+            let (due, lost_next) = (self.due[t + 1], !self.due[t + 1] & all);
+            let avoiding = t < self.task.avoid_through;
+            for s in 0..states {
+                for (r, &(o, l)) in self.running.iter().enumerate() {
+                    let p = self.tables.legs[o][l];
+                    let Some(a) = self.step[p][s] else { continue };
+                    let (moves, term) = (&self.moves[s * actions + a], &self.tables.term[p]);
+                    let last_leg = l + 1 == self.tables.legs[o].len();
+                    for met in (0..codes).filter(|met| lost & !met == 0) {
+                        let mut v = 0.0;
+                        for &(next, w) in moves {
+                            // `enter(next, t + 1, met)`, with what depends on `t` hoisted.
+                            if avoiding && self.task.avoid[next] {
+                                continue;
+                            }
+                            let met = met | (self.in_goal[next] & due);
+                            if lost_next & !met != 0 {
+                                continue;
+                            }
+                            let to = next * codes + met;
+                            v += w * if t + 1 == self.last {
+                                f64::from(u8::from(met == all))
+                            } else if !term[next] {
+                                later[to * k + r]
+                            } else if !last_leg {
+                                later[to * k + r + 1]
+                            } else {
+                                decide[to]
+                            };
                         }
-                    })
-                    .sum();
+                        here[(s * codes + met) * k + r] = v;
+                    }
+                }
             }
             let base = t * states * codes;
             for point in 0..states * codes {
                 decide[point] = here[point * k + self.slot[choices[point]]];
+                let Some(reached) = reached else { continue };
                 let w = reached[base + point];
                 if w > 0.0 {
                     times[point] += w;
@@ -241,7 +284,7 @@ impl<'a> Hierarchy<'a> {
                     }
                 }
             }
-            later = here;
+            std::mem::swap(&mut later, &mut here);
         }
         let success = start
             .iter()
