@@ -51,7 +51,7 @@
 
 use hstl_lang::CheckedSpec;
 use hstl_robustness::{
-    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor,
+    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, WindowStream,
 };
 
 use std::fmt;
@@ -184,10 +184,21 @@ pub struct EpisodeMonitor {
     log: Vec<f64>,
     /// Scratch values of [`at_state`].
     scratch: Vec<f64>,
+    /// Every value a push reads off the new state alone (the reward, the regions, the
+    /// parts of `task` and `prefix`), in one pass.
+    program: Program,
+    /// The formulas `program` evaluates, in slot order; the first `base_slots` are the
+    /// reward's, the regions' and the task's, the rest `prefix`'s.
+    slots: Vec<Formula>,
+    base_slots: usize,
+    /// The reward's slot, when it is read off the state alone (no past-time operator).
+    reward_slot: Option<usize>,
     /// The states so far, when the reward formula has a past-time operator.
     history: Option<Columns>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
+    /// Each region's slot.
+    region_slots: Vec<usize>,
     /// `tau_j`: steps since region `j` last held, capped at `N_j`.
     tau: Vec<usize>,
     steps: usize,
@@ -241,21 +252,36 @@ enum Part {
         /// The position of the first state in `states`.
         first: usize,
     },
+    /// `always[I] f` (`min`) or `eventually[I] f` (`max`) with `f` a state formula: the
+    /// value of `f` at a position is final when its state arrives, so the fold of those in
+    /// the window is the value, `O(|f|)` a step and nothing kept.
+    Fold {
+        always: bool,
+        /// The positions the window holds in a trace of any length.
+        window: std::ops::Range<usize>,
+        /// `f`, evaluated on the last state as the offline evaluator computes it.
+        body: Formula,
+        /// The fold of `f` over the positions so far in the window.
+        settled: f64,
+    },
     /// `always[c..] g` (`min`) or `eventually[c..] g` (`max`), `g` being
     /// `eventually[I] f` or `always[I] f` (the other operator) with `f` a state formula:
     /// the persistent task's shape, `O(1)` amortised a step. The positions whose value of
-    /// `g` is final come from the online monitor of `g`; every other position's window is
-    /// clipped at the end of the trace to a suffix of it, and of those suffixes the
-    /// latest position's (`g` on the last state alone) is the least for `always` over
-    /// `eventually` (the greatest for the dual), so it alone stands for them.
+    /// `g` is final come from the sliding window of `g` over the values of `f` (the online
+    /// monitor's stream of `g`); every other position's window is clipped at the end of
+    /// the trace to a suffix of it, and of those suffixes the latest position's (`g` on the
+    /// last state alone) is the least for `always` over `eventually` (the greatest for the
+    /// dual), so it alone stands for them.
     Stream {
         always: bool,
         /// The outer operator's first offset `c`.
         from: usize,
-        /// `g`, evaluated on the last state alone.
-        body: Formula,
-        /// The online monitor of `g`: its final values, in order.
-        online: Box<OnlineMonitor>,
+        /// The slot of `g` on the last state alone.
+        body: usize,
+        /// The slot of `f` on the last state.
+        inner: usize,
+        /// `g`'s final values, in order.
+        window: WindowStream,
         /// The fold of the final values of `g` at positions from `c` on.
         settled: f64,
     },
@@ -297,8 +323,20 @@ impl EpisodeMonitor {
         let mut scored: Vec<&Formula> = vec![&task, &reward];
         scored.extend(regions.iter().map(|r| &r.0));
         let nan_prone = NanProne::of_all(&scored, &vars);
-        let task = Running::new(&task, vars.len());
-        let scratch = Vec::new();
+        // The slots: every scored formula is evaluated on each state (its comparisons are
+        // the ones a NaN is looked for in), the reward's and the regions' read back.
+        let mut slots: Vec<Formula> = vec![task.clone(), reward.clone()];
+        let reward_slot = (!reward.has_past()).then_some(1);
+        let region_slots = regions
+            .iter()
+            .map(|(f, _)| {
+                slots.push(f.clone());
+                slots.len() - 1
+            })
+            .collect();
+        let task = Running::new(&task, vars.len(), &mut slots);
+        let base_slots = slots.len();
+        let program = Program::new(&slots);
         let history = reward.has_past().then(|| Columns::new(vars.len()));
         Ok(EpisodeMonitor {
             vars,
@@ -308,9 +346,14 @@ impl EpisodeMonitor {
             prefix: None,
             baseline: 0.0,
             log: Vec::new(),
-            scratch,
+            scratch: Vec::new(),
+            program,
+            slots,
+            base_slots,
+            reward_slot,
             history,
             regions,
+            region_slots,
             tau,
             steps: 0,
             eval: Evaluator::new(),
@@ -339,9 +382,15 @@ impl EpisodeMonitor {
                 return Err(RewardError::NotPersistent);
             }
             (RewardForm::Increment | RewardForm::Sparse, Some(_)) => {
-                self.prefix = Some(Running::new(&self.reward, self.vars.len()));
+                self.slots.truncate(self.base_slots);
+                self.prefix = Some(Running::new(&self.reward, self.vars.len(), &mut self.slots));
+                self.program = Program::new(&self.slots);
             }
-            _ => self.prefix = None,
+            _ => {
+                self.prefix = None;
+                self.slots.truncate(self.base_slots);
+                self.program = Program::new(&self.slots);
+            }
         }
         self.shaping = shaping;
         self.reset();
@@ -435,32 +484,41 @@ impl EpisodeMonitor {
         if let Some(var) = state.iter().position(|v| v.is_nan()) {
             return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps });
         }
-        self.nan_prone.check_state(state, self.steps)?;
+        // Every comparison of the scored formulas is in the program: only when one of them
+        // is NaN on this state is the state looked at again for the error's words.
+        if self.program.run(state) {
+            self.nan_prone.check_state(state, self.steps)?;
+        }
         self.steps += 1;
         self.log.extend_from_slice(state);
-        let robustness = match &mut self.history {
+        let program = &self.program;
+        let robustness = match (&mut self.history, self.reward_slot) {
             _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
-            Some(history) => {
+            (Some(history), _) => {
                 history.push(state);
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }
-            None => at_state(&self.reward, state, &mut self.scratch),
+            (None, Some(slot)) => program.value(slot),
+            (None, None) => f64::NAN,
         };
         let window_kept = if self.regions.is_empty() {
             None
         } else {
             let mut kept = true;
-            for ((formula, n), tau) in self.regions.iter().zip(&mut self.tau) {
-                let inside = at_state(formula, state, &mut self.scratch) > 0.0;
+            for ((&slot, (_, n)), tau) in
+                self.region_slots.iter().zip(&self.regions).zip(&mut self.tau)
+            {
+                let inside = program.value(slot) > 0.0;
                 *tau = if inside { 0 } else { (*tau + 1).min(*n) };
                 kept &= *tau < *n;
             }
             Some(kept)
         };
-        let task_robustness = self.task.push(state, self.steps, &mut self.eval, &mut self.scratch);
+        let mut ctx = Context { program, eval: &mut self.eval, scratch: &mut self.scratch };
+        let task_robustness = self.task.push(state, self.steps, &mut ctx);
         let prefix = match &mut self.prefix {
-            Some(p) => p.push(state, self.steps, &mut self.eval, &mut self.scratch),
+            Some(p) => p.push(state, self.steps, &mut ctx),
             None => task_robustness,
         };
         let value = match self.shaping.form {
@@ -491,7 +549,7 @@ impl Running {
     /// The parts of `f`: its `!`, `&&`, `||` and `->` (and `always` over `&&`, `eventually`
     /// over `||`, which distribute) split down to the parts [`Part::leaf`] shapes, with an
     /// explicit stack, each distinct subformula once.
-    fn new(f: &Formula, vars: usize) -> Running {
+    fn new(f: &Formula, vars: usize, slots: &mut Vec<Formula>) -> Running {
         let mut b = FormulaBuilder::new();
         let root = b.formula(f);
         let mut index: std::collections::HashMap<NodeId, usize> = Default::default();
@@ -522,7 +580,7 @@ impl Running {
                 (Node::Or(_) | Node::Eventually(..), Some(gs)) => {
                     Part::Or(gs.iter().map(at).collect())
                 }
-                _ => Part::leaf(&b.build(v), vars),
+                _ => Part::leaf(&b.build(v), vars, slots),
             };
             index.insert(v, parts.len());
             parts.push(part);
@@ -536,15 +594,9 @@ impl Running {
     }
 
     /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them.
-    fn push(
-        &mut self,
-        state: &[f64],
-        n: usize,
-        eval: &mut Evaluator,
-        scratch: &mut Vec<f64>,
-    ) -> f64 {
+    fn push(&mut self, state: &[f64], n: usize, ctx: &mut Context<'_>) -> f64 {
         for k in 0..self.parts.len() {
-            let v = self.parts[k].push(state, n, eval, scratch, &self.values);
+            let v = self.parts[k].push(state, n, ctx, &self.values);
             self.values[k] = v;
         }
         self.values.last().copied().unwrap_or(f64::NAN)
@@ -577,7 +629,7 @@ fn operands(b: &mut FormulaBuilder, v: NodeId) -> Option<Vec<NodeId>> {
 
 impl Part {
     /// The leaf part of `f`, the cheapest shape its form allows.
-    fn leaf(f: &Formula, vars: usize) -> Part {
+    fn leaf(f: &Formula, vars: usize, slots: &mut Vec<Formula>) -> Part {
         let whole = || Part::Whole {
             formula: f.clone(),
             horizon: f.horizon(),
@@ -590,11 +642,32 @@ impl Part {
             {
                 let always = matches!(f.root_node(), Node::Always(..));
                 let body = f.sub(*body);
+                let (inner_always, j, inner) = match body.root_node() {
+                    Node::Always(j, g) => (true, *j, body.sub(*g)),
+                    Node::Eventually(j, g) => (false, *j, body.sub(*g)),
+                    _ => return whole(),
+                };
+                let Some(window) = WindowStream::new(inner_always, &j) else { return whole() };
+                slots.push(body);
+                slots.push(inner);
                 Part::Stream {
                     always,
                     from: interval.start,
-                    online: Box::new(OnlineMonitor::new(&body, vars)),
-                    body,
+                    body: slots.len() - 2,
+                    inner: slots.len() - 1,
+                    window,
+                    settled: identity(always),
+                }
+            }
+            // A state formula's value at a position is final at once.
+            Node::Always(interval, body) | Node::Eventually(interval, body)
+                if f.is_state(*body) && !f.has_past() =>
+            {
+                let always = matches!(f.root_node(), Node::Always(..));
+                Part::Fold {
+                    always,
+                    window: interval.window(0, usize::MAX),
+                    body: f.sub(*body),
                     settled: identity(always),
                 }
             }
@@ -629,9 +702,9 @@ impl Part {
                 states.clear();
                 *first = 0;
             }
-            Part::Stream { always, online, settled, .. } => {
-                // Ending the trace readies the monitor for a new one.
-                online.finish();
+            Part::Fold { always, settled, .. } => *settled = identity(*always),
+            Part::Stream { always, window, settled, .. } => {
+                window.clear();
                 *settled = identity(*always);
             }
             Part::Not(_) | Part::And(_) | Part::Or(_) | Part::Implies(..) => {}
@@ -640,14 +713,8 @@ impl Part {
 
     /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them,
     /// as the reference evaluator combines it; `values` holds the earlier parts' values.
-    fn push(
-        &mut self,
-        state: &[f64],
-        n: usize,
-        eval: &mut Evaluator,
-        scratch: &mut Vec<f64>,
-        values: &[f64],
-    ) -> f64 {
+    fn push(&mut self, state: &[f64], n: usize, ctx: &mut Context<'_>, values: &[f64]) -> f64 {
+        let eval = &mut *ctx.eval;
         match self {
             Part::Whole { formula, horizon, states, fixed } => {
                 if let Some(v) = fixed {
@@ -690,10 +757,17 @@ impl Part {
                 }
                 value
             }
-            Part::Stream { always, from, body, online, settled } => {
+            Part::Fold { always, window, body, settled } => {
+                if window.contains(&(n - 1)) {
+                    let v = state_value_offline(body, state, ctx.scratch);
+                    *settled = if *always { settled.min(v) } else { settled.max(v) };
+                }
+                *settled
+            }
+            Part::Stream { always, from, body, inner, window, settled } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
-                // The state has the monitor's width and no NaN (checked by the caller).
-                if let Ok(Some(verdict)) = online.push(state)
+                // The state has no NaN (checked by the caller).
+                if let Some(verdict) = window.push(ctx.program.value(*inner))
                     && verdict.step >= *from
                 {
                     *settled = fold(*settled, verdict.value);
@@ -702,7 +776,7 @@ impl Part {
                     // No position of the outer window has arrived.
                     return *settled;
                 }
-                fold(*settled, at_state(body, state, scratch))
+                fold(*settled, ctx.program.value(*body))
             }
             Part::Not(g) => -values[*g],
             Part::And(gs) => gs.iter().map(|g| values[*g]).fold(f64::INFINITY, f64::min),
@@ -710,6 +784,95 @@ impl Part {
             Part::Implies(g, h) => (-values[*g]).max(values[*h]),
         }
     }
+}
+
+/// What a part's push reads besides the state: the program's values on it, and the
+/// buffers of the parts evaluated over the states so far.
+struct Context<'a> {
+    program: &'a Program,
+    eval: &'a mut Evaluator,
+    scratch: &'a mut Vec<f64>,
+}
+
+/// Formulas evaluated on the newest state alone ([`at_state`]) in one pass over one DAG
+/// that holds them all, each shared subformula once: a push reads the reward, the regions
+/// and the parts' state formulas off it instead of evaluating each formula on its own.
+#[derive(Clone, Debug)]
+struct Program {
+    /// `&&` of the formulas, in slot order (its operands are the slots' roots).
+    formula: Formula,
+    /// Each slot's node in `formula`.
+    roots: Vec<usize>,
+    /// The comparisons' nodes: a NaN is looked for there.
+    comparisons: Vec<usize>,
+    /// Each node's value on the last state run.
+    values: Vec<f64>,
+}
+
+impl Program {
+    fn new(slots: &[Formula]) -> Program {
+        let mut b = FormulaBuilder::new();
+        let ids: Vec<NodeId> = slots.iter().map(|f| b.formula(f)).collect();
+        let root = b.and(ids);
+        let formula = b.build(root);
+        // `&&` keeps its operands as given, so they are the slots in order.
+        let roots = match formula.root_node() {
+            Node::And(gs) => gs.iter().map(|g| g.index()).collect(),
+            _ => Vec::new(),
+        };
+        let comparisons = (formula.nodes().iter().enumerate())
+            .filter(|(_, n)| matches!(n, Node::Cmp { .. }))
+            .map(|(k, _)| k)
+            .collect();
+        let values = Vec::with_capacity(formula.len());
+        Program { formula, roots, comparisons, values }
+    }
+
+    /// Evaluates every slot on `state`; returns whether a comparison is NaN there.
+    fn run(&mut self, state: &[f64]) -> bool {
+        at_state(&self.formula, state, &mut self.values);
+        self.comparisons.iter().any(|&k| self.values[k].is_nan())
+    }
+
+    /// Slot `slot`'s value on the last state run.
+    fn value(&self, slot: usize) -> f64 {
+        self.values[self.roots[slot]]
+    }
+}
+
+/// `rho(f, 0)` on one state for a state formula `f`, with the offline evaluator's folds
+/// (`&&` and `||` keep the running value on a tie), so that a value folded over steps is
+/// the offline evaluator's bit for bit.
+fn state_value_offline(f: &Formula, state: &[f64], vals: &mut Vec<f64>) -> f64 {
+    vals.clear();
+    for node in f.nodes() {
+        let v = |g: &NodeId| vals[g.index()];
+        let e = |g: &hstl_robustness::ExprId| vals[g.index()];
+        let x = match node {
+            Node::Const(c) => *c,
+            Node::Var(i) => state.get(*i).copied().unwrap_or(f64::NAN),
+            Node::Neg(a) => -e(a),
+            Node::Abs(a) => e(a).abs(),
+            Node::Sqrt(a) => e(a).sqrt(),
+            Node::Add(a, b) => e(a) + e(b),
+            Node::Sub(a, b) => e(a) - e(b),
+            Node::Mul(a, b) => e(a) * e(b),
+            Node::Div(a, b) => e(a) / e(b),
+            Node::True => f64::INFINITY,
+            Node::False => f64::NEG_INFINITY,
+            Node::Cmp { lhs, op, rhs } => op.robustness(e(lhs), e(rhs)),
+            Node::Not(g) => -v(g),
+            Node::And(gs) => gs.iter().map(v).fold(f64::INFINITY, |a, x| if x < a { x } else { a }),
+            Node::Or(gs) => {
+                gs.iter().map(v).fold(f64::NEG_INFINITY, |a, x| if x > a { x } else { a })
+            }
+            Node::Implies(g, h) => (-v(g)).max(v(h)),
+            // Not a state formula: never asked for.
+            _ => f64::NAN,
+        };
+        vals.push(x);
+    }
+    vals[f.root().index()]
 }
 
 /// `rho(f, 0)` over the one-state trace `state`: the reference semantics with `n = 1`
@@ -763,7 +926,7 @@ fn at_state(f: &Formula, state: &[f64], vals: &mut Vec<f64>) -> f64 {
 }
 
 /// Whether `f` is `always[I] eventually[J] g` or `eventually[I] always[J] g` with `g` a
-/// state formula (horizon 0) and `J` bounded: what [`Part::Stream`] takes.
+/// state formula (no temporal operator) and `J` bounded: what [`Part::Stream`] takes.
 fn is_dual_over_state(f: &Formula) -> bool {
     let inner = match f.root_node() {
         Node::Always(_, body) => match &f[*body] {
@@ -776,7 +939,7 @@ fn is_dual_over_state(f: &Formula) -> bool {
         },
         _ => None,
     };
-    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.horizon_of(*g) == Some(0))
+    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.is_state(*g))
 }
 
 /// The value of an empty window: `+inf` for `always`, `-inf` for `eventually`.
