@@ -346,6 +346,11 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.reward_offset = offset
         self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
+        # Indices into the observation are read in Rust at each step, with no Python call.
+        indices = self._valuation.indices() if isinstance(self._valuation, _Picks) else None
+        if indices is not None:
+            self._monitor._observe(indices)
+        self._step_valuation: Optional[Callable[[Any], Any]] = None if indices is not None else self._valuation
 
     def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict[str, Any]]:
         reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
@@ -362,10 +367,8 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         return obs, info
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, env_reward, terminated, truncated, info = self.env.step(action)
-        reward, info = self._score(obs, info, bool(terminated or truncated))
-        info["env_reward"] = env_reward
-        return obs, reward, terminated, truncated, info
+        # One call into Rust scores the step and builds its info (see EpisodeMonitor._step).
+        return self._monitor._step(self.env.step(action), self._step_valuation)
 
 
 def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Callable[[Any], Any]:
@@ -424,6 +427,12 @@ class _Picks:
 
     def __call__(self, obs: Any) -> dict[str, Any]:
         return {v: obs[k] for v, k in self.picks}
+
+    def indices(self) -> Optional[list[int]]:
+        """The picks as observation indices, in order, when every one is an int."""
+        if all(type(k) is int and k >= 0 for _, k in self.picks):
+            return [k for _, k in self.picks]
+        return None
 
 
 def _missing(message: str, vars: Sequence[str]) -> Exception:
