@@ -24,13 +24,17 @@
 //! (the learner's reward); and the **sparse** reward, `rho(formula, 0)` over the episode
 //! at its last state ([`EpisodeMonitor::push_last`]) and 0 before.
 //!
-//! Cost per state: the reward is `O(|formula|)` (the formula on one state, each shared
-//! node once; `O(t |formula|)` with a past-time operator). The task's
+//! Cost per state: everything read off the new state alone (the reward without a
+//! past-time operator, the regions, the state formulas of the task's parts) is one pass
+//! over one flat DAG holding them all, each shared node once, `O(|formula|)`; a reward
+//! with a past-time operator is `O(t |formula|)`. The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
-//! distributes over `&&` (`eventually` over `||`); `always[c..] eventually[J] f` and
+//! distributes over `&&` (`eventually` over `||`); `always[I] f` with `f` a state formula
+//! (a safety conjunct) folds `f`'s value, `O(1)`; `always[c..] eventually[J] f` and
 //! `eventually[c..] always[J] f` with `f` a state formula (the persistent task's parts)
-//! take `O(1)` amortised through the online monitor of the inner operator;
+//! take `O(1)` amortised through a sliding window over `f`'s values
+//! ([`hstl_robustness::WindowStream`], the online monitor's stream of the inner operator);
 //! `always[I] f` and `eventually[I] f` with `f` of finite horizon `h` fold the values of
 //! `f` that are final and evaluate only the last `h` states again, `O(h)` a step; any
 //! other part with a finite horizon `H` is evaluated over the states so far until `H + 1`

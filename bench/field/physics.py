@@ -143,7 +143,7 @@ def main() -> None:
     args = ap.parse_args()
     print(f"machine: {machine()}; {args.steps} random steps a repeat, median of {args.repeats} repeats, "
           f"episodes of {args.episode_steps} steps\n")
-    print("| environment | bare, us/step | + STLReward, us/step | STLReward adds | + rtamt online monitor, us/step | rtamt adds | goal <= 2% | an empty wrapper adds | the monitor's push alone, us | push between bare steps adds, us |")
+    print("| environment | bare, us/step | + STLReward, us/step | STLReward adds | + rtamt online monitor, us/step | rtamt adds | goal <= 2% | an empty wrapper adds | _step alone, us | _step between bare steps adds, us |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for env_id in args.envs.split(","):

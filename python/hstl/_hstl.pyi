@@ -348,6 +348,9 @@ class EpisodeMonitor:
     def _step(
         self, result: Tuple[Any, Any, Any, Any, Any], valuation: Optional[Callable[[Any], Any]] = None
     ) -> Tuple[Any, float, bool, bool, dict[str, Any]]: ...
+    def _reset(
+        self, result: Tuple[Any, Any], valuation: Optional[Callable[[Any], Any]] = None
+    ) -> Tuple[Any, dict[str, Any]]: ...
     @staticmethod
     def _restore(
         spec: Spec,

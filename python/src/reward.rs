@@ -1,6 +1,6 @@
 //! `hstl._hstl.EpisodeMonitor`: what `hstl.STLReward` scores each step with.
 
-use hstl::reward::{EpisodeMonitor as Inner, RewardForm, Shaping};
+use hstl::reward::{EpisodeMonitor as Inner, RewardForm, Shaping, StepScore};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -148,32 +148,9 @@ impl EpisodeMonitor {
         let env_reward = result.get_item(1)?;
         let terminated = result.get_item(2)?;
         let truncated = result.get_item(3)?;
-        let info = result.get_item(4)?;
         let last = terminated.is_truthy()? || truncated.is_truthy()?;
-        let score = match (valuation, &self.picks) {
-            (None, Some(picks)) => {
-                read_picks(&obs, picks, self.inner.state_vars(), &mut self.state)?;
-                if last { self.inner.push_last(&self.state) } else { self.inner.push(&self.state) }
-            }
-            (valuation, _) => {
-                let state = match valuation {
-                    Some(f) => f.call1((&obs,))?,
-                    None => obs.clone(),
-                };
-                let values = state_values(&state, self.inner.state_vars())?;
-                if last { self.inner.push_last(&values) } else { self.inner.push(&values) }
-            }
-        };
-        let score = score.map_err(|e| trace_error(py, &e))?;
-        let info = match info.cast_exact::<PyDict>() {
-            Ok(d) => d.copy()?,
-            // Any other mapping, as `dict(info)` copies it.
-            Err(_) => py.get_type::<PyDict>().call1((&info,))?.cast_into::<PyDict>()?,
-        };
-        info.set_item(intern!(py, "task_robustness"), score.task_robustness)?;
-        if let Some(kept) = score.window_kept {
-            info.set_item(intern!(py, "window_kept"), kept)?;
-        }
+        let score = self.score(&obs, valuation, last)?;
+        let info = info_with(&result.get_item(4)?, &score)?;
         info.set_item(intern!(py, "env_reward"), env_reward)?;
         PyTuple::new(
             py,
@@ -185,6 +162,34 @@ impl EpisodeMonitor {
                 info.into_any(),
             ],
         )
+    }
+
+    /// `gymnasium`'s reset for `hstl.STLReward`: starts a new episode, scores the first
+    /// observation (as `_step` does) and returns `(obs, info)` from what the wrapped
+    /// environment's `reset` returned, `info` a new dict with `task_robustness` and
+    /// `window_kept` (persistent tasks).
+    #[pyo3(signature = (result, valuation=None))]
+    fn _reset<'py>(
+        &mut self,
+        result: &Bound<'py, PyTuple>,
+        valuation: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let py = result.py();
+        if result.len() != 2 {
+            return Err(type_error(
+                format!(
+                    "the wrapped environment's reset returned {} values, not the 2 of gymnasium's \
+                     (obs, info)",
+                    result.len()
+                ),
+                None,
+            ));
+        }
+        let obs = result.get_item(0)?;
+        self.inner.reset();
+        let score = self.score(&obs, valuation, false)?;
+        let info = info_with(&result.get_item(1)?, &score)?;
+        PyTuple::new(py, [obs, info.into_any()])
     }
 
     /// The state variables, in the order a sequence state lists them.
@@ -225,6 +230,31 @@ impl EpisodeMonitor {
 }
 
 impl EpisodeMonitor {
+    /// Scores observation `obs`: its entries at the picks when `valuation` is None and
+    /// picks are set, else `valuation(obs)` (or `obs` itself) as `push` takes a state.
+    fn score(
+        &mut self,
+        obs: &Bound<'_, PyAny>,
+        valuation: Option<&Bound<'_, PyAny>>,
+        last: bool,
+    ) -> PyResult<StepScore> {
+        let score = match (valuation, &self.picks) {
+            (None, Some(picks)) => {
+                read_picks(obs, picks, self.inner.state_vars(), &mut self.state)?;
+                if last { self.inner.push_last(&self.state) } else { self.inner.push(&self.state) }
+            }
+            (valuation, _) => {
+                let state = match valuation {
+                    Some(f) => f.call1((obs,))?,
+                    None => obs.clone(),
+                };
+                let values = state_values(&state, self.inner.state_vars())?;
+                if last { self.inner.push_last(&values) } else { self.inner.push(&values) }
+            }
+        };
+        score.map_err(|e| trace_error(obs.py(), &e))
+    }
+
     fn set_picks(&mut self, indices: Vec<usize>) -> PyResult<()> {
         let vars = self.inner.state_vars();
         if indices.len() != vars.len() {
@@ -236,6 +266,21 @@ impl EpisodeMonitor {
         self.picks = Some(indices);
         Ok(())
     }
+}
+
+/// A new dict with `info`'s items (any mapping, as `dict(info)` copies it) and the
+/// score's `task_robustness` and `window_kept` (when given).
+fn info_with<'py>(info: &Bound<'py, PyAny>, score: &StepScore) -> PyResult<Bound<'py, PyDict>> {
+    let py = info.py();
+    let info = match info.cast_exact::<PyDict>() {
+        Ok(d) => d.copy()?,
+        Err(_) => py.get_type::<PyDict>().call1((info,))?.cast_into::<PyDict>()?,
+    };
+    info.set_item(intern!(py, "task_robustness"), score.task_robustness)?;
+    if let Some(kept) = score.window_kept {
+        info.set_item(intern!(py, "window_kept"), kept)?;
+    }
+    Ok(info)
 }
 
 /// The entries `picks` of observation `obs` into `out`: a one-dimensional float64 or
