@@ -345,3 +345,61 @@ def test_the_startup_registration_can_be_turned_off():
     # `import hstl` registers them all the same.
     out = python_env("import hstl, gymnasium\nprint(gymnasium.make('hstl/GridWorld-v0').unwrapped.world.name)", HSTL_NO_GYMNASIUM_IDS="1")
     assert out.returncode == 0 and out.stdout == "paper\n", out.stderr
+
+
+PENDULUM = """spec Swing {
+    state { cart: float, angle: float }
+    let right = cart > 0.0;
+    let left = cart < 0.0;
+    let fallen = angle >= 0.2 || angle <= -0.2;
+    task always[0..] (eventually[0..=5] right && eventually[0..=5] left) && always[0..] !fallen;
+}"""
+
+
+class _Wobble(gymnasium.Env):
+    """Four observation entries from a seeded walk, in a given dtype (or a list), with an
+    info of its own; the episode ends at step 40."""
+
+    def __init__(self, dtype="float64"):
+        self.dtype = dtype
+        self.observation_space = gymnasium.spaces.Box(-10, 10, (4,), np.float64 if dtype == "list" else dtype)
+        self.action_space = gymnasium.spaces.Discrete(2)
+        self.infos = []
+
+    def _obs(self):
+        x = self.rng.normal(0, 0.15, 4)
+        return [float(v) for v in x] if self.dtype == "list" else x.astype(self.dtype)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.rng, self.t = np.random.default_rng(seed), 0
+        return self._obs(), {"from_env": 0}
+
+    def step(self, action):
+        self.t += 1
+        info = {"from_env": self.t}
+        self.infos.append(info)
+        return self._obs(), 0.5 * action, self.t == 40, False, info
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32", "list"])
+@pytest.mark.parametrize("reward", ["robustness", "window", "sparse"])
+def test_a_dict_of_observation_indices_scores_as_a_valuation_function_does(dtype, reward):
+    spec = hstl.Spec.parse(PENDULUM)
+    by_index = hstl.STLReward(_Wobble(dtype), spec, valuation={"angle": 1, "cart": 0}, reward=reward)
+    by_call = hstl.STLReward(_Wobble(dtype), spec, valuation=lambda o: [float(o[0]), float(o[1])], reward=reward)
+    for env in (by_index, by_call):
+        env.reset(seed=7)
+    for t in range(1, 41):
+        a = by_index.step(t % 2)
+        b = by_call.step(t % 2)
+        assert a[1:4] == b[1:4] and a[4] == b[4], t
+        assert a[4]["from_env"] == t and a[4]["env_reward"] == 0.5 * (t % 2) and "window_kept" in a[4]
+    # The wrapped environment's own info is left as it was.
+    assert all(set(i) == {"from_env"} for i in by_index.env.infos)
+
+
+def test_an_observation_index_past_the_end_says_which_variable():
+    env = hstl.STLReward(_Wobble(), hstl.Spec.parse(PENDULUM), valuation={"cart": 0, "angle": 4})
+    with pytest.raises(ValueError, match=r"the observation has 4 entries, and `angle` is read from index 4"):
+        env.reset(seed=1)
