@@ -18,12 +18,9 @@ pub const MAX_STEPS: u64 = 1_000_000;
 pub const MAX_MEMORY: u64 = 255;
 /// The longest window `memory` and `reward: window` count over (they keep a table per step).
 pub const MAX_WINDOW: u64 = 1_000_000;
-/// At most this many observations of the options level with memory (states times memory
-/// values): `policy.json` holds one options entry for each.
-pub const MAX_OBSERVATIONS: u64 = 1 << 21;
 
-/// `HSTL016` for a `learn` count above its limit, `HSTL033` for memory or window reward
-/// beyond theirs.
+/// `HSTL016` for a `learn` count above its limit, `HSTL033` for a window of memory or the
+/// window reward beyond theirs.
 pub(crate) fn learning(src: &str, learn: &syntax::Learn, out: &CheckedSpec) -> Vec<Diagnostic> {
     let mut found = Vec::new();
     let limits = [
@@ -74,26 +71,6 @@ pub(crate) fn learning(src: &str, learn: &syntax::Learn, out: &CheckedSpec) -> V
             .with_help("shorten the window, or train without `memory` and `reward: window`"),
         );
         return found;
-    }
-    let Some(states) = out.domain_size() else { return found };
-    let values = (l.memory + 1).checked_pow(conjuncts.len() as u32);
-    let observations = values.and_then(|v| v.checked_mul(states));
-    if l.memory > 0 && observations.is_none_or(|n| n > MAX_OBSERVATIONS) {
-        let values = values.map_or("too many".into(), thousands);
-        found.push(
-            Diagnostic::new(
-                "HSTL033",
-                at,
-                format!(
-                    "`memory: {}` over {} regions gives {} states x {values} memory values, more than the {} observations the options level may have",
-                    l.memory,
-                    conjuncts.len(),
-                    thousands(states),
-                    thousands(MAX_OBSERVATIONS)
-                ),
-            )
-            .with_help("use fewer memory buckets (the case study uses `memory: 8`), or fewer regions"),
-        );
     }
     found
 }
@@ -188,4 +165,263 @@ pub fn plan_time(states: u64, cells: &[u64], horizons: &[u64], options: u64, buc
         .saturating_mul(states)
         .saturating_mul(options);
     sweep.saturating_mul(30).saturating_add(fill)
+}
+
+/// The memory a run of what `check` accepts stays within, at the defaults: 2 GiB. `train`,
+/// `eval`, `study` (its training threads counted) and `hstl.Policy.load` each fit in it.
+pub const MEMORY_BUDGET: u64 = 2 << 30;
+/// `check` reports the estimate (`HSTL180`) above this: 512 MiB.
+pub const MEMORY_NOTE: u64 = 512 << 20;
+/// What every run takes beside its tables and documents, at most: the program, the spec,
+/// the pictures, the learning curve and the evaluation's runs at the defaults.
+pub const FIXED_BYTES: u64 = 64 << 20;
+/// The exact optimum's tables, at most, which `eval` of a persistent task computes (the
+/// runtime's solver refuses more before allocating: 64 bytes per state of its
+/// `max_states`, 2^24).
+pub const OPTIMUM_BYTES: u64 = 1 << 30;
+/// The grid worlds' action count (`Up`, `Down`, `Left`, `Right`).
+pub const GRID_ACTIONS: u64 = 4;
+
+/// The sizes the tabular learner's memory grows with: what [`cost`] reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Sizes {
+    /// States of the world (or of the spec's domain, which bounds them).
+    pub states: u64,
+    /// State variables.
+    pub vars: u64,
+    /// Actions of the world.
+    pub actions: u64,
+    /// Primitive options.
+    pub primitives: u64,
+    /// Options of the options set.
+    pub options: u64,
+    /// Regions the memory counts (0 without memory).
+    pub regions: u64,
+    /// Memory values `(B + 1)^k` (1 without memory).
+    pub values: u64,
+    /// Bytes of the longest state as `policy.json` writes it (`{"x": 12, "y": 14}`).
+    pub state_text: u64,
+    /// Bytes of the longest option or action name.
+    pub name_text: u64,
+    /// The product of the task's windows over its regions, 0 for a task that is not
+    /// persistent (whose `eval` computes no exact optimum).
+    pub windows: u64,
+}
+
+/// What a spec's runs take, in bytes, by [`cost`]'s model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Cost {
+    /// `policy.json` as written.
+    pub policy_bytes: u64,
+    /// The `policy.json` document in memory, as written or as read (the read one's lists
+    /// have room to grow: counted twice).
+    pub document: u64,
+    /// The learner: its per-state tables and Q-tables.
+    pub learner: u64,
+    /// A greedy agent: its tables over state indices.
+    pub agent: u64,
+    /// `train`: the learner, its agent, the document, its text as it is written, and
+    /// [`FIXED_BYTES`].
+    pub train: u64,
+    /// `hstl.Policy.load` (and `eval` before it evaluates): the text, the document read,
+    /// the learner that checks it and two agents, and [`FIXED_BYTES`].
+    pub load: u64,
+    /// `eval`: [`Cost::load`] and the exact optimum's tables.
+    pub evaluate: u64,
+}
+
+impl Cost {
+    /// The largest of the runs, and its name (`train`, `eval`): what must fit the budget.
+    pub fn peak(&self) -> (u64, &'static str) {
+        if self.evaluate > self.train { (self.evaluate, "eval") } else { (self.train, "train") }
+    }
+
+    /// The largest of what the spec's own sizes make grow (`train` and `load`, not the
+    /// optimum's fixed limit), and its name: what `HSTL180` notes.
+    pub fn own(&self) -> (u64, &'static str) {
+        if self.load > self.train { (self.load, "eval") } else { (self.train, "train") }
+    }
+}
+
+/// The bytes an allocation of `n` bytes takes from the allocator, at most (8 bytes of
+/// header, rounded up to 16, at least 32).
+const fn allocation(n: u64) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    let padded = (n + 8).div_ceil(16) * 16;
+    if padded < 32 { 32 } else { padded }
+}
+
+/// The memory model of the tabular learner, `policy.json` and its evaluation, counted from
+/// the runtime's own layouts (saturating): `hstl/tests/cost.rs` holds the figures against
+/// what the runs allocate.
+pub fn cost(s: &Sizes) -> Cost {
+    let m = |a: u64, b: u64| a.saturating_mul(b);
+    let add = |parts: &[u64]| parts.iter().fold(0u64, |a, &b| a.saturating_add(b));
+    let (n, p, o) = (s.states, s.primitives, s.options);
+    let observations = m(n, s.values);
+    let with_memory = s.regions > 0;
+    // A state: its shared names' handle and its values' box, and their allocation.
+    let state = 32 + allocation(8 * s.vars);
+    // An entry: the state, the buckets, the choice's name, and their allocations.
+    let entry = state + 48 + allocation(s.name_text);
+    let memory_entry = entry + allocation(8 * s.regions);
+    // As written: indent, keys and punctuation, the state, the buckets, the name.
+    let text_entry = 36 + s.state_text + s.name_text;
+    let text_memory_entry = text_entry + 14 + 4 * s.regions;
+    let text_value = 20;
+    let q_values = add(&[m(m(n, s.actions), p), m(observations, o)]);
+    let options_entries = if with_memory { observations } else { n };
+    let policy_bytes = add(&[
+        m(options_entries, if with_memory { text_memory_entry } else { text_entry }),
+        // Flat policies, termination sets and the memory's region states: a state each.
+        m(m(n, p), text_entry),
+        m(m(n, p + s.regions), s.state_text + 2),
+        m(q_values, text_value),
+    ]);
+    let document = add(&[
+        m(options_entries, if with_memory { memory_entry } else { entry }),
+        m(m(n, p), entry),
+        // Termination sets, the memory's region states, and the states listed once.
+        m(m(n, p + s.regions + 1), state),
+        m(q_values, 8),
+    ]);
+    let learner = add(&[
+        // Valuations, reach, termination and avoided states, available options.
+        m(n, 8 * s.vars + 10 * p + 24 + allocation(8 * o) + 16),
+        m(m(m(n, s.actions), p), 8),
+        m(m(observations, o), 8),
+        // The memory's region states.
+        m(n, s.regions),
+    ]);
+    let agent = add(&[m(observations, 8), m(n, 9 * p), m(m(observations, o), 8)]);
+    let text = policy_bytes;
+    // The text is written into a buffer that doubles as it grows: at most twice the text,
+    // and the half it moves out of while it grows.
+    let train = add(&[learner, agent, document, m(text, 3), FIXED_BYTES]);
+    let load = add(&[text, m(document, 2), learner, m(agent, 2), FIXED_BYTES]);
+    // The solver's own limit: its tables are refused past it, before they are allocated.
+    let optimum = if s.windows == 0 { 0 } else { OPTIMUM_BYTES };
+    Cost {
+        policy_bytes,
+        document,
+        learner,
+        agent,
+        train,
+        load,
+        evaluate: load.saturating_add(optimum),
+    }
+}
+
+/// `bytes` in the largest unit that keeps it above 1: `1.6 GiB`, `425 MiB`.
+pub fn bytes_words(bytes: u64) -> String {
+    let units = [(1u64 << 30, "GiB"), (1 << 20, "MiB"), (1 << 10, "KiB")];
+    for (unit, name) in units {
+        if bytes >= unit {
+            let v = bytes as f64 / unit as f64;
+            return if v < 10.0 { format!("{v:.1} {name}") } else { format!("{v:.0} {name}") };
+        }
+    }
+    format!("{bytes} bytes")
+}
+
+/// The sizes of a checked spec's tabular learner, counted from its declared domain (which
+/// bounds a world's states), or `None` for a spec the tabular learner does not run (no
+/// options, or a state that is not all `int`).
+pub fn spec_sizes(src: &str, out: &CheckedSpec) -> Option<Sizes> {
+    use crate::checked::Domain;
+    if out.primitives.is_empty() || out.is_continuous() {
+        return None;
+    }
+    let states = out.domain_size()?;
+    let digits = |v: i64| v.to_string().len() as u64;
+    let mut state_text = 2u64;
+    for v in &out.state_vars {
+        let Domain::Int { lo, hi } = v.domain else { return None };
+        state_text += v.name.len() as u64 + 6 + digits(lo).max(digits(hi));
+    }
+    let conjuncts = out.persistent_conjuncts(src);
+    let counted = out.learn.memory > 0 || out.learn.reward == Reward::Window;
+    let regions = if counted { conjuncts.as_ref().map_or(0, Vec::len) as u64 } else { 0 };
+    let values = if regions > 0 {
+        (out.learn.memory + 1).checked_pow(u32::try_from(regions).ok()?).unwrap_or(u64::MAX)
+    } else {
+        1
+    };
+    let names =
+        out.primitives.iter().map(|p| p.name.len()).chain(out.options.iter().map(|o| o.name.len()));
+    let name_text = names.max().unwrap_or(0).max(5) as u64;
+    let windows =
+        conjuncts.map_or(0, |c| c.iter().fold(1u64, |a, c| a.saturating_mul(c.steps.max(1))));
+    Some(Sizes {
+        states,
+        vars: out.state_vars.len() as u64,
+        actions: GRID_ACTIONS,
+        primitives: out.primitives.len() as u64,
+        options: out.options.len() as u64,
+        regions,
+        values,
+        state_text,
+        name_text,
+        windows,
+    })
+}
+
+/// `HSTL084` when the runs of a spec would take more than [`MEMORY_BUDGET`] by [`cost`]'s
+/// model, `HSTL180` when more than [`MEMORY_NOTE`]; at the `learn` item's `memory` (or the
+/// item, or the spec's name).
+pub(crate) fn memory(
+    src: &str,
+    learn: Option<&syntax::Learn>,
+    out: &CheckedSpec,
+) -> Option<Diagnostic> {
+    let sizes = spec_sizes(src, out)?;
+    let c = cost(&sizes);
+    let (peak, run) = c.peak();
+    if peak <= MEMORY_BUDGET && c.own().0 <= MEMORY_NOTE {
+        return None;
+    }
+    let at = learn.map_or(out.name_range.clone(), |l| {
+        l.params
+            .iter()
+            .find(|p| p.name.name == "memory")
+            .map_or(l.range.clone(), |p| p.range.clone())
+    });
+    let what = format!(
+        "{} states x {} memory values x {} options, and `policy.json` of {}",
+        thousands(sizes.states),
+        thousands(sizes.values),
+        sizes.options,
+        bytes_words(c.policy_bytes)
+    );
+    let figures = format!("train {}, eval {}", bytes_words(c.train), bytes_words(c.evaluate));
+    if peak > MEMORY_BUDGET {
+        Some(
+            Diagnostic::new(
+                "HSTL084",
+                at,
+                format!(
+                    "`{run}` of this spec would take about {} ({what}; {figures}), more than the {} memory budget",
+                    bytes_words(peak),
+                    bytes_words(MEMORY_BUDGET)
+                ),
+            )
+            .with_help("use fewer memory values (a smaller `memory: B`, or fewer regions), a smaller world, or fewer options"),
+        )
+    } else {
+        let (own, run) = c.own();
+        Some(
+            Diagnostic::new(
+                "HSTL180",
+                at,
+                format!(
+                    "`{run}` of this spec will take about {} of the {} memory budget ({what}; {figures})",
+                    bytes_words(own),
+                    bytes_words(MEMORY_BUDGET)
+                ),
+            )
+            .with_help("fewer memory values, a smaller world or fewer options make it smaller"),
+        )
+    }
 }
