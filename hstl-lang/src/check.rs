@@ -1639,11 +1639,14 @@ impl Cx<'_> {
             let reach = crate::preset::is_reach_task(out);
             crate::preset::learn(horizons.as_deref(), reach, out.is_continuous(), &mut out.learn);
             // The memory the preset sizes from the deadlines, made coarser until the runs
-            // fit the memory budget (HSTL084).
+            // fit the memory budget without the note of HSTL180.
             let over = |out: &CheckedSpec| {
                 crate::budget::spec_sizes(self.src, out)
                     .map(|s| crate::budget::cost(&s))
-                    .is_some_and(|c| c.peak().0 > crate::budget::MEMORY_BUDGET)
+                    .is_some_and(|c| {
+                        c.peak().0 > crate::budget::MEMORY_BUDGET
+                            || c.own().0 > crate::budget::MEMORY_NOTE
+                    })
             };
             while out.learn.memory > 1 && over(out) {
                 out.learn.memory -= 1;
