@@ -127,12 +127,12 @@ pub fn agent_pictures(
         out.push(OutFile::text(format!("flat_{}.svg", file_safe(&prim.name)), svg));
     }
     let names: Vec<String> = spec.options.iter().map(|o| o.name.clone()).collect();
-    for (file, what, tau) in option_slices(spec, agent) {
+    for (file, what, tau, met) in option_slices(spec, agent) {
         let choices: Vec<((i64, i64), String)> = cells
             .iter()
             .enumerate()
             .filter_map(|(s, &c)| {
-                let o = *agent.options.get(agent.observation(s, &tau))?;
+                let o = *agent.options.get(agent.observation(s, &tau, met))?;
                 Some((c, names.get(o)?.clone()))
             })
             .collect();
@@ -195,13 +195,25 @@ pub fn curve_picture(title: &str, curves: &[Vec<f64>]) -> Result<OutFile, Proble
     Ok(OutFile::text("curve.svg", svg))
 }
 
-/// The options maps to draw, as (file, what the map shows, memory): one without memory;
-/// with memory, one per region, as the agent sees the grid right after leaving that region
-/// with every other counter expired.
-fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usize>)> {
+/// The options maps to draw, as (file, what the map shows, memory, goals met): one
+/// without memory; with goals, one before any goal is met and one once all are; with
+/// memory, one per region, as the agent sees the grid right after leaving that region with
+/// every other counter expired.
+fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usize>, usize)> {
     let horizons: Vec<usize> = spec.regions.iter().map(|r| r.horizon).collect();
+    if let Some(g) = &agent.goals {
+        return vec![
+            ("options.svg".into(), "options policy before any goal is met".into(), Vec::new(), 0),
+            (
+                "options_goals_met.svg".into(),
+                "options policy once every goal is met".into(),
+                Vec::new(),
+                g.progress.all_met(),
+            ),
+        ];
+    }
     if agent.memory.is_none() || horizons.is_empty() {
-        return vec![("options.svg".into(), "options policy".into(), horizons)];
+        return vec![("options.svg".into(), "options policy".into(), horizons, 0)];
     }
     // A one-step window (a safety conjunct `always !S` is the region `!S` so) is kept where
     // the state is: every map shows it kept, and none is drawn after it.
@@ -217,6 +229,7 @@ fn option_slices(spec: &TaskSpec, agent: &Agent) -> Vec<(String, String, Vec<usi
                 format!("options_after_{}.svg", file_safe(&r.name)),
                 format!("options policy one step after {} (others overdue)", r.name),
                 tau,
+                0,
             )
         })
         .collect()

@@ -28,6 +28,7 @@ use serde_json::{Value, json};
 
 use crate::Problem;
 use crate::evaluate::Runs;
+use crate::gym::Described;
 use crate::train::EVAL_SEED;
 
 /// The most tiles along a variable that a world's step sets (a tile about one step wide).
@@ -94,12 +95,21 @@ pub fn train_until(
     seed: u64,
     progress: impl FnMut(usize, f64) -> ControlFlow<()>,
 ) -> Result<Trained, Error> {
-    with_world!(world, w => {
-        let mut learner = ApproxLearner::new(spec, w)?;
-        let trained = learner.train_until(&mut seeded_rng(seed), progress);
-        let agent = ApproxAgent::new(spec, w, learner.weights().clone())?;
-        Ok(Trained { agent, curve: trained.curve, steps: trained.steps })
-    })
+    with_world!(world, w => train_world_until(spec, w, seed, progress))
+}
+
+/// [`train_until`] in any [`World`](hstl_runtime::World) (such as a gymnasium environment
+/// stepped through Python); the spec's tiling is used as it is.
+pub fn train_world_until<W: hstl_runtime::World>(
+    spec: &TaskSpec,
+    world: &W,
+    seed: u64,
+    progress: impl FnMut(usize, f64) -> ControlFlow<()>,
+) -> Result<Trained, Error> {
+    let mut learner = ApproxLearner::new(spec, world)?;
+    let trained = learner.train_until(&mut seeded_rng(seed), progress);
+    let agent = ApproxAgent::new(spec, world, learner.weights().clone())?;
+    Ok(Trained { agent, curve: trained.curve, steps: trained.steps })
 }
 
 /// [`train_until`] without stopping.
@@ -123,6 +133,28 @@ pub fn policy_json(
     source: &str,
     seed: u64,
 ) -> Result<String, Error> {
+    policy_doc(spec, &EnvWords::of_any(world)?, agent, source, seed)
+}
+
+/// [`policy_json`] of a learned function trained in any [`World`](hstl_runtime::World),
+/// such as a [`Described`] gymnasium environment: `env` holds its name and parameters.
+pub fn policy_json_in<W: hstl_runtime::World>(
+    spec: &TaskSpec,
+    world: &W,
+    agent: &ApproxAgent,
+    source: &str,
+    seed: u64,
+) -> Result<String, Error> {
+    policy_doc(spec, &EnvWords::of(world), agent, source, seed)
+}
+
+fn policy_doc(
+    spec: &TaskSpec,
+    env: &EnvWords,
+    agent: &ApproxAgent,
+    source: &str,
+    seed: u64,
+) -> Result<String, Error> {
     let w = &agent.weights;
     let sparse = |v: &[f64]| -> Vec<Value> {
         // Each weight as the 16 hex digits of its bits, as `q_tables` holds Q-values, so
@@ -139,7 +171,7 @@ pub fn policy_json(
         .zip(&w.flat)
         .map(|(p, v)| (p.name.clone(), Value::Array(sparse(v))))
         .collect();
-    let mut doc = header(spec, world, &agent.model)?;
+    let mut doc = header(spec, env, &agent.model)?;
     doc.insert(
         "weights".into(),
         json!({
@@ -156,15 +188,32 @@ pub fn policy_json(
     serde_json::to_string_pretty(&Value::Object(doc)).map_err(|e| Error::Config(e.to_string()))
 }
 
+/// How `policy.json` names an environment: its name, parameters and actions.
+struct EnvWords {
+    name: String,
+    params: Value,
+    actions: Vec<String>,
+}
+
+impl EnvWords {
+    fn of<W: hstl_runtime::World>(w: &W) -> EnvWords {
+        EnvWords { name: w.name().to_string(), params: w.params(), actions: w.actions() }
+    }
+
+    fn of_any(world: &AnyWorld) -> Result<EnvWords, Error> {
+        with_world!(world, w => Ok(EnvWords::of(w)))
+    }
+}
+
 /// The entries of a learned function's `policy.json` that its spec, world and model
 /// determine: everything but the weights, the counts of training and the source. A replay
 /// requires each of them as written.
 fn header(
     spec: &TaskSpec,
-    world: &AnyWorld,
+    env: &EnvWords,
     m: &hstl_runtime::approx::Model,
 ) -> Result<serde_json::Map<String, Value>, Error> {
-    let actions: Vec<String> = with_world!(world, wd => Ok(hstl_runtime::World::actions(wd)))?;
+    let actions = &env.actions;
     let options: Vec<Value> = spec
         .options
         .iter()
@@ -176,7 +225,7 @@ fn header(
         .collect();
     let mut doc = serde_json::Map::new();
     doc.insert("spec".into(), json!(spec.name));
-    doc.insert("env".into(), json!({"name": world.name(), "params": world.params()}));
+    doc.insert("env".into(), json!({"name": env.name, "params": env.params}));
     doc.insert("state_vars".into(), json!(m.vars));
     doc.insert("actions".into(), json!(actions));
     doc.insert("options".into(), json!(options));
@@ -278,6 +327,61 @@ pub fn replay_text(text: &str) -> Result<Replay, Problem> {
         .and_then(|parts| de.end().map(|()| parts))
         .map_err(|e| Problem::new(format!("not a valid policy.json: {e}"), Some(edited.into())))?;
     replay_parts(&doc, weights)
+}
+
+/// A learned function's `policy.json` trained in a gymnasium environment (see
+/// [`Described`]), checked whole against its spec and the spaces it records.
+#[derive(Clone, Debug)]
+pub struct GymReplay {
+    /// The spec it was trained on, lowered again from `spec_source`.
+    pub spec: TaskSpec,
+    /// The environment's spaces as the document records them.
+    pub env: Described,
+    /// The greedy agent the document describes.
+    pub agent: ApproxAgent,
+    /// The spec file's text.
+    pub source: String,
+    /// The seed it was trained from, when recorded.
+    pub seed: Option<u64>,
+}
+
+/// A learned function's `policy.json` of either kind.
+#[derive(Clone, Debug)]
+pub enum AnyReplay {
+    /// Trained in a world the document holds whole (a plane, `mountain-car`).
+    World(Replay),
+    /// Trained in a gymnasium environment the document describes.
+    Gym(GymReplay),
+}
+
+/// [`replay_text`], also of a document trained in a gymnasium environment.
+pub fn replay_text_any(text: &str) -> Result<AnyReplay, Problem> {
+    let edited = "the file was edited or damaged: train the policy again with `hstlc train`";
+    let mut de = serde_json::Deserializer::from_str(text);
+    let (doc, weights) = serde::Deserializer::deserialize_map(&mut de, TopLevel)
+        .and_then(|parts| de.end().map(|()| parts))
+        .map_err(|e| Problem::new(format!("not a valid policy.json: {e}"), Some(edited.into())))?;
+    let env = doc.get("env");
+    let params = env.and_then(|e| e.get("params"));
+    if !params.is_some_and(Described::is_gymnasium) {
+        return replay_parts(&doc, weights).map(AnyReplay::World);
+    }
+    let name = env.and_then(|e| e.get("name")).and_then(Value::as_str).unwrap_or("");
+    let vars: Vec<String> = doc
+        .get("state_vars")
+        .and_then(Value::as_array)
+        .map(|l| l.iter().filter_map(Value::as_str).map(str::to_string).collect())
+        .unwrap_or_default();
+    let described = Described::from_params(name, vars, params.unwrap_or(&Value::Null))?;
+    let words = EnvWords::of(&described);
+    let Parts { spec, agent, source, seed } = replay_core(
+        &doc,
+        weights,
+        &words,
+        |_, _| {},
+        |spec| zero_of(spec, &described).and_then(|z| ApproxAgent::new(spec, &described, z)),
+    )?;
+    Ok(AnyReplay::Gym(GymReplay { spec, env: described, agent, source, seed }))
 }
 
 /// A list of sparse entries as a document gives it (`None`: not a list), each `(index,
@@ -629,6 +733,48 @@ impl<'de> serde::de::Visitor<'de> for EntriesOrMap {
 
 /// [`replay`] of the document `doc` and its weights, read apart.
 fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Replay, Problem> {
+    let edited =
+        || "the file was edited or damaged: train the policy again with `hstlc train`".to_string();
+    let env = doc.get("env").ok_or_else(|| Problem::new("it has no `env` entry", edited()))?;
+    let world_name = env.get("name").and_then(Value::as_str).unwrap_or("");
+    let params = env.get("params").cloned().unwrap_or(Value::Null);
+    let world = AnyWorld::from_params(world_name, &params)
+        .map_err(|e| Problem::new(format!("its world: {e}"), edited()))?;
+    if !world.is_continuous() {
+        return Err(Problem::new(
+            "its world is a grid, which a learned function is not trained in",
+            edited(),
+        ));
+    }
+    let words = EnvWords::of_any(&world).map_err(|e| Problem::new(e.to_string(), edited()))?;
+    let parts = replay_core(
+        doc,
+        weights_doc,
+        &words,
+        |spec, picked| fit_tiles(spec, picked, &world),
+        |spec| with_world!(&world, w => zero_of(spec, w).and_then(|z| ApproxAgent::new(spec, w, z))),
+    )?;
+    let Parts { spec, agent, source, seed } = parts;
+    Ok(Replay { spec, world, agent, source, seed })
+}
+
+/// What [`replay_core`] reads back besides the world.
+struct Parts {
+    spec: TaskSpec,
+    agent: ApproxAgent,
+    source: String,
+    seed: Option<u64>,
+}
+
+/// Reads a learned function's document in the environment `env` names: `fit` lays the
+/// tiling over it and `zero` makes the agent of zero weights there.
+fn replay_core(
+    doc: &Value,
+    weights_doc: Option<SparseWeights>,
+    words: &EnvWords,
+    fit: impl FnOnce(&mut TaskSpec, &CheckedSpec),
+    zero: impl FnOnce(&TaskSpec) -> Result<ApproxAgent, Error>,
+) -> Result<Parts, Problem> {
     let retrain = || "train the policy again with `hstlc train`".to_string();
     let edited =
         || "the file was edited or damaged: train the policy again with `hstlc train`".to_string();
@@ -648,17 +794,6 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
             v.as_u64().ok_or_else(|| Problem::new("its `seed` is not a whole number", edited()))?,
         ),
     };
-    let env = field("env")?;
-    let world_name = env.get("name").and_then(Value::as_str).unwrap_or("");
-    let params = env.get("params").cloned().unwrap_or(Value::Null);
-    let world = AnyWorld::from_params(world_name, &params)
-        .map_err(|e| Problem::new(format!("its world: {e}"), edited()))?;
-    if !world.is_continuous() {
-        return Err(Problem::new(
-            "its world is a grid, which a learned function is not trained in",
-            edited(),
-        ));
-    }
     let checked = hstl_lang::check(&source);
     let picked = checked
         .specs
@@ -673,17 +808,14 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
         })?;
     let mut spec = crate::lower::task_spec(picked, &source)
         .map_err(|e| Problem::new(e.to_string(), retrain()))?;
-    fit_tiles(&mut spec, picked, &world);
+    fit(&mut spec, picked);
     // The document's tiling must be the one the spec and the world give.
-    let agent0 =
-        with_world!(&world, w => zero_of(&spec, w).and_then(|z| ApproxAgent::new(&spec, w, z)))
-            .map_err(|e| {
-                Problem::new(format!("it does not fit its spec and world: {e}"), retrain())
-            })?;
+    let agent0 = zero(&spec)
+        .map_err(|e| Problem::new(format!("it does not fit its spec and world: {e}"), retrain()))?;
     // Every entry the spec, the world and the model determine must be as `policy_json`
     // writes it: the tiling, the world whole, the names of the variables, actions and
     // options, the memory and the switch.
-    let expected = header(&spec, &world, &agent0.model)
+    let expected = header(&spec, words, &agent0.model)
         .map_err(|e| Problem::new(format!("it does not fit its spec and world: {e}"), retrain()))?;
     field("tiles")?;
     for (key, want) in &expected {
@@ -756,7 +888,7 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
     weights.steps = steps;
     weights.choices = choices;
     let agent = ApproxAgent { weights, ..agent0 };
-    Ok(Replay { spec, world, agent, source, seed })
+    Ok(Parts { spec, agent, source, seed })
 }
 
 /// Zeroed weights of `spec`'s model in `w`.
@@ -812,16 +944,28 @@ pub enum Evaluation {
 /// that satisfy another.
 pub fn evaluate(replay: &Replay, runs: Runs) -> Result<Evaluation, Problem> {
     let Replay { spec, world, agent, .. } = replay;
+    with_world!(world, w => Ok(evaluate_in(spec, agent, w, runs)))
+        .map_err(|e: Error| Problem::new(e.to_string(), None))?
+}
+
+/// [`evaluate`] of `agent` (trained on `spec`) in any world, such as a gymnasium
+/// environment stepped through Python.
+pub fn evaluate_in<W: hstl_runtime::World>(
+    spec: &TaskSpec,
+    agent: &ApproxAgent,
+    world: &W,
+    runs: Runs,
+) -> Result<Evaluation, Problem> {
     let mut rng = seeded_rng(runs.seed);
-    let result: Result<Evaluation, Error> = with_world!(world, w => {
-        if agent.model.is_persistent() {
-            agent
-                .window_rate(w, spec, runs.starts, runs.steps, runs.burn_in, &mut rng)
-                .map(Evaluation::Window)
-        } else {
-            Ok(Evaluation::Satisfaction { rate: agent.satisfaction(w, spec, runs.starts, runs.steps, &mut rng) })
-        }
-    });
+    let result = if agent.model.is_persistent() {
+        agent
+            .window_rate(world, spec, runs.starts, runs.steps, runs.burn_in, &mut rng)
+            .map(Evaluation::Window)
+    } else {
+        Ok(Evaluation::Satisfaction {
+            rate: agent.satisfaction(world, spec, runs.starts, runs.steps, &mut rng),
+        })
+    };
     result.map_err(|e| Problem::new(e.to_string(), None))
 }
 
@@ -854,10 +998,10 @@ pub fn runs_after_training(spec: &TaskSpec, seed: u64) -> Runs {
 }
 
 /// The steps a run of a task that is not persistent needs: its horizon and one, at most
-/// [`MAX_RUN_STEPS`](hstl_runtime::approx::progress::MAX_RUN_STEPS) (an unbounded task gets
-/// 2,000).
+/// [`MAX_RUN_STEPS`](hstl_runtime::progress::MAX_RUN_STEPS) (an unbounded task gets
+/// [`UNBOUNDED_RUN_STEPS`](hstl_runtime::progress::UNBOUNDED_RUN_STEPS)).
 pub fn task_steps(spec: &TaskSpec) -> usize {
-    hstl_runtime::approx::progress::run_steps(&spec.task).unwrap_or(2000)
+    hstl_runtime::progress::run_steps(&spec.task)
 }
 
 /// `DIR/run_K.csv` of greedy runs (the contract "greedy runs as data"): `t,VAR...,action,

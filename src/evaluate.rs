@@ -27,7 +27,8 @@
 
 use hstl_robustness::{Trace, offline};
 use hstl_runtime::eval::{
-    AgentController, EntryCycle, RegionTable, WindowConfig, WindowReport, rollout, window_rate,
+    AgentController, EntryCycle, RegionTable, WindowConfig, WindowReport, rollout, sample_runs,
+    window_rate,
 };
 use hstl_runtime::optimum::{Moves, Optimum, SolveConfig, solve};
 use hstl_runtime::policy::EnvInfo;
@@ -332,6 +333,57 @@ pub fn optimum(
     solve(&Moves::of(env), &regions, config)
         .map(Some)
         .map_err(|e| Problem::new(e.to_string(), None))
+}
+
+/// The first `n` greedy runs [`evaluate`] scores with `runs` (the same starts and slips,
+/// drawn from the same generator), each as a `run_K.csv` file (DESIGN.md, "greedy runs as
+/// data"): `t,VAR...,action,option`, one row per step, then the final state with empty
+/// action and option.
+pub fn greedy_run_files<E: Env>(
+    replay: &Replay<E>,
+    n: usize,
+    runs: Runs,
+) -> Result<Vec<crate::artifacts::OutFile>, Problem> {
+    let Replay { spec, env, agent, .. } = replay;
+    let states = state_trace(spec, env)?;
+    let actions = env.actions();
+    let names: Vec<&str> = spec.state_vars.iter().map(|v| v.name.as_str()).collect();
+    let mut rng = seeded_rng(runs.seed);
+    let mut controller = AgentController::new(agent);
+    let sampled = sample_runs(env, &mut controller, n, runs.steps, &mut rng);
+    let mut row = Vec::new();
+    let mut line = |out: &mut String, t: usize, s: usize, act: Option<(usize, usize)>| {
+        out.push_str(&t.to_string());
+        states.row_into(s, &mut row);
+        for &v in &row {
+            out.push(',');
+            out.push_str(&crate::continuous::number(v));
+        }
+        match act {
+            Some((a, o)) => {
+                out.push(',');
+                out.push_str(actions.get(a).map_or("", String::as_str));
+                out.push(',');
+                out.push_str(spec.options.get(o).map_or("", |x| x.name.as_str()));
+            }
+            None => out.push_str(",,"),
+        }
+        out.push('\n');
+    };
+    Ok(sampled
+        .iter()
+        .enumerate()
+        .map(|(k, run)| {
+            let mut out = format!("t,{},action,option\n", names.join(","));
+            for (t, step) in run.iter().enumerate() {
+                line(&mut out, t, step.state, Some((step.decision.action, step.decision.option)));
+            }
+            if let Some(last) = run.last() {
+                line(&mut out, run.len(), last.next, None);
+            }
+            crate::artifacts::OutFile::text(format!("run_{}.csv", k + 1), out)
+        })
+        .collect())
 }
 
 /// Row `s`: the values of the spec's state variables in state `s` of `env`.

@@ -29,6 +29,7 @@ pub mod artifacts;
 pub mod continuous;
 pub mod cost;
 pub mod evaluate;
+pub mod gym;
 pub mod load;
 pub mod lower;
 pub mod monitor;

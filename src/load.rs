@@ -89,6 +89,19 @@ pub fn load_in_world(
     pick(crate::world::check(source, world, label), wanted)
 }
 
+/// [`load_in_world`] in a world of any kind (a grid, a plane, `mountain-car`): every spec
+/// is checked against it, as `hstlc train --world` checks them.
+pub fn load_in_any_world(
+    source: &str,
+    wanted: Option<&str>,
+    world: &crate::world::AnyWorld,
+    label: &str,
+) -> Result<Loaded, LoadError> {
+    let facts = crate::world::any_facts(world, label);
+    let parsed = hstl_lang::parse(source);
+    pick(hstl_lang::check_parsed_with_worlds(source, parsed, &|_| facts.spec_world()), wanted)
+}
+
 /// The spec named `wanted` (or the only one) of a checked text without errors.
 pub fn pick(mut checked: hstl_lang::Checked, wanted: Option<&str>) -> Result<Loaded, LoadError> {
     if checked.has_errors() {

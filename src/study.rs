@@ -139,10 +139,23 @@ pub fn run_seeds(
         };
         Ok((run, kept))
     };
-    type Done = Vec<(usize, Result<(SeedRun, Option<Kept>), Problem>)>;
+    on_threads(seeds, threads, stop, &one)
+}
+
+/// `one(seed)` for each of `seeds` on up to `threads` threads, each thread taking the next
+/// seed not yet taken; results in the order of `seeds`. Once `stop` is set, no further
+/// seed starts and the call fails.
+fn on_threads<T: Send>(
+    seeds: &[u64],
+    threads: usize,
+    stop: Option<&AtomicBool>,
+    one: &(dyn Fn(u64) -> Result<T, Problem> + Sync),
+) -> Result<Vec<T>, Problem> {
+    let threads = threads.min(seeds.len()).max(1);
+    type Done<T> = Vec<(usize, Result<T, Problem>)>;
     let next = AtomicUsize::new(0);
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let work = || -> Done {
+    let work = || -> Done<T> {
         let mut done = Vec::new();
         while !stopped() {
             let i = next.fetch_add(1, Ordering::Relaxed);
@@ -151,7 +164,7 @@ pub fn run_seeds(
         }
         done
     };
-    let mut all: Done = std::thread::scope(|scope| {
+    let mut all: Done<T> = std::thread::scope(|scope| {
         let work = &work;
         // The calling thread is one of the workers; a thread the system would not start
         // leaves its seeds to the others.
@@ -172,6 +185,46 @@ pub fn run_seeds(
     }
     all.sort_by_key(|(i, _)| *i);
     all.into_iter().map(|(_, r)| r).collect()
+}
+
+/// [`run_seeds`] of a spec on a continuous world (its tiling fitted, see
+/// [`crate::continuous::fit_tiles`]), as `hstlc study` trains one: each seed with the
+/// approximate learner, its greedy policy measured on the runs of evaluation seed
+/// `seed ^ EVAL_SEED` ([`crate::continuous::after_training`]). A persistent task's window
+/// rate is the run's `window_rate`; another task's satisfaction rate P (no exact optimum
+/// exists to pair it with) comes beside the run.
+pub fn run_continuous_seeds(
+    spec: &TaskSpec,
+    world: &hstl_runtime::world::AnyWorld,
+    seeds: &[u64],
+    threads: usize,
+    file: &str,
+    clock: Clock<'_>,
+    stop: Option<&AtomicBool>,
+) -> Result<Vec<(SeedRun, Option<f64>)>, Problem> {
+    use crate::continuous as c;
+    let one = |seed: u64| -> Result<(SeedRun, Option<f64>), Problem> {
+        let start = clock();
+        let trained = c::train(spec, world, seed, |_, _| {})
+            .map_err(|e| crate::train::cannot_train(file, &spec.name, &e))?;
+        let secs = clock() - start;
+        let (window_rate, satisfaction) =
+            match c::after_training(spec, world, &trained.agent, seed)? {
+                c::Evaluation::Window(w) => (Some(w.rate), None),
+                c::Evaluation::Satisfaction { rate } => (None, Some(rate)),
+            };
+        let run = SeedRun {
+            seed,
+            secs,
+            steps: trained.steps,
+            reward: tail_mean(&trained.curve, TAIL),
+            window_rate,
+            satisfaction: None,
+            curve: trained.curve,
+        };
+        Ok((run, satisfaction))
+    };
+    on_threads(seeds, threads, stop, &one)
 }
 
 /// About the bytes an agent's tables take.

@@ -396,3 +396,132 @@ fn once_the_goal_is_met_the_options_level_holds_instead_of_starting_again() {
     assert!(holding as f64 >= 0.9 * after as f64, "{holding} of {after} steps held");
     assert!(satisfied >= 45, "{satisfied} of 50 runs satisfied the task");
 }
+
+/// A greedy run driven one step at a time from outside (`ApproxAgent::stepper`, what
+/// `hstl.Policy.act` runs) takes the actions and options the agent's own run takes.
+#[test]
+fn a_run_stepped_from_outside_takes_the_agent_s_own_actions() {
+    use hstl::runtime::World;
+    let toml = "kind = \"plane\"\nx = [0.0, 10.0]\ny = [0.0, 10.0]\nstep = 1.0\nheadings = 8\n\
+                slip = 0.05\nnoise = 0.05\nobstacles = [{ circle = [5.0, 5.0, 1.5] }]\n";
+    let field = AnyWorld::from_toml(toml, "field").expect("a valid world");
+    for (src, world) in [(PATROL, plane()), (TIMED, field)] {
+        let spec = lowered(src, &world);
+        let t = c::train(&spec, &world, 3, |_, _| {}).expect("trains");
+        let AnyWorld::Plane(w) = &world else { unreachable!() };
+        let mut rng = hstl::runtime::seeded_rng(8);
+        for _ in 0..5 {
+            let start = w.reset(&mut rng);
+            let mut replay_rng = rng.clone();
+            let run = t.agent.run(w, start, 200, &mut rng);
+            let mut stepper = t.agent.stepper();
+            let (mut state, mut x, mut blocked) = (start, Vec::new(), Vec::new());
+            for k in 0..200 {
+                w.valuation(&state, &mut x);
+                assert_eq!(x[..], run.values[k * 2..k * 2 + 2]);
+                blocked.clear();
+                blocked.extend((0..w.actions().len()).map(|a| w.blocked(&state, a)));
+                let (a, o) = stepper.act(&t.agent, &x, &blocked);
+                assert_eq!((a, o), (run.actions[k], run.options[k]), "step {k}");
+                state = w.step(&state, a, &mut replay_rng);
+            }
+        }
+    }
+}
+
+/// `mountain-car`'s dynamics under a gymnasium environment's description, as the Python
+/// package's `BoxEnv` presents one: what a policy trained through `hstl.train(env=...)`
+/// records.
+struct Described(hstl::runtime::MountainCar, hstl::gym::Described);
+
+impl hstl::runtime::World for Described {
+    type State = hstl::runtime::CarState;
+    fn name(&self) -> &str {
+        &self.1.name
+    }
+    fn params(&self) -> Value {
+        self.1.params()
+    }
+    fn state_vars(&self) -> Vec<String> {
+        self.1.vars.clone()
+    }
+    fn actions(&self) -> Vec<String> {
+        hstl::runtime::World::actions(&self.1)
+    }
+    fn valuation(&self, s: &Self::State, out: &mut Vec<f64>) {
+        self.0.valuation(s, out)
+    }
+    fn reset(&self, rng: &mut hstl::runtime::Rng) -> Self::State {
+        self.0.reset(rng)
+    }
+    fn step(&self, s: &Self::State, a: usize, rng: &mut hstl::runtime::Rng) -> Self::State {
+        self.0.step(s, a, rng)
+    }
+}
+
+#[test]
+fn a_policy_trained_in_a_described_environment_replays_against_its_spaces() {
+    let src = car(200, 4);
+    let world = AnyWorld::builtin("mountain-car").expect("built in");
+    // The spec's own tiling: a described environment fits none (see `fit_tiles`).
+    let loaded = hstl::load::load(&src, None).expect("the spec checks");
+    let spec = hstl::train::trainable(&loaded.spec, &src, "car.hstl").expect("trainable");
+    let vars = vec!["x".to_string(), "v".to_string()];
+    let described = hstl::gym::Described::new(
+        "MountainCarEnv",
+        vars.clone(),
+        vec![-1.2, -0.07],
+        vec![0.6, 0.07],
+        3,
+        0,
+    )
+    .expect("bounded");
+    let env = Described(hstl::runtime::MountainCar, described.clone());
+    let t = c::train_world_until(&spec, &env, 5, |_, _| std::ops::ControlFlow::Continue(()))
+        .expect("trains");
+    let text = c::policy_json_in(&spec, &env, &t.agent, &src, 5).expect("writes");
+    let doc: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(doc["env"]["params"]["gymnasium"], Value::Bool(true));
+    let Ok(c::AnyReplay::Gym(replay)) = c::replay_text_any(&text) else {
+        panic!("a gymnasium document replays as one");
+    };
+    assert_eq!(replay.env, described);
+    assert_eq!(replay.agent.weights, t.agent.weights, "the same bits");
+    // The world's own document (its tiling fitted to the world) replays as a world.
+    let fitted = lowered(&src, &world);
+    let native_agent = c::train(&fitted, &world, 5, |_, _| {}).expect("trains").agent;
+    let native = c::policy_json(&fitted, &world, &native_agent, &src, 5).expect("writes");
+    assert!(matches!(c::replay_text_any(&native), Ok(c::AnyReplay::World(_))), "a world's");
+    // Spaces that contradict the document (an action count its actions do not have, a
+    // bound that is no finite number) are refused, in words.
+    for (from, to) in [("\"actions\": 3", "\"actions\": 4"), ("0.6", "1e999")] {
+        let edited = text.replacen(from, to, 1);
+        assert_ne!(edited, text, "{from} is in the document");
+        match c::replay_text_any(&edited) {
+            Ok(_) => panic!("{from} -> {to} was accepted"),
+            Err(e) => assert!(!e.message.ends_with('.') && e.help.is_some(), "{}", e.message),
+        }
+    }
+    // A bound nothing else in the document determines is read as written: the environment
+    // a replay is then given must have it (the Python package compares the two).
+    match c::replay_text_any(&text.replacen("-0.07", "-0.08", 1)) {
+        Ok(c::AnyReplay::Gym(r)) => assert_eq!(r.env.low, vec![-1.2, -0.08]),
+        _ => panic!("an edited bound reads as written"),
+    }
+    // Unbounded or empty spaces, and too many actions, give no environment.
+    let cases: [(Vec<f64>, Vec<f64>, usize, &str); 4] = [
+        (
+            vec![f64::NEG_INFINITY, 0.0],
+            vec![1.0, 1.0],
+            2,
+            "unbounded: component 0 lies in [-inf, 1]",
+        ),
+        (vec![0.0, 2.0], vec![1.0, 1.0], 2, "component 1 has low above high"),
+        (vec![], vec![], 2, "has 0 components"),
+        (vec![0.0, 0.0], vec![1.0, 1.0], 0, "has 0 actions"),
+    ];
+    for (low, high, actions, want) in cases {
+        let e = hstl::gym::Described::new("E", vars.clone(), low, high, actions, 0).unwrap_err();
+        assert!(e.message.contains(want), "{} does not hold {want}", e.message);
+    }
+}

@@ -31,7 +31,7 @@ fn a_corridor_learns_to_walk_right_and_its_policy_round_trips() {
     assert_eq!(policy.env.name, "corridor");
     assert_eq!(policy.env.params, env.params());
     let back = Policy::from_json(&policy.to_json().unwrap()).unwrap();
-    assert_eq!(back.agent(&env).unwrap(), agent);
+    assert_eq!(back.agent_for(&spec, &env).unwrap(), agent);
 }
 
 /// The corridor as an episodic environment: an episode ends at the right end (as a

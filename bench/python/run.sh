@@ -3,7 +3,8 @@
 # into a throwaway venv (.venv-bench-python), runs the facade's criterion bench of the same
 # calls, writes the benchmark walk, and prints the tables of bench.py (extra arguments go
 # to it, e.g. --repeats 3 --rtamt-steps 20000), then those of gym_bench.py (GridWorldEnv and
-# STLReward steps per second, hstl.train against a release `hstlc train`).
+# STLReward steps per second, hstl.train against a release `hstlc train`), and those of
+# continuous_bench.py (PlaneEnv and MountainCarEnv, hstl.train on continuous worlds).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 venv="$root/.venv-bench-python"
@@ -22,3 +23,4 @@ cargo run --release --locked -q -p hstl-robustness --example walk -- target/walk
 "$venv/bin/python" bench/python/bench.py target/walk.csv "$@"
 cargo build --release --locked -q -p hstlc
 "$venv/bin/python" bench/python/gym_bench.py target/release/hstlc
+"$venv/bin/python" bench/python/continuous_bench.py target/release/hstlc

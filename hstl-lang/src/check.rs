@@ -1259,8 +1259,8 @@ impl Cx<'_> {
     }
 
     /// Checks the options and builds the set; with `preset: auto`, fills in what the preset
-    /// gives. Returns which of `init`, `terminate` and `avoid` it filled in per primitive, and
-    /// whether it chose the options set.
+    /// gives. Returns which of `init`, `terminate` and `avoid` it filled in per primitive
+    /// (and whether it added the primitive), and whether it chose the options set.
     fn options(
         &mut self,
         decls: &[&syntax::OptionDecl],
@@ -1268,7 +1268,7 @@ impl Cx<'_> {
         spec: &syntax::Spec,
         preset: Preset,
         out: &mut CheckedSpec,
-    ) -> (Vec<[bool; 3]>, bool) {
+    ) -> (Vec<[bool; 4]>, bool) {
         let auto = preset == Preset::Auto;
         let persistent = auto && out.persistent_conjuncts(self.src).is_some();
         let auto_avoid = if auto {
@@ -1276,7 +1276,7 @@ impl Cx<'_> {
         } else {
             None
         };
-        let mut filled: Vec<[bool; 3]> = Vec::new();
+        let mut filled: Vec<[bool; 4]> = Vec::new();
         let mut by_name: HashMap<String, (usize, Range<usize>)> = HashMap::new();
         for o in decls {
             if let Some((_, first)) = by_name.get(&o.name.name) {
@@ -1409,7 +1409,7 @@ impl Cx<'_> {
                 auto && valid && terminate.is_none(),
                 avoid.is_none() && auto_avoid.is_some(),
             ];
-            filled.push(fill);
+            filled.push([fill[0], fill[1], fill[2], false]);
             if fill[0] {
                 init = Some(CFormula {
                     kind: CFormulaKind::Not(Box::new(reach.clone())),
@@ -1591,7 +1591,46 @@ impl Cx<'_> {
             seen.insert(o.name.clone(), o.range.clone());
             out.options.push(o);
         }
+        self.add_keep_clear(auto_avoid, &by_name, &seen, out, &mut filled);
         (filled, set_filled)
+    }
+
+    /// With `preset: auto` on a task that keeps out of its avoided regions for good, adds
+    /// the primitive and option [`crate::preset::KEEP_CLEAR`] (unless the spec uses the name).
+    fn add_keep_clear(
+        &self,
+        avoid: Option<CFormula>,
+        primitives: &HashMap<String, (usize, Range<usize>)>,
+        options: &HashMap<String, Range<usize>>,
+        out: &mut CheckedSpec,
+        filled: &mut Vec<[bool; 4]>,
+    ) {
+        let name = crate::preset::KEEP_CLEAR;
+        let Some(avoid) = avoid else { return };
+        let taken = primitives.contains_key(name)
+            || options.contains_key(name)
+            || out.lets.iter().any(|l| l.name == name);
+        if taken || out.primitives.is_empty() || !crate::preset::keeps_clear_for_good(out, self.src)
+        {
+            return;
+        }
+        // Named where its reason is: the first avoidance for good.
+        let range = crate::preset::safety_conjuncts(out)
+            .first()
+            .map_or(avoid.range.clone(), |c| c.conjunct.range.clone());
+        out.primitives.push(PrimitiveOption {
+            name: name.to_string(),
+            reach: CFormula { kind: CFormulaKind::Not(Box::new(avoid.clone())), range: avoid.range.clone() },
+            init: CFormula { kind: CFormulaKind::True, range: range.clone() },
+            terminate: Terminate::Argmax,
+            avoid: Some(avoid),
+            doc: Some("Added by `preset: auto`: once the goals are met, keep clear of the avoided regions.".to_string()),
+            name_range: range.clone(),
+            range: range.clone(),
+        });
+        filled.push([false, false, true, true]);
+        let leg = out.primitives.len() - 1;
+        out.options.push(CombinedOption { name: name.to_string(), sequence: vec![leg], range });
     }
 
     fn set_size_ok(&mut self, n: usize, perm: bool, range: Range<usize>) -> bool {

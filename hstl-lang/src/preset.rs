@@ -6,7 +6,10 @@
 //! region, and sets a memory sized from the deadlines, the window reward and the tuned step
 //! sizes. For any other task with options it makes the legs stop on entering their region.
 //! Wherever the task has safety conjuncts (`always !R`), every option gets `avoid:` of their
-//! regions. Anything written beside the preset is kept.
+//! regions. A task that is not persistent and keeps out of `R` for good (`always !R`, no
+//! window) gets one more option, [`KEEP_CLEAR`], for after its goals: once they are met
+//! only the avoidance is left, which no leg that enters a goal keeps well. Anything written
+//! beside the preset is kept.
 
 use crate::checked::{CFormula, CFormulaKind, CheckedSpec, LearnParams, Terminate};
 
@@ -39,6 +42,32 @@ pub const BUCKET_STEPS: u64 = 5;
 /// The preset keeps the memory values `(B + 1)^k` at most this many, so that the options
 /// table stays small enough to learn in the default episodes.
 pub const MAX_MEMORY_VALUES: u64 = 1000;
+
+/// The option the preset adds for a task that keeps out of its avoided regions for good
+/// ([`keeps_clear_for_good`]): `option keep_clear { reach: !R, terminate: argmax, avoid: R }`,
+/// a leg to the states farthest from `R` (by robustness), which the options level picks once
+/// the goals are met.
+pub const KEEP_CLEAR: &str = "keep_clear";
+
+/// Whether the preset adds [`KEEP_CLEAR`]: the task is not persistent, has an `eventually`
+/// conjunct, and a safety conjunct with no end (`always !R`, `always[0..] !R`), and the
+/// state is finite (`terminate: argmax` enumerates it).
+pub fn keeps_clear_for_good(spec: &CheckedSpec, src: &str) -> bool {
+    use crate::checked::Bound;
+    let Some(task) = &spec.task else { return false };
+    if spec.is_continuous() || spec.persistent_conjuncts(src).is_some() {
+        return false;
+    }
+    let parts: Vec<&CFormula> = match &task.formula.kind {
+        CFormulaKind::And(parts) => parts.iter().collect(),
+        _ => vec![&task.formula],
+    };
+    let goal = parts.iter().any(|c| matches!(c.kind, CFormulaKind::Eventually(..)));
+    let for_good = safety_conjuncts(spec).iter().any(
+        |c| matches!(&c.conjunct.kind, CFormulaKind::Always(iv, _) if iv.end == Bound::Unbounded),
+    );
+    goal && for_good
+}
 
 /// A conjunct `always[I] !R` of the task (or the task itself), with `R` a state formula.
 #[derive(Clone, Debug, PartialEq)]
@@ -180,7 +209,7 @@ pub fn learn(horizons: Option<&[u64]>, reach: bool, continuous: bool, learn: &mu
 
 /// What the preset expanded to in `spec`, as hstl text: each option's fields, the options
 /// set, and the `learn` values in force (after the values written beside the preset).
-pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 3]], set_filled: bool) -> String {
+pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 4]], set_filled: bool) -> String {
     let text = |f: &CFormula| -> String {
         match &f.kind {
             CFormulaKind::Let(i) => spec.lets.get(*i).map_or(String::new(), |l| l.name.clone()),
@@ -194,6 +223,12 @@ pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 3]], set_filled
     let mut lines = Vec::new();
     for (p, filled) in spec.primitives.iter().zip(filled) {
         let mut fields = Vec::new();
+        if filled[3]
+            && let Some(a) = &p.avoid
+        {
+            fields.push(format!("reach: !{}", paren(&text(a))));
+            fields.push("terminate: argmax".to_string());
+        }
         if filled[0] {
             fields.push(format!("init: {}", text(&p.init)));
         }
@@ -206,6 +241,12 @@ pub fn expansion(spec: &CheckedSpec, src: &str, filled: &[[bool; 3]], set_filled
             && let Some(a) = &p.avoid
         {
             fields.push(format!("avoid: {}", text(a)));
+        }
+        if filled[3] {
+            lines.push(
+                "// added, and in the options set: once the goals are met, only the avoidance is left"
+                    .to_string(),
+            );
         }
         if !fields.is_empty() {
             lines.push(format!("option {} {{ {} }}", p.name, fields.join(", ")));

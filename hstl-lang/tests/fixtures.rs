@@ -226,7 +226,14 @@ fn text(src: &str, f: &CFormula) -> String {
     // that `preset: auto` fills in.
     match &f.kind {
         CFormulaKind::True if t != "true" => "true (default)".into(),
-        CFormulaKind::Not(_) if !t.starts_with('!') => format!("!{t} (preset)"),
+        CFormulaKind::Not(inner) if !t.starts_with('!') => match &inner.kind {
+            // `keep_clear`'s reach, `!(R1 || R2)`, carries the first region's range.
+            CFormulaKind::Or(parts) => {
+                let parts: Vec<String> = parts.iter().map(|p| text(src, p)).collect();
+                format!("!({}) (preset)", parts.join(" || "))
+            }
+            _ => format!("!{t} (preset)"),
+        },
         _ => t.to_string(),
     }
 }

@@ -47,6 +47,26 @@ pub const DEFAULT_STEPS: usize = 2000;
 /// At most this many runs are written by `--runs`.
 pub const MAX_RUN_FILES: usize = 1000;
 
+/// At most this many rows in all, over the runs `--runs` writes (they are built in memory
+/// before the folder is written whole).
+pub const MAX_RUN_ROWS: usize = 10_000_000;
+
+/// Refuses a `--runs` that would write more than [`MAX_RUN_ROWS`] rows, before anything runs.
+fn check_run_rows(args: &EvalArgs, steps: usize) -> Result<(), CliError> {
+    let rows = args.starts.min(MAX_RUN_FILES).saturating_mul(steps.saturating_add(1));
+    if args.runs.is_some() && rows > MAX_RUN_ROWS {
+        return Err(CliError::new(
+            format!(
+                "--runs would write {rows} rows ({} runs of {} states), more than {MAX_RUN_ROWS}",
+                args.starts.min(MAX_RUN_FILES),
+                steps.saturating_add(1)
+            ),
+            Some("lower --starts or --steps, or leave out --runs".to_string()),
+        ));
+    }
+    Ok(())
+}
+
 /// The window rate's line: the rate, its range over the runs, and what a kept step is. A
 /// one-step window (a safety conjunct `always[0..] !S`, the region `!S`) holds at the step.
 fn window_line(
@@ -100,6 +120,13 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
     runs.check_burn_in(spec, flag)?;
+    // Decide what can be written before anything is printed.
+    check_run_rows(args, runs.steps)?;
+    let out = args
+        .runs
+        .as_ref()
+        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
+        .transpose()?;
     outln!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
@@ -129,6 +156,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
                     r.optimum
                 )?;
             }
+            write_runs(out, &replay, args.starts, runs)?;
             return Ok(Status::Clean);
         }
         Evaluation::Window { report } => report,
@@ -171,7 +199,24 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             )?;
         }
     }
+    write_runs(out, &replay, args.starts, runs)?;
     Ok(Status::Clean)
+}
+
+/// With `--runs DIR`, writes the first [`MAX_RUN_FILES`] greedy runs of a grid policy.
+fn write_runs(
+    out: Option<hstl_outdir::OutDir>,
+    replay: &evaluate::Replay<hstl::runtime::GridWorld>,
+    starts: usize,
+    runs: hstl::evaluate::Runs,
+) -> Result<(), CliError> {
+    let Some(out) = out else { return Ok(()) };
+    let n = starts.min(MAX_RUN_FILES);
+    let files = evaluate::greedy_run_files(replay, n, runs)?;
+    let dir = out.path().to_path_buf();
+    out.write(&files)?;
+    outln!("  wrote {n} greedy runs to {} (run_1.csv ...)", crate::output::shown(&dir))?;
+    Ok(())
 }
 
 /// `hstlc eval` of a learned function (a continuous world): the window rate of a
@@ -189,6 +234,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
     let runs = Runs { steps, ..runs };
     runs.check_burn_in(spec, flag)?;
     // Decide what can be written before anything is printed.
+    check_run_rows(args, runs.steps)?;
     let out = args
         .runs
         .as_ref()

@@ -38,20 +38,6 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         Windows::Clipped => Semantics::Clipped,
         Windows::Complete => Semantics::Complete,
     };
-    if args.online && windows == Semantics::Complete {
-        return Err(CliError::new(
-            format!(
-                "{name}: `--online` with `--windows complete` is not supported yet for \
-                 dense-time specs (spec `{}` has a `time` variable)",
-                spec.name
-            ),
-            Some(
-                "leave out `--online` to score the recorded trace over complete windows, or \
-                 `--windows complete` to stream it"
-                    .to_string(),
-            ),
-        ));
-    }
     let monitor = Dense::new(spec, args.formula.as_deref()).map_err(|e| {
         let help = match &e {
             hstl::lower::LowerError::UnknownLet { .. } => {
@@ -68,8 +54,27 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         .transpose()?;
     let mut cols = vec![Column { name: monitor.time_var(), kind: ColumnKind::Real }];
     cols.extend(columns(spec));
-    let opts = Options { gap: gap.as_ref(), relative: args.relative };
+    let opts = Options { gap: gap.as_ref(), relative: args.relative, windows };
     if args.online {
+        if windows == Semantics::Complete && !monitor.formula().future_reach().is_finite() {
+            // Over complete windows an unbounded operator reads up to its operand's own
+            // complete end, which only the whole trace gives.
+            return Err(CliError::new(
+                format!(
+                    "{name}: `--online` with `--windows complete` needs bounded future \
+                     operators, and {} has an unbounded one (such as `always`): no value is \
+                     final before the input ends",
+                    args.formula
+                        .as_deref()
+                        .map_or_else(|| "the task".to_string(), |f| format!("`{f}`"))
+                ),
+                Some(
+                    "leave out `--online`: the trace is scored whole, over complete windows, \
+                     with the same result"
+                        .to_string(),
+                ),
+            ));
+        }
         return online(&monitor, &cols, &traces[0], spec, args.formula.as_deref(), opts);
     }
     let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
@@ -246,7 +251,10 @@ fn at_time(p: &DenseProblem, origin: Option<i128>) -> String {
     p.time.map_or_else(String::new, |t| format!(" at time {}", time_text(origin, t)))
 }
 
-/// `--online`: each change point printed (and flushed) once no later row can change it.
+/// `--online`: each change point printed (and flushed) once no later row can change it;
+/// over complete windows (bounded operators only), once it also lies before the complete
+/// end of the rows so far, and at the end, as the whole trace's `--signal` prints them: the
+/// points before the complete end, then that end with no value.
 fn online(
     monitor: &Dense,
     cols: &[Column<'_>],
@@ -270,6 +278,9 @@ fn online(
         );
     }
     outln!("t,robustness")?;
+    let complete = opts.windows == Semantics::Complete;
+    // Decided points not yet known to lie before the complete end.
+    let mut held: Vec<(f64, f64)> = Vec::new();
     let mut order = StampOrder::default();
     let mut cells = vec![None; cols.len() - 1];
     let mut count = 0usize;
@@ -314,18 +325,47 @@ fn online(
             )
         })?;
         times.origin = live.origin();
-        for (t, v) in decided {
-            outln!("{},{v}", times.text(t))?;
+        if complete {
+            held.extend(decided);
+            let end = live
+                .span()
+                .map_or(f64::NEG_INFINITY, |(_, last)| monitor.formula().complete_end(last));
+            let before = held.partition_point(|&(t, _)| t < end);
+            for (t, v) in held.drain(..before) {
+                outln!("{},{v}", times.text(t))?;
+            }
+        } else {
+            for (t, v) in decided {
+                outln!("{},{v}", times.text(t))?;
+            }
         }
     }
     if count == 0 {
         return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
     }
     let origin = live.origin();
+    let span = live.span();
     let rest = live.finish().map_err(|e| {
         let p = monitor.problem(e);
         CliError::new(format!("{name}: {}{}", p.message, at_time(&p, origin)), p.help)
     })?;
+    if let (true, Some((t0, t_last))) = (complete, span) {
+        held.extend(rest);
+        let end = monitor.formula().complete_end(t_last);
+        if end < t_last {
+            let before = held.partition_point(|&(t, _)| t < end);
+            for &(t, v) in &held[..before] {
+                outln!("{},{v}", times.text(t))?;
+            }
+            outln!("{},", times.text(end.max(t0)))?;
+            note_open(&[(name.clone(), (end >= t0).then(|| times.text(end)))], false);
+        } else {
+            for (t, v) in held {
+                outln!("{},{v}", times.text(t))?;
+            }
+        }
+        return Ok(Status::Clean);
+    }
     for (t, v) in rest {
         outln!("{},{v}", times.text(t))?;
     }
@@ -346,6 +386,7 @@ fn csv_field(text: &str) -> String {
 struct Options<'a> {
     gap: Option<&'a MaxGap>,
     relative: bool,
+    windows: Semantics,
 }
 
 /// The previous row's stamp and line, for `--max-gap`.

@@ -228,40 +228,21 @@ fn continuous_spec(
     use hstl::continuous as c;
     let mut spec = spec.clone();
     c::fit_tiles(&mut spec, &l.spec, world);
-    let one = |seed: u64| -> Result<SeedResult, CliError> {
-        let start = Instant::now();
-        let trained = c::train(&spec, world, seed, |_, _| {}).map_err(|e| {
-            let p = hstl::train::cannot_train(&l.file, &spec.name, &e);
-            CliError::new(p.message, p.help)
-        })?;
-        let secs = start.elapsed().as_secs_f64();
-        let rate = match c::after_training(&spec, world, &trained.agent, seed)? {
-            c::Evaluation::Window(w) => w.rate,
-            c::Evaluation::Satisfaction { rate } => rate,
-        };
-        Ok(SeedResult { rate, secs, steps: trained.steps, curve: trained.curve })
-    };
-    let next = AtomicUsize::new(0);
-    let results: Vec<Result<(usize, SeedResult), CliError>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads.min(seeds.len()).max(1))
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(&seed) = seeds.get(i) else { break };
-                        mine.push(one(seed).map(|r| (i, r)));
-                    }
-                    mine
-                })
-            })
-            .collect();
-        handles.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
-    });
-    let mut runs: Vec<(usize, SeedResult)> = results.into_iter().collect::<Result<_, _>>()?;
-    if runs.len() != seeds.len() {
-        return Err(CliError::new("a training thread stopped before its seeds were done", None));
-    }
+    // Each seed as `hstl.study` trains it (the facade's), timed by this process's clock.
+    let start = Instant::now();
+    let clock = move || start.elapsed().as_secs_f64();
+    let done = facade::run_continuous_seeds(&spec, world, seeds, threads, &l.file, &clock, None)
+        .map_err(|p| CliError::new(p.message, p.help))?;
+    let mut runs: Vec<(usize, SeedResult)> = done
+        .into_iter()
+        .enumerate()
+        .map(|(i, (run, satisfaction))| {
+            let rate = run.window_rate.or(satisfaction).ok_or_else(|| {
+                CliError::new(format!("seed {} measured neither W nor P", run.seed), None)
+            })?;
+            Ok((i, SeedResult { rate, secs: run.secs, steps: run.steps, curve: run.curve }))
+        })
+        .collect::<Result<_, CliError>>()?;
     runs.sort_by_key(|r| r.0);
     let persistent = !spec.regions.is_empty();
     let measure = if persistent { "W" } else { "P" };

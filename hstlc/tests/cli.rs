@@ -520,7 +520,8 @@ fn online_rows_are_the_signal() {
 }
 
 /// A dense-time spec's `--online` rows are its `--signal` rows, on an irregular trace with
-/// empty cells, for bounded, unbounded, past and `until` formulas with decimal bounds.
+/// empty cells, for bounded, unbounded, past and `until` formulas with decimal bounds, over
+/// clipped windows and (bounded future operators) over complete ones.
 #[test]
 fn dense_online_rows_are_the_signal() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -563,5 +564,21 @@ fn dense_online_rows_are_the_signal() {
         let online = run(&[pick.as_slice(), &["--online"]].concat());
         assert_eq!(online, signal, "{formula:?}");
         assert!(signal.lines().count() > 3, "{formula:?}: {signal}");
+        // Over complete windows too, where every future operator is bounded.
+        let complete = ["--windows", "complete"];
+        if formula == Some("F") {
+            let refused = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+                .args(["monitor", "s.hstl", "--trace", "t.csv", "--formula", "F", "--online"])
+                .args(complete)
+                .current_dir(dir.path())
+                .output()
+                .expect("hstlc runs");
+            assert_eq!(refused.status.code(), Some(2));
+            assert!(String::from_utf8_lossy(&refused.stderr).contains("leave out `--online`"));
+            continue;
+        }
+        let signal = run(&[pick.as_slice(), &["--signal"], &complete].concat());
+        let online = run(&[pick.as_slice(), &["--online"], &complete].concat());
+        assert_eq!(online, signal, "{formula:?}, complete windows");
     }
 }

@@ -42,7 +42,21 @@ from typing import Any as _Any
 
 from . import _registration
 from ._errors import MissingVariableError, PolicyError, SpecError, SpecWarning, WorldError
-from ._hstl import EVAL_SEED, MAX_EPISODES, MAX_ONLINE_VALUES, Diagnostic, OnlineMonitor, Policy, Spec, World, __version__, check, explain, formula
+from ._hstl import (
+    EVAL_SEED,
+    MAX_EPISODES,
+    MAX_ONLINE_VALUES,
+    ContinuousWorld,
+    Diagnostic,
+    OnlineMonitor,
+    Policy,
+    Spec,
+    World,
+    __version__,
+    check,
+    explain,
+    formula,
+)
 from ._registration import MAX_EPISODE_STEPS
 from ._study import StudyResult, study
 from ._train import train
@@ -52,6 +66,7 @@ __all__ = [
     "MAX_EPISODES",
     "MAX_ONLINE_VALUES",
     "MAX_EPISODE_STEPS",
+    "ContinuousWorld",
     "Diagnostic",
     "MissingVariableError",
     "OnlineMonitor",
@@ -74,7 +89,7 @@ __all__ = [
 # gymnasium is optional and costs about 150 ms to import: the gymnasium classes load on
 # first use (`__getattr__` below), and the ids are registered with gymnasium once it is
 # imported (`_registration`).
-_GYM = ("GridWorldEnv", "STLReward")
+_GYM = ("GridWorldEnv", "MountainCarEnv", "PlaneEnv", "STLReward")
 
 if _find_spec("gymnasium") is not None:
     __all__ += _GYM
@@ -85,6 +100,8 @@ if _TYPE_CHECKING:
     # Type checkers see the classes (and no `__getattr__`, which would make every unknown
     # name `Any`).
     from ._gym import GridWorldEnv as GridWorldEnv
+    from ._gym import MountainCarEnv as MountainCarEnv
+    from ._gym import PlaneEnv as PlaneEnv
     from ._gym import STLReward as STLReward
 else:
 

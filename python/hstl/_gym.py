@@ -1,12 +1,16 @@
-"""Gymnasium environments and wrappers: ``GridWorldEnv`` and ``STLReward``.
+"""Gymnasium environments and wrappers: ``GridWorldEnv``, ``PlaneEnv``, ``MountainCarEnv``
+and ``STLReward``.
 
-``hstl`` loads this module on first use of ``hstl.GridWorldEnv`` or ``hstl.STLReward``, so
-that ``import hstl`` does not import gymnasium. ``import hstl`` registers the built-in
-worlds with gymnasium (when it is imported, or as soon as it is; see ``_registration``):
-``gymnasium.make("hstl/GridWorld-v0")`` is the paper's world and
-``gymnasium.make("hstl/FourRooms-v0")`` the four rooms, each with
-``max_episode_steps=MAX_EPISODE_STEPS``. Without ``import hstl`` first,
-``gymnasium.make("hstl:hstl/GridWorld-v0")`` imports it (gymnasium's ``module:id`` form).
+``hstl`` loads this module on first use of one of them, so that ``import hstl`` does not
+import gymnasium. ``import hstl`` registers the built-in worlds with gymnasium (when it is
+imported, or as soon as it is; see ``_registration``): ``gymnasium.make("hstl/GridWorld-v0")``
+is the paper's world, ``gymnasium.make("hstl/FourRooms-v0")`` the four rooms,
+``gymnasium.make("hstl/Plane-v0", world=...)`` a plane world (``paper-plane`` by default),
+``gymnasium.make("hstl/MountainCar-v0")`` the car without a task and
+``gymnasium.make("hstl/MountainCarPatrol-v0", window=200)`` the car rewarded for keeping
+its patrol, each with ``max_episode_steps=MAX_EPISODE_STEPS``. Without ``import hstl``
+first, ``gymnasium.make("hstl:hstl/GridWorld-v0")`` imports it (gymnasium's ``module:id``
+form).
 """
 
 from __future__ import annotations
@@ -19,10 +23,19 @@ import numpy as np
 import numpy.typing as npt
 from gymnasium import spaces
 
-from ._hstl import EpisodeMonitor, Generator, Spec, World
+from ._hstl import ContinuousWorld, EpisodeMonitor, Generator, Spec, World, _mountain_car_patrol
 from ._registration import MAX_EPISODE_STEPS, REGISTERED, register
 
-__all__ = ["GridWorldEnv", "MAX_EPISODE_STEPS", "REGISTERED", "STLReward", "register"]
+__all__ = [
+    "GridWorldEnv",
+    "MAX_EPISODE_STEPS",
+    "MountainCarEnv",
+    "PlaneEnv",
+    "REGISTERED",
+    "STLReward",
+    "make_mountain_car_patrol",
+    "register",
+]
 
 _MAX_SEED = 2**64 - 1
 
@@ -39,6 +52,21 @@ def _seed_of(seed: Any) -> int:
     if not 0 <= int(seed) <= _MAX_SEED:
         raise ValueError(f"`seed` must be in 0..={_MAX_SEED}; got {seed}")
     return int(seed)
+
+
+def _action_of(action: Any, names: Sequence[str]) -> int:
+    """``action`` as an index into ``names``: an integer (Python's or numpy's, or an integer
+    array of one element, as agents give), never a float or a bool, in range."""
+    value = action
+    if isinstance(value, np.ndarray) and value.size == 1 and np.issubdtype(value.dtype, np.integer):
+        value = value.reshape(()).item()
+    n = len(names)
+    listed = ", ".join(f"{i} {name}" for i, name in enumerate(names))
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"action {action!r} is not an integer of Discrete({n})\n  help: give one of {listed}")
+    if not 0 <= int(value) < n:
+        raise ValueError(f"action {action!r} is not in Discrete({n}) ({listed})")
+    return int(value)
 
 
 class GridWorldEnv(gymnasium.Env):
@@ -103,9 +131,7 @@ class GridWorldEnv(gymnasium.Env):
     def step(self, action: Any) -> tuple[npt.NDArray[np.int64], float, bool, bool, dict[str, Any]]:
         if self._state is None or self._generator is None:
             raise gymnasium.error.ResetNeeded("call reset() before step()")
-        a = int(action)
-        if not 0 <= a < 4:
-            raise ValueError(f"action {action!r} is not in Discrete(4) (0 Up, 1 Down, 2 Left, 3 Right)")
+        a = _action_of(action, ("Up", "Down", "Left", "Right"))
         state, x, y = self.world._step(self._state, a, self._generator)
         self._state, self._cell = state, (x, y)
         return np.array(self._cell, dtype=np.int64), 0.0, False, False, {"state": state}
@@ -118,6 +144,125 @@ class GridWorldEnv(gymnasium.Env):
             x, y = self._cell
             rows[self.world.height - 1 - y][x] = "R"
         return "\n".join("".join(r) for r in rows) + "\n"
+
+
+def _continuous(world: Union[ContinuousWorld, str, "os.PathLike[str]"], kind: str) -> ContinuousWorld:
+    w = world if isinstance(world, ContinuousWorld) else ContinuousWorld._resolve(os.fspath(world))
+    if w.kind != kind:
+        other = "hstl.MountainCarEnv" if w.kind == "mountain-car" else "hstl.PlaneEnv"
+        raise ValueError(f"world `{w.name}` is not a {kind} world\n  help: use {other} for it")
+    return w
+
+
+class _ContinuousEnv(gymnasium.Env):
+    """A continuous world as a gymnasium environment, stepped in Rust (see ``PlaneEnv``)."""
+
+    metadata: dict[str, Any] = {"render_modes": [], "render_fps": 30}
+
+    def __init__(self, world: ContinuousWorld, render_mode: Optional[str]) -> None:
+        if render_mode is not None:
+            raise ValueError(f"render_mode must be None; got {render_mode!r}\n  help: this environment does not render")
+        self.render_mode = render_mode
+        self.world = world
+        self.observation_space = spaces.Box(
+            low=np.array(world.low, dtype=np.float64), high=np.array(world.high, dtype=np.float64), dtype=np.float64
+        )
+        self.action_space = spaces.Discrete(len(world.actions))
+        self._generator: Optional[Generator] = None
+        self._state: Optional[list[float]] = None
+
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[npt.NDArray[np.float64], dict[str, Any]]:
+        super().reset(seed=seed)
+        if seed is not None:
+            self._generator = Generator(_seed_of(seed))
+        elif self._generator is None:
+            # No seed ever given: one from the entropy gymnasium seeded np_random with.
+            self._generator = Generator(int(self.np_random.integers(0, 2**63)))
+        start = (options or {}).get("start")
+        if start is None:
+            self._state = self.world._reset(self._generator)
+        else:
+            self._state = self.world._start(np.asarray(start, dtype=np.float64).tolist())
+        return np.array(self._state, dtype=np.float64), {}
+
+    def step(self, action: Any) -> tuple[npt.NDArray[np.float64], float, bool, bool, dict[str, Any]]:
+        if self._state is None or self._generator is None:
+            raise gymnasium.error.ResetNeeded("call reset() before step()")
+        a = _action_of(action, self.world.actions)
+        self._state = self.world._step(self._state, a, self._generator)
+        return np.array(self._state, dtype=np.float64), 0.0, False, False, {}
+
+
+class PlaneEnv(_ContinuousEnv):
+    """A plane world as a gymnasium environment, stepped in Rust.
+
+    ``world`` is a ``hstl.ContinuousWorld`` of kind ``"plane"``, a built-in plane world's
+    name (``"paper-plane"``: the paper's case study as a plane, 14 x 14, step 1, 4
+    headings, slip 0.3, noise 0.1) or a world file's path (``kind = "plane"``; see the
+    README's "Worlds"). The observation is the robot's position ``(x, y)``: a ``Box`` over
+    the world's extent, float64, so that it is the state the learner sees bit for bit
+    (float32 would round it). The actions are ``Discrete(headings)``: heading ``k`` moves
+    ``step`` along the direction ``k * 360 / headings`` degrees counter-clockwise from east
+    (``world.actions`` names them). With probability ``slip`` another heading is taken,
+    then Gaussian noise is added; a move whose segment leaves the extent or touches an
+    obstacle stays where it is (the contract "plane worlds" in DESIGN.md).
+
+    Every random draw (starts, slips and noise) comes from one Rust generator (ChaCha8,
+    the learner's), seeded by ``reset(seed=...)`` and continued by ``reset()``, exactly as
+    ``GridWorldEnv`` does: the same seed and actions give the same positions, bit for bit,
+    as the Rust world drawing from that seed. The reward is always 0 (the world has no
+    task: wrap it in ``hstl.STLReward``); episodes never terminate, and the registered id
+    ``hstl/Plane-v0`` truncates them after ``MAX_EPISODE_STEPS``.
+    ``reset(options={"start": (x, y)})`` starts at a given free position. The environment
+    pickles and deep-copies mid-episode (the copy continues with the same draws).
+    """
+
+    def __init__(
+        self, world: Union[ContinuousWorld, str, "os.PathLike[str]"] = "paper-plane", render_mode: Optional[str] = None
+    ) -> None:
+        super().__init__(_continuous(world, "plane"), render_mode)
+
+
+class MountainCarEnv(_ContinuousEnv):
+    """Gymnasium's MountainCar-v0 dynamics, stepped in Rust, without its goal.
+
+    The observation is ``(x, v)``, position and velocity: a ``Box`` over
+    ``[-1.2, 0.6] x [-0.07, 0.07]``, float64 (gymnasium's MountainCar-v0 computes its
+    state in float64 and rounds the observation to float32; here the observation is the
+    state itself). The actions are ``Discrete(3)``: 0 ``left``, 1 ``none``, 2 ``right``.
+    The states are gymnasium's bit for bit for the same start and actions
+    (``MountainCarEnv().unwrapped.state`` there equals the observation here); unlike
+    gymnasium, reaching ``x >= 0.5`` ends nothing (the task says what to reach) and the
+    reward is always 0 (wrap it in ``hstl.STLReward``, or make
+    ``hstl/MountainCarPatrol-v0``). A reset draws ``x`` uniformly in ``[-0.6, -0.4]``
+    from the environment's one Rust generator (seeded by ``reset(seed=...)``, as
+    ``GridWorldEnv``'s) and sets ``v = 0``; ``reset(options={"start": (x, v)})`` starts
+    at a given state. The registered id ``hstl/MountainCar-v0`` truncates episodes after
+    ``MAX_EPISODE_STEPS``.
+    """
+
+    def __init__(self, render_mode: Optional[str] = None) -> None:
+        super().__init__(ContinuousWorld.builtin("mountain-car"), render_mode)
+
+
+def make_mountain_car_patrol(
+    window: int = 200,
+    spec: Union[Spec, str, "os.PathLike[str]", None] = None,
+    reward: Literal["robustness", "increment", "window", "sparse"] = "window",
+) -> "STLReward":
+    """``hstl/MountainCarPatrol-v0``: ``MountainCarEnv`` in ``STLReward`` for the patrol
+    ``always[0..] (eventually[0..window] x < -1.0 && eventually[0..window] x > 0.4)`` (both
+    hill tops within every ``window`` steps; ``examples/specs/mountain_car_patrol.hstl`` is
+    ``window=200``). ``spec=`` gives another spec over ``x`` and ``v`` instead;
+    ``reward`` is ``STLReward``'s (by default ``"window"``: 1 for each step whose windows
+    are all kept). ``info["window_kept"]`` says whether a step's windows are kept."""
+    if spec is None:
+        if isinstance(window, (bool, float)) or not isinstance(window, (int, np.integer)):
+            raise TypeError(f"`window` must be an integer; got {type(window).__name__}")
+        spec = Spec.parse(_mountain_car_patrol(int(window)), filename=f"<MountainCarPatrol window={int(window)}>")
+    return STLReward(MountainCarEnv(), spec, reward=reward)
 
 
 Valuation = Union[Callable[[Any], Any], Mapping[str, Any], None]
@@ -247,6 +392,16 @@ def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Calla
         if vars == ["x", "y"]:
             return _identity
         return _Picks([(v, 0 if v == "x" else 1) for v in vars])
+    if isinstance(env.unwrapped, _ContinuousEnv):
+        state = env.unwrapped.world.state_vars
+        extra = [v for v in vars if v not in state]
+        if extra:
+            raise TypeError(
+                f"spec `{spec.name}` has state variable `{extra[0]}`, which a {type(env.unwrapped).__name__} "
+                f"observation ({', '.join(state)}) does not give\n"
+                "  help: pass valuation=, a function from the observation to the state variables"
+            )
+        return _Picks([(v, state.index(v)) for v in vars])
     if isinstance(env.observation_space, spaces.Dict):
         return _identity
     raise TypeError(

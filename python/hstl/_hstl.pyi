@@ -107,6 +107,8 @@ class Spec:
     @property
     def source(self) -> str: ...
     @property
+    def is_continuous(self) -> bool: ...
+    @property
     def state_vars(self) -> list[str]: ...
     @property
     def time_var(self) -> Optional[str]:
@@ -193,6 +195,8 @@ class OnlineMonitor:
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int
+#: Every built-in world's name: grids, planes, then the others.
+BUILTIN_WORLDS: list[str]
 #: ``hstl.study`` measures the policy of seed ``s`` as ``policy.evaluate(seed=s ^ EVAL_SEED)``.
 EVAL_SEED: int
 #: The `learn` values `hstl.tune` takes from a config (see `hstl.tune.LEARN_KEYS`).
@@ -237,6 +241,39 @@ class World:
     def _step(self, state: int, action: int, generator: Generator) -> Tuple[int, int, int]: ...
     def _index(self, x: int, y: int) -> Optional[int]: ...
 
+class ContinuousWorld:
+    """A continuous world: a plane world or ``mountain-car``; see ``help(hstl.ContinuousWorld)``."""
+
+    @staticmethod
+    def load(path: PathArg) -> ContinuousWorld: ...
+    @staticmethod
+    def builtin(name: str) -> ContinuousWorld: ...
+    @staticmethod
+    def parse(text: str, filename: str = "<string>", name: str = "world") -> ContinuousWorld: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def kind(self) -> str: ...
+    @property
+    def state_vars(self) -> list[str]: ...
+    @property
+    def actions(self) -> list[str]: ...
+    @property
+    def low(self) -> list[float]: ...
+    @property
+    def high(self) -> list[float]: ...
+    @property
+    def file(self) -> Optional[str]: ...
+    @property
+    def params_json(self) -> str: ...
+    @staticmethod
+    def _resolve(arg: str) -> ContinuousWorld: ...
+    def _reset(self, generator: Generator) -> list[float]: ...
+    def _step(self, state: Sequence[float], action: int, generator: Generator) -> list[float]: ...
+    def _start(self, state: Sequence[float]) -> list[float]: ...
+
+def _mountain_car_patrol(window: int) -> str: ...
+
 class Generator:
     """The one random generator of a ``GridWorldEnv`` (ChaCha8, as the learner's); it
     pickles and copies by its whole state."""
@@ -260,7 +297,9 @@ class Policy:
     @property
     def spec_name(self) -> str: ...
     @property
-    def world(self) -> Optional[World]: ...
+    def world(self) -> Union[World, ContinuousWorld, None]: ...
+    @property
+    def learned_function(self) -> bool: ...
     @property
     def env_name(self) -> str: ...
     @property
@@ -282,7 +321,7 @@ class Policy:
     def evaluate(
         self,
         starts: int = 100,
-        steps: int = 2000,
+        steps: Optional[int] = None,
         burn_in: int = 100,
         seed: int = 0,
         optimum: bool = True,
@@ -329,6 +368,27 @@ def _train_world(
     episodes: Optional[int] = None,
     progress: Any = None,
 ) -> Policy: ...
+def _train_continuous(
+    spec: Spec,
+    world: ContinuousWorld,
+    seed: int,
+    episodes: Optional[int] = None,
+    progress: Any = None,
+) -> Policy: ...
+def _train_box(
+    spec: Spec,
+    env: Any,
+    valuation: Any,
+    seed: int,
+    name: str,
+    low: Sequence[float],
+    high: Sequence[float],
+    actions: int,
+    action_start: int,
+    episodes: Optional[int] = None,
+    progress: Any = None,
+) -> Policy: ...
+def _resolve_any_world(arg: str) -> Union[World, ContinuousWorld]: ...
 def _train_env(
     spec: Spec,
     env: Any,
@@ -350,14 +410,14 @@ def _train_env(
 SeedRun = dict[str, Any]
 
 def _study_task(
-    spec: Spec, world: World, episodes: Optional[int] = None
+    spec: Spec, world: Union[World, ContinuousWorld], episodes: Optional[int] = None
 ) -> Tuple[str, int, Optional[str]]:
     """Checks the spec against the world: (name, episodes, a key of its regions or None)."""
     ...
 
 def _study_seeds(
     spec: Spec,
-    world: World,
+    world: Union[World, ContinuousWorld],
     seeds: Sequence[int],
     episodes: Optional[int] = None,
     threads: int = 1,
@@ -365,7 +425,7 @@ def _study_seeds(
     """Trains the spec for each seed on ``threads`` threads, the GIL released."""
     ...
 
-def _study_optimum(spec: Spec, world: World) -> Optional[float]:
+def _study_optimum(spec: Spec, world: Union[World, ContinuousWorld]) -> Optional[float]:
     """W* of the spec's regions in the world, or None for a task without regions."""
     ...
 

@@ -21,8 +21,16 @@ from typing import Any, Optional, Sequence
 #: ``hstlc eval`` and ``Policy.evaluate`` score (their ``steps`` default).
 MAX_EPISODE_STEPS = 2000
 
-#: The ids registered for the built-in worlds, and the world each makes.
+#: The ids registered for the built-in grid worlds, and the world each makes.
 REGISTERED = {"hstl/GridWorld-v0": "paper", "hstl/FourRooms-v0": "four-rooms"}
+
+#: The ids registered for the continuous worlds: each one's entry point and default kwargs
+#: (``gymnasium.make(id, world=...)`` and ``window=`` override them).
+CONTINUOUS: dict[str, tuple[str, dict[str, Any]]] = {
+    "hstl/Plane-v0": ("hstl._gym:PlaneEnv", {"world": "paper-plane"}),
+    "hstl/MountainCar-v0": ("hstl._gym:MountainCarEnv", {}),
+    "hstl/MountainCarPatrol-v0": ("hstl._gym:make_mountain_car_patrol", {"window": 200}),
+}
 
 
 def register() -> None:
@@ -30,12 +38,14 @@ def register() -> None:
     import gymnasium
     from gymnasium.envs.registration import registry
 
-    for env_id, world in REGISTERED.items():
+    ids = {env_id: ("hstl._gym:GridWorldEnv", {"world": world}) for env_id, world in REGISTERED.items()}
+    ids.update(CONTINUOUS)
+    for env_id, (entry_point, kwargs) in ids.items():
         if env_id not in registry:
             gymnasium.register(
                 id=env_id,
-                entry_point="hstl._gym:GridWorldEnv",
-                kwargs={"world": world},
+                entry_point=entry_point,
+                kwargs=dict(kwargs),
                 max_episode_steps=MAX_EPISODE_STEPS,
             )
 

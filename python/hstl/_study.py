@@ -13,7 +13,7 @@ import logging
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
 from . import _hstl
-from ._hstl import Spec, World
+from ._hstl import ContinuousWorld, Spec, World
 from ._train import _count_of, _seed_of, world_of
 
 #: What a Ray task costs beside its training, as a share of one seed's training. Measured
@@ -46,7 +46,7 @@ class StudyResult(List[Dict[str, Any]]):
 def study(
     specs: Union[Spec, str, "os.PathLike[str]", Sequence[Union[Spec, str, "os.PathLike[str]"]]],
     seeds: Union[int, Iterable[int]] = 20,
-    world: Union[World, str, "os.PathLike[str]", None] = None,
+    world: Union[World, ContinuousWorld, str, "os.PathLike[str]", None] = None,
     backend: str = "local",
     address: Optional[str] = None,
     out: Optional[Union[str, "os.PathLike[str]"]] = None,
@@ -78,8 +78,13 @@ def study(
     against ``world`` first (``hstl.SpecError`` with the diagnostics of ``hstlc check
     --world``), before anything trains. ``seeds``: a count (seeds 0, 1, ... N-1, as
     ``hstlc study --seeds N``) or the seeds themselves. ``world``: a ``hstl.World``, a
-    built-in name or a world file; by default the world the specs name (``paper`` when they
-    name none; specs that name different worlds are studied apart). ``episodes`` overrides each spec's ``learn {
+    ``hstl.ContinuousWorld``, a built-in name or a world file; by default the world the
+    specs name (``paper`` when they name none, ``paper-plane`` for specs over ``float``
+    variables; specs that name different worlds are studied apart). In a continuous world
+    (a plane, ``mountain-car``) each seed trains with the approximate learner, as
+    ``hstlc study`` trains it: ``window_rate`` is W for a persistent task, a row's
+    ``satisfaction`` the satisfaction rate P of another, and ``optimum`` is None (no exact
+    optimum exists; ``hstlc study`` prints a planned reference beside W). ``episodes`` overrides each spec's ``learn {
     episodes }``; ``optimum=False`` skips W* (value iteration, a few seconds per set of
     regions).
 
@@ -151,6 +156,11 @@ def _study(
         batch = _whole(batch, "batch", 1, 100_000)
     max_retries = _whole(max_retries, "max_retries", 0, 1000)
     world = _one_world(spec_list, world)
+    if out is not None and isinstance(world, ContinuousWorld):
+        raise ValueError(
+            f"`out=` writes a study's folder in a grid world; world `{world.name}` is continuous\n"
+            "  help: run `hstlc study SPEC... --out DIR` for a continuous world's folder"
+        )
     # Every spec checked against the world here, before anything trains or is sent away.
     tasks = [_hstl._study_task(spec, world, episodes) for spec in spec_list]
     paths = [_path_of(spec) for spec in spec_list]
@@ -199,6 +209,8 @@ def _study(
                     "curve": run["curve"],
                 }
             )
+            if isinstance(world, ContinuousWorld):
+                rows[-1]["satisfaction"] = run["satisfaction"]
         figures = _hstl._study_summary(spec_runs, w_star)
         summary.append({"spec": name, "file": file, "optimum": w_star, **figures})
     if folder is not None:
@@ -288,7 +300,7 @@ def _batch_size(seeds: int, cpus: int) -> int:
 
 def _train_batch(
     spec: Spec,
-    world: World,
+    world: Union[World, ContinuousWorld],
     seeds: List[int],
     episodes: Optional[int],
     before_batch: Optional[Callable[[List[int]], None]],
@@ -299,13 +311,13 @@ def _train_batch(
     return _hstl._study_seeds(spec, world, seeds, episodes, 1)
 
 
-def _optimum_task(spec: Spec, world: World) -> Optional[float]:
+def _optimum_task(spec: Spec, world: Union[World, ContinuousWorld]) -> Optional[float]:
     return _hstl._study_optimum(spec, world)
 
 
 def _on_ray(
     specs: List[Spec],
-    world: World,
+    world: Union[World, ContinuousWorld],
     seeds: List[int],
     episodes: Optional[int],
     wanted: Mapping[str, Spec],
@@ -367,13 +379,13 @@ def _on_ray(
             ray.shutdown()
 
 
-def _one_world(spec_list: List[Spec], world: Any) -> World:
+def _one_world(spec_list: List[Spec], world: Any) -> Union[World, ContinuousWorld]:
     """The world a study trains in: ``world`` when given, else the one every spec names (or
     ``paper`` when none names one); specs that name different worlds are studied apart."""
     if world is not None:
-        return world if isinstance(world, World) else World._resolve(os.fspath(world))
+        return world_of(spec_list[0], world)
     worlds = [world_of(spec, None) for spec in spec_list]
-    first = worlds[0] if worlds else World.builtin("paper")
+    first = worlds[0]
     if any(w != first for w in worlds[1:]):
         names = sorted({w.name for w in worlds})
         raise ValueError(

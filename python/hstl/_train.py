@@ -1,4 +1,5 @@
-"""``hstl.train``: the HSTL learner in a grid world (native) or a gymnasium environment."""
+"""``hstl.train``: the HSTL learner in a grid or continuous world (native) or a gymnasium
+environment."""
 
 from __future__ import annotations
 
@@ -7,36 +8,60 @@ import sys
 from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 from . import _hstl
-from ._hstl import Policy, Spec, World
+from ._hstl import ContinuousWorld, Policy, Spec, World
 
 _MAX_SEED = 2**64 - 1
 
 
+#: What ``valuation=`` takes: a function from an observation to the state variables (a
+#: dict, or numbers in ``spec.state_vars`` order), or for a ``Box`` observation a dict from
+#: each state variable to its index in the observation.
+Valuation = Union[Callable[[Any], Union[Mapping[str, float], Sequence[float]]], Mapping[str, int]]
+
+
 def train(
     spec: Union[Spec, str, "os.PathLike[str]"],
-    world: Union[World, str, "os.PathLike[str]", None] = None,
+    world: Union[World, ContinuousWorld, str, "os.PathLike[str]", None] = None,
     seed: int = 0,
     episodes: Optional[int] = None,
     progress: Optional[bool] = None,
     *,
     env: Any = None,
-    valuation: Optional[Callable[[int], Union[Mapping[str, float], Sequence[float]]]] = None,
+    valuation: Optional[Valuation] = None,
 ) -> Policy:
     """Trains ``spec`` with the hierarchical learner and returns the ``hstl.Policy``.
 
-    ``spec`` is a ``hstl.Spec`` or a spec file's path; ``world`` a ``hstl.World``, a
-    built-in world's name (``"paper"`` or ``"four-rooms"``) or a world file's path. By
-    default the world is the one the spec names (``world "...";``, a path relative to the
-    spec file), or ``"paper"`` when it names none; ``world=`` overrides it. The spec is
-    checked against the world first (raising ``hstl.SpecError`` with the diagnostics of
-    ``hstlc check --world``), and the policy's ``policy.json`` is byte for byte what
-    ``hstlc train SPEC --world WORLD --seed SEED --episodes EPISODES`` writes.
+    ``spec`` is a ``hstl.Spec`` or a spec file's path; ``world`` a ``hstl.World`` (a grid),
+    a ``hstl.ContinuousWorld`` (a plane world or ``mountain-car``), a built-in world's name
+    (``"paper"``, ``"four-rooms"``, ``"paper-plane"``, ``"mountain-car"``) or a world
+    file's path. By default the world is the one the spec names (``world "...";``, a path
+    relative to the spec file), or when it names none ``"paper"`` (``"paper-plane"`` for a
+    spec over ``float`` variables); ``world=`` overrides it. The spec is checked against the
+    world first (raising ``hstl.SpecError`` with the diagnostics of ``hstlc check
+    --world``), and the policy's ``policy.json`` is byte for byte what ``hstlc train SPEC
+    --world WORLD --seed SEED --episodes EPISODES`` writes: Q-tables in a grid world, a
+    learned function (the approximate learner's tiling and weights) in a continuous one,
+    trained natively at the command line's speed.
     ``episodes`` overrides the spec's ``learn { episodes }`` (1 to ``MAX_EPISODES``); every
     random draw comes from one generator seeded with ``seed`` (0 to 2**64 - 1), so the
     same seed gives the same Q-tables, bit for bit.
 
-    ``env=`` trains in a gymnasium environment instead: its observation and action spaces
-    must be ``Discrete`` (observations are the learner's states) and ``valuation(obs)``
+    ``env=`` trains in a gymnasium environment instead, with ``Discrete`` actions. With a
+    ``Box`` observation space the approximate learner runs (the spec's state variables are
+    ``float`` ranges, which it tiles): the ``Box`` must be bounded (finite ``low`` and
+    ``high``; an unbounded one is refused), every observation must lie in it and be
+    finite, and ``valuation`` maps an observation (a float64 array) to the spec's state
+    variables: a function returning a dict or numbers in ``spec.state_vars`` order, or a
+    dict such as ``{"x": 0, "v": 1}`` from each variable to its index. Without
+    ``valuation`` the observation's components are the state variables in order (there
+    must be as many). Each value must lie in the range the spec declares. A step that is
+    ``terminated`` or ``truncated`` leaves the learner's episode in that state until it
+    next resets the environment (give episodes room, such as ``env.unwrapped`` or a long
+    ``TimeLimit``). ``hstl.PlaneEnv`` and ``hstl.MountainCarEnv`` train this way too, one
+    Python call a step; ``world=`` trains their worlds natively, much faster.
+
+    With a ``Discrete`` observation space the tabular learner runs (observations are the
+    learner's states) and ``valuation(obs)``
     gives each observation's state variables (a dict, or numbers in ``spec.state_vars``
     order; every observation its own values, each in its declared ``int`` range). Every
     step calls back into Python, so it is much slower than a native world. Each episode
@@ -59,31 +84,86 @@ def train(
         if env is None:
             if valuation is not None:
                 raise TypeError("`valuation` goes with `env=`; a world gives its own (x, y)")
-            world = world_of(spec, world)
-            return _hstl._train_world(spec, world, seed, episodes, bar.callback)
+            resolved = world_of(spec, world)
+            if isinstance(resolved, ContinuousWorld):
+                return _hstl._train_continuous(spec, resolved, seed, episodes, bar.callback)
+            return _hstl._train_world(spec, resolved, seed, episodes, bar.callback)
+        if world is not None:
+            raise TypeError("pass either world= or env=, not both")
+        if _is_box(env) and spec.is_continuous:
+            return _hstl._train_box(
+                spec, env, _box_valuation(valuation, spec), seed, *_box_spaces(env), episodes, bar.callback
+            )
         if valuation is None:
             raise TypeError(
                 "train(env=...) needs valuation=, a function from an observation to the spec's state variables"
             )
-        if world is not None:
-            raise TypeError("pass either world= or env=, not both")
         return _hstl._train_env(spec, env, valuation, seed, *_spaces(env), episodes, bar.callback)
 
 
-def world_of(spec: Spec, world: Union[World, str, "os.PathLike[str]", None]) -> World:
+def world_of(
+    spec: Spec, world: Union[World, ContinuousWorld, str, "os.PathLike[str]", None]
+) -> Union[World, ContinuousWorld]:
     """The world to train ``spec`` in: ``world`` when given, else the one the spec names (a
-    path relative to its file), else ``paper``."""
+    path relative to its file), else ``paper`` (``paper-plane`` for a continuous spec)."""
     if world is not None:
-        return world if isinstance(world, World) else World._resolve(os.fspath(world))
+        if isinstance(world, (World, ContinuousWorld)):
+            return world
+        return _hstl._resolve_any_world(os.fspath(world))
     named = spec.world
     if named is None:
-        return World.builtin("paper")
-    try:
-        return World.builtin(named)
-    except ValueError:
-        pass
+        return _hstl._resolve_any_world("paper-plane" if spec.is_continuous else "paper")
+    if named in _hstl.BUILTIN_WORLDS:
+        return _hstl._resolve_any_world(named)
     folder = "" if spec.filename.startswith("<") else os.path.dirname(spec.filename)
-    return World._resolve(os.path.join(folder, named))
+    return _hstl._resolve_any_world(os.path.join(folder, named))
+
+
+def _is_box(env: Any) -> bool:
+    from gymnasium import spaces
+
+    return isinstance(getattr(env, "observation_space", None), spaces.Box)
+
+
+def _box_spaces(env: Any) -> tuple[str, list[float], list[float], int, int]:
+    """The environment's name, its ``Box`` observation space's bounds (flattened) and its
+    ``Discrete`` action space's size and start, as the native trainer and
+    ``Policy.evaluate`` take them."""
+    import numpy as np
+    from gymnasium import spaces
+
+    box = getattr(env, "observation_space", None)
+    if not isinstance(box, spaces.Box):
+        raise TypeError(
+            f"this policy acts on a `Box` observation space; the environment's is {type(box).__name__}\n"
+            "  help: pass the environment the policy was trained in"
+        )
+    act = _discrete(env, "action_space")
+    low = np.asarray(box.low, dtype=np.float64).ravel().tolist()
+    high = np.asarray(box.high, dtype=np.float64).ravel().tolist()
+    return _env_name(env), low, high, int(act.n), int(act.start)
+
+
+def _box_valuation(valuation: Optional[Valuation], spec: Spec) -> Optional[Callable[[Any], Any]]:
+    """``valuation=`` as the native trainer takes it: a callable, or None for the
+    observation's components in order."""
+    if valuation is None or callable(valuation):
+        return valuation
+    if isinstance(valuation, Mapping):
+        missing = [v for v in spec.state_vars if v not in valuation]
+        if missing:
+            from ._errors import MissingVariableError
+
+            raise MissingVariableError(
+                f"valuation has no entry for state variable `{missing[0]}`\n"
+                f"  help: the spec's state variables are {', '.join(f'`{v}`' for v in spec.state_vars)}"
+            )
+        from ._gym import _Picks
+
+        return _Picks([(v, valuation[v]) for v in spec.state_vars])
+    raise TypeError(
+        f"valuation must be a callable or a dict from state variables to observation indices; got {type(valuation).__name__}"
+    )
 
 
 def _spaces(env: Any) -> tuple[str, int, int, int, int]:
@@ -120,7 +200,9 @@ def _discrete(env: Any, name: str) -> Any:
         kind = type(space).__name__
         raise TypeError(
             f"train(env=...) needs a `Discrete` {name.replace('_', ' ')}; this environment's is {kind}\n"
-            "  help: the learner is tabular: wrap the environment so that it numbers its states and actions"
+            "  help: the tabular learner needs numbered states: wrap the environment so that it numbers its states "
+            "and actions, or for a `Box` observation space declare the spec's state variables as `float` ranges "
+            "(the approximate learner tiles them)"
         )
     return space
 

@@ -79,7 +79,7 @@ def trainable(config: Mapping[str, Any]) -> None:
         )
     spec = config["spec"]
     spec = spec if isinstance(spec, Spec) else Spec.load(os.fspath(spec))
-    world = world_of(spec, config.get("world"))
+    world = _grid_world(spec, config.get("world"))
     seed = _seed_of(config.get("seed", 0))
     chunk = config.get("chunk", DEFAULT_CHUNK)
     if isinstance(chunk, (bool, float)) or not hasattr(chunk, "__index__") or int(chunk) < 1:
@@ -117,7 +117,7 @@ def trainable_for(
     so that every trial reports ``ratio`` = W/W*.
     """
     spec = spec if isinstance(spec, Spec) else Spec.load(os.fspath(spec))
-    world = world_of(spec, world)
+    world = _grid_world(spec, world)
     _hstl._study_task(spec, world, None)
     w_star = _hstl._study_optimum(spec, world) if optimum else None
     bound = {"spec": spec, "world": world, "seed": seed, "chunk": chunk, "optimum": w_star}
@@ -127,6 +127,17 @@ def trainable_for(
 
     hstl_trainable.__doc__ = f"hstl.tune.trainable for `{spec.name}`"
     return hstl_trainable
+
+
+def _grid_world(spec: Spec, world: Any) -> World:
+    """The grid world ``spec`` is tuned in; a continuous world is refused in words."""
+    resolved = world_of(spec, world)
+    if not isinstance(resolved, World):
+        raise TypeError(
+            f"hstl.tune trains in grid worlds; `{spec.name}` is on world `{resolved.name}`, a continuous one\n"
+            "  help: compare settings of a continuous spec with hstl.study over specs that differ in them"
+        )
+    return resolved
 
 
 __all__ = ["DEFAULT_CHUNK", "LEARN_KEYS", "trainable", "trainable_for"]

@@ -9,6 +9,7 @@
 
 mod check;
 mod cli;
+mod continuous;
 mod dense;
 mod errors;
 mod files;
@@ -32,14 +33,19 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<online::OnlineMonitor>()?;
     m.add_class::<world::World>()?;
     m.add_class::<world::Generator>()?;
+    m.add_class::<continuous::ContinuousWorld>()?;
     m.add_class::<policy::Policy>()?;
     m.add_class::<reward::EpisodeMonitor>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
     m.add_function(wrap_pyfunction!(cli::cli, m)?)?;
+    m.add_function(wrap_pyfunction!(continuous::_mountain_car_patrol, m)?)?;
+    m.add_function(wrap_pyfunction!(continuous::_resolve_any_world, m)?)?;
     m.add_function(wrap_pyfunction!(spec::formula, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_world, m)?)?;
     m.add_function(wrap_pyfunction!(train::_train_env, m)?)?;
+    m.add_function(wrap_pyfunction!(train::_train_continuous, m)?)?;
+    m.add_function(wrap_pyfunction!(train::_train_box, m)?)?;
     m.add_class::<study::_StudyOut>()?;
     m.add_function(wrap_pyfunction!(study::_study_task, m)?)?;
     m.add_function(wrap_pyfunction!(study::_study_seeds, m)?)?;
@@ -47,6 +53,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study::_study_summary, m)?)?;
     m.add_function(wrap_pyfunction!(study::_train_chunks, m)?)?;
     m.add("LEARN_KEYS", hstl::train::LEARN_KEYS.to_vec())?;
+    m.add("BUILTIN_WORLDS", hstl::world::AnyWorld::builtin_names())?;
     m.add("MAX_EPISODES", hstl::lang::budget::MAX_EPISODES)?;
     m.add("EVAL_SEED", hstl::train::EVAL_SEED)?;
     m.add("MAX_ONLINE_VALUES", hstl::robustness::MAX_ONLINE_VALUES)?;

@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use hstl::Problem;
+use hstl::continuous;
 use hstl::evaluate::{self, Evaluation, Replay, Runs};
+use hstl::runtime::approx::{ApproxAgent, Stepper};
 use hstl::runtime::eval::{AgentController, AgentProgress, Controller};
 use hstl::runtime::optimum::SolveConfig;
 use hstl::runtime::{Agent, Env, GridWorld, Rng, TaskSpec, Value};
@@ -14,8 +16,9 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyInt, PyTuple};
 
+use crate::continuous::ContinuousWorld;
 use crate::errors::{self, policy_error, problem_error, value_error};
-use crate::gym::{PyEnv, Spaces};
+use crate::gym::{BoxEnv, PyEnv, Spaces};
 use crate::spec::Spec;
 use crate::trace::state_values;
 use crate::world::World;
@@ -51,6 +54,11 @@ enum Replayed {
     Grid(Replay<GridWorld>),
     /// A gymnasium environment, which the document cannot rebuild: its states as listed.
     Listed(Replay<Listed>, Spaces),
+    /// A learned function in a continuous world (a plane, `mountain-car`) it holds whole.
+    Tiles(Box<continuous::Replay>),
+    /// A learned function in a gymnasium environment with a `Box` observation space, which
+    /// the document describes.
+    GymTiles(Box<continuous::GymReplay>),
 }
 
 #[derive(Default)]
@@ -58,6 +66,8 @@ struct Runner {
     progress: AgentProgress,
     /// An action was given and its outcome not seen yet: the next state is it.
     pending: bool,
+    /// A learned function's run so far.
+    stepper: Stepper,
 }
 
 /// The states a `policy.json` lists (those of its first flat policy, in index order), as
@@ -151,10 +161,12 @@ impl Env for Listed {
 }
 
 impl Replayed {
-    fn agent(&self) -> &Agent {
+    /// The tabular agent; None for a learned function.
+    fn agent(&self) -> Option<&Agent> {
         match self {
-            Replayed::Grid(r) => &r.agent,
-            Replayed::Listed(r, _) => &r.agent,
+            Replayed::Grid(r) => Some(&r.agent),
+            Replayed::Listed(r, _) => Some(&r.agent),
+            Replayed::Tiles(_) | Replayed::GymTiles(_) => None,
         }
     }
 
@@ -162,13 +174,69 @@ impl Replayed {
         match self {
             Replayed::Grid(r) => &r.spec,
             Replayed::Listed(r, _) => &r.spec,
+            Replayed::Tiles(r) => &r.spec,
+            Replayed::GymTiles(r) => &r.spec,
         }
     }
 
-    fn document(&self) -> &hstl::runtime::Policy {
+    /// The tabular document; None for a learned function.
+    fn document(&self) -> Option<&hstl::runtime::Policy> {
         match self {
-            Replayed::Grid(r) => &r.policy,
-            Replayed::Listed(r, _) => &r.policy,
+            Replayed::Grid(r) => Some(&r.policy),
+            Replayed::Listed(r, _) => Some(&r.policy),
+            Replayed::Tiles(_) | Replayed::GymTiles(_) => None,
+        }
+    }
+
+    fn source(&self) -> &str {
+        match self {
+            Replayed::Grid(r) => &r.source,
+            Replayed::Listed(r, _) => &r.source,
+            Replayed::Tiles(r) => &r.source,
+            Replayed::GymTiles(r) => &r.source,
+        }
+    }
+
+    fn seed(&self) -> Option<u64> {
+        match self {
+            Replayed::Grid(r) => r.seed,
+            Replayed::Listed(r, _) => r.seed,
+            Replayed::Tiles(r) => r.seed,
+            Replayed::GymTiles(r) => r.seed,
+        }
+    }
+
+    fn env_name(&self) -> String {
+        match self {
+            Replayed::Tiles(r) => r.world.name().to_string(),
+            Replayed::GymTiles(r) => r.env.name.clone(),
+            _ => self.document().map_or(String::new(), |d| d.env.name.clone()),
+        }
+    }
+
+    fn state_vars(&self) -> Vec<String> {
+        match self {
+            Replayed::Tiles(r) => r.agent.model.vars.clone(),
+            Replayed::GymTiles(r) => r.agent.model.vars.clone(),
+            _ => self.document().map_or(Vec::new(), |d| d.state_vars.clone()),
+        }
+    }
+
+    fn actions(&self) -> Vec<String> {
+        match self {
+            Replayed::Tiles(r) => ContinuousWorld::actions_of(&r.world),
+            Replayed::GymTiles(r) => hstl::runtime::World::actions(&r.env),
+            _ => self.document().map_or(Vec::new(), |d| d.actions.clone()),
+        }
+    }
+
+    /// A learned function's agent and what `act` needs of its world: the first action's
+    /// value, and which actions a state blocks.
+    fn tiles(&self) -> Option<(&ApproxAgent, i64)> {
+        match self {
+            Replayed::Tiles(r) => Some((&r.agent, 0)),
+            Replayed::GymTiles(r) => Some((&r.agent, r.env.action_start)),
+            _ => None,
         }
     }
 }
@@ -185,6 +253,10 @@ impl Policy {
     ) -> PyResult<Policy> {
         let replayed =
             py.detach(|| replay_any(&text)).map_err(|p| policy_error(&p.in_file(file)))?;
+        if matches!(replayed, Replayed::Tiles(_) | Replayed::GymTiles(_)) {
+            let states = HashMap::new();
+            return Ok(Policy { text, replayed, curve, steps, states, runner: Mutex::default() });
+        }
         let mut states = HashMap::new();
         let mut row = Vec::new();
         let mut index = |env: &dyn Fn(usize, &mut Vec<f64>), n: usize| {
@@ -203,6 +275,7 @@ impl Policy {
                 r.env.num_states(),
             ),
             Replayed::Listed(r, _) => index(&|s, out| r.env.valuation(&s, out), r.env.num_states()),
+            Replayed::Tiles(_) | Replayed::GymTiles(_) => {}
         }
         Ok(Policy { text, replayed, curve, steps, states, runner: Mutex::default() })
     }
@@ -228,7 +301,7 @@ impl Policy {
                     )
                 });
         }
-        let vars = &self.replayed.document().state_vars;
+        let vars = &self.replayed.state_vars();
         let values = state_values(state, vars)?;
         self.states.get(&key(&values)).copied().ok_or_else(|| {
             let shown: Vec<String> =
@@ -239,7 +312,7 @@ impl Policy {
                     Replayed::Grid(r) => {
                         format!("give a free cell of {}", hstl::world::label(&r.env, None))
                     }
-                    Replayed::Listed(..) => "give an observation of the environment".into(),
+                    _ => "give an observation of the environment".into(),
                 }),
             )
         })
@@ -248,6 +321,12 @@ impl Policy {
 
 /// Replays a grid world policy, or a gymnasium one against the states it lists.
 fn replay_any(text: &str) -> Result<Replayed, Problem> {
+    if continuous::is_learned_function_text(text) {
+        return Ok(match continuous::replay_text_any(text)? {
+            continuous::AnyReplay::World(r) => Replayed::Tiles(Box::new(r)),
+            continuous::AnyReplay::Gym(r) => Replayed::GymTiles(Box::new(r)),
+        });
+    }
     // One typed pass over the document; the world it names decides the replay.
     let document = evaluate::read(text)?;
     let params = &document.policy.env.params;
@@ -325,10 +404,7 @@ impl Policy {
     /// The spec the policy was trained on (from the document's `spec_source`).
     #[getter]
     fn spec(&self, py: Python<'_>) -> PyResult<Spec> {
-        let source = match &self.replayed {
-            Replayed::Grid(r) => r.source.clone(),
-            Replayed::Listed(r, _) => r.source.clone(),
-        };
+        let source = self.replayed.source().to_string();
         let name = self.replayed.spec().name.clone();
         Spec::from_source(py, source, "<spec_source>".into(), Some(name), true)
     }
@@ -339,47 +415,55 @@ impl Policy {
         &self.replayed.spec().name
     }
 
-    /// The grid world the policy was trained in; None for a gymnasium environment.
+    /// The world the policy was trained in: a `hstl.World` (a grid) or a
+    /// `hstl.ContinuousWorld` (a plane, `mountain-car`); None for a gymnasium environment.
     #[getter]
-    fn world(&self) -> Option<World> {
-        match &self.replayed {
-            Replayed::Grid(r) => Some(World::new(r.env.clone(), None)),
-            Replayed::Listed(..) => None,
-        }
+    fn world(&self, py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
+        Ok(match &self.replayed {
+            Replayed::Grid(r) => Some(Py::new(py, World::new(r.env.clone(), None))?.into_any()),
+            Replayed::Tiles(r) => {
+                Some(Py::new(py, ContinuousWorld::of(r.world.clone()))?.into_any())
+            }
+            Replayed::Listed(..) | Replayed::GymTiles(_) => None,
+        })
+    }
+
+    /// Whether the policy is a learned function (the approximate learner's tiling and
+    /// weights, on a continuous state) rather than Q-tables.
+    #[getter]
+    fn learned_function(&self) -> bool {
+        self.replayed.tiles().is_some()
     }
 
     /// The environment's name: the world's, or the gymnasium environment's id.
     #[getter]
-    fn env_name(&self) -> &str {
-        &self.replayed.document().env.name
+    fn env_name(&self) -> String {
+        self.replayed.env_name()
     }
 
     /// The seed it was trained from, when the document records it.
     #[getter]
     fn seed(&self) -> Option<u64> {
-        match &self.replayed {
-            Replayed::Grid(r) => r.seed,
-            Replayed::Listed(r, _) => r.seed,
-        }
+        self.replayed.seed()
     }
 
     /// The state variables, in the order `act` takes a sequence state.
     #[getter]
     fn state_vars(&self) -> Vec<String> {
-        self.replayed.document().state_vars.clone()
+        self.replayed.state_vars()
     }
 
     /// The action names, in index order (`act` returns the index).
     #[getter]
     fn actions(&self) -> Vec<String> {
-        self.replayed.document().actions.clone()
+        self.replayed.actions()
     }
 
     /// The options' names, in the options set's order (the columns of
     /// `q_tables["options"]`).
     #[getter]
     fn options(&self) -> Vec<String> {
-        self.replayed.document().options.iter().map(|o| o.name.clone()).collect()
+        self.replayed.spec().options.iter().map(|o| o.name.clone()).collect()
     }
 
     /// The summed option rewards of each training episode (float64), when training ran in
@@ -401,7 +485,15 @@ impl Policy {
     /// `World.free_cells`); with `memory: B` an observation is `state * values + memory`.
     #[getter]
     fn q_tables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let doc = self.replayed.document();
+        let Some(doc) = self.replayed.document() else {
+            return Err(value_error(
+                "a learned function has no Q-tables: its weights over a tiling are in `policy.json`",
+                Some(
+                    "read `policy.json` (`policy.json`'s `weights`), or call `act` and `evaluate`"
+                        .into(),
+                ),
+            ));
+        };
         let q = doc.q_tables().map_err(|e| value_error(e.to_string(), None))?;
         let actions = doc.actions.len().max(1);
         let options = doc.options.len().max(1);
@@ -423,12 +515,36 @@ impl Policy {
     /// action led to; call `reset()` at the start of every episode.
     ///
     /// `state` is an observation of the environment the policy was trained in (a grid
-    /// world's `(x, y)`, a gymnasium environment's integer) or a mapping from the state
-    /// variables to values. Returns the action's index (for a gymnasium environment, the
-    /// action itself).
+    /// world's `(x, y)`, a gymnasium environment's integer, a continuous world's `(x, y)`
+    /// or `(x, v)` array) or a mapping from the state variables to values; for a policy
+    /// trained on a `Box` environment with a `valuation`, the valuation's result. A
+    /// learned function's state must lie in its world (or the ranges its spec declares):
+    /// NaN, infinite or outside values are refused. Returns the action's index (for a
+    /// gymnasium environment, the action itself).
     fn act(&self, state: &Bound<'_, PyAny>) -> PyResult<i64> {
+        if let Some((agent, start)) = self.replayed.tiles() {
+            let vars = self.replayed.state_vars();
+            let values = state_values(state, &vars)?;
+            let blocked = match &self.replayed {
+                Replayed::Tiles(r) => hstl::gym::start(&r.world, &values)
+                    .map(|_| hstl::gym::blocked(&r.world, &values))
+                    .map_err(|p| problem_error(&p))?,
+                _ => {
+                    in_ranges(self.replayed.spec(), &vars, &values)?;
+                    Vec::new()
+                }
+            };
+            let mut runner = self.runner.lock().unwrap_or_else(|p| p.into_inner());
+            let (action, _) = runner.stepper.act(agent, &values, &blocked);
+            return Ok(start + action as i64);
+        }
         let s = self.index_of(state)?;
-        let agent = self.replayed.agent();
+        let Some(agent) = self.replayed.agent() else {
+            return Err(value_error(
+                "the policy holds neither Q-tables nor a learned function",
+                None,
+            ));
+        };
         let mut runner = self.runner.lock().unwrap_or_else(|p| p.into_inner());
         let mut controller = AgentController::resume(agent, std::mem::take(&mut runner.progress));
         if runner.pending {
@@ -439,7 +555,7 @@ impl Policy {
         runner.pending = true;
         let start = match &self.replayed {
             Replayed::Listed(_, spaces) => spaces.action_start,
-            Replayed::Grid(_) => 0,
+            _ => 0,
         };
         Ok(start + decision.action as i64)
     }
@@ -472,19 +588,23 @@ impl Policy {
     /// A policy trained on a gymnasium environment is replayed in `env` (the same
     /// environment, with the same `valuation`), more slowly; its `baseline` and `optimum`
     /// are None.
-    #[pyo3(signature = (starts=100, steps=2000, burn_in=100, seed=0, optimum=true, *, env=None, valuation=None))]
+    #[pyo3(signature = (starts=100, steps=None, burn_in=100, seed=0, optimum=true, *, env=None, valuation=None))]
     #[allow(clippy::too_many_arguments)]
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
         starts: usize,
-        steps: usize,
+        steps: Option<usize>,
         burn_in: usize,
         seed: u64,
         optimum: bool,
         env: Option<&Bound<'py, PyAny>>,
         valuation: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if self.replayed.tiles().is_some() {
+            return self.evaluate_tiles(py, starts, steps, burn_in, seed, optimum, env, valuation);
+        }
+        let steps = steps.unwrap_or(Runs::default().steps);
         let runs = Runs { starts, steps, burn_in, seed };
         let flag = |name: &str| format!("`{name}`");
         runs.check_budget(flag).map_err(|p| problem_error(&p))?;
@@ -507,6 +627,9 @@ impl Policy {
                     Ok((evaluation, baseline, best))
                 })
                 .map_err(|p| problem_error(&p))?
+            }
+            Replayed::Tiles(_) | Replayed::GymTiles(_) => {
+                return Err(value_error("a learned function is evaluated apart", None));
             }
             Replayed::Listed(listed, spaces) => {
                 let (Some(env), Some(valuation)) = (env, valuation) else {
@@ -531,7 +654,7 @@ impl Policy {
                     ));
                 }
                 let pyenv = PyEnv::new(env, valuation, given, &listed.spec)?;
-                let agent = listed.policy.agent(&pyenv).map_err(|e| {
+                let agent = listed.policy.agent_for(&listed.spec, &pyenv).map_err(|e| {
                     value_error(
                         e.to_string(),
                         Some("pass the environment and valuation it was trained with".into()),
@@ -621,6 +744,181 @@ impl Policy {
         let seed = self.seed().map_or(String::new(), |s| format!(" (seed {s})"));
         format!("<hstl.Policy of `{}` on `{}`{seed}>", self.replayed.spec().name, self.env_name())
     }
+}
+
+impl Policy {
+    /// `evaluate` of a learned function: natively in the world the document holds, or in
+    /// `env` (a gymnasium environment with a `Box` observation space) through Python.
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate_tiles<'py>(
+        &self,
+        py: Python<'py>,
+        starts: usize,
+        steps: Option<usize>,
+        burn_in: usize,
+        seed: u64,
+        optimum: bool,
+        env: Option<&Bound<'py, PyAny>>,
+        valuation: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let spec = self.replayed.spec();
+        // A reach task is decided within its horizon, as `hstlc eval` runs it.
+        let steps = match steps {
+            Some(n) => n,
+            None if spec.regions.is_empty() => continuous::task_steps(spec),
+            None => Runs::default().steps,
+        };
+        let runs = Runs { starts, steps, burn_in, seed };
+        let flag = |name: &str| format!("`{name}`");
+        runs.check_budget(flag).map_err(|p| problem_error(&p))?;
+        runs.check_burn_in(spec, flag).map_err(|p| problem_error(&p))?;
+        let (evaluation, reference) = match (&self.replayed, env) {
+            (Replayed::Tiles(replay), None) => {
+                if valuation.is_some() {
+                    return Err(PyTypeError::new_err("`valuation` goes with `env=`"));
+                }
+                py.detach(|| -> Result<_, Problem> {
+                    let evaluation = continuous::evaluate(replay, runs)?;
+                    let reference = match optimum {
+                        true => hstl::reference::Reference::new(&replay.spec, &replay.world)
+                            .ok()
+                            .map(|r| r.evaluate(runs)),
+                        false => None,
+                    };
+                    Ok((evaluation, reference))
+                })
+                .map_err(|p| problem_error(&p))?
+            }
+            (Replayed::GymTiles(_), None) => {
+                return Err(PyTypeError::new_err(errors::with_help(
+                    "this policy was trained on a gymnasium environment, which policy.json cannot rebuild",
+                    Some(
+                        "pass `env=` (the environment) and `valuation=` (as given to `hstl.train`)"
+                            .into(),
+                    ),
+                )));
+            }
+            (_, Some(env)) => {
+                let given = py
+                    .import("hstl._train")?
+                    .call_method1("_box_spaces", (env,))?
+                    .extract::<(String, Vec<f64>, Vec<f64>, usize, i64)>()?;
+                let (name, low, high, actions, action_start) = given;
+                let vars = self.replayed.state_vars();
+                let described =
+                    hstl::gym::Described::new(&name, vars, low, high, actions, action_start)
+                        .map_err(|p| problem_error(&p))?;
+                let (agent, _) = self
+                    .replayed
+                    .tiles()
+                    .ok_or_else(|| value_error("the policy holds no learned function", None))?;
+                self.check_env(&described)?;
+                let boxed = BoxEnv::new(env, valuation, described, spec)?;
+                let (result, boxed) =
+                    py.detach(move || (continuous::evaluate_in(spec, agent, &boxed, runs), boxed));
+                if let Some(e) = boxed.take_error() {
+                    return Err(e);
+                }
+                (result.map_err(|p| problem_error(&p))?, None)
+            }
+            _ => return Err(value_error("the policy holds no learned function", None)),
+        };
+        let out = PyDict::new(py);
+        match evaluation {
+            continuous::Evaluation::Window(w) => {
+                out.set_item("window_rate", w.rate)?;
+                out.set_item("window_rates", w.per_run)?;
+                out.set_item("satisfaction", py.None())?;
+                let mean = w.robustness.iter().sum::<f64>() / w.robustness.len().max(1) as f64;
+                out.set_item("robustness_mean", mean)?;
+                out.set_item("robustness", w.robustness)?;
+            }
+            continuous::Evaluation::Satisfaction { rate } => {
+                out.set_item("window_rate", py.None())?;
+                out.set_item("window_rates", py.None())?;
+                out.set_item("satisfaction", rate)?;
+                out.set_item("robustness_mean", py.None())?;
+                out.set_item("robustness", py.None())?;
+            }
+        }
+        let reference = reference.map(|r| match r {
+            continuous::Evaluation::Window(w) => w.rate,
+            continuous::Evaluation::Satisfaction { rate } => rate,
+        });
+        out.set_item("reference", reference)?;
+        out.set_item("baseline", py.None())?;
+        out.set_item("optimum", py.None())?;
+        for (k, v) in [("starts", starts), ("steps", steps), ("burn_in", burn_in)] {
+            out.set_item(k, v)?;
+        }
+        out.set_item("seed", seed)?;
+        Ok(out)
+    }
+
+    /// Checks that a gymnasium environment's spaces are those the policy was trained with:
+    /// for a world it holds, the world's bounds and actions; else the recorded spaces.
+    fn check_env(&self, given: &hstl::gym::Described) -> PyResult<()> {
+        let fits = match &self.replayed {
+            Replayed::Tiles(r) => {
+                let bounds = hstl::gym::bounds(&r.world);
+                let n = ContinuousWorld::actions_of(&r.world).len();
+                let same =
+                    bounds.as_ref().is_some_and(|(lo, hi)| *lo == given.low && *hi == given.high);
+                if same && n == given.actions && given.action_start == 0 {
+                    return Ok(());
+                }
+                format!(
+                    "world `{}` (a Box of {} components, Discrete({n}))",
+                    r.world.name(),
+                    bounds.map_or(0, |b| b.0.len())
+                )
+            }
+            Replayed::GymTiles(r) => {
+                if r.env.name == given.name && r.env.params() == given.params() {
+                    return Ok(());
+                }
+                r.env.describe()
+            }
+            _ => return Ok(()),
+        };
+        Err(value_error(
+            format!("the policy was trained on {fits}; `env` is {}", given.describe()),
+            Some("pass the environment it was trained in (the same spaces and bounds)".into()),
+        ))
+    }
+}
+
+/// Checks a learned function's state against the ranges its spec declares (the tiling's).
+fn in_ranges(spec: &TaskSpec, vars: &[String], values: &[f64]) -> PyResult<()> {
+    if values.len() != vars.len() {
+        return Err(value_error(
+            format!(
+                "a state of the policy has {} numbers ({}), not {}",
+                vars.len(),
+                vars.join(", "),
+                values.len()
+            ),
+            Some("give the state variables' values in order, or a dict of them".into()),
+        ));
+    }
+    let Some(t) = &spec.learn.tiles else { return Ok(()) };
+    for (i, &x) in values.iter().enumerate() {
+        let (Some(&lo), Some(&hi)) = (t.lo.get(i), t.hi.get(i)) else { continue };
+        if !(x >= lo && x <= hi) {
+            let num = hstl::runtime::plane::num;
+            return Err(value_error(
+                format!(
+                    "`{}` = {} is outside its declared range {}..={}",
+                    vars[i],
+                    num(x),
+                    num(lo),
+                    num(hi)
+                ),
+                Some("give a state the policy was trained on".into()),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A state's values as a lookup key (`-0` read as `0`).

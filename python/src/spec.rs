@@ -360,6 +360,13 @@ impl Spec {
         self.spec.world.as_ref().map(|w| w.name.as_str())
     }
 
+    /// Whether some state variable is a `float`: the spec is learned with tilings, in a
+    /// continuous world (`paper-plane` when it names none).
+    #[getter]
+    fn is_continuous(&self) -> bool {
+        self.spec.is_continuous()
+    }
+
     /// The source text it was checked from.
     #[getter]
     fn source(&self) -> &str {

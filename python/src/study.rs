@@ -17,9 +17,74 @@ use hstl_outdir::{OutDir, StudyDir, Writer};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use crate::continuous::ContinuousWorld;
 use crate::errors::{self, problem_error, value_error, write_error};
 use crate::spec::Spec;
 use crate::world::World;
+
+/// A study's world: a grid (tables, W*) or a continuous one (tilings, no exact optimum).
+enum StudyWorld<'a> {
+    Grid(&'a World),
+    Continuous(&'a ContinuousWorld),
+}
+
+impl<'a> StudyWorld<'a> {
+    fn of(world: &'a Bound<'_, PyAny>) -> PyResult<StudyWorld<'a>> {
+        if let Ok(w) = world.cast::<World>() {
+            return Ok(StudyWorld::Grid(w.get()));
+        }
+        if let Ok(w) = world.cast::<ContinuousWorld>() {
+            return Ok(StudyWorld::Continuous(w.get()));
+        }
+        Err(errors::type_error(
+            "a study's world is a `hstl.World` or a `hstl.ContinuousWorld`",
+            Some("pass a built-in world's name or a world file's path".into()),
+        ))
+    }
+}
+
+/// `task_of` in either kind of world: a continuous world's tiling fitted.
+fn task_in(
+    py: Python<'_>,
+    spec: &Spec,
+    world: &StudyWorld<'_>,
+    episodes: Option<usize>,
+) -> PyResult<(TaskSpec, hstl::lang::CheckedSpec)> {
+    match world {
+        StudyWorld::Grid(w) => task_of(py, spec, w, episodes, None),
+        StudyWorld::Continuous(w) => {
+            let label = hstl::world::any_label(&w.world, w.file.as_deref());
+            let loaded = py
+                .detach(|| {
+                    hstl::load::load_in_any_world(
+                        &spec.source,
+                        Some(&spec.spec.name),
+                        &w.world,
+                        &label,
+                    )
+                })
+                .map_err(|e| errors::load_error(py, &spec.filename, &spec.source, e))?;
+            let mut task = hstl::train::trainable(&loaded.spec, &spec.source, &spec.filename)
+                .map_err(|p| problem_error(&p))?;
+            set_episodes(&mut task, episodes)?;
+            hstl::continuous::fit_tiles(&mut task, &loaded.spec, &w.world);
+            Ok((task, loaded.spec))
+        }
+    }
+}
+
+fn set_episodes(task: &mut TaskSpec, episodes: Option<usize>) -> PyResult<()> {
+    if let Some(n) = episodes {
+        if n == 0 || n as u64 > MAX_EPISODES {
+            return Err(value_error(
+                format!("`episodes` must be in 1..={MAX_EPISODES}; got {n}"),
+                Some("leave it out to train the spec's `learn { episodes }`".into()),
+            ));
+        }
+        task.learn.episodes = n;
+    }
+    Ok(())
+}
 
 /// How often `_study_seeds` looks for Ctrl-C while seeds train.
 const SIGNAL_EVERY: Duration = Duration::from_millis(100);
@@ -41,15 +106,7 @@ fn task_of(
         .map_err(|e| errors::load_error(py, &spec.filename, &spec.source, e))?;
     let mut task = hstl::train::trainable(&loaded.spec, &spec.source, &spec.filename)
         .map_err(|p| problem_error(&p))?;
-    if let Some(n) = episodes {
-        if n == 0 || n as u64 > MAX_EPISODES {
-            return Err(value_error(
-                format!("`episodes` must be in 1..={MAX_EPISODES}; got {n}"),
-                Some("leave it out to train the spec's `learn { episodes }`".into()),
-            ));
-        }
-        task.learn.episodes = n;
-    }
+    set_episodes(&mut task, episodes)?;
     if let Some(learn) = learn {
         for (key, value) in learn.iter() {
             let key: String = key.extract()?;
@@ -74,10 +131,10 @@ fn task_of(
 pub fn _study_task(
     py: Python<'_>,
     spec: &Bound<'_, Spec>,
-    world: &Bound<'_, World>,
+    world: &Bound<'_, PyAny>,
     episodes: Option<usize>,
 ) -> PyResult<(String, usize, Option<String>)> {
-    let (task, _) = task_of(py, spec.get(), world.get(), episodes, None)?;
+    let (task, _) = task_in(py, spec.get(), &StudyWorld::of(world)?, episodes)?;
     // The regions' data, only ever compared (never shown).
     let key = (!task.regions.is_empty()).then(|| format!("{:?}", task.regions));
     Ok((task.name, task.learn.episodes, key))
@@ -85,19 +142,22 @@ pub fn _study_task(
 
 /// Trains `spec` in `world` for each of `seeds` on `threads` threads (the GIL released) and
 /// returns one dict per seed: `seed`, `window_rate` (or None), `reward` (per episode, the
-/// mean of the last 100), `seconds` (training), `steps` and `curve` (reward per episode).
+/// mean of the last 100), `seconds` (training), `steps` and `curve` (reward per episode);
+/// in a continuous world, `satisfaction` is the satisfaction rate P of a task that is not
+/// persistent.
 #[pyfunction]
 #[pyo3(signature = (spec, world, seeds, episodes=None, threads=1))]
 pub fn _study_seeds<'py>(
     py: Python<'py>,
     spec: &Bound<'py, Spec>,
-    world: &Bound<'py, World>,
+    world: &Bound<'py, PyAny>,
     seeds: Vec<u64>,
     episodes: Option<usize>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyList>> {
-    let (spec, world) = (spec.get(), world.get());
-    let (task, _) = task_of(py, spec, world, episodes, None)?;
+    let spec = spec.get();
+    let world = StudyWorld::of(world)?;
+    let (task, _) = task_in(py, spec, &world, episodes)?;
     let threads = threads.max(1);
     let start = Instant::now();
     let clock = move || start.elapsed().as_secs_f64();
@@ -108,16 +168,28 @@ pub fn _study_seeds<'py>(
     let done = std::thread::scope(|scope| {
         let (task, stop, clock) = (&task, &stop, &clock);
         let trainer = std::thread::Builder::new().spawn_scoped(scope, move || {
-            let done = facade::run_seeds(
-                task,
-                &world.world,
-                &seeds,
-                threads,
-                &spec.filename,
-                clock,
-                None,
-                Some(stop),
-            );
+            let done = match world {
+                StudyWorld::Grid(w) => facade::run_seeds(
+                    task,
+                    &w.world,
+                    &seeds,
+                    threads,
+                    &spec.filename,
+                    clock,
+                    None,
+                    Some(stop),
+                )
+                .map(|runs| runs.into_iter().map(|(run, _)| (run, None)).collect::<Vec<_>>()),
+                StudyWorld::Continuous(w) => facade::run_continuous_seeds(
+                    task,
+                    &w.world,
+                    &seeds,
+                    threads,
+                    &spec.filename,
+                    clock,
+                    Some(stop),
+                ),
+            };
             let _ = tx.send(done);
         });
         if trainer.is_err() {
@@ -147,8 +219,12 @@ pub fn _study_seeds<'py>(
         }
     })?;
     let out = PyList::empty(py);
-    for (run, _) in done {
-        out.append(run_dict(py, &run)?)?;
+    for (run, rate) in done {
+        let d = run_dict(py, &run)?;
+        if let Some(p) = rate {
+            d.set_item("satisfaction", p)?;
+        }
+        out.append(d)?;
     }
     Ok(out)
 }
@@ -174,7 +250,8 @@ fn run_of(d: &Bound<'_, PyAny>) -> PyResult<SeedRun> {
         steps: get("steps")?.extract()?,
         reward: get("reward")?.extract()?,
         window_rate: get("window_rate")?.extract()?,
-        satisfaction: get("satisfaction")?.extract()?,
+        // A continuous world's P has no exact optimum beside it: no pair to summarise.
+        satisfaction: get("satisfaction")?.extract().unwrap_or(None),
         curve: get("curve")?.extract()?,
     })
 }
@@ -185,10 +262,14 @@ fn run_of(d: &Bound<'_, PyAny>) -> PyResult<SeedRun> {
 pub fn _study_optimum(
     py: Python<'_>,
     spec: &Bound<'_, Spec>,
-    world: &Bound<'_, World>,
+    world: &Bound<'_, PyAny>,
 ) -> PyResult<Option<f64>> {
-    let (task, _) = task_of(py, spec.get(), world.get(), None, None)?;
-    let world = world.get();
+    let world = match StudyWorld::of(world)? {
+        // No exact optimum on a continuous world.
+        StudyWorld::Continuous(_) => return Ok(None),
+        StudyWorld::Grid(w) => w,
+    };
+    let (task, _) = task_of(py, spec.get(), world, None, None)?;
     let optimum = py.detach(|| facade::optimum(&task, &world.world)).map_err(|p| {
         value_error(p.message, Some("pass `optimum=False` to skip the optimum W*".into()))
     })?;

@@ -13,8 +13,9 @@ use hstl::runtime::{Error, TaskSpec};
 use hstl::train::{policy_json, train_until};
 use pyo3::prelude::*;
 
+use crate::continuous::ContinuousWorld;
 use crate::errors::{self, problem_error, value_error};
-use crate::gym::{PyEnv, Spaces};
+use crate::gym::{BoxEnv, PyEnv, Spaces};
 use crate::policy::Policy;
 use crate::spec::Spec;
 use crate::world::World;
@@ -97,6 +98,108 @@ pub fn _train_env(
     let trained = trained.map_err(|e| cannot_train_env(&spec.filename, spec, &e))?;
     let text = policy_json(&trained.policy, &spec.source, seed)
         .map_err(|e| value_error(e.to_string(), None))?;
+    Policy::from_text(py, text, "<trained>", Some(trained.curve), Some(trained.steps))
+}
+
+/// Trains `spec` in a continuous world (a plane, `mountain-car`) with the approximate
+/// learner, as `hstlc train --world --seed --episodes` does: the spec is checked against
+/// the world first, and the policy's `policy.json` is byte for byte the one `hstlc train`
+/// writes.
+#[pyfunction]
+#[pyo3(signature = (spec, world, seed, episodes=None, progress=None))]
+pub fn _train_continuous(
+    py: Python<'_>,
+    spec: &Bound<'_, Spec>,
+    world: &Bound<'_, ContinuousWorld>,
+    seed: u64,
+    episodes: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Policy> {
+    let spec = spec.get();
+    let world = world.get();
+    let label = hstl::world::any_label(&world.world, world.file.as_deref());
+    let loaded = py
+        .detach(|| {
+            hstl::load::load_in_any_world(&spec.source, Some(&spec.spec.name), &world.world, &label)
+        })
+        .map_err(|e| errors::load_error(py, &spec.filename, &spec.source, e))?;
+    let mut task = trainable(&loaded.spec, spec, episodes)?;
+    hstl::continuous::fit_tiles(&mut task, &loaded.spec, &world.world);
+    let mut failure = None;
+    let trained = py.detach(|| {
+        let mut reporter = Reporter::new(progress.as_ref(), task.learn.episodes);
+        let trained =
+            hstl::continuous::train_until(&task, &world.world, seed, |e, r| reporter.tick(e, r));
+        failure = reporter.failure;
+        trained
+    });
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let trained = trained
+        .map_err(|e| problem_error(&hstl::train::cannot_train(&spec.filename, &task.name, &e)))?;
+    let text =
+        hstl::continuous::policy_json(&task, &world.world, &trained.agent, &spec.source, seed)
+            .map_err(|e| value_error(e.to_string(), None))?;
+    Policy::from_text(py, text, "<trained>", Some(trained.curve), Some(trained.steps))
+}
+
+/// Trains `spec` with the approximate learner in a gymnasium environment with a bounded
+/// `Box` observation space (`low`, `high`) and `Discrete` actions, whose observation `o`
+/// has the state `valuation(o)` (None: the observation's components in order); see
+/// `crate::gym::BoxEnv` for how its calls go.
+#[pyfunction]
+#[pyo3(signature = (spec, env, valuation, seed, name, low, high, actions, action_start, episodes=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn _train_box(
+    py: Python<'_>,
+    spec: &Bound<'_, Spec>,
+    env: &Bound<'_, PyAny>,
+    valuation: Option<&Bound<'_, PyAny>>,
+    seed: u64,
+    name: String,
+    low: Vec<f64>,
+    high: Vec<f64>,
+    actions: usize,
+    action_start: i64,
+    episodes: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Policy> {
+    let spec = spec.get();
+    let task = trainable(&spec.spec, spec, episodes)?;
+    if task.learn.tiles.is_none() {
+        return Err(value_error(
+            format!(
+                "{}: spec `{}` is learned with tables, which a `Box` observation space cannot index",
+                spec.filename, task.name
+            ),
+            Some("declare the state variables as `float` ranges (`x: float in 0..=14`), which the approximate learner tiles".into()),
+        ));
+    }
+    let vars: Vec<String> = task.state_vars.iter().map(|v| v.name.clone()).collect();
+    let described = hstl::gym::Described::new(&name, vars, low, high, actions, action_start)
+        .map_err(|p| problem_error(&p))?;
+    let boxed = BoxEnv::new(env, valuation, described, &task)?;
+    let (trained, failure, boxed) = py.detach(move || {
+        let mut reporter = Reporter::new(progress.as_ref(), task.learn.episodes);
+        let trained = hstl::continuous::train_world_until(&task, &boxed, seed, |e, r| {
+            if boxed.failed() { ControlFlow::Break(()) } else { reporter.tick(e, r) }
+        })
+        .map(|t| (t, task));
+        (trained, reporter.failure, boxed)
+    });
+    if let Some(e) = boxed.take_error().or(failure) {
+        return Err(e);
+    }
+    let (trained, task) = trained.map_err(|e| cannot_train_env(&spec.filename, spec, &e))?;
+    let text = hstl::continuous::policy_json_in(
+        &task,
+        boxed.described(),
+        &trained.agent,
+        &spec.source,
+        seed,
+    )
+    .map_err(|e| value_error(e.to_string(), None))?;
     Policy::from_text(py, text, "<trained>", Some(trained.curve), Some(trained.steps))
 }
 

@@ -67,25 +67,36 @@ def test_a_closed_pipe_ends_the_command_with_status_141_as_the_native_binary(hst
     # `hstlc fmt --help` into a pipe whose reader has gone.
     statuses = []
     for program in (INSTALLED, hstlc):
-        p = subprocess.Popen([str(program), "fmt", "--help"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        assert p.stdout is not None
-        p.stdout.close()  # nobody reads: every write fails with EPIPE
+        # The reader is closed before the program starts, so its first write fails with
+        # EPIPE (closing it after the start races with a program that has written it all).
+        read, write = os.pipe()
+        os.close(read)
+        try:
+            p = subprocess.Popen([str(program), "fmt", "--help"], stdout=write, stderr=subprocess.PIPE)
+        finally:
+            os.close(write)
         _, err = p.communicate(timeout=60)
         statuses.append((p.returncode, err))
     assert statuses[0] == statuses[1] == (141, b"")
 
 
-def test_ctrl_c_ends_the_command_at_once_as_the_native_binary(hstlc, tmp_path):
-    # A long training run, interrupted: both die by SIGINT (no Python traceback).
+def start_training(program: Path, out: Path, sigint: "signal.Handlers") -> subprocess.Popen:
+    """A long training run, started with SIGINT's disposition set to `sigint` (a test run in
+    the background of a script inherits it ignored, so it is set either way)."""
     spec = REPO / "examples" / "specs" / "surveillance_entry.hstl"
+    return subprocess.Popen(
+        [str(program), "train", str(spec), "--episodes", "1000000", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, sigint),
+    )
+
+
+def test_ctrl_c_ends_the_command_at_once_as_the_native_binary(hstlc, tmp_path):
+    # Both die by SIGINT (no Python traceback).
     results = []
     for program in (INSTALLED, hstlc):
-        out = tmp_path / program.parent.name
-        p = subprocess.Popen(
-            [str(program), "train", str(spec), "--episodes", "1000000", "--out", str(out)],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-        )
+        p = start_training(program, tmp_path / program.parent.name, signal.SIG_DFL)
         time.sleep(2)
         assert p.poll() is None, "the run ended before Ctrl-C"
         p.send_signal(signal.SIGINT)
@@ -93,3 +104,18 @@ def test_ctrl_c_ends_the_command_at_once_as_the_native_binary(hstlc, tmp_path):
         results.append((p.returncode, err))
     assert results[0] == results[1]
     assert results[1][0] == -signal.SIGINT
+
+
+def test_an_inherited_ignored_sigint_stays_ignored_as_in_the_native_binary(hstlc, tmp_path):
+    # Under `nohup` or in a script's background job, SIGINT starts ignored: neither program
+    # ends on it.
+    for program in (INSTALLED, hstlc):
+        p = start_training(program, tmp_path / program.parent.name, signal.SIG_IGN)
+        try:
+            time.sleep(2)
+            p.send_signal(signal.SIGINT)
+            time.sleep(1)
+            assert p.poll() is None, f"{program} ended on an ignored SIGINT"
+        finally:
+            p.kill()
+            p.communicate(timeout=30)

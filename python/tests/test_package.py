@@ -29,7 +29,7 @@ def stub_classes():
 
 def test_the_stubs_name_what_the_module_has_with_the_same_parameters():
     classes = stub_classes()
-    exported = {"Diagnostic", "Spec", "OnlineMonitor", "World", "Policy"}
+    exported = {"Diagnostic", "Spec", "OnlineMonitor", "World", "ContinuousWorld", "Policy"}
     assert set(classes) == exported | {"Generator", "EpisodeMonitor", "_StudyOut"}
     for name, node in classes.items():
         runtime = getattr(hstl if name in exported else hstl._hstl, name)

@@ -14,10 +14,22 @@ import ray
 import hstl
 import hstl.tune
 from hstl import _study
-from conftest import CLI_FIXTURES, run_cli
+from conftest import CLI_FIXTURES, REPO, run_cli
 
 SMALL = CLI_FIXTURES / "small.hstl"
 OTHER = CLI_FIXTURES / "small_other.hstl"
+PLANE = REPO / "examples" / "specs" / "surveillance_plane.hstl"
+PLANE_REACH = hstl.Spec.parse(
+    """spec PlaneReach {
+        world "paper-plane";
+        state { x: float in 0..=14, y: float in 0..=14 }
+        let A = x > 11 && y > 11;
+        task eventually[0..40] A;
+        option A;
+        learn { preset: auto }
+    }""",
+    filename="plane_reach.hstl",
+)
 
 
 def without_time(rows):
@@ -136,6 +148,40 @@ def test_ray_gives_the_local_figures_bit_for_bit(cluster, local):
         on_ray = hstl.study([SMALL, OTHER], seeds=[2, 0, 5], episodes=10, backend="ray", batch=batch)
         assert without_time(on_ray) == without_time(local)
         assert [s["window_rate"] for s in on_ray.summary] == [s["window_rate"] for s in local.summary]
+
+
+@pytest.fixture(scope="module")
+def plane_local():
+    """A persistent and a reach spec on `paper-plane`, two seeds, 6 episodes, here."""
+    return [hstl.study(spec, seeds=[3, 1], episodes=6) for spec in (PLANE, PLANE_REACH)]
+
+
+def test_ray_gives_the_local_figures_of_plane_specs_bit_for_bit(cluster, plane_local):
+    for spec, local_rows in zip((PLANE, PLANE_REACH), plane_local):
+        on_ray = hstl.study(spec, seeds=[3, 1], episodes=6, backend="ray", batch=1)
+        assert without_time(on_ray) == without_time(local_rows)
+        assert without_time(on_ray.summary) == without_time(local_rows.summary)
+
+
+def test_a_plane_study_gives_hstlc_study_s_figures(hstlc, tmp_path, plane_local):
+    persistent, reach = plane_local
+    out = tmp_path / "cli"
+    result = run_cli(hstlc, "study", str(PLANE), "--seeds", "4", "--episodes", "6", "--out", str(out), cwd=REPO)
+    assert result.returncode == 0, result.stderr
+    seeds_csv = next(out.glob("*/seeds.csv"))
+    by_seed = {int(r["seed"]): float(r["W"]) for r in csv.DictReader(open(seeds_csv))}
+    for row in persistent:
+        assert row["window_rate"] == by_seed[row["seed"]]
+        assert row["optimum"] is None and row["ratio"] is None
+        # The seed's policy, measured on its evaluation seed's runs, has the same W.
+        policy = hstl.train(PLANE, seed=row["seed"], episodes=6)
+        assert policy.evaluate(seed=row["seed"] ^ hstl.EVAL_SEED, optimum=False)["window_rate"] == row["window_rate"]
+    for row in reach:
+        assert row["window_rate"] is None and 0.0 <= row["satisfaction"] <= 1.0
+    with pytest.raises(ValueError, match="`out=` writes a study's folder in a grid world"):
+        hstl.study(PLANE, seeds=1, episodes=2, out=tmp_path / "py")
+    with pytest.raises(TypeError, match="hstl.tune trains in grid worlds"):
+        hstl.tune.trainable_for(PLANE)
 
 
 def test_a_killed_worker_does_not_lose_a_seed(cluster, local, tmp_path):

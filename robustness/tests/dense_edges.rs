@@ -418,3 +418,24 @@ fn complete_windows_cut_each_node_at_its_complete_end() {
     let (_, end, _) = complete(&long);
     assert!(end < trace.t0());
 }
+
+#[test]
+fn the_complete_end_without_a_trace_is_the_complete_signals() {
+    let (x, y) = (gt(0, 1.0), gt(1, 5.0));
+    let formulas = [
+        x.clone(),
+        Formula::eventually(iv(3, Some(7)), x.clone()),
+        Formula::always(iv(0, None), Formula::eventually(iv(1, Some(13)), y.clone())),
+        Formula::until(iv(2, Some(9)), x.clone(), Formula::always(iv(0, Some(3)), y.clone())),
+        Formula::and(vec![
+            Formula::eventually(iv(0, Some(10)), x.clone()),
+            Formula::once(iv(10, Some(20)), y),
+        ]),
+    ];
+    let (_, trace) = read_csv(EXAMPLE);
+    for f in &formulas {
+        let df = DenseFormula::new(f, TimeScale::decimals(1)).expect("a dense formula");
+        let (_, end) = df.complete_signal(&trace).expect("a signal");
+        assert_eq!(df.complete_end(trace.t_last()).to_bits(), end.to_bits(), "{f}");
+    }
+}

@@ -10,6 +10,7 @@
 
 use hstl_robustness::{Trace, complete, offline, reference};
 
+use crate::progress::GoalTracker;
 use crate::{Agent, Env, Error, Rng, Switch, TaskSpec};
 
 /// Decides actions step by step: a greedy [`Agent`] or a hand-written controller.
@@ -92,12 +93,14 @@ pub struct RegionTable {
 /// A greedy [`Agent`] executing options: the options policy picks an option where none
 /// runs, its legs follow their flat policies greedily. An agent with memory has its
 /// counters tracked along the run (from the first state after each reset), and picks on
-/// the state and buckets.
+/// the state and buckets; an agent with goals reads the goals the run has met where a leg
+/// ends, as the learner does.
 #[derive(Clone, Debug)]
 pub struct AgentController<'a> {
     agent: &'a Agent,
     running: Option<(usize, usize, usize)>,
     tau: Vec<usize>,
+    goals: GoalTracker,
     fresh: bool,
 }
 
@@ -134,7 +137,7 @@ pub const MAX_ENTRY_CYCLE_DISTANCES: usize = 1 << 26;
 impl Default for WindowConfig {
     /// 100 rollouts of 2000 steps, the first 100 not counted.
     fn default() -> WindowConfig {
-        WindowConfig { starts: 100, steps: 2000, burn_in: 100 }
+        WindowConfig { starts: 100, steps: crate::progress::UNBOUNDED_RUN_STEPS, burn_in: 100 }
     }
 }
 
@@ -217,19 +220,21 @@ impl RegionTable {
 }
 
 /// Where an [`AgentController`] is in its execution (the running option, its leg, the
-/// memory counters), apart from the agent: the owner of an agent pauses a controller into
-/// this and resumes it later, step by step (the Python package's `Policy.act`).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// memory counters, the run so far and the goals it met), apart from the agent: the owner
+/// of an agent pauses a controller into this and resumes it later, step by step (the
+/// Python package's `Policy.act`).
+#[derive(Clone, Debug, PartialEq)]
 pub struct AgentProgress {
     running: Option<(usize, usize, usize)>,
     tau: Vec<usize>,
+    goals: GoalTracker,
     fresh: bool,
 }
 
 impl Default for AgentProgress {
     /// Nothing running: the next step starts afresh, as after [`Controller::reset`].
     fn default() -> AgentProgress {
-        AgentProgress { running: None, tau: Vec::new(), fresh: true }
+        AgentProgress { running: None, tau: Vec::new(), goals: GoalTracker::default(), fresh: true }
     }
 }
 
@@ -241,13 +246,13 @@ impl<'a> AgentController<'a> {
 
     /// A controller following `agent` from where `progress` left off.
     pub fn resume(agent: &'a Agent, progress: AgentProgress) -> AgentController<'a> {
-        let AgentProgress { running, tau, fresh } = progress;
-        AgentController { agent, running, tau, fresh }
+        let AgentProgress { running, tau, goals, fresh } = progress;
+        AgentController { agent, running, tau, goals, fresh }
     }
 
     /// Where the controller is, to [`AgentController::resume`] it later with the same agent.
     pub fn pause(self) -> AgentProgress {
-        AgentProgress { running: self.running, tau: self.tau, fresh: self.fresh }
+        AgentProgress { running: self.running, tau: self.tau, goals: self.goals, fresh: self.fresh }
     }
 
     /// The counters `tau_j` of an agent with memory, as of the last state seen (empty
@@ -270,6 +275,9 @@ impl Controller for AgentController<'_> {
             if let Some(m) = &agent.memory {
                 m.start(s, &mut self.tau);
             }
+            if let Some(g) = &agent.goals {
+                g.start(&mut self.goals, s);
+            }
             self.fresh = false;
         }
         // Interruption: the options policy's pick here replaces a running option of
@@ -277,7 +285,7 @@ impl Controller for AgentController<'_> {
         if agent.switch == Switch::Step
             && let Some((o, ..)) = self.running
         {
-            let obs = agent.observation(s, &self.tau);
+            let obs = agent.observation(s, &self.tau, self.goals.met());
             let row = agent.options_q.get(obs * agent.legs.len()..).unwrap_or(&[]);
             if let Some(&c) = agent.options.get(obs)
                 && let (Some(q_c), Some(q_o)) = (row.get(c), row.get(o))
@@ -289,7 +297,7 @@ impl Controller for AgentController<'_> {
         let (o, leg, _) = match self.running {
             Some(r) => r,
             None => {
-                let obs = agent.observation(s, &self.tau);
+                let obs = agent.observation(s, &self.tau, self.goals.met());
                 *self.running.insert((agent.options.get(obs).copied().unwrap_or(0), 0, 0))
             }
         };
@@ -311,6 +319,11 @@ impl Controller for AgentController<'_> {
         {
             m.step(next, &mut self.tau);
         }
+        if let Some(g) = &agent.goals
+            && !self.fresh
+        {
+            g.push(&mut self.goals, next);
+        }
         let Some((o, leg, steps)) = self.running else { return };
         let legs = agent.legs.get(o).map_or(0, Vec::len);
         let done = agent
@@ -320,6 +333,10 @@ impl Controller for AgentController<'_> {
             .and_then(|&p| agent.terminate.get(p)?.get(next).copied())
             .unwrap_or(true);
         self.running = if done || steps + 1 >= agent.max_steps {
+            // A leg ends where a goal's region is entered: the next pick sees it.
+            if let Some(g) = &agent.goals {
+                self.goals.read(&g.progress);
+            }
             (leg + 1 < legs).then_some((o, leg + 1, 0))
         } else {
             Some((o, leg, steps + 1))

@@ -27,6 +27,12 @@
 //! `sum_{j=1..k-i} gamma^(j-1) psi(i + j)` (options gamma) instead of the segment
 //! robustness, and each suffix the same sum over its own steps.
 //!
+//! **Goals** (LANGUAGE.md, "Task progress"; see [`crate::progress`]). For a task that is
+//! not persistent, the options table is indexed by the observation times `2^goals` plus
+//! the goals the episode has met (read where a leg ends), an execution and each of its
+//! suffixes are scored against the conjuncts still open where they start, and once every
+//! goal is met the episode goes on to the task's horizon, as a greedy run does.
+//!
 //! **Options.** An option runs at least one step; a leg stops at the first `s'` in its
 //! termination set, or is cut off after `max_steps` steps. Exploration is epsilon-greedy
 //! at both levels with linear decay and a floor: the flat epsilon decays per primitive
@@ -41,6 +47,7 @@ use crate::env::EpisodeEnd;
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
 use crate::plan_reach::ReachPlanner;
+use crate::progress::{GoalTracker, StateGoals, run_steps};
 use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
@@ -66,6 +73,14 @@ pub struct Learner<'e, E: Env> {
     code: usize,
     /// Memory values the options policy tells apart (1 without memory).
     values: usize,
+    /// The goals of a task that is not persistent, when it has some.
+    goals: Option<StateGoals>,
+    /// Progress codes the options policy tells apart (`2^goals`; 1 without goals).
+    codes: usize,
+    /// The running episode's states so far and the goals it has met.
+    tracker: GoalTracker,
+    /// The suffix rewards under another progress code (a buffer).
+    other_rewards: Vec<f64>,
     /// `gamma_powers[i]`: the options gamma to the power `i`, grown on demand.
     gamma_powers: Vec<f64>,
     /// Every state by index, so that a step does not rebuild its state from the index.
@@ -158,8 +173,9 @@ impl Counters {
 /// How an option execution and its suffixes are rewarded.
 #[derive(Clone, Debug)]
 enum Reward {
-    /// The task's robustness over the segment (the paper's).
-    Segment(Box<TabularScorer>),
+    /// The task's robustness over the segment (the paper's); with goals, one scorer per
+    /// progress code, of the conjuncts still open (`None`: nothing is left).
+    Segment(Vec<Option<TabularScorer>>),
     /// The discounted count of steps whose windows are kept.
     Window,
 }
@@ -175,6 +191,8 @@ struct Run {
     obs: Vec<usize>,
     /// `psi` at each position (empty without counters).
     psi: Vec<bool>,
+    /// The goals met at each position (empty without goals).
+    met: Vec<usize>,
     /// The environment ended its episode during the option ([`Env::episode_ended`]).
     ended: bool,
 }
@@ -186,15 +204,22 @@ impl<'e, E: Env> Learner<'e, E> {
         let tables = Tables::new(spec, env)?;
         let memory = Memory::of_spec(spec, env)?;
         let values = memory.as_ref().map_or(1, Memory::values);
+        let goals = if spec.regions.is_empty() {
+            StateGoals::of_task(&spec.task, &tables.trace)
+        } else {
+            None
+        };
+        let codes = goals.as_ref().map_or(1, StateGoals::codes);
         let size = tables
             .states
             .checked_mul(values)
+            .and_then(|v| v.checked_mul(codes))
             .and_then(|v| v.checked_mul(tables.legs.len()))
             .filter(|&v| v <= MAX_OPTION_VALUES);
         let Some(size) = size else {
             return Err(Error::Config(format!(
-                "{} states with {values} memory values and {} options need more than \
-                 {MAX_OPTION_VALUES} options Q-values; lower memory",
+                "{} states with {values} memory values, {codes} goal codes and {} options need \
+                 more than {MAX_OPTION_VALUES} options Q-values; lower memory",
                 tables.states,
                 tables.legs.len()
             )));
@@ -206,9 +231,12 @@ impl<'e, E: Env> Learner<'e, E> {
             choices: 0,
         };
         let reward = match spec.learn.reward {
-            RewardKind::Segment => {
-                Reward::Segment(Box::new(TabularScorer::new(&spec.task, &tables.trace)))
-            }
+            RewardKind::Segment => Reward::Segment(match &goals {
+                Some(g) => (0..g.codes())
+                    .map(|mask| g.progress.rest(mask).map(|f| TabularScorer::new(f, &tables.trace)))
+                    .collect(),
+                None => vec![Some(TabularScorer::new(&spec.task, &tables.trace))],
+            }),
             RewardKind::Window => Reward::Window,
         };
         let states = (0..tables.states).filter_map(|s| env.state(s)).collect();
@@ -240,6 +268,10 @@ impl<'e, E: Env> Learner<'e, E> {
             tau: Vec::new(),
             code: 0,
             values,
+            goals,
+            codes,
+            tracker: GoalTracker::default(),
+            other_rewards: Vec::new(),
             gamma_powers: vec![1.0],
             states,
             flat_floor: floor_from(&spec.learn.flat),
@@ -285,7 +317,14 @@ impl<'e, E: Env> Learner<'e, E> {
     /// The greedy policies of the current Q-tables.
     pub fn agent(&self) -> crate::Agent {
         let l = &self.spec.learn;
-        crate::Agent::from_q(&self.tables, &self.q, l.max_steps, self.memory(), l.switch)
+        crate::Agent::from_q(
+            &self.tables,
+            &self.q,
+            l.max_steps,
+            self.memory(),
+            self.goals.as_ref(),
+            l.switch,
+        )
     }
 
     /// The learner's per-state tables (crate-internal).
@@ -359,7 +398,21 @@ impl<'e, E: Env> Learner<'e, E> {
         }
         self.begin(s);
         let mut total = 0.0;
-        for _ in 0..self.spec.learn.choices {
+        // Once every goal is met, the episode goes on to the task's horizon, as a greedy
+        // run does: the options level learns to keep the rest where the run then is (with
+        // one option it has nothing to learn).
+        let hold = match &self.goals {
+            Some(g) if self.tables.legs.len() > 1 => {
+                Some((g.progress.all_met(), run_steps(&self.spec.task) - 1))
+            }
+            _ => None,
+        };
+        let mut steps = 0;
+        for choice in 0.. {
+            let holding = hold.is_some_and(|(all, h)| self.tracker.met() == all && steps < h);
+            if choice >= self.spec.learn.choices && !holding {
+                break;
+            }
             let o = self.choose_option(s, rng);
             self.run_option(o, s, rng, run);
             self.suffix_rewards(run, rewards);
@@ -368,6 +421,7 @@ impl<'e, E: Env> Learner<'e, E> {
             if self.spec.learn.counterfactual > 0 {
                 self.counterfactual_updates(o, run, rng);
             }
+            steps += run.states.len() - 1;
             s = *run.states.last().unwrap_or(&s);
             if run.ended {
                 // The environment's episode is over: the next episode resets it.
@@ -377,18 +431,22 @@ impl<'e, E: Env> Learner<'e, E> {
         total
     }
 
-    /// Starts an episode in state `s`: the counters take their start values.
+    /// Starts an episode in state `s`: the counters take their start values, and the goals
+    /// met in `s` are read.
     fn begin(&mut self, s: usize) {
         if let (Some(m), Some(c)) = (&self.memory, &self.counters) {
             m.start(s, &mut self.tau);
             self.code = c.code(&self.tau);
         }
+        if let Some(g) = &self.goals {
+            g.start(&mut self.tracker, s);
+        }
     }
 
-    /// What the options policy observes in state `s` with the current counters.
+    /// What the options policy observes in state `s` with the current counters and goals.
     #[inline]
     fn observe(&self, s: usize) -> usize {
-        s * self.values + self.code
+        (s * self.values + self.code) * self.codes + self.tracker.met()
     }
 
     fn choose_option(&mut self, s: usize, rng: &mut Rng) -> usize {
@@ -414,19 +472,26 @@ impl<'e, E: Env> Learner<'e, E> {
             tau,
             code,
             values,
+            goals,
+            codes,
+            tracker,
             states,
             flat_floor,
             planning,
             ..
         } = self;
-        let (actions, values) = (tables.actions, *values);
+        let (actions, values, codes) = (tables.actions, *values, *codes);
         run.states.clear();
         run.leg_starts.clear();
         run.obs.clear();
         run.psi.clear();
+        run.met.clear();
         run.ended = false;
         run.states.push(s);
-        run.obs.push(s * values + *code);
+        run.obs.push((s * values + *code) * codes + tracker.met());
+        if goals.is_some() {
+            run.met.push(tracker.met());
+        }
         if let Some(m) = memory {
             run.psi.push(m.kept(tau));
         }
@@ -479,15 +544,31 @@ impl<'e, E: Env> Learner<'e, E> {
                     *code = new_code;
                     run.psi.push(kept);
                 }
-                run.obs.push(next * values + *code);
+                run.obs.push((next * values + *code) * codes + tracker.met());
+                if let Some(g) = goals {
+                    g.push(tracker, next);
+                    run.met.push(tracker.met());
+                }
                 s = next;
                 if end.is_some() {
                     run.ended = true;
-                    break 'legs;
+                    break;
                 }
                 if term[next] {
                     break;
                 }
+            }
+            // A leg ends where a goal's region is entered: the observation from here on
+            // says so.
+            if let Some(g) = goals {
+                let met = tracker.read(&g.progress);
+                if let (Some(m), Some(obs)) = (run.met.last_mut(), run.obs.last_mut()) {
+                    *m = met;
+                    *obs = (s * values + *code) * codes + met;
+                }
+            }
+            if run.ended {
+                break 'legs;
             }
         }
     }
@@ -525,7 +606,8 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
                 tau.push(rng.random_range(lo..hi));
             }
-            let start = s0 * self.values + c.code(&tau);
+            let met = (run.met.first().copied().unwrap_or(0), run.met.last().copied().unwrap_or(0));
+            let start = (s0 * self.values + c.code(&tau)) * self.codes + met.0;
             let (mut reward, mut discount, mut code) = (0.0, 1.0, 0);
             for &s in &run.states[1..] {
                 let (kept, next_code) = c.step(s, &mut tau);
@@ -535,7 +617,7 @@ impl<'e, E: Env> Learner<'e, E> {
                 discount *= params.gamma;
                 code = next_code;
             }
-            let end_row = (end * self.values + code) * n;
+            let end_row = ((end * self.values + code) * self.codes + met.1) * n;
             let best = self.tables.available[end]
                 .iter()
                 .map(|&a| self.q.options[end_row + a])
@@ -585,7 +667,31 @@ impl<E: Env> Learner<'_, E> {
     /// window reward).
     fn suffix_rewards(&mut self, run: &Run, out: &mut Vec<f64>) {
         match &mut self.reward {
-            Reward::Segment(scorer) => scorer.suffix_rewards(&run.states, out),
+            Reward::Segment(scorers) => {
+                let k = run.states.len() - 1;
+                let mut score = |met: usize, into: &mut Vec<f64>| match scorers.get_mut(met) {
+                    Some(Some(scorer)) => scorer.suffix_rewards(&run.states, into),
+                    _ => {
+                        into.clear();
+                        into.resize(k + 1, 0.0);
+                    }
+                };
+                score(run.met.first().copied().unwrap_or(0), out);
+                // Goals met along the run: the positions after score against the rest.
+                let mut j = 0;
+                let mut other = std::mem::take(&mut self.other_rewards);
+                while let Some(offset) =
+                    run.met.get(j..).and_then(|m| m.iter().position(|&x| x != m[0]))
+                {
+                    j += offset;
+                    let met = run.met[j];
+                    score(met, &mut other);
+                    let until =
+                        run.met[j..].iter().position(|&m| m != met).map_or(k + 1, |e| j + e);
+                    out[j..until].copy_from_slice(&other[j..until]);
+                }
+                self.other_rewards = other;
+            }
             Reward::Window => {
                 // R_j = psi(j + 1) + gamma R_{j+1}, R_k = 0: the sum over the suffix's steps
                 // of gamma^(m-1) psi(j + m).
@@ -743,7 +849,9 @@ mod tests {
 
     /// A 5 x 1 deterministic line: P1 reaches `x > 1` (stops there), P2 reaches `x > 3`
     /// (stops at the argmax x = 4); options [P1, P2] and [P2]; task
-    /// `eventually[0..10] x < 1`, so the suffix from `x_j` on a rightward run earns `1 - x_j`.
+    /// `!always[0..10] x >= 1` (`eventually[0..10] x < 1` written without a goal, so that
+    /// the options table is the state's alone), so the suffix from `x_j` on a rightward run
+    /// earns `1 - x_j`.
     fn line(intra: Intra, max_steps: usize, p2_terminate: Terminate) -> TaskSpec {
         let prim = |name: &str, reach: Formula, terminate| PrimitiveOption {
             name: name.into(),
@@ -758,10 +866,10 @@ mod tests {
                 StateVar { name: "x".into(), domain: Some(0..=4) },
                 StateVar { name: "y".into(), domain: Some(0..=0) },
             ],
-            task: Formula::eventually(
+            task: Formula::not(Formula::always(
                 Interval { start: 0, end: Bound::Exclusive(10) },
-                x(CmpOp::Lt, 1.0),
-            ),
+                x(CmpOp::Ge, 1.0),
+            )),
             primitives: vec![
                 prim("P1", x(CmpOp::Gt, 1.0), Terminate::Formula(x(CmpOp::Gt, 1.0))),
                 prim("P2", x(CmpOp::Gt, 3.0), p2_terminate),

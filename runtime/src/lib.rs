@@ -16,6 +16,8 @@
 //! - [`plan`]: `plan: model`, the options values planned over the memory's
 //!   counters and a model of the learned legs (beyond the paper).
 //! - [`policy`]: greedy policies and the `policy.json` document.
+//! - [`progress`]: the goals of a task that is not persistent, which the options level of
+//!   both learners sees beside the state once a run has met them.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
 //! - [`optimum`]: the exact optimal window rate `W*` of a persistent task on any grid world.
 //! - [`reach_avoid`]: the exact optimal probability of a reach-avoid task.
@@ -40,6 +42,7 @@ mod plan_reach;
 pub mod plane;
 pub mod policy;
 mod policy_parts;
+pub mod progress;
 pub mod reach_avoid;
 pub mod spec;
 mod tables;

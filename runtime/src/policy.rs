@@ -15,6 +15,12 @@
 //! there (inside region `j`, `b_j` is 0). Beyond the contract, `memory.states` lists the
 //! states of each region, so that a replay can track the counters without the spec.
 //!
+//! **Beyond the contract, with goals** (a task that is not persistent, see
+//! [`crate::progress`]): the document also holds `"goals": [TEXT...]`, the task's goals in
+//! conjunct order as formulas, and each `options_policy` entry holds `"goals_met": [j...]`,
+//! the indices of the goals met: one entry per state, memory value and set of goals met.
+//! A replay reads the goals from the spec ([`Policy::agent_for`]).
+//!
 //! The JSON is indented down to the entries; each entry, state and table is on one line.
 
 use std::collections::{BTreeMap, HashMap};
@@ -26,6 +32,7 @@ pub use crate::policy_parts::{HexTable, State};
 
 use crate::learn::{argmax, best_of};
 use crate::memory::Memory;
+use crate::progress::StateGoals;
 use crate::tables::Tables;
 use crate::{Env, Error, Learner, QTables, Switch, TaskSpec};
 
@@ -34,9 +41,10 @@ use crate::{Env, Error, Learner, QTables, Switch, TaskSpec};
 pub struct Agent {
     /// `legs[o]`: the primitives option `o` runs, in order.
     pub legs: Vec<Vec<usize>>,
-    /// `options[obs]`: the option the options policy picks on observing `obs`: the state
-    /// index without memory, `s * memory.values() + code` with it. An observation that
-    /// cannot occur (a bucket other than 0 inside its region) holds `usize::MAX`.
+    /// `options[obs]`: the option the options policy picks on observing `obs`:
+    /// `(s * memory.values() + code) * goals.codes() + met` (the state index without
+    /// memory and goals). An observation that cannot occur (a bucket other than 0 inside
+    /// its region) holds `usize::MAX`.
     pub options: Vec<usize>,
     /// `flat[p][s]`: the action primitive `p` takes in state `s`.
     pub flat: Vec<Vec<usize>>,
@@ -46,6 +54,8 @@ pub struct Agent {
     pub max_steps: usize,
     /// The memory the options policy observes (`memory: B > 0`), or `None`.
     pub memory: Option<Memory>,
+    /// The goals the options policy observes (a task that is not persistent), or `None`.
+    pub goals: Option<StateGoals>,
     /// When a run chooses an option: on termination, or at every step.
     pub switch: Switch,
     /// With [`Switch::Step`], the options Q-table (`obs * options + o`): a running option
@@ -71,6 +81,9 @@ pub struct Policy {
     /// The memory the options policy observes, for a spec with `memory: B > 0`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory: Option<MemoryDoc>,
+    /// The goals the options policy observes, as formulas, for a task with goals.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goals: Option<Vec<String>>,
     /// The greedy option in every state (and every memory value there, with memory).
     pub options_policy: Vec<Entry>,
     /// For every primitive option, the greedy action in every state.
@@ -133,6 +146,10 @@ pub struct Entry {
     /// The buckets `[b_1, ...]` of an options-policy entry with memory.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory: Option<Vec<usize>>,
+    /// The goals met (indices into the document's `goals`) of an options-policy entry of a
+    /// task with goals.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goals_met: Option<Vec<usize>>,
     /// The chosen option or action.
     pub choice: String,
 }
@@ -156,14 +173,16 @@ impl Agent {
         q: &QTables,
         max_steps: usize,
         memory: Option<&Memory>,
+        goals: Option<&StateGoals>,
         switch: Switch,
     ) -> Agent {
         let (n, a) = (tables.legs.len(), tables.actions);
         let values = memory.map_or(1, Memory::values);
-        let options = (0..tables.states * values)
+        let codes = goals.map_or(1, StateGoals::codes);
+        let options = (0..tables.states * values * codes)
             .map(|obs| {
-                let s = obs / values;
-                if memory.is_some_and(|m| !m.consistent(s, obs % values)) {
+                let s = obs / (values * codes);
+                if memory.is_some_and(|m| !m.consistent(s, obs / codes % values)) {
                     usize::MAX
                 } else {
                     best_of(&tables.available[s], &q.options[obs * n..][..n])
@@ -182,14 +201,20 @@ impl Agent {
             terminate: tables.term.clone(),
             max_steps,
             memory: memory.cloned(),
+            goals: goals.cloned(),
             switch,
             options_q: if switch == Switch::Step { q.options.clone() } else { Vec::new() },
         }
     }
 
-    /// The observation of state `s` with counters `tau` (ignored without memory).
-    pub fn observation(&self, s: usize, tau: &[usize]) -> usize {
-        self.memory.as_ref().map_or(s, |m| m.observation(s, tau))
+    /// The observation of state `s` with counters `tau` (ignored without memory) and the
+    /// goals `met` (ignored without goals).
+    pub fn observation(&self, s: usize, tau: &[usize], met: usize) -> usize {
+        let obs = self.memory.as_ref().map_or(s, |m| m.observation(s, tau));
+        match &self.goals {
+            Some(g) => obs * g.codes() + met,
+            None => obs,
+        }
     }
 }
 
@@ -197,7 +222,7 @@ impl Policy {
     /// The document's own field names, in the order it writes them (an optional field
     /// counts even where it is absent: a reader would take an extra field of its name for
     /// it).
-    pub const FIELDS: [&str; 12] = [
+    pub const FIELDS: [&str; 13] = [
         "spec",
         "env",
         "state_vars",
@@ -205,6 +230,7 @@ impl Policy {
         "options",
         "primitives",
         "memory",
+        "goals",
         "options_policy",
         "flat_policies",
         "max_steps",
@@ -244,17 +270,21 @@ impl Policy {
             .collect();
         let memory = agent.memory.as_ref();
         let values = memory.map_or(1, Memory::values);
+        let goals = agent.goals.as_ref();
+        let codes = goals.map_or(1, StateGoals::codes);
         let options_policy = agent
             .options
             .iter()
             .enumerate()
             .filter(|&(_, &o)| o != usize::MAX)
             .map(|(obs, &o)| Entry {
-                state: states[obs / values].clone(),
-                memory: memory.map(|m| m.decode(obs % values)),
+                state: states[obs / (values * codes)].clone(),
+                memory: memory.map(|m| m.decode(obs / codes % values)),
+                goals_met: goals.map(|g| g.progress.decode(obs % codes)),
                 choice: spec.options[o].name.clone(),
             })
             .collect();
+        let goals = goals.map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
         let memory = memory.map(|m| MemoryDoc {
             regions: m.regions.clone(),
             horizons: m.horizons.clone(),
@@ -276,6 +306,7 @@ impl Policy {
                     .map(|(s, &a)| Entry {
                         state: states[s].clone(),
                         memory: None,
+                        goals_met: None,
                         choice: actions[a].clone(),
                     })
                     .collect();
@@ -297,6 +328,7 @@ impl Policy {
             options,
             primitives,
             memory,
+            goals,
             options_policy,
             flat_policies,
             max_steps: agent.max_steps,
@@ -392,11 +424,12 @@ impl Policy {
 
     /// Checks the document whole against the spec and environment it claims: its Q-tables
     /// have the spec's shape and hold no NaN, and every other entry (options, termination
-    /// sets, greedy choices, memory) is what those Q-tables give for this spec on `env`,
-    /// each state listed once. A document edited by hand, truncated or paired with another
-    /// spec fails. The greedy policies are compared as tables over state indices, so the
+    /// sets, greedy choices, memory, goals) is what those Q-tables give for this spec on
+    /// `env`, each state listed once (with goals, once per set of goals met). A document
+    /// edited by hand, truncated or paired with another spec fails. The greedy policies are
+    /// compared as tables over observations (state, memory value and goals met), so the
     /// check costs what the document's numbers do, not a second document. Returns the
-    /// document's greedy agent on `env` ([`Policy::agent`]).
+    /// document's greedy agent on `env` ([`Policy::agent_for`]).
     pub fn check_against<E: Env>(&self, spec: &TaskSpec, env: &E) -> Result<Agent, Error> {
         let err = |m: String| Err(Error::Policy(m));
         let q = self.q_tables()?;
@@ -454,10 +487,17 @@ impl Policy {
         if !memory_same {
             return differs("memory");
         }
+        let goals = theirs
+            .goals
+            .as_ref()
+            .map(|g| g.progress.goal_formulas().map(ToString::to_string).collect::<Vec<_>>());
+        if goals != self.goals {
+            return differs("goals");
+        }
         if self.max_steps != theirs.max_steps {
             return differs("max_steps");
         }
-        let mine = self.agent(env)?;
+        let mine = self.agent_for(spec, env)?;
         let count = |t: &[bool]| t.iter().filter(|&&b| b).count();
         let terminate_same = mine.terminate == theirs.terminate
             && self
@@ -490,8 +530,39 @@ impl Policy {
     }
 
     /// The greedy policies on `env`'s state indices. Fails when the document does not fit
-    /// `env`: another environment, a state it does not cover, an unknown name.
+    /// `env`: another environment, a state it does not cover, an unknown name; and for a
+    /// policy whose options level reads the task's goals, which [`Policy::agent_for`]
+    /// replays.
     pub fn agent<E: Env>(&self, env: &E) -> Result<Agent, Error> {
+        if self.goals.is_some() {
+            return Err(Error::Policy(
+                "the policy's options level reads the task's goals, which a replay takes from \
+                 the spec (Policy::agent_for)"
+                    .into(),
+            ));
+        }
+        self.agent_with(env, None)
+    }
+
+    /// [`Policy::agent`] with the spec it was trained on, which gives the task's goals; fails
+    /// as [`Policy::agent`] does, and when the document's goals are not the spec's.
+    pub fn agent_for<E: Env>(&self, spec: &TaskSpec, env: &E) -> Result<Agent, Error> {
+        let goals = if spec.regions.is_empty() {
+            StateGoals::of_task(&spec.task, &crate::tables::valuations(spec, env)?)
+        } else {
+            None
+        };
+        let texts: Option<Vec<String>> =
+            goals.as_ref().map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
+        if texts != self.goals {
+            return Err(Error::Policy(
+                "the document's `goals` are not the goals of the spec it was trained on".into(),
+            ));
+        }
+        self.agent_with(env, goals)
+    }
+
+    fn agent_with<E: Env>(&self, env: &E, goals: Option<StateGoals>) -> Result<Agent, Error> {
         let err = |m: String| Err(Error::Policy(m));
         if self.env.name != env.name() {
             return err(format!(
@@ -548,9 +619,10 @@ impl Policy {
             None => None,
             Some(doc) => Some(self.memory_of(doc, n, &lookup)?),
         };
-        let options = fill_options(n, memory.as_ref(), &self.options_policy, &lookup, |c| {
-            self.options.iter().position(|o| o.name == c)
-        })?;
+        let options =
+            fill_options(n, memory.as_ref(), goals.as_ref(), &self.options_policy, &lookup, |c| {
+                self.options.iter().position(|o| o.name == c)
+            })?;
         let mut flat = Vec::new();
         let mut terminate = Vec::new();
         for p in &self.primitives {
@@ -579,7 +651,7 @@ impl Policy {
                 options.len() * legs.len()
             ));
         }
-        Ok(Agent { legs, options, flat, terminate, max_steps, memory, switch, options_q })
+        Ok(Agent { legs, options, flat, terminate, max_steps, memory, goals, switch, options_q })
     }
 
     /// The memory of the document's `memory` part.
@@ -695,7 +767,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
             (None, None, None, None, None);
         let (mut primitives, mut memory, mut options_policy, mut flat_policies) =
             (None, None, None, None);
-        let (mut max_steps, mut switch, mut q_tables) = (None, None, None);
+        let (mut goals, mut max_steps, mut switch, mut q_tables) = (None, None, None, None);
         let mut extras = Map::new();
         while let Some(key) = map.next_key::<String>()? {
             match key.as_str() {
@@ -706,6 +778,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
                 "options" => set(&mut options, map.next_value()?, &key)?,
                 "primitives" => set(&mut primitives, map.next_value()?, &key)?,
                 "memory" => set(&mut memory, map.next_value::<Option<MemoryDoc>>()?, &key)?,
+                "goals" => set(&mut goals, map.next_value::<Option<Vec<String>>>()?, &key)?,
                 "options_policy" => set(&mut options_policy, map.next_value()?, &key)?,
                 "flat_policies" => set(&mut flat_policies, map.next_value()?, &key)?,
                 "max_steps" => set(&mut max_steps, map.next_value()?, &key)?,
@@ -731,6 +804,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
             options: options.ok_or_else(|| A::Error::missing_field("options"))?,
             primitives: primitives.ok_or_else(|| A::Error::missing_field("primitives"))?,
             memory: memory.flatten(),
+            goals: goals.flatten(),
             options_policy: options_policy
                 .ok_or_else(|| A::Error::missing_field("options_policy"))?,
             flat_policies: flat_policies.ok_or_else(|| A::Error::missing_field("flat_policies"))?,
@@ -844,54 +918,102 @@ fn state_of<E: Env>(env: &E, vars: &[String], s: usize) -> State {
 }
 
 /// The options table from policy entries, indexed by observation: every state (with
-/// every memory value that can occur there) must be covered.
+/// every memory value that can occur there, and every set of goals met) must be covered.
 fn fill_options(
     n: usize,
     memory: Option<&Memory>,
+    goals: Option<&StateGoals>,
     entries: &[Entry],
     lookup: &impl Fn(&State, &str) -> Result<usize, Error>,
     choice: impl Fn(&str) -> Option<usize>,
 ) -> Result<Vec<usize>, Error> {
-    let Some(m) = memory else {
+    let err = |m: String| Err(Error::Policy(m));
+    if memory.is_none() && goals.is_none() {
         if entries.iter().any(|e| e.memory.is_some()) {
-            return Err(Error::Policy(
+            return err(
                 "options_policy has an entry with memory, but the document has no memory part"
                     .into(),
-            ));
+            );
+        }
+        if entries.iter().any(|e| e.goals_met.is_some()) {
+            return err(
+                "options_policy has an entry with goals_met, but the document has no goals".into(),
+            );
         }
         return fill(n, entries, "options_policy", lookup, choice);
-    };
-    let values = m.values();
-    let mut out = vec![usize::MAX; n * values];
+    }
+    let values = memory.map_or(1, Memory::values);
+    let codes = goals.map_or(1, StateGoals::codes);
+    let mut out = vec![usize::MAX; n * values * codes];
     for e in entries {
         let s = lookup(&e.state, "options_policy")?;
-        let Some(b) = &e.memory else {
-            return Err(Error::Policy(format!(
-                "options_policy has an entry for state {} without memory; a memory policy \
-                 gives [b_1, ...] in each entry",
-                e.state
-            )));
+        let code = match (memory, &e.memory) {
+            (None, None) => 0,
+            (None, Some(_)) => {
+                return err(
+                    "options_policy has an entry with memory, but the document has no memory \
+                     part"
+                        .into(),
+                );
+            }
+            (Some(_), None) => {
+                return err(format!(
+                    "options_policy has an entry for state {} without memory; a memory policy \
+                     gives [b_1, ...] in each entry",
+                    e.state
+                ));
+            }
+            (Some(m), Some(b)) => {
+                m.code_of_buckets(b).filter(|&c| m.consistent(s, c)).ok_or_else(|| {
+                    Error::Policy(format!(
+                        "options_policy gives state {} the memory {b:?}, which is not {} \
+                         buckets in 0..={} with 0 for the regions the state lies in",
+                        e.state,
+                        m.len(),
+                        m.buckets
+                    ))
+                })?
+            }
         };
-        let code = m.code_of_buckets(b).filter(|&c| m.consistent(s, c)).ok_or_else(|| {
-            Error::Policy(format!(
-                "options_policy gives state {} the memory {b:?}, which is not {} buckets in \
-                 0..={} with 0 for the regions the state lies in",
-                e.state,
-                m.len(),
-                m.buckets
-            ))
-        })?;
-        out[s * values + code] = choice(&e.choice)
+        let met = match (goals, &e.goals_met) {
+            (None, None) => 0,
+            (None, Some(_)) => {
+                return err(
+                    "options_policy has an entry with goals_met, but the document has no goals"
+                        .into(),
+                );
+            }
+            (Some(_), None) => {
+                return err(format!(
+                    "options_policy has an entry for state {} without goals_met; a policy with \
+                     goals gives the goals met in each entry",
+                    e.state
+                ));
+            }
+            (Some(g), Some(list)) => g.progress.encode(list).ok_or_else(|| {
+                Error::Policy(format!(
+                    "options_policy gives state {} the goals met {list:?}, which are not \
+                     indices of its {} goals",
+                    e.state,
+                    g.progress.goals()
+                ))
+            })?,
+        };
+        out[(s * values + code) * codes + met] = choice(&e.choice)
             .ok_or_else(|| Error::Policy(format!("options_policy chooses unknown {}", e.choice)))?;
     }
-    if let Some(obs) = (0..out.len())
-        .find(|&obs| out[obs] == usize::MAX && m.consistent(obs / values, obs % values))
-    {
-        return Err(Error::Policy(format!(
-            "options_policy does not cover state index {} with memory {:?}",
-            obs / values,
-            m.decode(obs % values)
-        )));
+    let possible = |obs: usize| {
+        memory.is_none_or(|m| m.consistent(obs / (values * codes), obs / codes % values))
+    };
+    if let Some(obs) = (0..out.len()).find(|&obs| out[obs] == usize::MAX && possible(obs)) {
+        let memory = memory.map(|m| format!(" with memory {:?}", m.decode(obs / codes % values)));
+        let goals = goals.map(|g| format!(" with goals met {:?}", g.progress.decode(obs % codes)));
+        return err(format!(
+            "options_policy does not cover state index {}{}{}",
+            obs / (values * codes),
+            memory.unwrap_or_default(),
+            goals.unwrap_or_default()
+        ));
     }
     Ok(out)
 }

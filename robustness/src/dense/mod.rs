@@ -343,6 +343,13 @@ impl DenseFormula {
         offline::evaluate(self, &rows, true)
     }
 
+    /// The complete end ([`DenseFormula::complete_signal`]) of a trace whose last stamp is
+    /// `t_last`, bit for bit, without a trace: what an online monitor over complete windows
+    /// cuts at.
+    pub fn complete_end(&self, t_last: f64) -> f64 {
+        offline::complete_end_of(self, t_last)
+    }
+
     /// The robustness at the trace's first stamp.
     pub fn robustness(&self, trace: &DenseTrace) -> Result<f64, DenseError> {
         Ok(self.signal(trace)?.first())

@@ -207,6 +207,18 @@ pub(crate) fn evaluate(
     }
 }
 
+/// The root's complete end over a trace whose last stamp is `t_last`: what [`evaluate`]
+/// returns beside the signal with `complete`, without computing the signal (an
+/// expression node's end is `t_last`, as its operands' are).
+pub(crate) fn complete_end_of(df: &DenseFormula, t_last: f64) -> f64 {
+    let nodes = df.formula.nodes();
+    let mut ends = vec![t_last; nodes.len()];
+    for (i, node) in nodes.iter().enumerate() {
+        ends[i] = complete_end(node, &ends, df.bounds[i], t_last);
+    }
+    ends.last().copied().unwrap_or(t_last)
+}
+
 /// The complete end of formula node `node` (interval `(a, b)`), given its operands'
 /// `ends`: the last time whose windows lie inside them, each window end one IEEE
 /// subtraction as a breakpoint is.

@@ -595,6 +595,13 @@ impl DenseMonitor {
         self.row()
     }
 
+    /// The first and the last stamp pushed since the trace began, in the times of the
+    /// change points (relative to [`DenseMonitor::origin`] for whole-number stamps); `None`
+    /// before the first row.
+    pub fn span(&self) -> Option<(f64, f64)> {
+        (!self.t0.is_nan()).then_some((self.t0, self.x))
+    }
+
     /// The first whole-number stamp, when rows have whole-number stamps.
     pub fn origin(&self) -> Option<i128> {
         self.rows.origin()

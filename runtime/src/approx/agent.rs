@@ -10,7 +10,7 @@
 use hstl_robustness::{StateEval, Trace};
 
 use super::learn::{Model, Weights};
-use super::progress::GoalTracker;
+use crate::progress::GoalTracker;
 use crate::spec::Switch;
 use crate::{Error, Rng, TaskSpec, World};
 
@@ -35,6 +35,40 @@ pub struct GreedyRun {
     pub actions: Vec<usize>,
     /// The option running at each step.
     pub options: Vec<usize>,
+}
+
+/// Where a greedy run driven from outside is ([`ApproxAgent::stepper`]): each
+/// [`Stepper::act`] is told the state the previous action led to, and the actions are those
+/// [`ApproxAgent::run`] takes through the same states.
+#[derive(Clone, Debug, Default)]
+pub struct Stepper {
+    cur: Cursor,
+    eval: StateEval,
+    started: bool,
+}
+
+impl Stepper {
+    /// The greedy action in the state of valuation `x` and the option running it; `blocked`
+    /// says which actions the world blocks there (empty: none). The first call starts the
+    /// run at `x`; each later one takes `x` as the state the previous action led to.
+    pub fn act(&mut self, agent: &ApproxAgent, x: &[f64], blocked: &[bool]) -> (usize, usize) {
+        let Stepper { cur, eval, started } = self;
+        if *started {
+            let leg_ended = agent.observe(eval, cur, x);
+            agent.record(cur, x, leg_ended);
+        } else {
+            agent.model.start_counters(eval, x, &mut cur.tau);
+            cur.goals.start(x);
+            if let Some(progress) = &agent.model.progress {
+                cur.goals.read(progress);
+            }
+            *started = true;
+        }
+        cur.blocked.clear();
+        cur.blocked
+            .extend((0..agent.model.actions).map(|a| blocked.get(a).copied().unwrap_or(false)));
+        agent.act(eval, cur, x)
+    }
 }
 
 /// How well a greedy agent keeps a persistent task.
@@ -113,6 +147,12 @@ impl ApproxAgent {
             out.options.push(option);
         }
         out
+    }
+
+    /// A greedy run one step at a time, for a caller that steps the world itself (a
+    /// gymnasium environment): see [`Stepper`].
+    pub fn stepper(&self) -> Stepper {
+        Stepper::default()
     }
 
     fn act(&self, eval: &mut StateEval, cur: &mut Cursor, x: &[f64]) -> (usize, usize) {

@@ -35,8 +35,8 @@ use hstl_robustness::segment::SegmentScorer;
 use hstl_robustness::{Formula, StateEval, Trace};
 use rand::RngExt;
 
-use super::progress::{GoalTracker, Progress};
 use super::tiles::TileCoder;
+use crate::progress::{GoalTracker, Progress};
 use crate::spec::{LevelParams, RewardKind, Terminate, TileParams};
 use crate::{Error, Rng, TaskSpec, World};
 
@@ -544,7 +544,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         // one option it has nothing to learn).
         let hold = match &self.model.progress {
             Some(p) if self.model.legs.len() > 1 => {
-                super::progress::run_steps(&self.spec.task).map(|n| (p.all_met(), n - 1))
+                Some((p.all_met(), crate::progress::run_steps(&self.spec.task) - 1))
             }
             _ => None,
         };

@@ -9,8 +9,8 @@
 //!   `rho(reach, s')`, as the tabular learner's) and one for the options level over a
 //!   coarser tiling and the task memory's buckets; intra-option updates of every suffix,
 //!   epsilon-greedy at both levels, `reward: window`, `avoid:`.
-//! - [`progress`]: which goals of a task that is not persistent a run has met, seen by the
-//!   options level beside the state.
+//! - task progress ([`crate::progress`]): which goals of a task that is not persistent a
+//!   run has met, seen by the options level beside the state.
 //! - [`agent`]: the greedy policy, greedy runs as data, the window and satisfaction rates.
 //!
 //! Nothing here names a state index, a table or a grid: a state is the world's own value,
@@ -19,10 +19,8 @@
 
 pub mod agent;
 pub mod learn;
-pub mod progress;
 pub mod tiles;
 
-pub use agent::{ApproxAgent, GreedyRun, WindowSummary, task_robustness};
+pub use agent::{ApproxAgent, GreedyRun, Stepper, WindowSummary, task_robustness};
 pub use learn::{ApproxLearner, Model, Weights};
-pub use progress::Progress;
 pub use tiles::TileCoder;

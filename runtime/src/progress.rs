@@ -16,7 +16,7 @@
 
 use hstl_robustness::offline::Evaluator;
 use hstl_robustness::segment::SegmentScorer;
-use hstl_robustness::{Formula, Node, NodeId};
+use hstl_robustness::{Formula, Node, NodeId, Trace};
 
 /// At most this many goals are tracked (the options level's weights double with each).
 pub const MAX_GOALS: usize = 4;
@@ -25,14 +25,18 @@ pub const MAX_GOALS: usize = 4;
 /// this many (what `eval` and `study` judge it over, and what training holds to).
 pub const MAX_RUN_STEPS: usize = 100_000;
 
+/// The steps a greedy run of a task without a horizon (`always !R`) lasts, as a persistent
+/// task's runs do ([`crate::eval::WindowConfig`]'s default).
+pub const UNBOUNDED_RUN_STEPS: usize = 2000;
+
 /// The steps a greedy run of `task` (not persistent) lasts: its horizon and one, at most
-/// [`MAX_RUN_STEPS`]; `None` for an unbounded task.
-pub fn run_steps(task: &Formula) -> Option<usize> {
-    task.horizon().map(|h| h.saturating_add(1).min(MAX_RUN_STEPS))
+/// [`MAX_RUN_STEPS`]; [`UNBOUNDED_RUN_STEPS`] for an unbounded task.
+pub fn run_steps(task: &Formula) -> usize {
+    task.horizon().map_or(UNBOUNDED_RUN_STEPS, |h| h.saturating_add(1).min(MAX_RUN_STEPS))
 }
 
 /// The goals of a task and the rest of the task once some are met.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Progress {
     /// The goals, in conjunct order, each with its horizon (`None`: unbounded).
     goals: Vec<(Formula, Option<usize>)>,
@@ -102,6 +106,21 @@ impl Progress {
     /// What is left of the task once the goals in `mask` are met (`None`: nothing).
     pub fn rest(&self, mask: usize) -> Option<&Formula> {
         self.rest.get(mask).and_then(Option::as_ref)
+    }
+
+    /// The goals, in conjunct order.
+    pub fn goal_formulas(&self) -> impl Iterator<Item = &Formula> {
+        self.goals.iter().map(|(g, _)| g)
+    }
+
+    /// The goals in `mask`, by their index in conjunct order.
+    pub fn decode(&self, mask: usize) -> Vec<usize> {
+        (0..self.goals.len()).filter(|j| mask & (1 << j) != 0).collect()
+    }
+
+    /// The mask of the goals listed by index; `None` when an index is not a goal's.
+    pub fn encode(&self, met: &[usize]) -> Option<usize> {
+        met.iter().try_fold(0, |mask, &j| (j < self.goals.len()).then_some(mask | (1 << j)))
     }
 
     /// A segment scorer for each progress code.
@@ -175,6 +194,62 @@ impl GoalTracker {
     /// The goals met when last read (a [`Progress`] mask).
     pub fn met(&self) -> usize {
         self.met
+    }
+}
+
+/// The goals of a task over a world of numbered states: its [`Progress`] and every state's
+/// valuation, which the tabular learner and a greedy agent over state indices read goals
+/// from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateGoals {
+    /// The task's goals.
+    pub progress: Progress,
+    /// `rows[s * vars ..][.. vars]`: state `s`'s valuation, in the spec's variable order.
+    rows: Vec<f64>,
+    vars: usize,
+}
+
+impl StateGoals {
+    /// The goals of `task` over the states whose valuations are the rows of `states`, or
+    /// `None` when the task has none.
+    pub fn of_task(task: &Formula, states: &Trace) -> Option<StateGoals> {
+        let progress = Progress::of_task(task)?;
+        let vars = states.vars();
+        let mut rows = Vec::with_capacity(states.len() * vars);
+        let mut row = Vec::with_capacity(vars);
+        for s in 0..states.len() {
+            states.row_into(s, &mut row);
+            rows.extend_from_slice(&row);
+        }
+        Some(StateGoals { progress, rows, vars })
+    }
+
+    /// The valuation of state `s` (empty past the last state).
+    pub fn row(&self, s: usize) -> &[f64] {
+        self.rows.get(s * self.vars..(s + 1) * self.vars).unwrap_or(&[])
+    }
+
+    /// The number of progress codes.
+    pub fn codes(&self) -> usize {
+        self.progress.codes()
+    }
+
+    /// Starts `tracker` on a run in state `s` and reads the goals met there.
+    pub fn start(&self, tracker: &mut GoalTracker, s: usize) -> usize {
+        tracker.start(self.row(s));
+        tracker.read(&self.progress)
+    }
+
+    /// Moves `tracker` on to state `s`.
+    pub fn push(&self, tracker: &mut GoalTracker, s: usize) {
+        tracker.push(self.row(s));
+    }
+}
+
+impl PartialEq for GoalTracker {
+    /// The same run and the same goals met (the evaluator is a cache).
+    fn eq(&self, other: &GoalTracker) -> bool {
+        (&self.columns, self.met, self.given_up) == (&other.columns, other.met, other.given_up)
     }
 }
 

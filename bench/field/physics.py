@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""The reward's cost on physics: `hstl.STLReward` on gymnasium's MuJoCo environments.
+
+For each environment, in one run: the time of a step of the bare environment, of the same
+environment wrapped in `STLReward` (a small STL task over its observations), and of the bare
+step plus rtamt's online monitor computing the same task's robustness (the reference).
+CPU time of the process (time.process_time: the machine is shared). Random actions from one seeded generator, episodes of --episode-steps steps, --steps steps a
+repeat; the figure is the median over --repeats repeats, the three setups interleaved in
+each repeat so that load changes hit them alike. Writes out/physics.csv.
+
+Goal (issue 27): the STL reward adds at most 2% to a step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+
+import gymnasium
+import numpy as np
+
+import hstl
+from common import OUT, SPECS, machine, write_csv
+
+# Each task over the observation's entries (gymnasium's documented observation layout): the
+# spec file for hstl, and rtamt's online form of the same task. rtamt's online monitor takes
+# past-time formulas (its `update` returns the value at the newest step), so the future
+# windows are read backwards: `always[0..] eventually[0..=N] R` as `historically once[0,N] R`,
+# the task's verdict on the prefix so far, what STLReward keeps in `info["task_robustness"]`.
+TASKS = {
+    # obs[1] is the pole's angle (rad): stay upright (within 0.2 rad, InvertedPendulum's own
+    # limit) and visit both sides of the rail's middle (obs[0], the cart) every 100 steps.
+    "InvertedPendulum-v5": ("inverted_pendulum.hstl", {"cart": 0, "angle": 1},
+                            "(historically((angle < 0.2) and (angle > -0.2))) and "
+                            "(historically((once[0,100](cart > 0.0)) and (once[0,100](cart < 0.0))))"),
+    # obs[0] is the torso's height (z), obs[8] its forward speed: the height in a band at
+    # every step, and forward speed above 1 within every 50 steps.
+    "HalfCheetah-v5": ("half_cheetah.hstl", {"z": 0, "vx": 8},
+                       "(historically((z < 0.5) and (z > -0.5))) and (historically(once[0,50](vx > 1.0)))"),
+}
+
+
+class Columns:
+    """The state variables as the observation's entries, in `spec.state_vars` order (a numpy
+    array: the cheapest form `STLReward` reads)."""
+
+    def __init__(self, columns: list[int]) -> None:
+        self.columns = np.array(columns)
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        return obs[self.columns]
+
+
+class Passthrough(gymnasium.Wrapper):
+    """A wrapper that does nothing: the floor of any Python wrapper's cost per step."""
+
+    def step(self, action):
+        return self.env.step(action)
+
+
+def push_alone(spec, columns, observations):
+    """CPU seconds per step of the monitor alone (`EpisodeMonitor.push`, what STLReward calls
+    into Rust) on recorded observations."""
+    from hstl._hstl import EpisodeMonitor
+
+    monitor = EpisodeMonitor(spec)
+    pick = Columns(columns)
+    t0 = time.process_time()
+    for o in observations:
+        monitor.push(pick(o))
+    return (time.process_time() - t0) / len(observations)
+
+
+def run_manual(env, actions, steps, episode, spec, columns):
+    """The bare step and the monitor's push, no wrapper: what the push costs between MuJoCo
+    steps (more than alone: the two share the core's caches)."""
+    from hstl._hstl import EpisodeMonitor
+
+    monitor = EpisodeMonitor(spec)
+    pick = Columns(columns)
+    env.reset(seed=0)
+    t0 = time.process_time()
+    for i in range(steps):
+        monitor.push(pick(env.step(actions[i])[0]))
+        if (i + 1) % episode == 0:
+            env.reset()
+            monitor.reset()
+    return (time.process_time() - t0) / steps
+
+
+def rtamt_monitor(formula: str, names: list[str]):
+    import rtamt
+
+    spec = rtamt.StlDiscreteTimeSpecification()
+    for n in names:
+        spec.declare_var(n, "float")
+    spec.spec = formula
+    spec.parse()
+    return spec
+
+
+def run_bare(env, actions, steps, episode):
+    env.reset(seed=0)
+    t0 = time.process_time()
+    for i in range(steps):
+        env.step(actions[i])
+        if (i + 1) % episode == 0:
+            env.reset()
+    return (time.process_time() - t0) / steps
+
+
+def run_rtamt(env, actions, steps, episode, formula, picks):
+    names = list(picks)
+    spec = rtamt_monitor(formula, names)
+    obs, _ = env.reset(seed=0)
+    t = 0
+    t0 = time.process_time()
+    for i in range(steps):
+        obs, *_ = env.step(actions[i])
+        spec.update(t, [(n, float(obs[k])) for n, k in picks.items()])
+        t += 1
+        if (i + 1) % episode == 0:
+            env.reset()
+            spec.reset()
+            t = 0
+    return (time.process_time() - t0) / steps
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=20000)
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--episode-steps", type=int, default=1000)
+    ap.add_argument("--envs", default=",".join(TASKS))
+    ap.add_argument("--no-rtamt", action="store_true")
+    args = ap.parse_args()
+    print(f"machine: {machine()}; {args.steps} random steps a repeat, median of {args.repeats} repeats, "
+          f"episodes of {args.episode_steps} steps\n")
+    print("| environment | bare, us/step | + STLReward, us/step | STLReward adds | + rtamt online monitor, us/step | rtamt adds | goal <= 2% | an empty wrapper adds | the monitor's push alone, us | push between bare steps adds, us |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
+    for env_id in args.envs.split(","):
+        file, picks, rtamt_formula = TASKS[env_id]
+        spec = hstl.Spec.load(SPECS / file)
+        bare = gymnasium.make(env_id, max_episode_steps=None).unwrapped
+        columns = list(picks.values())
+        wrapped = hstl.STLReward(gymnasium.make(env_id).unwrapped, spec, valuation=Columns(columns))
+        rng = np.random.default_rng(0)
+        space = bare.action_space
+        actions = rng.uniform(space.low, space.high, size=(max(args.steps, 5000),) + space.shape).astype(space.dtype)
+        # Warm up each (imports, caches).
+        run_bare(bare, actions, 1000, args.episode_steps)
+        run_bare(wrapped, actions, 1000, args.episode_steps)
+        empty = Passthrough(gymnasium.make(env_id).unwrapped)
+        recorded = []
+        bare.reset(seed=0)
+        for a in actions[:5000]:
+            recorded.append(bare.step(a)[0])
+        times = {"bare": [], "stl": [], "rtamt": [], "empty": [], "push": [], "manual": []}
+        for _ in range(args.repeats):
+            times["bare"].append(run_bare(bare, actions, args.steps, args.episode_steps))
+            times["stl"].append(run_bare(wrapped, actions, args.steps, args.episode_steps))
+            times["empty"].append(run_bare(empty, actions, args.steps, args.episode_steps))
+            times["push"].append(push_alone(spec, columns, recorded))
+            times["manual"].append(run_manual(bare, actions, args.steps, args.episode_steps, spec, columns))
+            if not args.no_rtamt:
+                times["rtamt"].append(run_rtamt(bare, actions, args.steps, args.episode_steps, rtamt_formula, picks))
+        med = {k: statistics.median(v) * 1e6 for k, v in times.items() if v}
+        # The overhead within each repeat (paired), then its median: steadier under load.
+        paired = [s / b - 1 for s, b in zip(times["stl"], times["bare"])]
+        added = statistics.median(paired)
+        r_added = statistics.median([r / b - 1 for r, b in zip(times["rtamt"], times["bare"])]) if times["rtamt"] else float("nan")
+        met = "met" if added <= 0.02 else "not met"
+        e_added = statistics.median([e / b - 1 for e, b in zip(times["empty"], times["bare"])])
+        print(f"| {env_id} | {med['bare']:.1f} | {med['stl']:.1f} | {100 * added:+.1f}% (repeats {min(paired) * 100:+.1f}% to {max(paired) * 100:+.1f}%) "
+              f"| {med.get('rtamt', float('nan')):.1f} | {100 * r_added:+.0f}% | {met} | {100 * e_added:+.1f}% | {med['push']:.2f} | {med['manual'] - med['bare']:.1f} |", flush=True)
+        rows.append([env_id, args.steps, args.repeats, med["bare"], med["stl"], added, min(paired), max(paired),
+                     med.get("rtamt", float("nan")), r_added, e_added, med["push"], med["manual"] - med["bare"], machine()])
+        bare.close()
+        wrapped.close()
+    write_csv(OUT / "physics.csv", ["env", "steps", "repeats", "bare_us", "stlreward_us", "stlreward_added",
+                                     "added_min", "added_max", "rtamt_us", "rtamt_added", "empty_wrapper_added", "push_us", "push_between_steps_us", "machine"], rows)
+    print(f"\nwrote {OUT / 'physics.csv'}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
