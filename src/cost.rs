@@ -37,6 +37,13 @@ pub fn sizes<E: Env>(spec: &TaskSpec, env: &E) -> Sizes {
         .chain(spec.options.iter().map(|o| o.name.len()));
     let actions = env.actions();
     let name_text = names.chain(actions.iter().map(String::len)).max().unwrap_or(0).max(5) as u64;
+    // The goals the options level of a task that is not persistent tracks (the learner's
+    // own count).
+    let goals = if spec.regions.is_empty() {
+        hstl_runtime::progress::Progress::of_task(&spec.task).map_or(0, |p| p.goals() as u64)
+    } else {
+        0
+    };
     let windows = if spec.regions.is_empty() {
         0
     } else {
@@ -50,6 +57,7 @@ pub fn sizes<E: Env>(spec: &TaskSpec, env: &E) -> Sizes {
         options: spec.options.len() as u64,
         regions,
         values,
+        goals,
         state_text,
         name_text,
         windows,
@@ -67,12 +75,13 @@ pub fn check<E: Env>(spec: &TaskSpec, env: &E) -> Result<Cost, Problem> {
     }
     Err(Problem::new(
         format!(
-            "`{run}` of `{}` on {} would take about {} ({} states x {} memory values x {} options, and `policy.json` of {}), more than the {} memory budget",
+            "`{run}` of `{}` on {} would take about {} ({} states x {} memory values{} x {} options, and `policy.json` of {}), more than the {} memory budget",
             spec.name,
             env.name(),
             bytes_words(peak),
             s.states,
             s.values,
+            budget::goal_words(&s),
             s.options,
             bytes_words(cost.policy_bytes),
             bytes_words(MEMORY_BUDGET)

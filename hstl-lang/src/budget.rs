@@ -182,6 +182,10 @@ pub const OPTIMUM_BYTES: u64 = 1 << 30;
 /// The grid worlds' action count (`Up`, `Down`, `Left`, `Right`).
 pub const GRID_ACTIONS: u64 = 4;
 
+/// At most this many goals are tracked by the options level of a task that is not
+/// persistent (the runtime's `hstl_runtime::progress::MAX_GOALS`).
+pub const MAX_GOALS: u64 = 4;
+
 /// The sizes the tabular learner's memory grows with: what [`cost`] reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Sizes {
@@ -199,6 +203,10 @@ pub struct Sizes {
     pub regions: u64,
     /// Memory values `(B + 1)^k` (1 without memory).
     pub values: u64,
+    /// Goals the options level of a task that is not persistent tracks, at most
+    /// [`MAX_GOALS`] (0 for a persistent task, or one without goals): its table and its
+    /// `options_policy` hold `2^goals` rows per observation.
+    pub goals: u64,
     /// Bytes of the longest state as `policy.json` writes it (`{"x": 12, "y": 14}`).
     pub state_text: u64,
     /// Bytes of the longest option or action name.
@@ -260,28 +268,43 @@ pub fn cost(s: &Sizes) -> Cost {
     let m = |a: u64, b: u64| a.saturating_mul(b);
     let add = |parts: &[u64]| parts.iter().fold(0u64, |a, &b| a.saturating_add(b));
     let (n, p, o) = (s.states, s.primitives, s.options);
-    let observations = m(n, s.values);
+    let goals = s.goals.min(MAX_GOALS);
+    // The options level observes the state, the memory's value and the goals met.
+    let observations = m(m(n, s.values), 1 << goals);
     let with_memory = s.regions > 0;
     // A state: its shared names' handle and its values' box, and their allocation.
     let state = 32 + allocation(8 * s.vars);
-    // An entry: the state, the buckets, the choice's name, and their allocations.
-    let entry = state + 48 + allocation(s.name_text);
-    let memory_entry = entry + allocation(8 * s.regions);
-    // As written: indent, keys and punctuation, the state, the buckets, the name.
+    // An entry: the state, the buckets, the goals met, the choice's name, and their
+    // allocations (the goals met grow as pushed: room for 4 at least).
+    let entry = state + 72 + allocation(s.name_text);
+    let options_entry = add(&[
+        entry,
+        if with_memory { allocation(8 * s.regions) } else { 0 },
+        if goals > 0 { allocation(8 * goals.max(4)) } else { 0 },
+    ]);
+    // As written: indent, keys and punctuation, the state, the buckets, the goals met,
+    // the name.
     let text_entry = 36 + s.state_text + s.name_text;
-    let text_memory_entry = text_entry + 14 + 4 * s.regions;
+    let text_options_entry = add(&[
+        text_entry,
+        if with_memory { 14 + 4 * s.regions } else { 0 },
+        if goals > 0 { 17 + 3 * goals } else { 0 },
+    ]);
     let text_value = 20;
     let q_values = add(&[m(m(n, s.actions), p), m(observations, o)]);
-    let options_entries = if with_memory { observations } else { n };
+    let options_entries = if with_memory || goals > 0 { observations } else { n };
+    // Every state's valuation, which the goals are read from: the learner's and each
+    // agent's copy.
+    let goal_rows = if goals > 0 { m(n, 8 * s.vars) } else { 0 };
     let policy_bytes = add(&[
-        m(options_entries, if with_memory { text_memory_entry } else { text_entry }),
+        m(options_entries, text_options_entry),
         // Flat policies, termination sets and the memory's region states: a state each.
         m(m(n, p), text_entry),
         m(m(n, p + s.regions), s.state_text + 2),
         m(q_values, text_value),
     ]);
     let document = add(&[
-        m(options_entries, if with_memory { memory_entry } else { entry }),
+        m(options_entries, options_entry),
         m(m(n, p), entry),
         // Termination sets, the memory's region states, and the states listed once.
         m(m(n, p + s.regions + 1), state),
@@ -294,13 +317,15 @@ pub fn cost(s: &Sizes) -> Cost {
         m(m(observations, o), 8),
         // The memory's region states.
         m(n, s.regions),
+        goal_rows,
     ]);
-    let agent = add(&[m(observations, 8), m(n, 9 * p), m(m(observations, o), 8)]);
+    let agent = add(&[m(observations, 8), m(n, 9 * p), m(m(observations, o), 8), goal_rows]);
     let text = policy_bytes;
     // The text is written into a buffer that doubles as it grows: at most twice the text,
     // and the half it moves out of while it grows.
     let train = add(&[learner, agent, document, m(text, 3), FIXED_BYTES]);
-    let load = add(&[text, m(document, 2), learner, m(agent, 2), FIXED_BYTES]);
+    // With goals, the replay reads the valuations once more to find them.
+    let load = add(&[text, m(document, 2), learner, m(agent, 2), goal_rows, FIXED_BYTES]);
     // The solver's own limit: its tables are refused past it, before they are allocated.
     let optimum = if s.windows == 0 { 0 } else { OPTIMUM_BYTES };
     Cost {
@@ -311,6 +336,15 @@ pub fn cost(s: &Sizes) -> Cost {
         train,
         load,
         evaluate: load.saturating_add(optimum),
+    }
+}
+
+/// ` x 4 sets of goals met` for a task whose options level tracks 2 goals; empty without
+/// goals.
+pub fn goal_words(s: &Sizes) -> String {
+    match s.goals.min(MAX_GOALS) {
+        0 => String::new(),
+        g => format!(" x {} sets of goals met", 1u64 << g),
     }
 }
 
@@ -352,6 +386,7 @@ pub fn spec_sizes(src: &str, out: &CheckedSpec) -> Option<Sizes> {
     let names =
         out.primitives.iter().map(|p| p.name.len()).chain(out.options.iter().map(|o| o.name.len()));
     let name_text = names.max().unwrap_or(0).max(5) as u64;
+    let goals = if conjuncts.is_some() { 0 } else { goals_at_most(out) };
     let windows =
         conjuncts.map_or(0, |c| c.iter().fold(1u64, |a, c| a.saturating_mul(c.steps.max(1))));
     Some(Sizes {
@@ -362,10 +397,138 @@ pub fn spec_sizes(src: &str, out: &CheckedSpec) -> Option<Sizes> {
         options: out.options.len() as u64,
         regions,
         values,
+        goals,
         state_text,
         name_text,
         windows,
     })
+}
+
+/// At most the goals the runtime finds in the task of a spec that is not persistent (its
+/// `hstl_runtime::progress::Progress`): the top-level conjuncts (of the task, or of the
+/// `let` it names) other than state formulas and `always`, at most [`MAX_GOALS`]. A goal
+/// is monotone with an `eventually`; counting more conjuncts only makes the model larger.
+fn goals_at_most(out: &CheckedSpec) -> u64 {
+    (goal_candidates(out).len() as u64).min(MAX_GOALS)
+}
+
+/// The top-level conjuncts of the task (or of the `let` it names) that may be goals: all
+/// but state formulas and `always`.
+fn goal_candidates(out: &CheckedSpec) -> Vec<&crate::checked::CFormula> {
+    use crate::checked::{CFormula, CFormulaKind};
+    fn through_lets<'a>(out: &'a CheckedSpec, mut f: &'a CFormula) -> &'a CFormula {
+        // A chain of lets is at most as long as the lets (a cycle was an error).
+        for _ in 0..=out.lets.len() {
+            match &f.kind {
+                CFormulaKind::Let(i) => match out.lets.get(*i) {
+                    Some(l) => f = &l.formula,
+                    None => break,
+                },
+                _ => break,
+            }
+        }
+        f
+    }
+    let Some(task) = &out.task else { return Vec::new() };
+    let root = through_lets(out, &task.formula);
+    let parts: Vec<&CFormula> = match &root.kind {
+        CFormulaKind::And(parts) => parts.iter().collect(),
+        _ => vec![root],
+    };
+    parts
+        .into_iter()
+        .filter(|p| {
+            !out.is_state_formula(p)
+                && !matches!(through_lets(out, p).kind, CFormulaKind::Always(..))
+        })
+        .collect()
+}
+
+/// The longest text of one goal `policy.json` holds (the runtime's
+/// `hstl_runtime::progress::MAX_GOAL_TEXT`): the goals are written out as formulas, every
+/// `let` inside them in full wherever it is used.
+pub const MAX_GOAL_TEXT: u64 = 1 << 20;
+
+/// `HSTL084` when a goal of a task that is not persistent, written out in full as
+/// `policy.json` holds it, could be longer than [`MAX_GOAL_TEXT`] (a `let` used twice in
+/// each of many nested lets doubles with each): counted from above, saturating, over the
+/// lets once each.
+pub(crate) fn goal_text(src: &str, out: &CheckedSpec) -> Option<Diagnostic> {
+    if out.primitives.is_empty() || out.is_continuous() || out.persistent_conjuncts(src).is_some() {
+        return None;
+    }
+    let candidates = goal_candidates(out);
+    if candidates.is_empty() {
+        return None;
+    }
+    let mut lets = vec![u64::MAX; out.lets.len()];
+    for &i in &out.let_order {
+        if let Some(l) = out.lets.get(i) {
+            lets[i] = formula_text(&l.formula, &lets);
+        }
+    }
+    let (at, bytes) = candidates
+        .iter()
+        .map(|c| (c.range.clone(), formula_text(c, &lets)))
+        .find(|&(_, b)| b > MAX_GOAL_TEXT)?;
+    Some(
+        Diagnostic::new(
+            "HSTL084",
+            at,
+            format!(
+                "this goal, written out in full as `policy.json` holds it, could take {} (each `let` in it is written wherever it is used), more than the {} a goal may",
+                if bytes == u64::MAX { "more than 16 EiB".to_string() } else { bytes_words(bytes) },
+                bytes_words(MAX_GOAL_TEXT)
+            ),
+        )
+        .with_help("write the goal with fewer nested lets, or lets that do not use the same let twice"),
+    )
+}
+
+/// The bytes of `f` as the runtime writes it, at most: every node with parentheses, its
+/// lets' bytes `lets[i]` (`u64::MAX` for one not counted), saturating. Recursive over one
+/// formula, whose height the parser bounds.
+fn formula_text(f: &crate::checked::CFormula, lets: &[u64]) -> u64 {
+    use crate::checked::CFormulaKind as K;
+    let sum = |parts: &[u64]| parts.iter().fold(0u64, |a, &b| a.saturating_add(b));
+    // An interval: `[`, two numbers of at most 20 digits, `..=`, `]`.
+    let interval = 45;
+    let own = match &f.kind {
+        K::True | K::False => 5,
+        K::Invalid => 0,
+        K::Let(i) => lets.get(*i).copied().unwrap_or(u64::MAX),
+        K::Cmp(_, a, b) => sum(&[expr_text(a), expr_text(b), 4]),
+        K::Not(a) => sum(&[1, formula_text(a, lets)]),
+        K::And(v) | K::Or(v) => {
+            let parts: Vec<u64> = v.iter().map(|g| formula_text(g, lets)).collect();
+            sum(&parts).saturating_add(4u64.saturating_mul(v.len() as u64))
+        }
+        K::Implies(a, b) => sum(&[formula_text(a, lets), formula_text(b, lets), 4]),
+        K::Always(_, a) | K::Eventually(_, a) | K::Once(_, a) | K::Historically(_, a) => {
+            sum(&[13 + interval, formula_text(a, lets)])
+        }
+        K::Until(_, a, b) | K::Since(_, a, b) => {
+            sum(&[8 + interval, formula_text(a, lets), formula_text(b, lets)])
+        }
+        K::Prev(a) | K::Next(a) => sum(&[5, formula_text(a, lets)]),
+    };
+    own.saturating_add(2)
+}
+
+/// The bytes of `e` as the runtime writes it, at most (see [`formula_text`]).
+fn expr_text(e: &crate::checked::CExpr) -> u64 {
+    use crate::checked::CExprKind as K;
+    let own = match &e.kind {
+        K::Const(c) => (format!("{c}").len() as u64).max(7),
+        K::Var(i) => 1 + i.to_string().len() as u64,
+        K::Invalid => 0,
+        K::Neg(a) => 1 + expr_text(a),
+        K::Abs(a) | K::Sqrt(a) => 6 + expr_text(a),
+        K::Add(a, b) | K::Sub(a, b) | K::Mul(a, b) | K::Div(a, b) => {
+            expr_text(a).saturating_add(expr_text(b)).saturating_add(3)
+        }
+    };
+    own.saturating_add(2)
 }
 
 /// `HSTL084` when the runs of a spec would take more than [`MEMORY_BUDGET`] by [`cost`]'s
@@ -389,9 +552,10 @@ pub(crate) fn memory(
             .map_or(l.range.clone(), |p| p.range.clone())
     });
     let what = format!(
-        "{} states x {} memory values x {} options, and `policy.json` of {}",
+        "{} states x {} memory values{} x {} options, and `policy.json` of {}",
         thousands(sizes.states),
         thousands(sizes.values),
+        goal_words(&sizes),
         sizes.options,
         bytes_words(c.policy_bytes)
     );

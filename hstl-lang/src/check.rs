@@ -478,6 +478,11 @@ impl Cx<'_> {
         {
             self.push(d);
         }
+        if self.error_count() == 0
+            && let Some(d) = crate::budget::goal_text(self.src, &out)
+        {
+            self.push(d);
+        }
         self.mark_used(&mut out);
         // A broken item or an invalid part may have used any let: stay quiet then.
         if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {

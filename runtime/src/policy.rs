@@ -284,7 +284,8 @@ impl Policy {
                 choice: spec.options[o].name.clone(),
             })
             .collect();
-        let goals = goals.map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
+        // The learner refused goals too long to write out: this does not fail.
+        let goals = goals.map(|g| g.progress.goal_texts().unwrap_or_default());
         let memory = memory.map(|m| MemoryDoc {
             regions: m.regions.clone(),
             horizons: m.horizons.clone(),
@@ -487,10 +488,7 @@ impl Policy {
         if !memory_same {
             return differs("memory");
         }
-        let goals = theirs
-            .goals
-            .as_ref()
-            .map(|g| g.progress.goal_formulas().map(ToString::to_string).collect::<Vec<_>>());
+        let goals = theirs.goals.as_ref().map(|g| g.progress.goal_texts()).transpose()?;
         if goals != self.goals {
             return differs("goals");
         }
@@ -552,8 +550,7 @@ impl Policy {
         } else {
             None
         };
-        let texts: Option<Vec<String>> =
-            goals.as_ref().map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
+        let texts = goals.as_ref().map(|g| g.progress.goal_texts()).transpose()?;
         if texts != self.goals {
             return Err(Error::Policy(
                 "the document's `goals` are not the goals of the spec it was trained on".into(),
