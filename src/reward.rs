@@ -24,13 +24,17 @@
 //! (the learner's reward); and the **sparse** reward, `rho(formula, 0)` over the episode
 //! at its last state ([`EpisodeMonitor::push_last`]) and 0 before.
 //!
-//! Cost per state: the reward is `O(|formula|)` (the formula on one state, each shared
-//! node once; `O(t |formula|)` with a past-time operator). The task's
+//! Cost per state: everything read off the new state alone (the reward without a
+//! past-time operator, the regions, the state formulas of the task's parts) is one pass
+//! over one flat DAG holding them all, each shared node once, `O(|formula|)`; a reward
+//! with a past-time operator is `O(t |formula|)`. The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
-//! distributes over `&&` (`eventually` over `||`); `always[c..] eventually[J] f` and
+//! distributes over `&&` (`eventually` over `||`); `always[I] f` with `f` a state formula
+//! (a safety conjunct) folds `f`'s value, `O(1)`; `always[c..] eventually[J] f` and
 //! `eventually[c..] always[J] f` with `f` a state formula (the persistent task's parts)
-//! take `O(1)` amortised through the online monitor of the inner operator;
+//! take `O(1)` amortised through a sliding window over `f`'s values
+//! ([`hstl_robustness::WindowStream`], the online monitor's stream of the inner operator);
 //! `always[I] f` and `eventually[I] f` with `f` of finite horizon `h` fold the values of
 //! `f` that are final and evaluate only the last `h` states again, `O(h)` a step; any
 //! other part with a finite horizon `H` is evaluated over the states so far until `H + 1`
@@ -51,7 +55,7 @@
 
 use hstl_lang::CheckedSpec;
 use hstl_robustness::{
-    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor,
+    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, WindowStream,
 };
 
 use std::fmt;
@@ -182,12 +186,22 @@ pub struct EpisodeMonitor {
     /// The states of the episode so far, row after row: what [`EpisodeMonitor::restore`]
     /// replays.
     log: Vec<f64>,
-    /// Scratch values of [`at_state`].
-    scratch: Vec<f64>,
+    /// Every value a push reads off the new state alone (the reward, the regions, the
+    /// parts of `task` and `prefix`), in one pass.
+    program: Program,
+    /// The formulas `program` evaluates, in slot order (each with whether it is folded as
+    /// the offline evaluator folds); the first `base_slots` are the reward's, the
+    /// regions' and the task's, the rest `prefix`'s.
+    slots: Vec<(Formula, bool)>,
+    base_slots: usize,
+    /// The reward's slot, when it is read off the state alone (no past-time operator).
+    reward_slot: Option<usize>,
     /// The states so far, when the reward formula has a past-time operator.
     history: Option<Columns>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
+    /// Each region's slot.
+    region_slots: Vec<usize>,
     /// `tau_j`: steps since region `j` last held, capped at `N_j`.
     tau: Vec<usize>,
     steps: usize,
@@ -241,21 +255,36 @@ enum Part {
         /// The position of the first state in `states`.
         first: usize,
     },
+    /// `always[I] f` (`min`) or `eventually[I] f` (`max`) with `f` a state formula: the
+    /// value of `f` at a position is final when its state arrives, so the fold of those in
+    /// the window is the value, `O(|f|)` a step and nothing kept.
+    Fold {
+        always: bool,
+        /// The positions the window holds in a trace of any length.
+        window: std::ops::Range<usize>,
+        /// The slot of `f` on the last state, as the offline evaluator computes it.
+        body: usize,
+        /// The fold of `f` over the positions so far in the window.
+        settled: f64,
+    },
     /// `always[c..] g` (`min`) or `eventually[c..] g` (`max`), `g` being
     /// `eventually[I] f` or `always[I] f` (the other operator) with `f` a state formula:
     /// the persistent task's shape, `O(1)` amortised a step. The positions whose value of
-    /// `g` is final come from the online monitor of `g`; every other position's window is
-    /// clipped at the end of the trace to a suffix of it, and of those suffixes the
-    /// latest position's (`g` on the last state alone) is the least for `always` over
-    /// `eventually` (the greatest for the dual), so it alone stands for them.
+    /// `g` is final come from the sliding window of `g` over the values of `f` (the online
+    /// monitor's stream of `g`); every other position's window is clipped at the end of
+    /// the trace to a suffix of it, and of those suffixes the latest position's (`g` on the
+    /// last state alone) is the least for `always` over `eventually` (the greatest for the
+    /// dual), so it alone stands for them.
     Stream {
         always: bool,
         /// The outer operator's first offset `c`.
         from: usize,
-        /// `g`, evaluated on the last state alone.
-        body: Formula,
-        /// The online monitor of `g`: its final values, in order.
-        online: Box<OnlineMonitor>,
+        /// The slot of `g` on the last state alone.
+        body: usize,
+        /// The slot of `f` on the last state.
+        inner: usize,
+        /// `g`'s final values, in order.
+        window: WindowStream,
         /// The fold of the final values of `g` at positions from `c` on.
         settled: f64,
     },
@@ -297,8 +326,20 @@ impl EpisodeMonitor {
         let mut scored: Vec<&Formula> = vec![&task, &reward];
         scored.extend(regions.iter().map(|r| &r.0));
         let nan_prone = NanProne::of_all(&scored, &vars);
-        let task = Running::new(&task, vars.len());
-        let scratch = Vec::new();
+        // The slots: every scored formula is evaluated on each state (its comparisons are
+        // the ones a NaN is looked for in), the reward's and the regions' read back.
+        let mut slots: Vec<(Formula, bool)> = vec![(task.clone(), false), (reward.clone(), false)];
+        let reward_slot = (!reward.has_past()).then_some(1);
+        let region_slots = regions
+            .iter()
+            .map(|(f, _)| {
+                slots.push((f.clone(), false));
+                slots.len() - 1
+            })
+            .collect();
+        let task = Running::new(&task, vars.len(), &mut slots);
+        let base_slots = slots.len();
+        let program = Program::new(&slots);
         let history = reward.has_past().then(|| Columns::new(vars.len()));
         Ok(EpisodeMonitor {
             vars,
@@ -308,9 +349,13 @@ impl EpisodeMonitor {
             prefix: None,
             baseline: 0.0,
             log: Vec::new(),
-            scratch,
+            program,
+            slots,
+            base_slots,
+            reward_slot,
             history,
             regions,
+            region_slots,
             tau,
             steps: 0,
             eval: Evaluator::new(),
@@ -339,9 +384,15 @@ impl EpisodeMonitor {
                 return Err(RewardError::NotPersistent);
             }
             (RewardForm::Increment | RewardForm::Sparse, Some(_)) => {
-                self.prefix = Some(Running::new(&self.reward, self.vars.len()));
+                self.slots.truncate(self.base_slots);
+                self.prefix = Some(Running::new(&self.reward, self.vars.len(), &mut self.slots));
+                self.program = Program::new(&self.slots);
             }
-            _ => self.prefix = None,
+            _ => {
+                self.prefix = None;
+                self.slots.truncate(self.base_slots);
+                self.program = Program::new(&self.slots);
+            }
         }
         self.shaping = shaping;
         self.reset();
@@ -435,32 +486,41 @@ impl EpisodeMonitor {
         if let Some(var) = state.iter().position(|v| v.is_nan()) {
             return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps });
         }
-        self.nan_prone.check_state(state, self.steps)?;
+        // Every comparison of the scored formulas is in the program: only when one of them
+        // is NaN on this state is the state looked at again for the error's words.
+        if self.program.run(state) {
+            self.nan_prone.check_state(state, self.steps)?;
+        }
         self.steps += 1;
         self.log.extend_from_slice(state);
-        let robustness = match &mut self.history {
+        let program = &self.program;
+        let robustness = match (&mut self.history, self.reward_slot) {
             _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
-            Some(history) => {
+            (Some(history), _) => {
                 history.push(state);
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }
-            None => at_state(&self.reward, state, &mut self.scratch),
+            (None, Some(slot)) => program.value(slot),
+            (None, None) => f64::NAN,
         };
         let window_kept = if self.regions.is_empty() {
             None
         } else {
             let mut kept = true;
-            for ((formula, n), tau) in self.regions.iter().zip(&mut self.tau) {
-                let inside = at_state(formula, state, &mut self.scratch) > 0.0;
+            for ((&slot, (_, n)), tau) in
+                self.region_slots.iter().zip(&self.regions).zip(&mut self.tau)
+            {
+                let inside = program.value(slot) > 0.0;
                 *tau = if inside { 0 } else { (*tau + 1).min(*n) };
                 kept &= *tau < *n;
             }
             Some(kept)
         };
-        let task_robustness = self.task.push(state, self.steps, &mut self.eval, &mut self.scratch);
+        let mut ctx = Context { program, eval: &mut self.eval };
+        let task_robustness = self.task.push(state, self.steps, &mut ctx);
         let prefix = match &mut self.prefix {
-            Some(p) => p.push(state, self.steps, &mut self.eval, &mut self.scratch),
+            Some(p) => p.push(state, self.steps, &mut ctx),
             None => task_robustness,
         };
         let value = match self.shaping.form {
@@ -491,7 +551,7 @@ impl Running {
     /// The parts of `f`: its `!`, `&&`, `||` and `->` (and `always` over `&&`, `eventually`
     /// over `||`, which distribute) split down to the parts [`Part::leaf`] shapes, with an
     /// explicit stack, each distinct subformula once.
-    fn new(f: &Formula, vars: usize) -> Running {
+    fn new(f: &Formula, vars: usize, slots: &mut Vec<(Formula, bool)>) -> Running {
         let mut b = FormulaBuilder::new();
         let root = b.formula(f);
         let mut index: std::collections::HashMap<NodeId, usize> = Default::default();
@@ -522,7 +582,7 @@ impl Running {
                 (Node::Or(_) | Node::Eventually(..), Some(gs)) => {
                     Part::Or(gs.iter().map(at).collect())
                 }
-                _ => Part::leaf(&b.build(v), vars),
+                _ => Part::leaf(&b.build(v), vars, slots),
             };
             index.insert(v, parts.len());
             parts.push(part);
@@ -536,15 +596,9 @@ impl Running {
     }
 
     /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them.
-    fn push(
-        &mut self,
-        state: &[f64],
-        n: usize,
-        eval: &mut Evaluator,
-        scratch: &mut Vec<f64>,
-    ) -> f64 {
+    fn push(&mut self, state: &[f64], n: usize, ctx: &mut Context<'_>) -> f64 {
         for k in 0..self.parts.len() {
-            let v = self.parts[k].push(state, n, eval, scratch, &self.values);
+            let v = self.parts[k].push(state, n, ctx, &self.values);
             self.values[k] = v;
         }
         self.values.last().copied().unwrap_or(f64::NAN)
@@ -577,7 +631,7 @@ fn operands(b: &mut FormulaBuilder, v: NodeId) -> Option<Vec<NodeId>> {
 
 impl Part {
     /// The leaf part of `f`, the cheapest shape its form allows.
-    fn leaf(f: &Formula, vars: usize) -> Part {
+    fn leaf(f: &Formula, vars: usize, slots: &mut Vec<(Formula, bool)>) -> Part {
         let whole = || Part::Whole {
             formula: f.clone(),
             horizon: f.horizon(),
@@ -590,11 +644,33 @@ impl Part {
             {
                 let always = matches!(f.root_node(), Node::Always(..));
                 let body = f.sub(*body);
+                let (inner_always, j, inner) = match body.root_node() {
+                    Node::Always(j, g) => (true, *j, body.sub(*g)),
+                    Node::Eventually(j, g) => (false, *j, body.sub(*g)),
+                    _ => return whole(),
+                };
+                let Some(window) = WindowStream::new(inner_always, &j) else { return whole() };
+                slots.push((body, false));
+                slots.push((inner, false));
                 Part::Stream {
                     always,
                     from: interval.start,
-                    online: Box::new(OnlineMonitor::new(&body, vars)),
-                    body,
+                    body: slots.len() - 2,
+                    inner: slots.len() - 1,
+                    window,
+                    settled: identity(always),
+                }
+            }
+            // A state formula's value at a position is final at once.
+            Node::Always(interval, body) | Node::Eventually(interval, body)
+                if f.is_state(*body) && !f.has_past() =>
+            {
+                let always = matches!(f.root_node(), Node::Always(..));
+                slots.push((f.sub(*body), true));
+                Part::Fold {
+                    always,
+                    window: interval.window(0, usize::MAX),
+                    body: slots.len() - 1,
                     settled: identity(always),
                 }
             }
@@ -629,9 +705,9 @@ impl Part {
                 states.clear();
                 *first = 0;
             }
-            Part::Stream { always, online, settled, .. } => {
-                // Ending the trace readies the monitor for a new one.
-                online.finish();
+            Part::Fold { always, settled, .. } => *settled = identity(*always),
+            Part::Stream { always, window, settled, .. } => {
+                window.clear();
                 *settled = identity(*always);
             }
             Part::Not(_) | Part::And(_) | Part::Or(_) | Part::Implies(..) => {}
@@ -640,14 +716,8 @@ impl Part {
 
     /// Takes state number `n - 1` (so `n` states are in) and gives `rho(f, 0)` over them,
     /// as the reference evaluator combines it; `values` holds the earlier parts' values.
-    fn push(
-        &mut self,
-        state: &[f64],
-        n: usize,
-        eval: &mut Evaluator,
-        scratch: &mut Vec<f64>,
-        values: &[f64],
-    ) -> f64 {
+    fn push(&mut self, state: &[f64], n: usize, ctx: &mut Context<'_>, values: &[f64]) -> f64 {
+        let eval = &mut *ctx.eval;
         match self {
             Part::Whole { formula, horizon, states, fixed } => {
                 if let Some(v) = fixed {
@@ -690,10 +760,17 @@ impl Part {
                 }
                 value
             }
-            Part::Stream { always, from, body, online, settled } => {
+            Part::Fold { always, window, body, settled } => {
+                if window.contains(&(n - 1)) {
+                    let v = ctx.program.value(*body);
+                    *settled = if *always { settled.min(v) } else { settled.max(v) };
+                }
+                *settled
+            }
+            Part::Stream { always, from, body, inner, window, settled } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
-                // The state has the monitor's width and no NaN (checked by the caller).
-                if let Ok(Some(verdict)) = online.push(state)
+                // The state has no NaN (checked by the caller).
+                if let Some(verdict) = window.push(ctx.program.value(*inner))
                     && verdict.step >= *from
                 {
                     *settled = fold(*settled, verdict.value);
@@ -702,7 +779,7 @@ impl Part {
                     // No position of the outer window has arrived.
                     return *settled;
                 }
-                fold(*settled, at_state(body, state, scratch))
+                fold(*settled, ctx.program.value(*body))
             }
             Part::Not(g) => -values[*g],
             Part::And(gs) => gs.iter().map(|g| values[*g]).fold(f64::INFINITY, f64::min),
@@ -712,58 +789,244 @@ impl Part {
     }
 }
 
-/// `rho(f, 0)` over the one-state trace `state`: the reference semantics with `n = 1`
-/// (a window holds step 0 or nothing), without building a trace: one pass over the nodes,
-/// `vals` holding their values.
-fn at_state(f: &Formula, state: &[f64], vals: &mut Vec<f64>) -> f64 {
-    let holds_now = |i: &Interval| !i.window(0, 1).is_empty();
-    vals.clear();
-    for node in f.nodes() {
-        let v = |g: &NodeId| vals[g.index()];
-        let e = |g: &hstl_robustness::ExprId| vals[g.index()];
-        let x = match node {
-            Node::Const(c) => *c,
-            Node::Var(i) => state.get(*i).copied().unwrap_or(f64::NAN),
-            Node::Neg(a) => -e(a),
-            Node::Abs(a) => e(a).abs(),
-            Node::Sqrt(a) => e(a).sqrt(),
-            Node::Add(a, b) => e(a) + e(b),
-            Node::Sub(a, b) => e(a) - e(b),
-            Node::Mul(a, b) => e(a) * e(b),
-            Node::Div(a, b) => e(a) / e(b),
-            Node::True => f64::INFINITY,
-            Node::False => f64::NEG_INFINITY,
-            Node::Cmp { lhs, op, rhs } => op.robustness(e(lhs), e(rhs)),
-            Node::Not(g) => -v(g),
-            Node::And(gs) => gs.iter().map(v).fold(f64::INFINITY, f64::min),
-            Node::Or(gs) => gs.iter().map(v).fold(f64::NEG_INFINITY, f64::max),
-            Node::Implies(g, h) => (-v(g)).max(v(h)),
-            Node::Always(i, g) if holds_now(i) => f64::INFINITY.min(v(g)),
-            Node::Always(..) => f64::INFINITY,
-            Node::Eventually(i, g) if holds_now(i) => f64::NEG_INFINITY.max(v(g)),
-            Node::Eventually(..) => f64::NEG_INFINITY,
-            // Nothing comes before step 0, so the left side's minimum is over no step.
-            Node::Until(i, _, h) if holds_now(i) => f64::NEG_INFINITY.max(v(h).min(f64::INFINITY)),
-            Node::Until(..) => f64::NEG_INFINITY,
-            // Past windows at step 0 hold step 0 when they start there.
-            Node::Historically(i, g) if i.past_window(0).contains(&0) => f64::INFINITY.min(v(g)),
-            Node::Historically(..) => f64::INFINITY,
-            Node::Once(i, g) if i.past_window(0).contains(&0) => f64::NEG_INFINITY.max(v(g)),
-            Node::Once(..) => f64::NEG_INFINITY,
-            Node::Since(i, _, h) if i.past_window(0).contains(&0) => {
-                f64::NEG_INFINITY.max(v(h).min(f64::INFINITY))
-            }
-            Node::Since(..) => f64::NEG_INFINITY,
-            // Weak: the step before (or after) a one-state trace does not exist.
-            Node::Prev(_) | Node::Next(_) => f64::INFINITY,
+/// What a part's push reads besides the state: the program's values on it, and the
+/// evaluator of the parts evaluated over the states so far.
+struct Context<'a> {
+    program: &'a Program,
+    eval: &'a mut Evaluator,
+}
+
+/// Formulas evaluated on the newest state alone in one pass over one DAG that holds them
+/// all, each shared subformula once: a push reads the reward, the regions and the parts'
+/// state formulas off it instead of evaluating each formula on its own. The DAG is laid out
+/// flat ([`Op`], 16 bytes a node, operands by index), so that a push between two steps of
+/// a physics engine, which has the caches to itself, touches few lines.
+///
+/// A slot is `rho(f, 0)` over the one-state trace `state` (the reference semantics with
+/// `n = 1`: a window holds step 0 or nothing), or, when asked, with the offline evaluator's
+/// folds (`&&` and `||` keep the running value on a tie of `0` and `-0`), so that a value
+/// folded over steps is the offline evaluator's bit for bit: those slots' `&&`, `||`, `!`
+/// and `->` nodes are laid out a second time, over the same comparisons.
+#[derive(Clone, Debug)]
+struct Program {
+    ops: Vec<Op>,
+    /// The operands of the `&&` and `||` ops, each op's in a run.
+    args: Vec<u32>,
+    /// Each slot's value's index.
+    roots: Vec<u32>,
+    /// Each op's value on the last state run.
+    values: Vec<f64>,
+}
+
+/// One node of a [`Program`]; operands are indices of earlier values.
+#[derive(Clone, Copy, Debug)]
+enum Op {
+    Const(f64),
+    Var(u32),
+    Neg(u32),
+    Abs(u32),
+    Sqrt(u32),
+    Add(u32, u32),
+    Sub(u32, u32),
+    Mul(u32, u32),
+    Div(u32, u32),
+    /// A comparison: `a - b` (`b - a` for `<`, as [`hstl_robustness::CmpOp::robustness`]).
+    Cmp(u32, u32),
+    Not(u32),
+    /// `&&` over `args[start..start + len]`, folded as `f64::min` (or the offline
+    /// evaluator's fold when `offline`).
+    And {
+        start: u32,
+        len: u32,
+        offline: bool,
+    },
+    Or {
+        start: u32,
+        len: u32,
+        offline: bool,
+    },
+    Implies(u32, u32),
+    /// `+inf.min(v)`: an `always` whose window holds the one step.
+    MinInf(u32),
+    /// `-inf.max(v)`: an `eventually` (or past `once`) whose window holds the one step.
+    MaxNegInf(u32),
+    /// `-inf.max(v.min(+inf))`: an `until` or `since` whose window holds the one step.
+    UntilNow(u32),
+}
+
+impl Program {
+    fn new(slots: &[(Formula, bool)]) -> Program {
+        let mut b = FormulaBuilder::new();
+        let ids: Vec<NodeId> = slots.iter().map(|(f, _)| b.formula(f)).collect();
+        let root = b.and(ids);
+        let formula = b.build(root);
+        // `&&` keeps its operands as given, so they are the slots in order.
+        let slot_nodes: Vec<usize> = match formula.root_node() {
+            Node::And(gs) => gs.iter().map(|g| g.index()).collect(),
+            _ => Vec::new(),
         };
-        vals.push(x);
+        let nodes = formula.nodes();
+        let mut ops = Vec::with_capacity(nodes.len());
+        let mut args: Vec<u32> = Vec::new();
+        let ix = |k: usize| k as u32;
+        let holds_now = |i: &Interval| !i.window(0, 1).is_empty();
+        let past_now = |i: &Interval| i.past_window(0).contains(&0);
+        let fold = |gs: &[NodeId], map: &dyn Fn(usize) -> u32, args: &mut Vec<u32>| {
+            let start = ix(args.len());
+            args.extend(gs.iter().map(|g| map(g.index())));
+            (start, ix(gs.len()))
+        };
+        for node in nodes {
+            let e = |g: &hstl_robustness::ExprId| ix(g.index());
+            let v = |g: &NodeId| ix(g.index());
+            let op = match node {
+                Node::Const(c) => Op::Const(*c),
+                Node::Var(i) => Op::Var(ix(*i)),
+                Node::Neg(a) => Op::Neg(e(a)),
+                Node::Abs(a) => Op::Abs(e(a)),
+                Node::Sqrt(a) => Op::Sqrt(e(a)),
+                Node::Add(a, c) => Op::Add(e(a), e(c)),
+                Node::Sub(a, c) => Op::Sub(e(a), e(c)),
+                Node::Mul(a, c) => Op::Mul(e(a), e(c)),
+                Node::Div(a, c) => Op::Div(e(a), e(c)),
+                Node::True => Op::Const(f64::INFINITY),
+                Node::False => Op::Const(f64::NEG_INFINITY),
+                Node::Cmp { lhs, op, rhs } => match op {
+                    hstl_robustness::CmpOp::Lt | hstl_robustness::CmpOp::Le => {
+                        Op::Cmp(e(rhs), e(lhs))
+                    }
+                    hstl_robustness::CmpOp::Gt | hstl_robustness::CmpOp::Ge => {
+                        Op::Cmp(e(lhs), e(rhs))
+                    }
+                },
+                Node::Not(g) => Op::Not(v(g)),
+                Node::And(gs) => {
+                    let (start, len) = fold(gs, &|k| ix(k), &mut args);
+                    Op::And { start, len, offline: false }
+                }
+                Node::Or(gs) => {
+                    let (start, len) = fold(gs, &|k| ix(k), &mut args);
+                    Op::Or { start, len, offline: false }
+                }
+                Node::Implies(g, h) => Op::Implies(v(g), v(h)),
+                Node::Always(i, g) if holds_now(i) => Op::MinInf(v(g)),
+                Node::Always(..) => Op::Const(f64::INFINITY),
+                Node::Eventually(i, g) if holds_now(i) => Op::MaxNegInf(v(g)),
+                Node::Eventually(..) => Op::Const(f64::NEG_INFINITY),
+                // Nothing comes before step 0, so the left side's minimum is over no step.
+                Node::Until(i, _, h) if holds_now(i) => Op::UntilNow(v(h)),
+                Node::Until(..) => Op::Const(f64::NEG_INFINITY),
+                // Past windows at step 0 hold step 0 when they start there.
+                Node::Historically(i, g) if past_now(i) => Op::MinInf(v(g)),
+                Node::Historically(..) => Op::Const(f64::INFINITY),
+                Node::Once(i, g) if past_now(i) => Op::MaxNegInf(v(g)),
+                Node::Once(..) => Op::Const(f64::NEG_INFINITY),
+                Node::Since(i, _, h) if past_now(i) => Op::UntilNow(v(h)),
+                Node::Since(..) => Op::Const(f64::NEG_INFINITY),
+                // Weak: the step before (or after) a one-state trace does not exist.
+                Node::Prev(_) | Node::Next(_) => Op::Const(f64::INFINITY),
+            };
+            ops.push(op);
+        }
+        // The offline-folded slots (state formulas): their connectives again, over the
+        // same atoms, in node order, each once.
+        let mut offline: Vec<Option<u32>> = vec![None; nodes.len()];
+        let mut wanted = vec![false; nodes.len()];
+        for (&k, (_, off)) in slot_nodes.iter().zip(slots) {
+            wanted[k] |= *off;
+        }
+        for k in (0..nodes.len()).rev() {
+            if wanted[k] {
+                for c in nodes[k].children() {
+                    wanted[c] = true;
+                }
+            }
+        }
+        for (k, node) in nodes.iter().enumerate() {
+            if !wanted[k] {
+                continue;
+            }
+            let map = |c: usize| offline[c].unwrap_or(ix(c));
+            let op = match node {
+                Node::Not(g) => Op::Not(map(g.index())),
+                Node::Implies(g, h) => Op::Implies(map(g.index()), map(h.index())),
+                Node::And(gs) => {
+                    let (start, len) = fold(gs, &map, &mut args);
+                    Op::And { start, len, offline: true }
+                }
+                Node::Or(gs) => {
+                    let (start, len) = fold(gs, &map, &mut args);
+                    Op::Or { start, len, offline: true }
+                }
+                _ => continue,
+            };
+            offline[k] = Some(ix(ops.len()));
+            ops.push(op);
+        }
+        let roots = slot_nodes
+            .iter()
+            .zip(slots)
+            .map(|(&k, (_, off))| if *off { offline[k].unwrap_or(ix(k)) } else { ix(k) })
+            .collect();
+        let values = vec![0.0; ops.len()];
+        Program { ops, args, roots, values }
     }
-    vals[f.root().index()]
+
+    /// Evaluates every slot on `state`; returns whether a comparison is NaN there.
+    fn run(&mut self, state: &[f64]) -> bool {
+        let mut nan = false;
+        let (ops, args, vals) = (&self.ops, &self.args, &mut self.values);
+        for k in 0..ops.len() {
+            let v = |i: u32| vals[i as usize];
+            let run = |start: u32, len: u32| &args[start as usize..(start + len) as usize];
+            let x = match ops[k] {
+                Op::Const(c) => c,
+                Op::Var(i) => state.get(i as usize).copied().unwrap_or(f64::NAN),
+                Op::Neg(a) => -v(a),
+                Op::Abs(a) => v(a).abs(),
+                Op::Sqrt(a) => v(a).sqrt(),
+                Op::Add(a, b) => v(a) + v(b),
+                Op::Sub(a, b) => v(a) - v(b),
+                Op::Mul(a, b) => v(a) * v(b),
+                Op::Div(a, b) => v(a) / v(b),
+                Op::Cmp(a, b) => {
+                    let x = v(a) - v(b);
+                    nan |= x.is_nan();
+                    x
+                }
+                Op::Not(g) => -v(g),
+                Op::And { start, len, offline: false } => {
+                    run(start, len).iter().map(|&g| v(g)).fold(f64::INFINITY, f64::min)
+                }
+                Op::And { start, len, offline: true } => run(start, len)
+                    .iter()
+                    .map(|&g| v(g))
+                    .fold(f64::INFINITY, |a, x| if x < a { x } else { a }),
+                Op::Or { start, len, offline: false } => {
+                    run(start, len).iter().map(|&g| v(g)).fold(f64::NEG_INFINITY, f64::max)
+                }
+                Op::Or { start, len, offline: true } => run(start, len)
+                    .iter()
+                    .map(|&g| v(g))
+                    .fold(f64::NEG_INFINITY, |a, x| if x > a { x } else { a }),
+                Op::Implies(g, h) => (-v(g)).max(v(h)),
+                Op::MinInf(g) => f64::INFINITY.min(v(g)),
+                Op::MaxNegInf(g) => f64::NEG_INFINITY.max(v(g)),
+                Op::UntilNow(h) => f64::NEG_INFINITY.max(v(h).min(f64::INFINITY)),
+            };
+            vals[k] = x;
+        }
+        nan
+    }
+
+    /// Slot `slot`'s value on the last state run.
+    fn value(&self, slot: usize) -> f64 {
+        self.values[self.roots[slot] as usize]
+    }
 }
 
 /// Whether `f` is `always[I] eventually[J] g` or `eventually[I] always[J] g` with `g` a
-/// state formula (horizon 0) and `J` bounded: what [`Part::Stream`] takes.
+/// state formula (no temporal operator) and `J` bounded: what [`Part::Stream`] takes.
 fn is_dual_over_state(f: &Formula) -> bool {
     let inner = match f.root_node() {
         Node::Always(_, body) => match &f[*body] {
@@ -776,7 +1039,7 @@ fn is_dual_over_state(f: &Formula) -> bool {
         },
         _ => None,
     };
-    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.horizon_of(*g) == Some(0))
+    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.is_state(*g))
 }
 
 /// The value of an empty window: `+inf` for `always`, `-inf` for `eventually`.

@@ -377,3 +377,25 @@ fn an_episode_monitor_restored_from_its_states_continues_exactly() {
         }
     }
 }
+
+/// A state where an expression of the task computes NaN is refused, naming the step and
+/// the expression, whatever part of the task it is in (a region of a persistent task, a
+/// safety conjunct, a `let` rewarded on its own), and changes nothing.
+#[test]
+fn a_state_where_an_expression_is_nan_is_refused_in_every_part() {
+    let src = "spec T { state { x: float, y: float } let R = sqrt(x) > 1; let Safe = y / x < 5; \
+               task always[0..] eventually[0..=3] R && always[0..] Safe; }";
+    let loaded = load(src, None).unwrap();
+    for formula in [None, Some("R"), Some("Safe")] {
+        let mut episode = EpisodeMonitor::new(&loaded.spec, src, formula).unwrap();
+        episode.push(&[4.0, 1.0]).unwrap();
+        for (state, culprit) in [([-1.0, 1.0], "sqrt"), ([0.0, 0.0], "/")] {
+            let e = episode.push(&state).unwrap_err().to_string();
+            assert!(e.contains("step 1") && e.contains(culprit), "{formula:?} {state:?}: {e}");
+            assert_eq!(episode.steps(), 1);
+        }
+        let mut fresh = EpisodeMonitor::new(&loaded.spec, src, formula).unwrap();
+        fresh.push(&[4.0, 1.0]).unwrap();
+        assert_eq!(episode.push(&[0.25, 0.0]).unwrap(), fresh.push(&[0.25, 0.0]).unwrap());
+    }
+}

@@ -40,15 +40,25 @@ import numpy as np
 
 import hstl
 from common import OUT, ROOT, SPECS, band_plot, machine, read_csv, torch_one_thread, write_csv
-from wrappers import Columns, NoTermination
+from wrappers import Bounded, Columns, NoTermination
 
 RUN_STEPS, BURN_IN = 2000, 100
 FORMS = ["robustness", "increment", "window", "sparse"]
 
 
 class Task:
-    def __init__(self, name: str, spec_path: Any, make_base: Callable[[], gymnasium.Env], columns: list[int]) -> None:
+    def __init__(
+        self,
+        name: str,
+        spec_path: Any,
+        make_base: Callable[[], gymnasium.Env],
+        columns: list[int],
+        bounds: tuple[list[float], list[float]] | None = None,
+    ) -> None:
         self.name = name
+        #: hstl's learner needs a bounded `Box`: these (the spec's declared ranges) where the
+        #: environment's space is not.
+        self.bounds = bounds
         self.spec_path = spec_path
         self.spec = hstl.Spec.load(spec_path)
         self.make_base = make_base
@@ -69,7 +79,8 @@ def cartpole() -> gymnasium.Env:
 
 TASKS = {
     "mountain_car": Task("mountain_car", ROOT / "examples" / "specs" / "mountain_car_patrol.hstl", mountain_car, [0, 1]),
-    "cartpole": Task("cartpole", SPECS / "cartpole_patrol.hstl", cartpole, [0, 1, 2, 3]),
+    "cartpole": Task("cartpole", SPECS / "cartpole_patrol.hstl", cartpole, [0, 1, 2, 3],
+                     ([-4.8, -10.0, -0.42, -10.0], [4.8, 10.0, 0.42, 10.0])),
 }
 
 
@@ -196,7 +207,10 @@ def hstl_env_hook(task: Task, seed: int, episodes: int | None) -> list[list[Any]
     """hstl's learner on the gymnasium environment itself (`hstl.train(env=Box)`, issue 27
     item 2, branch py-plane). PENDING until that lands: today `hstl.train(env=)` takes
     `Discrete` observations only, and this records a `pending` row instead of a figure."""
-    env = gymnasium.wrappers.TimeLimit(task.make_base(), RUN_STEPS)
+    base = task.make_base()
+    if task.bounds is not None:
+        base = Bounded(base, *task.bounds)
+    env = gymnasium.wrappers.TimeLimit(base, RUN_STEPS)
     valuation = Columns(task.columns)
     try:
         t0 = time.perf_counter()

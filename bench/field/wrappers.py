@@ -35,6 +35,21 @@ class NoTermination(gymnasium.Wrapper):
         return obs, reward, False, truncated, info
 
 
+class Bounded(gymnasium.ObservationWrapper):
+    """The observation clipped to `[low, high]`, with that `Box` as its space: `hstl.train`
+    on an environment whose space is unbounded (CartPole's speeds), with the bounds the spec
+    declares (a state outside them would be refused anyway)."""
+
+    def __init__(self, env: gymnasium.Env, low: Sequence[float], high: Sequence[float]) -> None:
+        super().__init__(env)
+        self._low = np.asarray(low, dtype=np.float64)
+        self._high = np.asarray(high, dtype=np.float64)
+        self.observation_space = spaces.Box(self._low, self._high, dtype=np.float64)
+
+    def observation(self, observation: Any) -> Any:
+        return np.clip(np.asarray(observation, dtype=np.float64), self._low, self._high)
+
+
 class TauMDP(gymnasium.ObservationWrapper):
     """The tau-MDP observation: the state with the last `tau` states before it, oldest first
     (`tau + 1` observations of a `Box` space, flattened). At reset the history is the start

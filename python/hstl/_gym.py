@@ -321,7 +321,10 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     robustness is kept up to date incrementally, not by scoring the whole trace again:
     O(1) amortised for a persistent task (``always[0..] (eventually[0..N1] R1 && ...)``)
     and for a bounded task once its horizon has passed, O(h) for ``always``/``eventually``
-    over another body of horizon ``h`` (see the facade's ``hstl::reward``).
+    over another body of horizon ``h`` (see the facade's ``hstl::reward``). A step is one
+    call into Rust; a ``valuation`` given as a dict of observation indices is read there
+    with no Python call (the cheapest form: about 1 us a step on top of the environment's,
+    bench/field/RESULTS.md), a callable is called once a step.
     """
 
     def __init__(
@@ -346,26 +349,19 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
         self.reward_offset = offset
         self.reward_scale = scale
         self._valuation = _valuation_of(env, self.stl_spec, valuation)
-
-    def _score(self, obs: Any, info: Mapping[str, Any], last: bool = False) -> tuple[float, dict[str, Any]]:
-        reward, robustness, kept = self._monitor.push(self._valuation(obs), last)
-        info = dict(info)
-        info["task_robustness"] = robustness
-        if kept is not None:
-            info["window_kept"] = kept
-        return reward, info
+        # Indices into the observation are read in Rust at each step, with no Python call.
+        indices = self._valuation.indices() if isinstance(self._valuation, _Picks) else None
+        if indices is not None:
+            self._monitor._observe(indices)
+        self._step_valuation: Optional[Callable[[Any], Any]] = None if indices is not None else self._valuation
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(seed=seed, options=options)
-        self._monitor.reset()
-        _, info = self._score(obs, info)
+        obs, info = self._monitor._reset(self.env.reset(seed=seed, options=options), self._step_valuation)
         return obs, info
 
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
-        obs, env_reward, terminated, truncated, info = self.env.step(action)
-        reward, info = self._score(obs, info, bool(terminated or truncated))
-        info["env_reward"] = env_reward
-        return obs, reward, terminated, truncated, info
+        # One call into Rust scores the step and builds its info (see EpisodeMonitor._step).
+        return self._monitor._step(self.env.step(action), self._step_valuation)
 
 
 def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Callable[[Any], Any]:
@@ -424,6 +420,12 @@ class _Picks:
 
     def __call__(self, obs: Any) -> dict[str, Any]:
         return {v: obs[k] for v, k in self.picks}
+
+    def indices(self) -> Optional[list[int]]:
+        """The picks as observation indices, in order, when every one is an int."""
+        if all(type(k) is int and k >= 0 for _, k in self.picks):
+            return [k for _, k in self.picks]
+        return None
 
 
 def _missing(message: str, vars: Sequence[str]) -> Exception:

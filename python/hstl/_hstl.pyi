@@ -1,7 +1,7 @@
 """Type stubs of the native module ``hstl._hstl`` (re-exported by ``hstl``)."""
 
 from os import PathLike
-from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -344,9 +344,22 @@ class EpisodeMonitor:
     ) -> None: ...
     def reset(self) -> None: ...
     def push(self, state: State, last: bool = False) -> Tuple[float, float, Optional[bool]]: ...
+    def _observe(self, indices: Sequence[int]) -> None: ...
+    def _step(
+        self, result: Tuple[Any, Any, Any, Any, Any], valuation: Optional[Callable[[Any], Any]] = None
+    ) -> Tuple[Any, float, bool, bool, dict[str, Any]]: ...
+    def _reset(
+        self, result: Tuple[Any, Any], valuation: Optional[Callable[[Any], Any]] = None
+    ) -> Tuple[Any, dict[str, Any]]: ...
     @staticmethod
     def _restore(
-        spec: Spec, formula: Optional[str], reward: RewardForm, offset: float, scale: float, states: Sequence[float]
+        spec: Spec,
+        formula: Optional[str],
+        reward: RewardForm,
+        offset: float,
+        scale: float,
+        states: Sequence[float],
+        picks: Optional[Sequence[int]] = None,
     ) -> EpisodeMonitor: ...
     @property
     def reward(self) -> RewardForm: ...

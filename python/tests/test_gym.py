@@ -314,10 +314,92 @@ def test_the_ids_are_registered_whichever_is_imported_first(code):
     assert out.returncode == 0 and out.stdout == "ok\n", out.stderr
 
 
-def test_without_import_hstl_gymnasium_does_not_know_the_ids():
-    # gymnasium >= 1.0 has no plugin entry points (removed in 1.0; `load_plugin_envs` is
-    # gone), so nothing registers the ids before something imports hstl: gymnasium's own
-    # error (the `hstl:` form the docs give works: see the test above). This fails, as a
-    # reminder to register through the plugin, the day gymnasium finds them by itself.
-    out = python("import gymnasium\ngymnasium.make('hstl/GridWorld-v0')")
+def python_env(code: str, **env: str) -> subprocess.CompletedProcess:
+    """`python(code)` with `env` added to the environment."""
+    import os
+
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env={**os.environ, **env}
+    )
+
+
+def test_gymnasium_knows_the_ids_without_import_hstl():
+    # gymnasium >= 1.0 has no plugin entry points: the wheel's `hstl-gymnasium.pth` imports
+    # the top-level `_hstl_gym` at interpreter start, which waits for gymnasium's import
+    # without importing hstl (its extension loads only when an environment is made).
+    out = python(
+        "import sys\n"
+        "assert '_hstl_gym' in sys.modules, 'hstl-gymnasium.pth did not run'\n"
+        "assert 'hstl' not in sys.modules and 'gymnasium' not in sys.modules\n"
+        "import gymnasium\n"
+        "assert 'hstl' not in sys.modules, 'registering imported hstl'\n"
+        "env = gymnasium.make('hstl/FourRooms-v0')\n"
+        "print(env.unwrapped.world.name)"
+    )
+    assert out.returncode == 0 and out.stdout == "four-rooms\n", out.stderr
+
+
+def test_the_startup_registration_can_be_turned_off():
+    out = python_env("import gymnasium\ngymnasium.make('hstl/GridWorld-v0')", HSTL_NO_GYMNASIUM_IDS="1")
     assert out.returncode != 0 and "NamespaceNotFound" in out.stderr, out.stderr
+    # `import hstl` registers them all the same.
+    out = python_env("import hstl, gymnasium\nprint(gymnasium.make('hstl/GridWorld-v0').unwrapped.world.name)", HSTL_NO_GYMNASIUM_IDS="1")
+    assert out.returncode == 0 and out.stdout == "paper\n", out.stderr
+
+
+PENDULUM = """spec Swing {
+    state { cart: float, angle: float }
+    let right = cart > 0.0;
+    let left = cart < 0.0;
+    let fallen = angle >= 0.2 || angle <= -0.2;
+    task always[0..] (eventually[0..=5] right && eventually[0..=5] left) && always[0..] !fallen;
+}"""
+
+
+class _Wobble(gymnasium.Env):
+    """Four observation entries from a seeded walk, in a given dtype (or a list), with an
+    info of its own; the episode ends at step 40."""
+
+    def __init__(self, dtype="float64"):
+        self.dtype = dtype
+        self.observation_space = gymnasium.spaces.Box(-10, 10, (4,), np.float64 if dtype == "list" else dtype)
+        self.action_space = gymnasium.spaces.Discrete(2)
+        self.infos = []
+
+    def _obs(self):
+        x = self.rng.normal(0, 0.15, 4)
+        return [float(v) for v in x] if self.dtype == "list" else x.astype(self.dtype)
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.rng, self.t = np.random.default_rng(seed), 0
+        return self._obs(), {"from_env": 0}
+
+    def step(self, action):
+        self.t += 1
+        info = {"from_env": self.t}
+        self.infos.append(info)
+        return self._obs(), 0.5 * action, self.t == 40, False, info
+
+
+@pytest.mark.parametrize("dtype", ["float64", "float32", "list"])
+@pytest.mark.parametrize("reward", ["robustness", "window", "sparse"])
+def test_a_dict_of_observation_indices_scores_as_a_valuation_function_does(dtype, reward):
+    spec = hstl.Spec.parse(PENDULUM)
+    by_index = hstl.STLReward(_Wobble(dtype), spec, valuation={"angle": 1, "cart": 0}, reward=reward)
+    by_call = hstl.STLReward(_Wobble(dtype), spec, valuation=lambda o: [float(o[0]), float(o[1])], reward=reward)
+    for env in (by_index, by_call):
+        env.reset(seed=7)
+    for t in range(1, 41):
+        a = by_index.step(t % 2)
+        b = by_call.step(t % 2)
+        assert a[1:4] == b[1:4] and a[4] == b[4], t
+        assert a[4]["from_env"] == t and a[4]["env_reward"] == 0.5 * (t % 2) and "window_kept" in a[4]
+    # The wrapped environment's own info is left as it was.
+    assert all(set(i) == {"from_env"} for i in by_index.env.infos)
+
+
+def test_an_observation_index_past_the_end_says_which_variable():
+    env = hstl.STLReward(_Wobble(), hstl.Spec.parse(PENDULUM), valuation={"cart": 0, "angle": 4})
+    with pytest.raises(ValueError, match=r"the observation has 4 entries, and `angle` is read from index 4"):
+        env.reset(seed=1)

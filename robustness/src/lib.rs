@@ -40,4 +40,5 @@ pub use formula::{Bound, CmpOp, Expr, ExprId, Formula, FormulaBuilder, Interval,
 pub use offline::Evaluator;
 pub use online::{MAX_ONLINE_VALUES, OnlineMonitor, Verdict};
 pub use state::StateEval;
+pub use stream::WindowStream;
 pub use trace::{Trace, TraceError};

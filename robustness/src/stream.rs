@@ -166,14 +166,9 @@ impl Stream {
                     Node::Not(_) => Kind::Not,
                     Node::And(_) | Node::Or(_) => Kind::Fold,
                     Node::Implies(..) => Kind::Implies,
-                    Node::Always(i, _) | Node::Eventually(i, _) => Kind::Window(Box::new(Window {
-                        max: matches!(node, Node::Eventually(..)),
-                        a: i.start,
-                        last: last(i),
-                        end: end(i),
-                        seen: 0,
-                        deque: VecDeque::new(),
-                    })),
+                    Node::Always(i, _) | Node::Eventually(i, _) => {
+                        Kind::Window(Box::new(Window::new(matches!(node, Node::Eventually(..)), i)))
+                    }
                     Node::Once(i, _) | Node::Historically(i, _) => Kind::PastWindow(Box::new(
                         PastWindow::new(matches!(node, Node::Once(..)), i),
                     )),
@@ -537,7 +532,49 @@ impl Until {
     }
 }
 
+/// `always[I] f` (a sliding minimum) or `eventually[I] f` (maximum) over the values of `f`
+/// given one step at a time: the online monitor's stream of such a node on its own, for a
+/// caller that computes `f` itself (the facade's episode reward, which evaluates every
+/// state formula of a task in one pass). Amortised `O(1)` a value, `O(b)` values kept for
+/// `I = [a..=b]`; the values, and the ties between equal ones, are the online monitor's.
+#[derive(Clone, Debug)]
+pub struct WindowStream {
+    window: Window,
+}
+
+impl WindowStream {
+    /// The stream of `always[interval]` (`always = true`) or `eventually[interval]`; `None`
+    /// for an unbounded interval, whose value is never final before the trace ends.
+    pub fn new(always: bool, interval: &Interval) -> Option<WindowStream> {
+        if interval.end == Bound::Unbounded {
+            return None;
+        }
+        Some(WindowStream { window: Window::new(!always, interval) })
+    }
+
+    /// Takes `f` at the next step; returns the operator's value at the step it makes final
+    /// (step `t` once `f` at `t + b` is in), counted from the first value after creation or
+    /// [`WindowStream::clear`]. `f` is not NaN (a NaN is skipped, as the online monitor
+    /// skips it).
+    pub fn push(&mut self, f: f64) -> Option<crate::Verdict> {
+        let j = self.window.seen;
+        let value = self.window.take(f)?;
+        Some(crate::Verdict { step: j - self.window.end, value })
+    }
+
+    /// Forgets every value: a new trace starts.
+    pub fn clear(&mut self) {
+        // The deque keeps its allocation.
+        self.window.seen = 0;
+        self.window.deque.clear();
+    }
+}
+
 impl Window {
+    fn new(max: bool, i: &Interval) -> Window {
+        Window { max, a: i.start, last: last(i), end: end(i), seen: 0, deque: VecDeque::new() }
+    }
+
     /// Takes the operand's next value; returns this node's next value once final.
     fn take(&mut self, v: f64) -> Option<f64> {
         let j = self.seen;
@@ -667,5 +704,55 @@ pub(crate) fn state_value(node: &Node, vals: &[f64], row: &[f64]) -> f64 {
         Node::Or(gs) => gs.iter().map(v).fold(NEG_INF, f64::max),
         Node::Implies(g, h) => (-v(g)).max(v(h)),
         _ => expr_value(node, vals, row),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WindowStream;
+    use crate::{CmpOp, Expr, Formula, Interval, OnlineMonitor};
+
+    /// The window on its own gives the online monitor's verdicts of `always[I] x > 0` and
+    /// `eventually[I] x > 0` over the values of `x > 0`, bit for bit (signed zeros and
+    /// ties included), across a restart.
+    #[test]
+    fn a_window_stream_gives_the_online_monitors_verdicts() {
+        let xs: Vec<f64> = (0..200u64)
+            .map(|k| match (k * 2654435761) % 7 {
+                0 => 0.0,
+                1 => -0.0,
+                r => r as f64 - 3.5,
+            })
+            .collect();
+        let atom = Formula::cmp(Expr::var(0), CmpOp::Gt, Expr::constant(0.0));
+        for (a, b, inclusive) in
+            [(0, 0, true), (0, 3, true), (2, 5, true), (1, 4, false), (3, 3, false)]
+        {
+            let end =
+                if inclusive { crate::Bound::Inclusive(b) } else { crate::Bound::Exclusive(b) };
+            let i = Interval { start: a, end };
+            for always in [true, false] {
+                let f = if always {
+                    Formula::always(i, atom.clone())
+                } else {
+                    Formula::eventually(i, atom.clone())
+                };
+                let mut online = OnlineMonitor::new(&f, 1);
+                let mut window = WindowStream::new(always, &i).unwrap();
+                for round in 0..2 {
+                    for &x in &xs {
+                        let want = online.push(&[x]).unwrap();
+                        let got = window.push(x - 0.0);
+                        assert_eq!(
+                            got.map(|v| (v.step, v.value.to_bits())),
+                            want.map(|v| (v.step, v.value.to_bits())),
+                            "{f}, round {round}"
+                        );
+                    }
+                    online.finish();
+                    window.clear();
+                }
+            }
+        }
     }
 }

@@ -46,7 +46,7 @@ use rand::RngExt;
 use crate::env::EpisodeEnd;
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
-use crate::plan_reach::ReachPlanner;
+use crate::plan_reach::{OptionsLayout, ReachPlanner};
 use crate::progress::{GoalTracker, StateGoals, run_steps};
 use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
@@ -386,7 +386,25 @@ impl<'e, E: Env> Learner<'e, E> {
             }
             (Plans::Reach(planner), _) => {
                 let flat = planner.legs(&self.tables, &self.q.flat, &moves, model.starts());
-                (flat, self.q.options.clone())
+                match &self.goals {
+                    Some(g) => {
+                        let layout = OptionsLayout {
+                            values: self.values,
+                            codes: self.codes,
+                            all_met: g.progress.all_met(),
+                        };
+                        planner.hierarchy(
+                            &self.tables,
+                            &self.q.flat,
+                            flat,
+                            &moves,
+                            model.starts(),
+                            &self.q.options,
+                            layout,
+                        )
+                    }
+                    None => (flat, self.q.options.clone()),
+                }
             }
             (Plans::Options(_), None) => return,
         };

@@ -31,7 +31,8 @@
 //! an estimate `g` of the gain per step, and a second table tracks how many steps each
 //! value spans (its horizon, one more than its successors' along the chosen action); after
 //! each sweep `g += mean(change of V) / mean(change of horizon)`, a Newton step on the
-//! drift. At `g = W*` the fixed points of the update are exactly the solutions of the
+//! drift, held in `[0, 1]` (a step's reward is 0 or 1: a step past it fed a drift that grew
+//! without bound on a slow two-room world). At `g = W*` the fixed points of the update are exactly the solutions of the
 //! average-reward equation. Once the steps per sweep settle the horizons are no longer
 //! tracked. Nearly deterministic worlds can make the sweeps oscillate; when the changes
 //! stop shrinking, the updates are damped (`V += step * (update - V)`, the same fixed
@@ -747,7 +748,10 @@ impl Table {
                 steps = dh;
             }
             if steps > 0.0 && steps.is_finite() {
-                gain += damping * dv / steps;
+                // A step's reward is 0 or 1, so the gain lies in [0, 1]: a Newton step past
+                // it (a sweep whose values moved far more than its horizons did) is held
+                // there instead of feeding a drift that grows without bound.
+                gain = (gain + damping * dv / steps).clamp(0.0, 1.0);
             }
             let spread = stats.hi - stats.lo;
             rises += usize::from(spread >= last);

@@ -17,7 +17,14 @@
 //! where nothing is known keeps its learned values.
 //!
 //! With several goals each leg is planned against its own deadline from the starts of
-//! training; the options level stays Q-learned.
+//! training; the options level stays Q-learned, but for a hold: a leg that enters no goal
+//! and keeps out of exactly the task's avoided states (`keep_clear`, which `preset: auto`
+//! adds). Once every goal is met only the avoidance is left, so the hold's leg is planned
+//! to keep out longest, and the options values of those observations become the
+//! probability of keeping out over the next [`TAIL_STEPS`] steps if each option's first leg
+//! were followed throughout; before then the hold enters no goal, so it is never chosen.
+
+mod choices;
 
 use crate::plan::UNTRIED;
 use crate::reach_avoid::ReachAvoid;
@@ -39,6 +46,19 @@ pub(crate) struct ReachPlanner {
     /// `goal_of[p]`: the goal (0 for the first, `1 + j` for `also[j]`) primitive `p` stops
     /// on entering, if any.
     goal_of: Vec<Option<usize>>,
+    /// `hold[p]`: primitive `p` enters no goal and keeps out of exactly the task's avoided
+    /// states.
+    hold: Vec<bool>,
+}
+
+/// Where the options values are in their table: `options[obs * n + o]`, the observation of
+/// state `s`, memory value `v` and goals met `m` being `(s * values + v) * codes + m`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct OptionsLayout {
+    pub values: usize,
+    pub codes: usize,
+    /// The code of every goal met.
+    pub all_met: usize,
 }
 
 impl ReachPlanner {
@@ -62,8 +82,17 @@ impl ReachPlanner {
                     .collect();
                 goals.iter().position(|g| **g == stops && g.iter().any(|&x| x))
             })
+            .collect::<Vec<_>>();
+        let hold = (0..tables.term.len())
+            .map(|p| goal_of[p].is_none() && tables.ends[p].as_ref() == Some(&task.avoid))
             .collect();
-        Ok(Some(ReachPlanner { task, goal_of }))
+        Ok(Some(ReachPlanner { task, goal_of, hold }))
+    }
+
+    /// The steps a hold leg is planned to keep out over: the avoidance's, at most
+    /// [`TAIL_STEPS`].
+    fn hold_steps(&self) -> usize {
+        self.task.avoid_through.clamp(1, TAIL_STEPS)
     }
 
     /// The flat tables with every leg that enters a goal planned under `moves` (the
@@ -82,28 +111,173 @@ impl ReachPlanner {
             return out;
         }
         let start: Vec<f64> = starts.iter().map(|&c| f64::from(c) / total).collect();
-        for (p, goal) in self.goal_of.iter().enumerate() {
-            let Some(j) = *goal else { continue };
-            let (goal, by) = match j {
-                0 => (&self.task.goal, self.task.reach_by),
-                j => (&self.task.also[j - 1].0, self.task.also[j - 1].1),
-            };
+        if self.hold.iter().any(|&h| h) {
             let leg = LegTask {
-                goal,
+                goal: &self.task.goal,
                 avoid: &self.task.avoid,
-                reach_by: by,
+                reach_by: 0,
                 avoid_through: self.task.avoid_through,
             };
-            if let Some(table) = leg.plan(tables.states, tables.actions, moves, &start) {
-                for s in 0..tables.states {
-                    let row = &table[s * tables.actions..][..tables.actions];
-                    if row.iter().any(|&v| v > UNTRIED) {
-                        out[p][s * tables.actions..][..tables.actions].copy_from_slice(row);
+            let (_, rows) = leg.safety(tables.states, tables.actions, moves, self.hold_steps());
+            for p in (0..self.hold.len()).filter(|&p| self.hold[p]) {
+                overlay(&mut out[p], &rows, tables.actions);
+            }
+        }
+        for (p, goal) in self.goal_of.iter().enumerate() {
+            let Some(j) = *goal else { continue };
+            if let Some(table) = self.leg(j).plan(tables.states, tables.actions, moves, &start) {
+                overlay(&mut out[p], &table, tables.actions);
+            }
+        }
+        out
+    }
+
+    /// The legs `flat` (from [`ReachPlanner::legs`]) and the options values `options`
+    /// (laid out as `layout` says) planned together under `moves`, from the episode starts
+    /// `starts` (counts per state): the holds first ([`ReachPlanner::holds`]); then, without
+    /// memory, the choices improved on the whole task's success probability (`choices`),
+    /// each goal's leg replaced by the candidate best for the whole task under those
+    /// choices (a leg is planned alone from the starts of training, where the hierarchy
+    /// runs it from where the leg before it arrives, with the time that leaves), and the
+    /// choices improved again. `learned` are the learned flat values, which a planned leg
+    /// keeps where the model knows nothing.
+    #[allow(clippy::too_many_arguments)]
+    pub fn hierarchy(
+        &self,
+        tables: &Tables,
+        learned: &[Vec<f64>],
+        mut flat: Vec<Vec<f64>>,
+        moves: &[Vec<(usize, f64)>],
+        starts: &[u32],
+        options: &[f64],
+        layout: OptionsLayout,
+    ) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let mut out = self.holds(tables, &flat, moves, options, layout);
+        let total: f64 = starts.iter().map(|&c| f64::from(c)).sum();
+        if layout.values != 1 || total == 0.0 {
+            return (flat, out);
+        }
+        let start: Vec<f64> = starts.iter().map(|&c| f64::from(c) / total).collect();
+        let hierarchy = |flat: &[Vec<f64>]| {
+            choices::Hierarchy::new(&self.task, tables, flat, moves, layout.codes)
+        };
+        let Some(h) = hierarchy(&flat) else { return (flat, out) };
+        if let Some(better) = h.improve(&out, &start) {
+            out = better;
+        }
+        let (states, actions) = (tables.states, tables.actions);
+        let mut changed = false;
+        for (p, goal) in self.goal_of.iter().enumerate() {
+            let Some(j) = *goal else { continue };
+            let Some(candidates) = self.leg(j).candidates(states, actions, moves, &start) else {
+                continue;
+            };
+            let mut best: Option<(f64, Vec<f64>)> = None;
+            for (_, table) in candidates {
+                let mut trial = flat.clone();
+                trial[p] = learned[p].clone();
+                overlay(&mut trial[p], &table, actions);
+                let value = hierarchy(&trial).map_or(0.0, |h| h.success(&out, &start));
+                if best.as_ref().is_none_or(|(b, _)| value > *b) {
+                    best = Some((value, trial.swap_remove(p)));
+                }
+            }
+            if let Some((_, leg)) = best
+                && leg != flat[p]
+            {
+                flat[p] = leg;
+                changed = true;
+            }
+        }
+        if changed
+            && let Some(h) = hierarchy(&flat)
+            && let Some(better) = h.improve(&out, &start)
+        {
+            out = better;
+        }
+        (flat, out)
+    }
+
+    /// The task of the leg that enters goal `j` (0 for the first, `1 + i` for `also[i]`).
+    fn leg(&self, j: usize) -> LegTask<'_> {
+        let (goal, reach_by) = match j {
+            0 => (&self.task.goal, self.task.reach_by),
+            j => (&self.task.also[j - 1].0, self.task.also[j - 1].1),
+        };
+        LegTask { goal, avoid: &self.task.avoid, reach_by, avoid_through: self.task.avoid_through }
+    }
+
+    /// The options values `options` with the holds planned: where every goal is met, each
+    /// option's value is the probability under `moves` of keeping out of the avoided states
+    /// over the next steps if its first leg's greedy actions in `flat` were followed
+    /// throughout (0 from a state with no known action); before then a hold option is worth
+    /// [`UNTRIED`]. Unchanged without a hold option.
+    fn holds(
+        &self,
+        tables: &Tables,
+        flat: &[Vec<f64>],
+        moves: &[Vec<(usize, f64)>],
+        options: &[f64],
+        layout: OptionsLayout,
+    ) -> Vec<f64> {
+        let mut out = options.to_vec();
+        let n = tables.legs.len();
+        let is_hold = |o: usize| tables.legs[o].first().is_some_and(|&p| self.hold[p]);
+        if !(0..n).any(is_hold) {
+            return out;
+        }
+        let (states, actions) = (tables.states, tables.actions);
+        // survive[o][s]: the probability of keeping out from `s` under option `o`'s first leg.
+        let survive: Vec<Vec<f64>> = (0..n)
+            .map(|o| {
+                let p = tables.legs[o][0];
+                let step: Vec<Option<usize>> = (0..states)
+                    .map(|s| {
+                        let row = &flat[p][s * actions..][..actions];
+                        let a = crate::learn::argmax(row);
+                        (!moves[s * actions + a].is_empty()).then_some(a)
+                    })
+                    .collect();
+                let mut w: Vec<f64> =
+                    (0..states).map(|s| if self.task.avoid[s] { 0.0 } else { 1.0 }).collect();
+                for _ in 0..self.hold_steps() {
+                    w = (0..states)
+                        .map(|s| match step[s] {
+                            Some(a) if !self.task.avoid[s] => {
+                                moves[s * actions + a].iter().map(|&(t, q)| q * w[t]).sum()
+                            }
+                            _ => 0.0,
+                        })
+                        .collect();
+                }
+                w
+            })
+            .collect();
+        let OptionsLayout { values, codes, all_met } = layout;
+        for s in 0..states {
+            for v in 0..values {
+                for met in 0..codes {
+                    let row = &mut out[((s * values + v) * codes + met) * n..][..n];
+                    for (o, value) in row.iter_mut().enumerate() {
+                        if met == all_met {
+                            *value = survive[o][s];
+                        } else if is_hold(o) {
+                            *value = UNTRIED;
+                        }
                     }
                 }
             }
         }
         out
+    }
+}
+
+/// `planned`'s rows over `table` where it knows something (a row not all [`UNTRIED`]).
+fn overlay(table: &mut [f64], planned: &[f64], actions: usize) {
+    for (row, new) in table.chunks_mut(actions).zip(planned.chunks(actions)) {
+        if new.iter().any(|&v| v > UNTRIED) {
+            row.copy_from_slice(new);
+        }
     }
 }
 
@@ -118,7 +292,8 @@ struct LegTask<'a> {
 
 impl LegTask<'_> {
     /// The planned table, `Q(s, a)` with [`UNTRIED`] for untried actions and a row of
-    /// [`UNTRIED`] where nothing is known; `None` when the tables would be too large.
+    /// [`UNTRIED`] where nothing is known: the best of [`LegTask::candidates`] alone, the
+    /// first on a tie; `None` when the tables would be too large.
     fn plan(
         &self,
         states: usize,
@@ -126,6 +301,27 @@ impl LegTask<'_> {
         moves: &[Vec<(usize, f64)>],
         start: &[f64],
     ) -> Option<Vec<f64>> {
+        let mut best: Option<(f64, Vec<f64>)> = None;
+        for (value, table) in self.candidates(states, actions, moves, start)? {
+            if best.as_ref().is_none_or(|(b, _)| value > *b) {
+                best = Some((value, table));
+            }
+        }
+        best.map(|(_, table)| table)
+    }
+
+    /// The candidate tables, each with the probability under the model and from `start`
+    /// that the leg alone satisfies the goal's conjunct and the task's avoidance: the
+    /// stationary policies "act as if `h` steps were left", from the longest horizon down,
+    /// each followed by its variant whose goal cells keep out of the avoided states longest
+    /// when the avoidance outlasts the deadline; `None` when the tables would be too large.
+    fn candidates(
+        &self,
+        states: usize,
+        actions: usize,
+        moves: &[Vec<(usize, f64)>],
+        start: &[f64],
+    ) -> Option<Vec<(f64, Vec<f64>)>> {
         let horizon = self.reach_by.max(1);
         if horizon.checked_mul(states)?.checked_mul(actions)? > MAX_VALUES {
             return None;
@@ -161,72 +357,54 @@ impl LegTask<'_> {
             q.push(qh);
             v = next;
         }
-        // Each candidate's action per state: the best with `h` steps left, or with the
-        // fewest more under which the goal can be entered at all.
+        // The row of the horizon a state's action comes from: the best with `h` steps
+        // left, or with the fewest more under which the goal can be entered at all.
+        let row_of = |h: usize, s: usize| -> Option<&[f64]> {
+            q[h - 1..]
+                .iter()
+                .map(|qh| &qh[s * actions..][..actions])
+                .find(|row| row[crate::learn::argmax(row)] > 0.0)
+        };
         let policy = |h: usize| -> Vec<Option<usize>> {
-            (0..states)
-                .map(|s| {
-                    q[h - 1..].iter().find_map(|qh| {
-                        let row = &qh[s * actions..][..actions];
-                        let best = crate::learn::argmax(row);
-                        (row[best] > 0.0).then_some(best)
-                    })
-                })
-                .collect()
+            (0..states).map(|s| row_of(h, s).map(crate::learn::argmax)).collect()
+        };
+        let table = |h: usize, keep_out: Option<&(Vec<Option<usize>>, Vec<f64>)>| -> Vec<f64> {
+            let mut table = vec![UNTRIED; states * actions];
+            for s in 0..states {
+                let row = match keep_out {
+                    Some((safe, rows)) if self.goal[s] && safe[s].is_some() => {
+                        Some(&rows[s * actions..][..actions])
+                    }
+                    _ => row_of(h, s),
+                };
+                if let Some(row) = row {
+                    table[s * actions..][..actions].copy_from_slice(row);
+                }
+            }
+            table
         };
         // Once the goal has held, only the avoidance is left: in the goal's cells the
-        // candidates may instead keep out of the avoided states longest.
+        // variants keep out of the avoided states longest.
         let tail = self.last().saturating_sub(self.reach_by);
         let safe = (tail > 0).then(|| self.safety(states, actions, moves, tail));
         let step = horizon.div_ceil(CANDIDATES).max(1);
-        let mut best: Option<(f64, usize, bool)> = None;
-        // From the longest horizon down: on a tie the policy that plans with more time.
+        let mut out = Vec::new();
         let mut h = horizon;
         loop {
             let mut pi = policy(h);
-            let value = self.evaluate(&pi, moves, actions, start);
-            if best.is_none_or(|(b, _, _)| value > b) {
-                best = Some((value, h, false));
-            }
-            if let Some((safe, _)) = &safe {
-                for s in (0..states).filter(|&s| self.goal[s] && safe[s].is_some()) {
-                    pi[s] = safe[s];
+            out.push((self.evaluate(&pi, moves, actions, start), table(h, None)));
+            if let Some(safe) = &safe {
+                for s in (0..states).filter(|&s| self.goal[s] && safe.0[s].is_some()) {
+                    pi[s] = safe.0[s];
                 }
-                let value = self.evaluate(&pi, moves, actions, start);
-                if best.is_none_or(|(b, _, _)| value > b) {
-                    best = Some((value, h, true));
-                }
+                out.push((self.evaluate(&pi, moves, actions, start), table(h, Some(safe))));
             }
             if h <= step {
                 break;
             }
             h -= step;
         }
-        let (_, h, keep_out) = best?;
-        let chosen = policy(h);
-        let mut table = vec![UNTRIED; states * actions];
-        for s in 0..states {
-            if keep_out
-                && self.goal[s]
-                && let Some((safe, rows)) = &safe
-                && safe[s].is_some()
-            {
-                table[s * actions..][..actions].copy_from_slice(&rows[s * actions..][..actions]);
-                continue;
-            }
-            if chosen[s].is_none() {
-                continue;
-            }
-            // The row of the horizon the state's action came from: greedy picks it.
-            if let Some(row) = q[h - 1..]
-                .iter()
-                .map(|qh| &qh[s * actions..][..actions])
-                .find(|row| row[crate::learn::argmax(row)] > 0.0)
-            {
-                table[s * actions..][..actions].copy_from_slice(row);
-            }
-        }
-        Some(table)
+        Some(out)
     }
 
     /// The last step the candidates are judged to: the deadline, and past it the
