@@ -44,6 +44,16 @@ pub fn sizes<E: Env>(spec: &TaskSpec, env: &E) -> Sizes {
     } else {
         0
     };
+    // `plan: model` on a reach task: the latest deadline its legs are planned over.
+    let form = hstl_runtime::reach_avoid::reach_avoid_form(&spec.task);
+    let plan_horizon = match (spec.learn.plan, form) {
+        (hstl_runtime::Plan::Model, Some(f)) if spec.regions.is_empty() => {
+            let last = f.also.iter().map(|&(_, t)| t).fold(f.reach_by, usize::max);
+            last.max(1) as u64
+        }
+        _ => 0,
+    };
+    let legs = spec.options.iter().map(|o| o.sequence.len() as u64).sum();
     let windows = if spec.regions.is_empty() {
         0
     } else {
@@ -58,6 +68,8 @@ pub fn sizes<E: Env>(spec: &TaskSpec, env: &E) -> Sizes {
         regions,
         values,
         goals,
+        plan_horizon,
+        legs,
         state_text,
         name_text,
         windows,

@@ -81,6 +81,19 @@ fn spec(memory: u64, regions: &[&str]) -> String {
     )
 }
 
+/// Reach A and then B, never entering O: two goals, and `keep_clear` from the preset.
+const REACH_TWO: &str = "spec Two {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let A = x > 11 && y < 3;
+    let B = x < 3 && y > 11;
+    let O = x > 5 && x < 9 && y > 5 && y < 9;
+    task eventually[0..=30] A && eventually[0..=60] B && always !O;
+    option A;
+    option B;
+    learn { preset: auto, episodes: 20 }
+}
+";
+
 // One test: the counters are the process's, so nothing else may run beside it.
 #[test]
 fn memory() {
@@ -90,12 +103,22 @@ fn memory() {
 
 fn the_memory_model_bounds_training_writing_and_reading_a_policy() {
     let world = hstl::world::GridWorld::builtin("paper").expect("paper");
-    for (memory, regions) in
-        [(0, &["A", "B"][..]), (4, &["A", "B"]), (8, &["A", "B", "C"]), (12, &["A", "B", "C"])]
-    {
-        let src = spec(memory, regions);
+    let cases =
+        [(0, &["A", "B"][..]), (4, &["A", "B"]), (8, &["A", "B", "C"]), (12, &["A", "B", "C"])];
+    let persistent =
+        cases.iter().map(|&(memory, regions)| (memory, regions, spec(memory, regions)));
+    // A task with goals: the options level's table and `options_policy` hold a row per
+    // set of goals met (2^2 here), and the preset adds `keep_clear`.
+    let goals = (0, &["goals"][..], REACH_TWO.to_string());
+    for (memory, regions, src) in persistent.chain(std::iter::once(goals)) {
         let loaded = hstl::load::load(&src, None).expect("checks");
         let sizes = spec_sizes(&src, &loaded.spec).expect("a tabular spec");
+        if regions == ["goals"] {
+            assert_eq!(sizes.goals, 2, "two goals");
+            let names: Vec<&str> = loaded.spec.options.iter().map(|o| o.name.as_str()).collect();
+            assert!(names.contains(&"keep_clear"), "{names:?}");
+            assert_eq!(sizes.options, names.len() as u64);
+        }
         let model = cost(&sizes);
         let task = hstl::train::trainable(&loaded.spec, &src, "s.hstl").expect("trainable");
         // The facade's sizes (the world's states) are the checker's on the open grid.

@@ -186,6 +186,19 @@ pub const GRID_ACTIONS: u64 = 4;
 /// persistent (the runtime's `hstl_runtime::progress::MAX_GOALS`).
 pub const MAX_GOALS: u64 = 4;
 
+/// `plan: model` on a reach task judges the avoidance at most this many steps past the
+/// latest deadline (the runtime's `plan_reach::TAIL_STEPS`).
+pub const PLAN_TAIL_STEPS: u64 = 400;
+/// The reach planner's limits (the runtime's `plan_reach::MAX_VALUES`, the candidates it
+/// keeps, `plan_reach::CANDIDATES`, and `choices::MAX_WORK`): past them it keeps the
+/// learned values.
+const PLAN_REACH_VALUES: u64 = 1 << 24;
+const PLAN_REACH_CANDIDATES: u64 = 24;
+const PLAN_REACH_WORK: u64 = 1 << 26;
+/// At most this many next states per state and action in a grid world's model (a move, and
+/// the slips to the other neighbours or staying).
+const GRID_SUCCESSORS: u64 = 5;
+
 /// The sizes the tabular learner's memory grows with: what [`cost`] reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct Sizes {
@@ -207,6 +220,11 @@ pub struct Sizes {
     /// [`MAX_GOALS`] (0 for a persistent task, or one without goals): its table and its
     /// `options_policy` hold `2^goals` rows per observation.
     pub goals: u64,
+    /// `plan: model` on a reach task: the latest goal's deadline `T` (the steps its legs
+    /// are planned over), 0 when there is no such planning.
+    pub plan_horizon: u64,
+    /// Legs of all options together (what a planned hierarchy runs).
+    pub legs: u64,
     /// Bytes of the longest state as `policy.json` writes it (`{"x": 12, "y": 14}`).
     pub state_text: u64,
     /// Bytes of the longest option or action name.
@@ -228,8 +246,8 @@ pub struct Cost {
     pub learner: u64,
     /// A greedy agent: its tables over state indices.
     pub agent: u64,
-    /// `train`: the learner, its agent, the document, its text as it is written, and
-    /// [`FIXED_BYTES`].
+    /// `train`: the learner (and the reach planner of `plan: model`), its agent, the
+    /// document, its text as it is written, and [`FIXED_BYTES`].
     pub train: u64,
     /// `hstl.Policy.load` (and `eval` before it evaluates): the text, the document read,
     /// the learner that checks it and two agents, and [`FIXED_BYTES`].
@@ -310,6 +328,25 @@ pub fn cost(s: &Sizes) -> Cost {
         m(m(n, p + s.regions + 1), state),
         m(q_values, 8),
     ]);
+    // `plan: model` on a reach task: the model's counts and moves, each leg's tables over
+    // the steps to the deadline and its candidates, and the hierarchy's passes (how often
+    // each decision point is reached at each step, and its running legs).
+    let plan = if s.plan_horizon == 0 {
+        0
+    } else {
+        let (sa, codes) = (m(n, s.actions), 1u64 << goals);
+        let steps = s.plan_horizon.saturating_add(PLAN_TAIL_STEPS + 1);
+        let points = m(n, codes);
+        let successors = m(sa, 2 * (24 + allocation(16 * GRID_SUCCESSORS)));
+        add(&[
+            successors,
+            m(m(s.plan_horizon.max(1), sa).min(PLAN_REACH_VALUES), 8),
+            m(m(sa, PLAN_REACH_CANDIDATES), 8),
+            m(m(steps, points).min(PLAN_REACH_WORK), 8),
+            m(m(points, 4 * s.legs.max(1) + o + 2), 8),
+            m(m(points, o), 16),
+        ])
+    };
     let learner = add(&[
         // Valuations, reach, termination and avoided states, available options.
         m(n, 8 * s.vars + 10 * p + 24 + allocation(8 * o) + 16),
@@ -323,7 +360,7 @@ pub fn cost(s: &Sizes) -> Cost {
     let text = policy_bytes;
     // The text is written into a buffer that doubles as it grows: at most twice the text,
     // and the half it moves out of while it grows.
-    let train = add(&[learner, agent, document, m(text, 3), FIXED_BYTES]);
+    let train = add(&[learner, plan, agent, document, m(text, 3), FIXED_BYTES]);
     // With goals, the replay reads the valuations once more to find them.
     let load = add(&[text, m(document, 2), learner, m(agent, 2), goal_rows, FIXED_BYTES]);
     // The solver's own limit: its tables are refused past it, before they are allocated.
@@ -387,6 +424,13 @@ pub fn spec_sizes(src: &str, out: &CheckedSpec) -> Option<Sizes> {
         out.primitives.iter().map(|p| p.name.len()).chain(out.options.iter().map(|o| o.name.len()));
     let name_text = names.max().unwrap_or(0).max(5) as u64;
     let goals = if conjuncts.is_some() { 0 } else { goals_at_most(out) };
+    let plan_horizon =
+        if out.learn.plan == crate::checked::Plan::Model && crate::preset::is_reach_task(out) {
+            latest_deadline(out)
+        } else {
+            0
+        };
+    let legs = out.options.iter().map(|o| o.sequence.len() as u64).sum();
     let windows =
         conjuncts.map_or(0, |c| c.iter().fold(1u64, |a, c| a.saturating_mul(c.steps.max(1))));
     Some(Sizes {
@@ -398,10 +442,31 @@ pub fn spec_sizes(src: &str, out: &CheckedSpec) -> Option<Sizes> {
         regions,
         values,
         goals,
+        plan_horizon,
+        legs,
         state_text,
         name_text,
         windows,
     })
+}
+
+/// The latest deadline `T` of the task's `eventually[0..=T]` conjuncts (at least 1).
+fn latest_deadline(out: &CheckedSpec) -> u64 {
+    use crate::checked::{Bound, CFormulaKind};
+    let Some(task) = &out.task else { return 1 };
+    let parts = match &task.formula.kind {
+        CFormulaKind::And(parts) => parts.as_slice(),
+        _ => std::slice::from_ref(&task.formula),
+    };
+    let ends = parts.iter().filter_map(|p| match &p.kind {
+        CFormulaKind::Eventually(iv, _) => match iv.end {
+            Bound::Inclusive(t) => Some(t),
+            Bound::Exclusive(t) => Some(t.saturating_sub(1)),
+            Bound::Unbounded => None,
+        },
+        _ => None,
+    });
+    ends.max().unwrap_or(0).max(1)
 }
 
 /// At most the goals the runtime finds in the task of a spec that is not persistent (its
