@@ -120,12 +120,13 @@ fn edited_goals_are_refused_with_their_reason() {
     let first = all.iter().position(|e| e["goals_met"] == Value::from(Vec::<usize>::new()));
     let i = first.expect("an entry with no goal met");
     doc["options_policy"][i]["goals_met"] = Value::from(vec![0]);
-    let e = evaluate::replay(&serde_json::to_string(&doc).expect("JSON")).err();
-    let e = e.expect("a moved entry is refused");
+    let Err(e) = evaluate::replay(&serde_json::to_string(&doc).expect("JSON")) else {
+        panic!("a moved entry is accepted")
+    };
     assert!(e.message.contains("options_policy"), "{}", e.message);
     // The field twice, as text.
     let twice = text.replacen("\"goals\":", "\"goals\": [], \"goals\":", 1);
-    let e = evaluate::replay(&twice).err().expect("a field twice is refused");
+    let Err(e) = evaluate::replay(&twice) else { panic!("a field twice is accepted") };
     assert!(e.message.contains("given twice"), "{}", e.message);
 }
 
@@ -166,7 +167,8 @@ fn a_goal_too_long_to_write_out_is_refused_before_anything_runs() {
         // Past the checker, the learner refuses it without writing it out.
         let task = hstl::lower::task_spec(&checked.specs[0], &src).expect("lowers");
         let world = GridWorld::builtin("paper").expect("paper");
-        let e = Learner::new(&task, &world).err().expect("refused").to_string();
+        let Err(e) = Learner::new(&task, &world) else { panic!("depth {depth}: trains") };
+        let e = e.to_string();
         assert!(e.contains("goal 1 of the task is longer than 1048576 bytes"), "{e}");
     }
     // A shallower one checks, trains and writes its goal whole.
