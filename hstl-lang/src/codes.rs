@@ -523,10 +523,14 @@ actions x states per primitive option), `policy.json` as written (an options-pol
 per state and memory value, a flat-policy entry per state and primitive), the document as \
 `eval` and `hstl.Policy.load` read it back, and the exact optimum's tables; the states are \
 the spec's `int` domain, which bounds the world's cells. `memory: B` over k regions gives \
-(B + 1)^k memory values per state.\n\n\
+(B + 1)^k memory values per state; a task that is not persistent has a row per set of goals \
+met (2^goals, at most 4 goals), and `plan: model` on a reach task plans over the steps to its \
+latest deadline. A goal is also written out in full in `policy.json`, every `let` wherever it \
+is used: at most 1 MiB a goal, which nested lets that each use the one before twice pass \
+quickly.\n\n\
 Example:\n    learn { memory: 30 }   // 225 cells x 31^3 memory values: 6.7 million entries\n\n\
 Fix: fewer memory values (a smaller `memory: B`, or fewer regions), a smaller world, or \
-fewer options.",
+fewer options; a goal with fewer nested lets.",
     },
     CodeInfo {
         code: "HSTL101",
