@@ -156,7 +156,12 @@ impl Runs {
 /// the grid world in its `env` (a document written before world files loads as the open
 /// grid it was). Messages are worded as `hstlc eval` prints them, after `FILE: `.
 pub fn replay(text: &str) -> Result<Replay<GridWorld>, Problem> {
-    replay_in(text, |policy| {
+    replay_grid(read(text)?)
+}
+
+/// [`replay`] of a document already read.
+pub fn replay_grid(document: Document) -> Result<Replay<GridWorld>, Problem> {
+    replay_document(document, |policy| {
         let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
             Problem::new(
                 format!("its world: {e}"),
@@ -178,38 +183,75 @@ pub fn replay_in<E: Env>(
     text: &str,
     make_env: impl FnOnce(&mut Policy) -> Result<E, Problem>,
 ) -> Result<Replay<E>, Problem> {
-    let mut policy = Policy::from_json(text).map_err(|e| {
+    replay_document(read(text)?, make_env)
+}
+
+/// A `policy.json` as read, not yet checked: the document, the spec's text it was trained
+/// on (`spec_source`) and its seed.
+#[derive(Clone, Debug)]
+pub struct Document {
+    /// The document.
+    pub policy: Policy,
+    /// Its `spec_source`.
+    pub source: String,
+    /// Its `seed`, when it records one.
+    pub seed: Option<u64>,
+}
+
+/// Reads a `policy.json` in one typed pass (fields it does not know skipped, not kept):
+/// the document, its `spec_source` (a string, required) and its `seed` (a whole number
+/// from 0 to 2^64 - 1, if present).
+pub fn read(text: &str) -> Result<Document, Problem> {
+    let (policy, extra) = Policy::from_json_with(text, &["spec_source", "seed"]).map_err(|e| {
         Problem::new(e.to_string(), "pass the policy.json that `hstlc train` wrote".to_string())
     })?;
-    let (source, seed) = trained_from(text)
-        .map_err(|m| Problem::new(m, "train the policy again with `hstlc train`".to_string()))?;
+    let again = || "train the policy again with `hstlc train`".to_string();
+    let source = match extra.get("spec_source") {
+        Some(serde_json::Value::String(s)) => s.clone(),
+        Some(_) => {
+            return Err(Problem::new("its `spec_source` is not a string of hstl text", again()));
+        }
+        None => {
+            return Err(Problem::new(
+                "it has no `spec_source` entry with the spec it was trained on",
+                again(),
+            ));
+        }
+    };
+    let seed = match extra.get("seed") {
+        None => None,
+        Some(v) => Some(v.as_u64().ok_or_else(|| {
+            Problem::new(
+                format!("its `seed` is {v}, not a whole number from 0 to 2^64 - 1"),
+                again(),
+            )
+        })?),
+    };
+    Ok(Document { policy, source, seed })
+}
+
+/// [`replay_in`] of a document already read.
+pub fn replay_document<E: Env>(
+    document: Document,
+    make_env: impl FnOnce(&mut Policy) -> Result<E, Problem>,
+) -> Result<Replay<E>, Problem> {
+    let Document { mut policy, source, seed } = document;
     let spec = lowered(&source, &policy.spec)
         .map_err(|m| Problem::new(m, "train the policy again with `hstlc train`".to_string()))?;
     let env = make_env(&mut policy)?;
-    policy.check_against(&spec, &env).map_err(|e| {
+    let agent = policy.check_against(&spec, &env).map_err(|e| {
         Problem::new(
             e.to_string(),
             "the file was edited or damaged: train the policy again with `hstlc train`".to_string(),
         )
-    })?;
-    let agent = policy.agent_for(&spec, &env).map_err(|e| {
-        Problem::new(e.to_string(), "the policy does not fit its world".to_string())
     })?;
     Ok(Replay { policy, spec, env, agent, source, seed })
 }
 
 /// The spec that `policy.json` was trained from, checked and lowered again.
 pub fn spec_of(policy_text: &str, expected: &str) -> Result<TaskSpec, String> {
-    lowered(&trained_from(policy_text)?.0, expected)
-}
-
-/// The document's `spec_source` and `seed`.
-fn trained_from(policy_text: &str) -> Result<(String, Option<u64>), String> {
-    let value: serde_json::Value = serde_json::from_str(policy_text).map_err(|e| e.to_string())?;
-    let Some(source) = value.get("spec_source").and_then(|s| s.as_str()) else {
-        return Err("it has no `spec_source` entry with the spec it was trained on".into());
-    };
-    Ok((source.to_string(), value.get("seed").and_then(serde_json::Value::as_u64)))
+    let document = read(policy_text).map_err(|p| p.message)?;
+    lowered(&document.source, expected)
 }
 
 /// The spec called `expected` in `source`, checked and lowered.

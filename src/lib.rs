@@ -27,6 +27,7 @@
 
 pub mod artifacts;
 pub mod continuous;
+pub mod cost;
 pub mod evaluate;
 pub mod gym;
 pub mod load;

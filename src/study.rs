@@ -115,7 +115,11 @@ pub fn run_seeds(
     keep: Option<&Keep<'_>>,
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<(SeedRun, Option<Kept>)>, Problem> {
-    let threads = threads.min(seeds.len()).max(1);
+    // Each thread trains one seed at a time: only as many as fit the memory budget.
+    let cost = crate::cost::check(spec, env).map_err(|p| p.in_file(file))?;
+    let kept_bytes = keep.map_or(0, |k| k.budget.load(Ordering::Relaxed) as u64);
+    let threads =
+        crate::cost::threads_within_budget(&cost, kept_bytes, threads.min(seeds.len()).max(1));
     let one = |seed: u64| -> Result<(SeedRun, Option<Kept>), Problem> {
         let (run, trained) = run_seed(spec, env, seed, file, clock)?;
         let kept = match keep {

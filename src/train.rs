@@ -110,6 +110,8 @@ pub fn train_until<E: Env>(
     seed: u64,
     progress: impl FnMut(usize, f64) -> ControlFlow<()>,
 ) -> Result<Trained, Error> {
+    // The memory model first: nothing over the budget is allocated.
+    crate::cost::check(spec, env).map_err(|p| Error::Config(p.message))?;
     let mut learner = Learner::new(spec, env)?;
     let trained = learner.train_until(&mut seeded_rng(seed), progress);
     let policy = Policy::new(&learner);

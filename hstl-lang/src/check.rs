@@ -473,6 +473,16 @@ impl Cx<'_> {
         if let Some(l) = learn {
             self.diags.extend(crate::budget::learning(self.src, l, &out));
         }
+        if self.error_count() == 0
+            && let Some(d) = crate::budget::memory(self.src, learn, &out)
+        {
+            self.push(d);
+        }
+        if self.error_count() == 0
+            && let Some(d) = crate::budget::goal_text(self.src, &out)
+        {
+            self.push(d);
+        }
         self.mark_used(&mut out);
         // A broken item or an invalid part may have used any let: stay quiet then.
         if out.task.is_some() && spec.broken.is_empty() && self.error_count() == 0 {
@@ -1672,6 +1682,19 @@ impl Cx<'_> {
             out.learn.preset = Preset::Auto;
             let reach = crate::preset::is_reach_task(out);
             crate::preset::learn(horizons.as_deref(), reach, out.is_continuous(), &mut out.learn);
+            // The memory the preset sizes from the deadlines, made coarser until the runs
+            // fit the memory budget without the note of HSTL180.
+            let over = |out: &CheckedSpec| {
+                crate::budget::spec_sizes(self.src, out)
+                    .map(|s| crate::budget::cost(&s))
+                    .is_some_and(|c| {
+                        c.peak().0 > crate::budget::MEMORY_BUDGET
+                            || c.own().0 > crate::budget::MEMORY_NOTE
+                    })
+            };
+            while out.learn.memory > 1 && over(out) {
+                out.learn.memory -= 1;
+            }
         }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();
         for p in &l.params {

@@ -349,15 +349,13 @@ Fix: widen `terminate`, or leave it out: the option then stops where its region 
         name: "memory-too-large",
         severity: E,
         summary: "memory or the window reward would need more than the stated limits",
-        explanation: "`memory: B` gives the options level one observation per state and memory \
-value, (B + 1)^k memory values for k regions; `policy.json` holds an entry for each. At most \
-2,097,152 observations (states times memory values) are allowed. Memory and `reward: window` \
-also keep a table entry per step of each window: windows of at most 1,000,000 steps. \
+        explanation: "Memory and `reward: window` keep a table entry per step of each window: \
+windows of at most 1,000,000 steps (what the memory's values cost is HSTL084's). \
 `plan: model` plans over the exact counters of every region and each leg's durations from \
 every state: at most 67,108,864 planned values and 2,147,483,648 operations per sweep, \
 counted from the states, the regions' sizes and the windows.\n\n\
-Example:\n    learn { memory: 40 }   // 225 cells x 41^3 memory values: 15.5 million\n\n\
-Fix: fewer buckets (the case study uses `memory: 8`), fewer regions, or shorter windows.",
+Example:\n    task always[0..] eventually[0..2000000] A;\n    learn { memory: 8 }\n\n\
+Fix: shorter windows, smaller or fewer regions for `plan: model`.",
     },
     CodeInfo {
         code: "HSTL034",
@@ -514,6 +512,27 @@ Fix: remove those items from the dense spec (keep the learning in a discrete-tim
 its own), or remove the time variable to learn in steps.",
     },
     CodeInfo {
+        code: "HSTL084",
+        name: "over-memory-budget",
+        severity: E,
+        summary: "the runs of a spec would take more than the 2 GiB memory budget",
+        explanation: "Everything `check` accepts trains, evaluates and loads within a stated \
+memory budget of 2 GiB (`study` runs fewer seeds at once when a spec needs it). The budget \
+counts what the tabular learner holds: the Q-tables (options x memory values x states, and \
+actions x states per primitive option), `policy.json` as written (an options-policy entry \
+per state and memory value, a flat-policy entry per state and primitive), the document as \
+`eval` and `hstl.Policy.load` read it back, and the exact optimum's tables; the states are \
+the spec's `int` domain, which bounds the world's cells. `memory: B` over k regions gives \
+(B + 1)^k memory values per state; a task that is not persistent has a row per set of goals \
+met (2^goals, at most 4 goals), and `plan: model` on a reach task plans over the steps to its \
+latest deadline. A goal is also written out in full in `policy.json`, every `let` wherever it \
+is used: at most 1 MiB a goal, which nested lets that each use the one before twice pass \
+quickly.\n\n\
+Example:\n    learn { memory: 30 }   // 225 cells x 31^3 memory values: 6.7 million entries\n\n\
+Fix: fewer memory values (a smaller `memory: B`, or fewer regions), a smaller world, or \
+fewer options; a goal with fewer nested lets.",
+    },
+    CodeInfo {
         code: "HSTL101",
         name: "unused-let",
         severity: W,
@@ -596,5 +615,17 @@ shortest way to their region, through `R` if it lies on the way. Give the option
 that stays out, and the leg stops there. `learn { preset: auto }` fills it in on every option.\n\n\
 Example:\n    task eventually[0..=30] Goal && always !Pit;\n    option Goal;   // its leg may cross Pit\n\n\
 Fix: `option Goal { avoid: Pit }`, or `learn { preset: auto }`.",
+    },
+    CodeInfo {
+        code: "HSTL180",
+        name: "large-memory-estimate",
+        severity: W,
+        summary: "the runs of a spec will take more than 512 MiB",
+        explanation: "The memory model of HSTL084 puts `train` or `eval` of this spec above \
+512 MiB, within the 2 GiB budget: it runs, and the note says how much it will take (and \
+how large `policy.json` will be) before it does.\n\n\
+Example:\n    learn { memory: 20 }   // 225 cells x 21^3 memory values: 2.1 million entries\n\n\
+Fix: nothing is wrong; fewer memory values, a smaller world or fewer options make it \
+smaller.",
     },
 ];

@@ -20,9 +20,32 @@ pub fn read_text(
     what: &str,
     io_error: impl FnOnce(&std::io::Error) -> PyErr,
 ) -> PyResult<String> {
+    read(path, limit, what, false, io_error)
+}
+
+/// [`read_text`] of a regular file only: a named pipe, a device or a socket is refused
+/// before a byte is read ([`hstl::load::open_regular`], as `hstlc` reads world files), so
+/// that a named pipe cannot make the call wait for a writer forever.
+pub fn read_regular_text(
+    path: &Path,
+    limit: u64,
+    what: &str,
+    io_error: impl FnOnce(&std::io::Error) -> PyErr,
+) -> PyResult<String> {
+    read(path, limit, what, true, io_error)
+}
+
+fn read(
+    path: &Path,
+    limit: u64,
+    what: &str,
+    regular: bool,
+    io_error: impl FnOnce(&std::io::Error) -> PyErr,
+) -> PyResult<String> {
     let name = path.display().to_string();
     let read = || -> std::io::Result<Option<Vec<u8>>> {
-        let file = std::fs::File::open(path)?;
+        let file =
+            if regular { hstl::load::open_regular(path)? } else { std::fs::File::open(path)? };
         let meta = file.metadata()?;
         if meta.is_dir() {
             return Err(std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a folder"));
@@ -34,7 +57,19 @@ pub fn read_text(
         file.take(limit + 1).read_to_end(&mut bytes)?;
         Ok((bytes.len() as u64 <= limit).then_some(bytes))
     };
-    let Some(mut bytes) = read().map_err(|e| io_error(&e))? else {
+    let read = read().map_err(|e| {
+        if regular && e.kind() == std::io::ErrorKind::InvalidInput {
+            value_error(
+                format!("`{}` is {e}", hstl::load::escape_controls(&name)),
+                Some(format!(
+                    "a {what} is read only from a regular file: save it as one and name that file"
+                )),
+            )
+        } else {
+            io_error(&e)
+        }
+    })?;
+    let Some(mut bytes) = read else {
         return Err(value_error(
             format!("`{name}` is larger than {}, the limit for a {what}", size_words(limit)),
             Some(format!("check that `{name}` is the {what} you meant; hstl reads no larger one")),

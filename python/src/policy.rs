@@ -95,7 +95,7 @@ impl Listed {
         let mut values = Vec::with_capacity(entries.len() * policy.state_vars.len());
         for (s, e) in entries.iter().enumerate() {
             for var in &policy.state_vars {
-                let v = e.state.get(var).and_then(Value::as_f64).ok_or_else(|| {
+                let v = e.state.get(var).ok_or_else(|| {
                     bad(format!("state {s} of its flat policies has no number for `{var}`"))
                 })?;
                 values.push(v);
@@ -327,17 +327,18 @@ fn replay_any(text: &str) -> Result<Replayed, Problem> {
             continuous::AnyReplay::Gym(r) => Replayed::GymTiles(Box::new(r)),
         });
     }
-    let gymnasium = hstl::runtime::Policy::from_json(text).ok().and_then(|doc| {
-        let params = doc.env.params;
-        params.get("gymnasium")?.as_bool()?.then_some(params.clone())
-    });
-    let Some(params) = gymnasium else {
-        return evaluate::replay(text).map(Replayed::Grid);
-    };
+    // One typed pass over the document; the world it names decides the replay.
+    let document = evaluate::read(text)?;
+    let params = &document.policy.env.params;
+    let gymnasium = params.get("gymnasium").and_then(Value::as_bool) == Some(true);
+    if !gymnasium {
+        return evaluate::replay_grid(document).map(Replayed::Grid);
+    }
+    let params = params.clone();
     let count =
         |key: &str| params.get(key).and_then(Value::as_u64).and_then(|n| usize::try_from(n).ok());
     let start = |key: &str| params.get(key).and_then(Value::as_i64);
-    let replay = evaluate::replay_in(text, |p| Listed::of(p))?;
+    let replay = evaluate::replay_document(document, |p| Listed::of(p))?;
     let spaces = match (
         count("observations"),
         start("observation_start"),

@@ -69,7 +69,7 @@ impl World {
 
     /// The world in the file at `path`, with the CLI's words for every error.
     pub fn read(path: &Path) -> PyResult<World> {
-        let text = crate::files::read_text(
+        let text = crate::files::read_regular_text(
             path,
             hstl::world::MAX_WORLD_BYTES as u64,
             "world file",

@@ -91,3 +91,26 @@ def test_unknown_and_unreadable_worlds_raise_what_hstlc_prints(hstlc, monkeypatc
         with pytest.raises(hstl.WorldError) as builtin:
             hstl.World.builtin("mars")
         assert str(builtin.value) == str(e.value)
+
+
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
+    # Opening a named pipe for reading waits for a writer: `World.load` refuses it first, as
+    # `hstlc --world` does. A child process, so that a hang fails the test instead of it.
+    import subprocess
+    import sys
+
+    fifo = tmp_path / "world.toml"
+    os.mkfifo(fifo)
+    code = (
+        "import sys, hstl\n"
+        "try:\n"
+        "    hstl.World.load(sys.argv[1])\n"
+        "except ValueError as e:\n"
+        "    print(type(e).__name__, e)\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", code, str(fifo)], capture_output=True, text=True, timeout=60
+    )
+    assert run.returncode == 0, run.stderr
+    assert "is a named pipe, not a regular file" in run.stdout, run.stdout
+    assert "read only from a regular file" in run.stdout, run.stdout

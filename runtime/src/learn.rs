@@ -209,6 +209,10 @@ impl<'e, E: Env> Learner<'e, E> {
         } else {
             None
         };
+        if let Some(g) = &goals {
+            // `policy.json` writes the goals out: refused before training when too long.
+            g.progress.goal_texts()?;
+        }
         let codes = goals.as_ref().map_or(1, StateGoals::codes);
         let size = tables
             .states

@@ -41,6 +41,7 @@ pub mod plan;
 mod plan_reach;
 pub mod plane;
 pub mod policy;
+mod policy_parts;
 pub mod progress;
 pub mod reach_avoid;
 pub mod spec;

@@ -28,6 +28,8 @@ use std::collections::{BTreeMap, HashMap};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
+pub use crate::policy_parts::{HexTable, State};
+
 use crate::learn::{argmax, best_of};
 use crate::memory::Memory;
 use crate::progress::StateGoals;
@@ -120,7 +122,7 @@ pub struct PrimitiveInfo {
     /// The option's name.
     pub name: String,
     /// The states where it terminates.
-    pub terminate: Vec<Map<String, Value>>,
+    pub terminate: Vec<State>,
 }
 
 /// The memory part of `policy.json`.
@@ -133,14 +135,14 @@ pub struct MemoryDoc {
     /// `B`.
     pub buckets: usize,
     /// The states where each region holds.
-    pub states: Vec<Vec<Map<String, Value>>>,
+    pub states: Vec<Vec<State>>,
 }
 
 /// One row of a policy table: in `state` (with `memory`), choose `choice`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Entry {
-    /// The state, as a map from variable name to value.
-    pub state: Map<String, Value>,
+    /// The state, `{VAR: value, ...}`.
+    pub state: State,
     /// The buckets `[b_1, ...]` of an options-policy entry with memory.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory: Option<Vec<usize>>,
@@ -156,9 +158,9 @@ pub struct Entry {
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct QTablesDoc {
     /// Per primitive option, its table in state-major order (`s * actions + a`).
-    pub flat: BTreeMap<String, Vec<String>>,
+    pub flat: BTreeMap<String, HexTable>,
     /// The options table in observation-major order (`obs * options + o`).
-    pub options: Vec<String>,
+    pub options: HexTable,
     /// Primitive steps taken.
     pub steps: u64,
     /// Option choices made.
@@ -244,8 +246,7 @@ impl Policy {
         let q = learner.q();
         let vars = env.state_vars();
         let actions = env.actions();
-        let states: Vec<Map<String, Value>> =
-            (0..env.num_states()).map(|s| state_map(env, &vars, s)).collect();
+        let states: Vec<State> = (0..env.num_states()).map(|s| state_of(env, &vars, s)).collect();
         let prim = |p: usize| spec.primitives[p].name.clone();
         let options = spec
             .options
@@ -283,7 +284,8 @@ impl Policy {
                 choice: spec.options[o].name.clone(),
             })
             .collect();
-        let goals = goals.map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
+        // The learner refused goals too long to write out: this does not fail.
+        let goals = goals.map(|g| g.progress.goal_texts().unwrap_or_default());
         let memory = memory.map(|m| MemoryDoc {
             regions: m.regions.clone(),
             horizons: m.horizons.clone(),
@@ -312,7 +314,7 @@ impl Policy {
                 (prim(p), entries)
             })
             .collect();
-        let hex = |t: &[f64]| t.iter().map(|v| format!("{:016x}", v.to_bits())).collect();
+        let hex = |t: &[f64]| HexTable(t.to_vec());
         let q_tables = QTablesDoc {
             flat: q.flat.iter().enumerate().map(|(p, t)| (prim(p), hex(t))).collect(),
             options: hex(&q.options),
@@ -375,11 +377,34 @@ impl Policy {
 
     /// Reads a document; the error says what is wrong and where.
     pub fn from_json(text: &str) -> Result<Policy, Error> {
-        serde_json::from_str(text).map_err(|e| Error::Policy(e.to_string()))
+        Policy::from_json_with(text, &[]).map(|(policy, _)| policy)
+    }
+
+    /// Reads a document and the `extra` fields among those beyond the document's own (as
+    /// [`Policy::to_json_with`] writes them), in one typed pass: every field is read into
+    /// its type as it comes, a field the document does not know and `extra` does not name
+    /// is skipped without being kept, and a field given twice is an error. The error says
+    /// what is wrong and where (line and column).
+    pub fn from_json_with(
+        text: &str,
+        extra: &[&str],
+    ) -> Result<(Policy, Map<String, Value>), Error> {
+        let mut de = serde_json::Deserializer::from_str(text);
+        let read = serde::Deserializer::deserialize_map(&mut de, DocumentVisitor { extra })
+            .and_then(|doc| de.end().map(|()| doc));
+        read.map_err(|e| Error::Policy(e.to_string()))
     }
 
     /// The stored Q-tables, in the primitive order of [`Policy::primitives`].
     pub fn q_tables(&self) -> Result<QTables, Error> {
+        if let Some(extra) =
+            self.q_tables.flat.keys().find(|k| !self.primitives.iter().any(|p| &p.name == *k))
+        {
+            return Err(Error::Policy(format!(
+                "q_tables.flat has a table for `{}`, which is no primitive option of the document",
+                extra.escape_debug()
+            )));
+        }
         let flat = self
             .primitives
             .iter()
@@ -387,22 +412,26 @@ impl Policy {
                 let t = self.q_tables.flat.get(&p.name).ok_or_else(|| {
                     Error::Policy(format!("q_tables.flat has no table for option {}", p.name))
                 })?;
-                unhex(t, &format!("q_tables.flat.{}", p.name))
+                Ok(t.0.clone())
             })
-            .collect::<Result<_, _>>()?;
+            .collect::<Result<_, Error>>()?;
         Ok(QTables {
             flat,
-            options: unhex(&self.q_tables.options, "q_tables.options")?,
+            options: self.q_tables.options.0.clone(),
             steps: self.q_tables.steps,
             choices: self.q_tables.choices,
         })
     }
 
     /// Checks the document whole against the spec and environment it claims: its Q-tables
-    /// decode, have the spec's shape and hold no NaN, and every other entry (options,
-    /// termination sets, greedy choices, memory) is what those Q-tables give for this spec
-    /// on `env`. A document edited by hand, truncated or paired with another spec fails.
-    pub fn check_against<E: Env>(&self, spec: &TaskSpec, env: &E) -> Result<(), Error> {
+    /// have the spec's shape and hold no NaN, and every other entry (options, termination
+    /// sets, greedy choices, memory, goals) is what those Q-tables give for this spec on
+    /// `env`, each state listed once (with goals, once per set of goals met). A document
+    /// edited by hand, truncated or paired with another spec fails. The greedy policies are
+    /// compared as tables over observations (state, memory value and goals met), so the
+    /// check costs what the document's numbers do, not a second document. Returns the
+    /// document's greedy agent on `env` ([`Policy::agent_for`]).
+    pub fn check_against<E: Env>(&self, spec: &TaskSpec, env: &E) -> Result<Agent, Error> {
         let err = |m: String| Err(Error::Policy(m));
         let q = self.q_tables()?;
         let tables =
@@ -414,32 +443,88 @@ impl Policy {
             }
         }
         let learner = Learner::new(spec, env)?.with_tables(q)?;
-        let rebuilt = Policy::new(&learner);
-        if rebuilt.spec != self.spec {
-            return err(format!("it names spec `{}`, not `{}`", self.spec, rebuilt.spec));
+        if spec.name != self.spec {
+            return err(format!("it names spec `{}`, not `{}`", self.spec, spec.name));
         }
-        if rebuilt.switch != self.switch {
+        let theirs = learner.agent();
+        if theirs.switch != self.switch {
             return err(format!(
                 "its `switch` is `{}`, but the spec it was trained on has `switch: {}`",
                 self.switch.word(),
-                rebuilt.switch.word()
+                theirs.switch.word()
             ));
         }
-        let parts = [
-            ("options", rebuilt.options == self.options),
-            ("primitives", rebuilt.primitives == self.primitives),
-            ("memory", rebuilt.memory == self.memory),
-            ("goals", rebuilt.goals == self.goals),
-            ("max_steps", rebuilt.max_steps == self.max_steps),
-            ("flat_policies", rebuilt.flat_policies == self.flat_policies),
-            ("options_policy", rebuilt.options_policy == self.options_policy),
-        ];
-        match parts.iter().find(|(_, same)| !same) {
-            Some((part, _)) => err(format!(
+        let differs = |part: &str| {
+            Err(Error::Policy(format!(
                 "its `{part}` is not what its `q_tables` give for the spec it was trained on"
-            )),
-            None => Ok(()),
+            )))
+        };
+        let prim = |p: usize| spec.primitives[p].name.as_str();
+        let options_same = self.options.len() == spec.options.len()
+            && self.options.iter().zip(&spec.options).all(|(mine, o)| {
+                mine.name == o.name
+                    && mine
+                        .sequence
+                        .iter()
+                        .map(String::as_str)
+                        .eq(o.sequence.iter().map(|&p| prim(p)))
+            });
+        if !options_same {
+            return differs("options");
         }
+        let names_same = self.primitives.len() == spec.primitives.len()
+            && self.primitives.iter().zip(&spec.primitives).all(|(a, b)| a.name == b.name);
+        if !names_same {
+            return differs("primitives");
+        }
+        let header = |m: &MemoryDoc| (m.regions.clone(), m.horizons.clone(), m.buckets);
+        let memory_same = match (&self.memory, &theirs.memory) {
+            (None, None) => true,
+            (Some(doc), Some(m)) => {
+                header(doc) == (m.regions.clone(), m.horizons.clone(), m.buckets)
+            }
+            _ => false,
+        };
+        if !memory_same {
+            return differs("memory");
+        }
+        let goals = theirs.goals.as_ref().map(|g| g.progress.goal_texts()).transpose()?;
+        if goals != self.goals {
+            return differs("goals");
+        }
+        if self.max_steps != theirs.max_steps {
+            return differs("max_steps");
+        }
+        let mine = self.agent_for(spec, env)?;
+        let count = |t: &[bool]| t.iter().filter(|&&b| b).count();
+        let terminate_same = mine.terminate == theirs.terminate
+            && self
+                .primitives
+                .iter()
+                .zip(&theirs.terminate)
+                .all(|(p, t)| p.terminate.len() == count(t));
+        if !terminate_same {
+            return differs("primitives");
+        }
+        if let (Some(doc), Some(m)) = (&self.memory, &theirs.memory) {
+            let holds_same = mine.memory.as_ref().is_some_and(|mm| mm.holds == m.holds)
+                && doc.states.iter().zip(&m.holds).all(|(s, h)| s.len() == count(h));
+            if !holds_same {
+                return differs("memory");
+            }
+        }
+        let n = env.num_states();
+        let flat_same = mine.flat == theirs.flat
+            && self.flat_policies.len() == self.primitives.len()
+            && self.flat_policies.values().all(|t| t.len() == n);
+        if !flat_same {
+            return differs("flat_policies");
+        }
+        let observed = theirs.options.iter().filter(|&&o| o != usize::MAX).count();
+        if mine.options != theirs.options || self.options_policy.len() != observed {
+            return differs("options_policy");
+        }
+        Ok(mine)
     }
 
     /// The greedy policies on `env`'s state indices. Fails when the document does not fit
@@ -465,8 +550,7 @@ impl Policy {
         } else {
             None
         };
-        let texts: Option<Vec<String>> =
-            goals.as_ref().map(|g| g.progress.goal_formulas().map(ToString::to_string).collect());
+        let texts = goals.as_ref().map(|g| g.progress.goal_texts()).transpose()?;
         if texts != self.goals {
             return Err(Error::Policy(
                 "the document's `goals` are not the goals of the spec it was trained on".into(),
@@ -495,16 +579,23 @@ impl Policy {
         }
         let n = env.num_states();
         let mut index = HashMap::with_capacity(n);
+        let mut names = Vec::new();
         for s in 0..n {
-            index.insert(key(&state_map(env, &self.state_vars, s)), s);
+            let state = state_of(env, &self.state_vars, s);
+            if s == 0 {
+                names = state.names().to_vec();
+            }
+            index.insert(state.bits(), s);
         }
-        let lookup = |state: &Map<String, Value>, what: &str| {
-            index.get(&key(state)).copied().ok_or_else(|| {
-                Error::Policy(format!(
-                    "{what} names state {}, which the environment lacks",
-                    Value::Object(state.clone())
-                ))
-            })
+        let lookup = |state: &State, what: &str| {
+            (state.names() == names.as_slice())
+                .then(|| index.get(&state.bits()).copied())
+                .flatten()
+                .ok_or_else(|| {
+                    Error::Policy(format!(
+                        "{what} names state {state}, which the environment lacks"
+                    ))
+                })
         };
         let prim_index = |name: &str| {
             self.primitives.iter().position(|p| p.name == name).ok_or_else(|| {
@@ -547,7 +638,7 @@ impl Policy {
         }
         let (max_steps, switch) = (self.max_steps, self.switch);
         let options_q = match switch {
-            Switch::Step => unhex(&self.q_tables.options, "q_tables.options")?,
+            Switch::Step => self.q_tables.options.0.clone(),
             Switch::Termination => Vec::new(),
         };
         if switch == Switch::Step && options_q.len() != options.len() * legs.len() {
@@ -565,7 +656,7 @@ impl Policy {
         &self,
         doc: &MemoryDoc,
         n: usize,
-        lookup: &impl Fn(&Map<String, Value>, &str) -> Result<usize, Error>,
+        lookup: &impl Fn(&State, &str) -> Result<usize, Error>,
     ) -> Result<Memory, Error> {
         if doc.buckets == 0 {
             return Err(Error::Policy("memory.buckets is 0; a memory policy has B > 0".into()));
@@ -611,13 +702,13 @@ impl Policy {
                 doc.regions.join(", ")
             )));
         }
-        let inside: Vec<std::collections::HashSet<Vec<(String, u64)>>> =
-            doc.states.iter().map(|states| states.iter().map(key).collect()).collect();
+        let inside: Vec<std::collections::HashSet<Vec<u64>>> =
+            doc.states.iter().map(|states| states.iter().map(State::bits).collect()).collect();
         Ok(self
             .options_policy
             .iter()
             .filter(|e| {
-                let k = key(&e.state);
+                let k = e.state.bits();
                 let want = memory
                     .iter()
                     .zip(&inside)
@@ -641,6 +732,84 @@ impl Policy {
                 })
                 .collect(),
         }
+    }
+}
+
+/// The one pass over a document that [`Policy::from_json_with`] makes.
+struct DocumentVisitor<'a> {
+    extra: &'a [&'a str],
+}
+
+impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
+    type Value = (Policy, Map<String, Value>);
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a policy.json document, an object")
+    }
+
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+        use serde::de::{Error as _, IgnoredAny};
+        fn set<T, E: serde::de::Error>(
+            slot: &mut Option<T>,
+            value: T,
+            name: &str,
+        ) -> Result<(), E> {
+            if slot.is_some() {
+                return Err(E::custom(format!("the field `{name}` is given twice")));
+            }
+            *slot = Some(value);
+            Ok(())
+        }
+        let (mut spec, mut env, mut state_vars, mut actions, mut options) =
+            (None, None, None, None, None);
+        let (mut primitives, mut memory, mut options_policy, mut flat_policies) =
+            (None, None, None, None);
+        let (mut goals, mut max_steps, mut switch, mut q_tables) = (None, None, None, None);
+        let mut extras = Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            match key.as_str() {
+                "spec" => set(&mut spec, map.next_value()?, &key)?,
+                "env" => set(&mut env, map.next_value()?, &key)?,
+                "state_vars" => set(&mut state_vars, map.next_value()?, &key)?,
+                "actions" => set(&mut actions, map.next_value()?, &key)?,
+                "options" => set(&mut options, map.next_value()?, &key)?,
+                "primitives" => set(&mut primitives, map.next_value()?, &key)?,
+                "memory" => set(&mut memory, map.next_value::<Option<MemoryDoc>>()?, &key)?,
+                "goals" => set(&mut goals, map.next_value::<Option<Vec<String>>>()?, &key)?,
+                "options_policy" => set(&mut options_policy, map.next_value()?, &key)?,
+                "flat_policies" => set(&mut flat_policies, map.next_value()?, &key)?,
+                "max_steps" => set(&mut max_steps, map.next_value()?, &key)?,
+                "switch" => set(&mut switch, map.next_value()?, &key)?,
+                "q_tables" => set(&mut q_tables, map.next_value()?, &key)?,
+                k if self.extra.contains(&k) => {
+                    if extras.contains_key(k) {
+                        return Err(A::Error::custom(format!("the field `{k}` is given twice")));
+                    }
+                    let value: Value = map.next_value()?;
+                    extras.insert(key, value);
+                }
+                _ => {
+                    map.next_value::<IgnoredAny>()?;
+                }
+            }
+        }
+        let policy = Policy {
+            spec: spec.ok_or_else(|| A::Error::missing_field("spec"))?,
+            env: env.ok_or_else(|| A::Error::missing_field("env"))?,
+            state_vars: state_vars.ok_or_else(|| A::Error::missing_field("state_vars"))?,
+            actions: actions.ok_or_else(|| A::Error::missing_field("actions"))?,
+            options: options.ok_or_else(|| A::Error::missing_field("options"))?,
+            primitives: primitives.ok_or_else(|| A::Error::missing_field("primitives"))?,
+            memory: memory.flatten(),
+            goals: goals.flatten(),
+            options_policy: options_policy
+                .ok_or_else(|| A::Error::missing_field("options_policy"))?,
+            flat_policies: flat_policies.ok_or_else(|| A::Error::missing_field("flat_policies"))?,
+            max_steps: max_steps.ok_or_else(|| A::Error::missing_field("max_steps"))?,
+            switch: switch.unwrap_or_default(),
+            q_tables: q_tables.ok_or_else(|| A::Error::missing_field("q_tables"))?,
+        };
+        Ok((policy, extras))
     }
 }
 
@@ -735,31 +904,14 @@ impl serde_json::ser::Formatter for Shallow {
     }
 }
 
-/// The state with index `s` as a `{VAR: value}` map; integral values are written as integers.
-fn state_map<E: Env>(env: &E, vars: &[String], s: usize) -> Map<String, Value> {
+/// The state with index `s` of `env` as the document writes it.
+fn state_of<E: Env>(env: &E, vars: &[String], s: usize) -> State {
     let mut values = Vec::new();
     if let Some(state) = env.state(s) {
         env.valuation(&state, &mut values);
     }
-    vars.iter()
-        .zip(values)
-        .map(|(name, v)| {
-            let value = if v.fract() == 0.0 && v.abs() < 9.0e15 {
-                Value::from(v as i64)
-            } else {
-                serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number)
-            };
-            (name.clone(), value)
-        })
-        .collect()
-}
-
-/// A hashable key of a state map: its values as `f64` bits, in key order.
-fn key(state: &Map<String, Value>) -> Vec<(String, u64)> {
-    state
-        .iter()
-        .map(|(k, v)| (k.clone(), v.as_f64().map_or(u64::MAX, |f| (f + 0.0).to_bits())))
-        .collect()
+    values.resize(vars.len(), f64::NAN);
+    State::new(vars, &values)
 }
 
 /// The options table from policy entries, indexed by observation: every state (with
@@ -769,11 +921,10 @@ fn fill_options(
     memory: Option<&Memory>,
     goals: Option<&StateGoals>,
     entries: &[Entry],
-    lookup: &impl Fn(&Map<String, Value>, &str) -> Result<usize, Error>,
+    lookup: &impl Fn(&State, &str) -> Result<usize, Error>,
     choice: impl Fn(&str) -> Option<usize>,
 ) -> Result<Vec<usize>, Error> {
     let err = |m: String| Err(Error::Policy(m));
-    let state = |e: &Entry| Value::Object(e.state.clone());
     if memory.is_none() && goals.is_none() {
         if entries.iter().any(|e| e.memory.is_some()) {
             return err(
@@ -806,7 +957,7 @@ fn fill_options(
                 return err(format!(
                     "options_policy has an entry for state {} without memory; a memory policy \
                      gives [b_1, ...] in each entry",
-                    state(e)
+                    e.state
                 ));
             }
             (Some(m), Some(b)) => {
@@ -814,7 +965,7 @@ fn fill_options(
                     Error::Policy(format!(
                         "options_policy gives state {} the memory {b:?}, which is not {} \
                          buckets in 0..={} with 0 for the regions the state lies in",
-                        state(e),
+                        e.state,
                         m.len(),
                         m.buckets
                     ))
@@ -833,14 +984,14 @@ fn fill_options(
                 return err(format!(
                     "options_policy has an entry for state {} without goals_met; a policy with \
                      goals gives the goals met in each entry",
-                    state(e)
+                    e.state
                 ));
             }
             (Some(g), Some(list)) => g.progress.encode(list).ok_or_else(|| {
                 Error::Policy(format!(
                     "options_policy gives state {} the goals met {list:?}, which are not \
                      indices of its {} goals",
-                    state(e),
+                    e.state,
                     g.progress.goals()
                 ))
             })?,
@@ -869,7 +1020,7 @@ fn fill(
     n: usize,
     entries: &[Entry],
     what: &str,
-    lookup: &impl Fn(&Map<String, Value>, &str) -> Result<usize, Error>,
+    lookup: &impl Fn(&State, &str) -> Result<usize, Error>,
     choice: impl Fn(&str) -> Option<usize>,
 ) -> Result<Vec<usize>, Error> {
     let mut out = vec![usize::MAX; n];
@@ -882,19 +1033,4 @@ fn fill(
         return Err(Error::Policy(format!("{what} does not cover state index {s}")));
     }
     Ok(out)
-}
-
-fn unhex(values: &[String], what: &str) -> Result<Vec<f64>, Error> {
-    values
-        .iter()
-        .map(|h| {
-            u64::from_str_radix(h, 16)
-                .ok()
-                .filter(|_| h.len() == 16)
-                .map(f64::from_bits)
-                .ok_or_else(|| {
-                    Error::Policy(format!("{what} holds {h:?}, not 16 hex digits of f64 bits"))
-                })
-        })
-        .collect()
 }

@@ -21,6 +21,11 @@ use hstl_robustness::{Formula, Node, NodeId, Trace};
 /// At most this many goals are tracked (the options level's weights double with each).
 pub const MAX_GOALS: usize = 4;
 
+/// The longest text of one goal, written out as `policy.json` holds it (every subformula
+/// wherever it is used, so a formula of few nodes can be written out at great length):
+/// 1 MiB. A task with a longer goal is refused ([`Progress::goal_texts`]).
+pub const MAX_GOAL_TEXT: usize = 1 << 20;
+
 /// A greedy run of a task that is not persistent lasts its horizon and one step, at most
 /// this many (what `eval` and `study` judge it over, and what training holds to).
 pub const MAX_RUN_STEPS: usize = 100_000;
@@ -111,6 +116,37 @@ impl Progress {
     /// The goals, in conjunct order.
     pub fn goal_formulas(&self) -> impl Iterator<Item = &Formula> {
         self.goals.iter().map(|(g, _)| g)
+    }
+
+    /// The goals as text, in conjunct order, as `policy.json` holds them; fails (without
+    /// writing more than [`MAX_GOAL_TEXT`] bytes) for a goal longer than that.
+    pub fn goal_texts(&self) -> Result<Vec<String>, crate::Error> {
+        /// A text that refuses to grow past [`MAX_GOAL_TEXT`].
+        struct Capped(String);
+        impl std::fmt::Write for Capped {
+            fn write_str(&mut self, s: &str) -> std::fmt::Result {
+                if self.0.len() + s.len() > MAX_GOAL_TEXT {
+                    return Err(std::fmt::Error);
+                }
+                self.0.push_str(s);
+                Ok(())
+            }
+        }
+        self.goal_formulas()
+            .enumerate()
+            .map(|(j, g)| {
+                let mut text = Capped(String::new());
+                std::fmt::write(&mut text, format_args!("{g}")).map_err(|_| {
+                    crate::Error::Config(format!(
+                        "goal {} of the task is longer than {} bytes written out (each `let` \
+                         in it is written wherever it is used); write it with fewer nested lets",
+                        j + 1,
+                        MAX_GOAL_TEXT
+                    ))
+                })?;
+                Ok(text.0)
+            })
+            .collect()
     }
 
     /// The goals in `mask`, by their index in conjunct order.

@@ -578,7 +578,10 @@ fn memory_slices_pick_one_entry_per_state() {
     for (_, b) in &slices {
         let slice = policy.options_slice(b).unwrap();
         assert_eq!(slice.len(), 225, "{b:?}");
-        let inside_b = slice.iter().find(|e| e.state["x"] == 3 && e.state["y"] == 3).unwrap();
+        let inside_b = slice
+            .iter()
+            .find(|e| e.state.get("x") == Some(3.0) && e.state.get("y") == Some(3.0))
+            .unwrap();
         assert_eq!(inside_b.memory, Some(vec![b[0], 0, b[2]]));
     }
     let err = policy.options_slice(&[3, 0, 0]).unwrap_err().to_string();
