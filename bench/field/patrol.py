@@ -7,17 +7,18 @@ kept over greedy runs (100 runs of 2,000 steps, the first 100 of each not counte
 MountainCar patrol (examples/specs/mountain_car_patrol.hstl: both hill tops within every
 200 steps). hstl: `hstlc train` (the wheel's command) on its built-in `mountain-car` world
 (gymnasium's MountainCar-v0 dynamics, pinned by a Rust test) over a ladder of episode
-budgets, each rung a training of its own, `--seed s`; steps and training seconds as it
-prints them. SB3: gymnasium's `MountainCarEnv` with its goal termination removed
+budgets, each rung a training of its own, `--seed s`; steps as it prints them, and the
+CPU time of the whole command (training, its evaluation and pictures). SB3: gymnasium's `MountainCarEnv` with its goal termination removed
 (`NoTermination`), a TimeLimit of the evaluation's run length (2,000 steps), and
 `hstl.STLReward` over the task as the reward (the form picked by `--part forms`, the best of
 the four); hyperparameters rl-baselines3-zoo's for MountainCar-v0. Checkpoints along
-training, each evaluated greedily (its evaluation time not counted).
+training, each evaluated greedily (its evaluation time not counted). Times are CPU seconds
+on one core (SB3 on one torch thread), not wall clock, so that a shared machine slows
+neither side's figures.
 
 CartPole patrol (specs/cartpole_patrol.hstl): the same for SB3 on CartPole-v1 without the
-pole-fall termination (the fall is the task's `always[0..] !fallen`); hstl's side needs
-`hstl.train(env=Box)` (issue 27, item 2): `hstl_env_hook` runs it when the package has it
-and otherwise records `pending`.
+pole-fall termination (the fall is the task's `always[0..] !fallen`); hstl's side is `hstl.train(env=Box)` on
+the same environment, its speeds clipped to the spec's ranges (`hstl_env_hook`).
 
 Writes out/patrol/<task>/<method>_s<seed>.csv (one per run, so that a partial run keeps
 what it finished) and out/patrol/<task>/curves.csv; `--part plot` draws the pictures.
@@ -28,6 +29,7 @@ from __future__ import annotations
 import argparse
 import math
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -167,9 +169,9 @@ def run_sb3(task: Task, method: str, reward: str, seed: int, budget: int, runs: 
     rows, trained, secs = [], 0, 0.0
     pts = checkpoints(budget)
     for p in pts:
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         model.learn(total_timesteps=p - trained, reset_num_timesteps=False)
-        secs += time.perf_counter() - t0
+        secs += time.process_time() - t0
         trained = model.num_timesteps
         w, rob = window_rate(task, act, final_runs if p == pts[-1] else runs, seed ^ 0x5EED)
         rows.append([task.name, method, reward, seed, trained, round(secs, 3), w, rob])
@@ -183,6 +185,13 @@ TRAINED = re.compile(r"(\d+) episodes, (\d+) steps in ([0-9.]+) s")
 RATE = re.compile(r"window rate ([0-9.]+) over")
 
 
+def children_cpu() -> float:
+    """CPU seconds of the finished child processes (hstlc train: its training, the
+    evaluation after it and the pictures, so hstl's time is if anything overstated)."""
+    u = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return u.ru_utime + u.ru_stime
+
+
 def run_hstl_native(task: Task, seed: int, ladder: list[int | None]) -> list[list[Any]]:
     """`hstlc train` at each rung of episodes (None: the spec's own preset), one core."""
     rows = []
@@ -192,13 +201,15 @@ def run_hstl_native(task: Task, seed: int, ladder: list[int | None]) -> list[lis
         cmd = [hstlc, "train", str(task.spec_path), "--seed", str(seed), "--out", str(out)]
         if episodes is not None:
             cmd += ["--episodes", str(episodes)]
+        before = children_cpu()
         r = subprocess.run(cmd, capture_output=True, text=True)
+        cpu = children_cpu() - before
         if r.returncode != 0:
             sys.exit(f"{' '.join(cmd)} failed:\n{r.stdout}\n{r.stderr}")
         m, w = TRAINED.search(r.stdout), RATE.search(r.stdout)
         if not m or not w:
             sys.exit(f"cannot read hstlc train's output:\n{r.stdout}")
-        rows.append([task.name, "hstl", "window (learner)", seed, int(m.group(2)), float(m.group(3)), float(w.group(1)), math.nan])
+        rows.append([task.name, "hstl", "window (learner)", seed, int(m.group(2)), round(cpu, 3), float(w.group(1)), math.nan])
         print(f"  {task.name} hstl seed {seed}: {m.group(1)} episodes, {m.group(2)} steps, {m.group(3)} s, W = {w.group(1)}", flush=True)
     return rows
 
@@ -213,9 +224,9 @@ def hstl_env_hook(task: Task, seed: int, episodes: int | None) -> list[list[Any]
     env = gymnasium.wrappers.TimeLimit(base, RUN_STEPS)
     valuation = Columns(task.columns)
     try:
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         policy = hstl.train(task.spec, env=env, valuation=valuation, seed=seed, episodes=episodes, progress=False)
-        secs = time.perf_counter() - t0
+        secs = time.process_time() - t0
     except (TypeError, ValueError) as e:
         first = str(e).splitlines()[0]
         print(f"  {task.name} hstl seed {seed}: PENDING (hstl.train(env=Box) not available: {first})", flush=True)
@@ -227,7 +238,7 @@ def hstl_env_hook(task: Task, seed: int, episodes: int | None) -> list[list[Any]
 
 # --- parts -----------------------------------------------------------------------------
 
-HEADER = ["task", "method", "reward", "seed", "steps", "train_secs", "W", "task_robustness_mean"]
+HEADER = ["task", "method", "reward", "seed", "steps", "train_cpu_secs", "W", "task_robustness_mean"]
 
 
 def save(task: Task, name: str, rows: list[list[Any]]) -> None:
@@ -297,20 +308,20 @@ def plot(task: Task) -> None:
             continue
         label = r["method"] if r["method"] == "hstl" else f"SB3 {r['method'].upper()} (STLReward {r['reward']})"
         series_steps.setdefault(label, {}).setdefault(r["seed"], []).append((float(r["steps"]), float(r["W"])))
-        series_secs.setdefault(label, {}).setdefault(r["seed"], []).append((max(float(r["train_secs"]), 1e-2), float(r["W"])))
+        series_secs.setdefault(label, {}).setdefault(r["seed"], []).append((max(float(r["train_cpu_secs"]), 1e-2), float(r["W"])))
     title = {"mountain_car": "MountainCar patrol (both hill tops every 200 steps)",
              "cartpole": "CartPole patrol (balance; each end of the track every 200 steps)"}[task.name]
     band_plot(folder / "steps.png", {k: list(v.values()) for k, v in series_steps.items()}, "environment steps",
               "window rate W (greedy runs of 2000 steps)", title, logx=True)
-    band_plot(folder / "wall.png", {k: list(v.values()) for k, v in series_secs.items()}, "training wall clock, s (one core)",
+    band_plot(folder / "cpu.png", {k: list(v.values()) for k, v in series_secs.items()}, "training CPU time, s (one core)",
               "window rate W", title, logx=True)
-    print(f"wrote {folder / 'curves.csv'}, steps.png, wall.png\n")
+    print(f"wrote {folder / 'curves.csv'}, steps.png, cpu.png\n")
     table(task, rows)
 
 
 def table(task: Task, rows: list[dict[str, str]]) -> None:
     """The Markdown tables: each method's last checkpoint (mean ± sd, min-max over seeds),
-    hstl at equal environment steps and at equal wall clock with each SB3 method, and the
+    hstl at equal environment steps and at equal CPU time with each SB3 method, and the
     time to each method's plateau."""
     from common import fmt_spread, spread
 
@@ -318,7 +329,7 @@ def table(task: Task, rows: list[dict[str, str]]) -> None:
     for r in rows:
         runs.setdefault(r["method"], {}).setdefault(r["seed"], []).append(r)
     lines = [f"machine: {machine()}", "",
-             "| method | reward | seeds | env steps (mean) | training s (mean) | W at the end, mean ± sd (min-max) |",
+             "| method | reward | seeds | env steps (mean) | training CPU s (mean) | W at the end, mean ± sd (min-max) |",
              "|---|---|---|---|---|---|"]
     for method, seeds in runs.items():
         last = [s_[-1] for s_ in seeds.values()]
@@ -326,15 +337,15 @@ def table(task: Task, rows: list[dict[str, str]]) -> None:
             lines.append(f"| {method} | {last[0]['reward']} | {len(last)} | | | pending |")
             continue
         lines.append(f"| {method} | {last[0]['reward']} | {len(last)} | {spread([float(r['steps']) for r in last])[0]:,.0f} "
-                     f"| {spread([float(r['train_secs']) for r in last])[0]:.1f} | {fmt_spread([float(r['W']) for r in last])} |")
+                     f"| {spread([float(r['train_cpu_secs']) for r in last])[0]:.1f} | {fmt_spread([float(r['W']) for r in last])} |")
     hstl_runs = runs.get("hstl", {})
     if hstl_runs and all(r["W"] not in ("", "nan") for v in hstl_runs.values() for r in v):
-        lines += ["", "| SB3 method | its steps, s and W (mean) | hstl at equal steps: W (its rungs with at most those steps, best) | hstl at equal wall clock: W | hstl's time to its plateau, s (mean) | SB3's time to its own best, s (mean) |",
+        lines += ["", "| SB3 method | its steps, s and W (mean) | hstl at equal steps: W (its rungs with at most those steps, best) | hstl at equal CPU time: W | hstl's time to its plateau, s (mean) | SB3's time to its own best, s (mean) |",
                   "|---|---|---|---|---|---|"]
 
         def plateau_secs(seed_rows: list[dict[str, str]]) -> float:
             best = max(float(r["W"]) for r in seed_rows)
-            return next(float(r["train_secs"]) for r in seed_rows if float(r["W"]) >= 0.95 * best)
+            return next(float(r["train_cpu_secs"]) for r in seed_rows if float(r["W"]) >= 0.95 * best)
 
         h_plateau = statistics.fmean(plateau_secs(v) for v in hstl_runs.values())
         for method, seeds in runs.items():
@@ -342,7 +353,7 @@ def table(task: Task, rows: list[dict[str, str]]) -> None:
                 continue
             last = [v[-1] for v in seeds.values()]
             steps = statistics.fmean(float(r["steps"]) for r in last)
-            secs = statistics.fmean(float(r["train_secs"]) for r in last)
+            secs = statistics.fmean(float(r["train_cpu_secs"]) for r in last)
             w = statistics.fmean(float(r["W"]) for r in last)
 
             def best_within(key: str, limit: float) -> list[float]:
@@ -353,7 +364,7 @@ def table(task: Task, rows: list[dict[str, str]]) -> None:
                 return out
 
             at_steps = best_within("steps", steps)
-            at_secs = best_within("train_secs", secs)
+            at_secs = best_within("train_cpu_secs", secs)
             fmt = lambda xs: ("no rung that small" if any(math.isnan(x) for x in xs) else fmt_spread(xs))  # noqa: E731
             sb3_plateau = statistics.fmean(plateau_secs(v) for v in seeds.values())
             lines.append(f"| {method} | {steps:,.0f} steps, {secs:.0f} s, W {w:.3f} | {fmt(at_steps)} | {fmt(at_secs)} "
