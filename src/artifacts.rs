@@ -14,21 +14,7 @@ use hstl_runtime::{Agent, Env, GridWorld, Rng, TaskSpec};
 
 use crate::Problem;
 
-/// A file to write: its name inside the output folder and its bytes.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct OutFile {
-    /// The file name, such as `policy.json`.
-    pub name: String,
-    /// The whole contents.
-    pub contents: Vec<u8>,
-}
-
-impl OutFile {
-    /// A file from text.
-    pub fn text(name: impl Into<String>, text: String) -> OutFile {
-        OutFile { name: name.into(), contents: text.into_bytes() }
-    }
-}
+pub use crate::outfile::OutFile;
 
 /// What the pictures of a trained agent say about where they come from.
 #[derive(Clone, Debug)]
@@ -582,7 +568,7 @@ pub fn plane_pictures(
 
     // Sample runs of the greedy policy.
     let steps = plane_run_steps(spec, m);
-    let mut rng = hstl_runtime::seeded_rng(seed ^ crate::train::PICTURE_SEED);
+    let mut rng = hstl_runtime::seeded_rng(seed ^ crate::seeds::PICTURE_SEED);
     for k in 1..=2 {
         let run = match world {
             AnyWorld::Plane(w) => {

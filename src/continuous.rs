@@ -29,7 +29,7 @@ use serde_json::{Value, json};
 use crate::Problem;
 use crate::evaluate::Runs;
 use crate::gym::Described;
-use crate::train::EVAL_SEED;
+use crate::seeds::EVAL_SEED;
 
 /// The most tiles along a variable that a world's step sets (a tile about one step wide).
 pub const MAX_STEP_BINS: usize = 64;
@@ -1049,13 +1049,4 @@ pub fn greedy_runs(
     result.unwrap_or_default()
 }
 
-/// `v` in the shortest form that reads back to the same double (`inf`, `-inf`, `NaN` as
-/// such).
-pub fn number(v: f64) -> String {
-    match serde_json::Number::from_f64(v) {
-        Some(n) => n.to_string(),
-        None if v.is_nan() => "NaN".into(),
-        None if v > 0.0 => "inf".into(),
-        None => "-inf".into(),
-    }
-}
+pub use crate::outfile::number;

@@ -343,7 +343,7 @@ pub fn greedy_run_files<E: Env>(
     replay: &Replay<E>,
     n: usize,
     runs: Runs,
-) -> Result<Vec<crate::artifacts::OutFile>, Problem> {
+) -> Result<Vec<crate::outfile::OutFile>, Problem> {
     let Replay { spec, env, agent, .. } = replay;
     let states = state_trace(spec, env)?;
     let actions = env.actions();
@@ -357,7 +357,7 @@ pub fn greedy_run_files<E: Env>(
         states.row_into(s, &mut row);
         for &v in &row {
             out.push(',');
-            out.push_str(&crate::continuous::number(v));
+            out.push_str(&crate::outfile::number(v));
         }
         match act {
             Some((a, o)) => {
@@ -381,7 +381,7 @@ pub fn greedy_run_files<E: Env>(
             if let Some(last) = run.last() {
                 line(&mut out, run.len(), last.next, None);
             }
-            crate::artifacts::OutFile::text(format!("run_{}.csv", k + 1), out)
+            crate::outfile::OutFile::text(format!("run_{}.csv", k + 1), out)
         })
         .collect())
 }

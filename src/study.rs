@@ -15,14 +15,14 @@ use hstl_runtime::{Agent, GridWorld, RewardKind, TaskSpec, seeded_rng};
 
 use crate::Problem;
 use crate::artifacts::{self, Captions, OutFile};
-use crate::train::{PICTURE_SEED, Trained};
+use crate::seeds::PICTURE_SEED;
+use crate::train::Trained;
 
 /// Seconds since a fixed moment of the caller's choice (an `Instant` it took): the facade
 /// reads no clock of its own.
 pub type Clock<'a> = &'a (dyn Fn() -> f64 + Sync);
 
-/// The episodes at the end of training whose mean reward a study reports.
-pub const TAIL: usize = 100;
+pub use crate::train::{TAIL, tail_mean};
 
 /// What one seed's training run measured.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,12 +61,6 @@ pub struct Keep<'a> {
     pub source: &'a str,
     /// Bytes left; each kept run takes its share, and past it runs are not kept.
     pub budget: &'a AtomicUsize,
-}
-
-/// The mean of the last `n` values (0 for none).
-pub fn tail_mean(curve: &[f64], n: usize) -> f64 {
-    let tail = &curve[curve.len().saturating_sub(n)..];
-    tail.iter().sum::<f64>() / tail.len().max(1) as f64
 }
 
 /// Trains `spec` in `env` from `seed` and measures the greedy policy (`file` names the

@@ -9,10 +9,16 @@ use hstl_runtime::{Agent, Env, Error, Learner, Policy, TaskSpec, seeded_rng};
 
 use crate::Problem;
 
-/// The seed offset of the generator that draws the sample runs of the pictures.
-pub const PICTURE_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
-/// The seed offset of the generator that draws the evaluation's starts after training.
-pub const EVAL_SEED: u64 = 0x5eed;
+pub use crate::seeds::{EVAL_SEED, PICTURE_SEED};
+
+/// The episodes at the end of training whose mean reward a study reports.
+pub const TAIL: usize = 100;
+
+/// The mean of the last `n` values (0 for none).
+pub fn tail_mean(curve: &[f64], n: usize) -> f64 {
+    let tail = &curve[curve.len().saturating_sub(n)..];
+    tail.iter().sum::<f64>() / tail.len().max(1) as f64
+}
 
 /// A trained policy and what training measured (wall-clock time is the caller's to take).
 #[derive(Clone, Debug)]
@@ -291,12 +297,8 @@ pub fn train_in_chunks<E: Env>(
         curve.extend(part.curve);
         steps += part.steps;
         let window = window_summary(spec, env, &learner.agent(), seed)?;
-        let at = Checkpoint {
-            episodes: curve.len(),
-            steps,
-            reward: crate::study::tail_mean(&curve, crate::study::TAIL),
-            window,
-        };
+        let at =
+            Checkpoint { episodes: curve.len(), steps, reward: tail_mean(&curve, TAIL), window };
         if report(&at).is_break() {
             break;
         }
@@ -346,7 +348,7 @@ mod tests {
         // The last checkpoint measures the trained policy as a study does.
         let last = seen.last().expect("a checkpoint");
         assert_eq!(last.window, window_summary(&spec, &world, &whole.agent, 3).expect("W"));
-        assert_eq!(last.reward, crate::study::tail_mean(&whole.curve, 100));
+        assert_eq!(last.reward, tail_mean(&whole.curve, 100));
         // Stopped after the first chunk: the curve holds its episodes.
         let stopped =
             train_in_chunks(&spec, &world, 3, 10, |_| ControlFlow::Break(())).expect("trains");

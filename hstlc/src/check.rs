@@ -4,10 +4,11 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use hstl::lang::{Diagnostic, Severity};
+use hstl::lang::Severity;
 
 use crate::cli_error::CliError;
 use crate::output::out;
+pub use crate::render::Checked;
 use crate::world_arg::{LoadedWorld, check_source, override_note};
 use crate::{CmdResult, Status, input, render};
 
@@ -47,16 +48,6 @@ pub enum Format {
     Json,
     /// SARIF 2.1.0.
     Sarif,
-}
-
-/// One checked input: its name, text and diagnostics.
-pub struct Checked {
-    /// The path, or the `--stdin-filename` name.
-    pub name: String,
-    /// The source text.
-    pub source: String,
-    /// Everything the front end found, in source order.
-    pub diagnostics: Vec<Diagnostic>,
 }
 
 /// Runs `hstlc check`.

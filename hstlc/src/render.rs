@@ -9,8 +9,17 @@ use miette::{
 };
 use serde_json::{Value, json};
 
-use crate::check::Checked;
 use crate::cli_error::CliError;
+
+/// One checked input: its name, text and diagnostics.
+pub struct Checked {
+    /// The path, or the `--stdin-filename` name.
+    pub name: String,
+    /// The source text.
+    pub source: String,
+    /// Everything the front end found, in source order.
+    pub diagnostics: Vec<Diagnostic>,
+}
 
 /// The `full` format: miette's graphical reports, then a summary line.
 pub fn full(files: &[Checked], colour: bool) -> String {

@@ -410,10 +410,23 @@ fn slip_thresholds(p: f64) -> [f64; 2] {
     })
 }
 
+/// The slip of a world file that does not set one.
+pub const DEFAULT_SLIP: f64 = 0.3;
+
+/// The paper's world: 15 x 15, no walls, slip 0.3.
+pub(crate) fn paper() -> GridWorld {
+    let rows = vec![vec![Tile::Free; 15]; 15];
+    match GridWorld::from_rows("paper", DEFAULT_SLIP, &rows) {
+        Ok(world) => world,
+        // A fixed, valid map: `from_rows` accepts it.
+        Err(_) => unreachable!("the paper's world is a valid map"),
+    }
+}
+
 impl Default for GridWorld {
     /// The paper's world, built in as `paper`: 15 x 15, no walls, slip 0.3 (p = 0.7).
     fn default() -> GridWorld {
-        crate::world::paper()
+        paper()
     }
 }
 

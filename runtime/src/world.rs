@@ -64,7 +64,7 @@ use serde_json::Value;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
-use crate::env::{MAX_GRID_CELLS, Tile};
+use crate::grid::{MAX_GRID_CELLS, Tile};
 use crate::plane::PlaneWorld;
 pub use crate::plane::{MAX_OBSTACLES, PLANE_BUILTIN};
 use crate::{Error, GridWorld, MountainCar, World};
@@ -73,8 +73,7 @@ use crate::{Error, GridWorld, MountainCar, World};
 /// plane ones, and [`AnyWorld::builtin`] takes both.
 pub const BUILTIN: [&str; 2] = ["paper", "four-rooms"];
 
-/// The slip of a world file that does not set one.
-pub const DEFAULT_SLIP: f64 = 0.3;
+pub use crate::grid::DEFAULT_SLIP;
 
 /// Why a world file could not be read: what is wrong, where, and how to fix it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -246,21 +245,11 @@ impl AnyWorld {
 /// `four-rooms` (13 x 13 with outer walls, four rooms joined by one-cell doorways).
 pub fn builtin(name: &str) -> Option<GridWorld> {
     let text = match name {
-        "paper" => return Some(paper()),
+        "paper" => return Some(crate::grid::paper()),
         "four-rooms" => FOUR_ROOMS,
         _ => return None,
     };
     parse(text, name).ok()
-}
-
-/// The paper's world: 15 x 15, no walls, slip 0.3.
-pub(crate) fn paper() -> GridWorld {
-    let rows = vec![vec![Tile::Free; 15]; 15];
-    match GridWorld::from_rows("paper", DEFAULT_SLIP, &rows) {
-        Ok(world) => world,
-        // A fixed, valid map: `from_rows` accepts it.
-        Err(_) => unreachable!("the paper's world is a valid map"),
-    }
 }
 
 /// The four-rooms world, as DESIGN.md draws it.

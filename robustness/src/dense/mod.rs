@@ -36,6 +36,7 @@
 //!   signal once no later sample can change it, streaming: its work per row does not grow
 //!   with the windows' lengths.
 
+mod minmax;
 mod offline;
 mod online;
 mod signal;

@@ -52,15 +52,7 @@ impl Ext {
     }
 }
 
-#[inline]
-pub(crate) fn min(a: f64, b: f64) -> f64 {
-    if b < a { b } else { a }
-}
-
-#[inline]
-pub(crate) fn max(a: f64, b: f64) -> f64 {
-    if b > a { b } else { a }
-}
+pub(crate) use super::minmax::{max, min};
 
 /// The rows an evaluation reads: stamps and every variable's value at each.
 pub(crate) struct Rows<'a> {

@@ -23,7 +23,7 @@
 //! depend only on the breakpoints, not on how the pieces arrive, so they agree bit for bit
 //! (the sign of a zero included).
 
-use super::offline::{max, min};
+use super::minmax::{max, min};
 use std::collections::VecDeque;
 
 const INF: f64 = f64::INFINITY;
