@@ -298,9 +298,10 @@ impl Plane {
             };
             if !ok {
                 return Err(PictureError::new(format!(
-                    "obstacle {} ({shape:?}) is not a finite circle of positive radius or a \
+                    "obstacle {} ({}) is not a finite circle of positive radius or a \
                      rectangle with x0 < x1 and y0 < y1",
-                    k + 1
+                    k + 1,
+                    shape_words(shape)
                 )));
             }
         }
@@ -1277,6 +1278,16 @@ fn draw_run_timeline(
     }
     let after = text_style(LABEL_SIZE * 0.75, &INK, HPos::Left, VPos::Center);
     draw_text(area, "step", (right + 8, (band.0 + band.1) / 2), &after)
+}
+
+/// An obstacle as a world file writes it: `circle [cx, cy, r]`, `rect [x0, y0, x1, y1]`.
+fn shape_words(shape: &Shape) -> String {
+    let (kind, numbers) = match *shape {
+        Shape::Circle { cx, cy, r } => ("circle", vec![cx, cy, r]),
+        Shape::Rect { x0, y0, x1, y1 } => ("rect", vec![x0, y0, x1, y1]),
+    };
+    let numbers: Vec<String> = numbers.iter().map(ToString::to_string).collect();
+    format!("{kind} [{}]", numbers.join(", "))
 }
 
 #[cfg(test)]
