@@ -203,6 +203,16 @@ pub fn run_continuous_seeds(
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<(SeedRun, Option<f64>)>, Problem> {
     use crate::continuous as c;
+    // Each thread trains one seed at a time: only as many as fit the memory budget (the
+    // continuous study keeps no policies; it writes none).
+    use hstl_runtime::world::AnyWorld;
+    let cost = match world {
+        AnyWorld::Plane(w) => crate::cost::check_approx(spec, w),
+        AnyWorld::MountainCar(w) => crate::cost::check_approx(spec, w),
+        AnyWorld::Grid(_) => Err(Problem::new("a grid world is learned with tables", None)),
+    }
+    .map_err(|p| p.in_file(file))?;
+    let threads = crate::cost::threads_within_budget(&cost, 0, threads.min(seeds.len()).max(1));
     let one = |seed: u64| -> Result<(SeedRun, Option<f64>), Problem> {
         let start = clock();
         let trained = c::train(spec, world, seed, |_, _| {})
