@@ -789,3 +789,39 @@ fn control_characters_in_names_are_escaped() {
     assert!(!raw(&run), "{:?}", run.stderr);
     assert!(run.stderr.contains("column `\\x1b[31mred` is not"), "{}", run.stderr);
 }
+
+/// Issue 30: file names that are not UTF-8 were shown lossily (every bad byte as U+FFFD),
+/// so two files printed under one name. Each bad byte is shown as `\xff`, in diagnostics,
+/// `fmt --check`'s list and read errors alike.
+#[cfg(unix)]
+#[test]
+fn file_names_that_are_not_utf8_are_shown_losslessly() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let names = [OsStr::from_bytes(b"a\xff.hstl"), OsStr::from_bytes(b"a\xfe.hstl")];
+    for n in names {
+        std::fs::write(d.join(n), "spec  S {state{x:int in 0..=9} task x>1 &&;}\n").expect("file");
+    }
+    let run = |args: &[&OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .expect("hstlc runs");
+        let all = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (out.status.code(), all)
+    };
+    let (status, shown) = run(&[OsStr::new("check"), names[0], names[1]]);
+    assert_eq!(status, Some(1), "{shown}");
+    assert!(shown.contains("[a\\xff.hstl:1:"), "{shown}");
+    assert!(shown.contains("[a\\xfe.hstl:1:"), "{shown}");
+    assert!(!shown.contains('\u{fffd}'), "{shown}");
+    let (_, shown) = run(&[OsStr::new("check"), OsStr::from_bytes(b"gone\xff.hstl")]);
+    assert!(shown.contains("cannot read `gone\\xff.hstl`"), "{shown}");
+}
