@@ -162,13 +162,17 @@ pub fn replay(text: &str) -> Result<Replay<GridWorld>, Problem> {
 /// [`replay`] of a document already read.
 pub fn replay_grid(document: Document) -> Result<Replay<GridWorld>, Problem> {
     replay_document(document, |policy| {
-        let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
-            Problem::new(
-                format!("its world: {e}"),
-                "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)"
-                    .to_string(),
-            )
-        })?;
+        let help = || "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)";
+        // Through the one reader of worlds in documents, which also holds a built-in
+        // world's name to that world's parameters.
+        let any = hstl_runtime::world::AnyWorld::from_params(&policy.env.name, &policy.env.params)
+            .map_err(|e| Problem::new(format!("its world: {e}"), help().to_string()))?;
+        let hstl_runtime::world::AnyWorld::Grid(env) = any else {
+            return Err(Problem::new(
+                "its world is not a grid, which the tables of `q_tables` are learned on",
+                help().to_string(),
+            ));
+        };
         if policy.env.params.get("map").is_none() {
             // Written before world files: the open grid it was, in today's terms.
             policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };

@@ -1687,10 +1687,11 @@ impl Cx<'_> {
             // A continuous spec's learned function is counted over the spec's own tile box
             // (the checked spec is the same whatever the world; `check` against a world
             // counts that world's tiles and actions).
-            let over = |out: &CheckedSpec| {
+            // `note`: above the note of HSTL180 too, not only the budget.
+            let over = |out: &CheckedSpec, note: bool| {
                 let too_big = |c: crate::budget::Cost| {
                     c.peak().0 > crate::budget::MEMORY_BUDGET
-                        || c.own().0 > crate::budget::MEMORY_NOTE
+                        || (note && c.own().0 > crate::budget::MEMORY_NOTE)
                 };
                 if out.is_continuous() {
                     return crate::budget::approx_spec_sizes(self.src, out, None, None)
@@ -1703,8 +1704,15 @@ impl Cx<'_> {
                     .map(|s| crate::budget::cost(&s))
                     .is_some_and(too_big)
             };
-            while out.learn.memory > 1 && over(out) {
+            while out.learn.memory > 1 && over(out, true) {
                 out.learn.memory -= 1;
+            }
+            // Past the budget with even one bucket a region (a large world, many regions):
+            // no memory, so that the preset never fails the check on its own choice (the
+            // window reward still scores the options; `plan: model` needs the memory and is
+            // left out).
+            if out.learn.memory == 1 && over(out, false) {
+                out.learn.memory = 0;
             }
         }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();

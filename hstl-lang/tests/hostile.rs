@@ -102,3 +102,29 @@ fn the_preset_q_learns_where_the_domain_is_not_counted() {
     let expansion = spec.preset_expansion.as_deref().unwrap_or_default();
     assert!(expansion.contains("learn {") && !expansion.contains("plan: model"), "{expansion}");
 }
+
+/// Issue 30: `preset: auto` on a 400 x 400 grid failed on its own choice (HSTL033: its
+/// memory and the window reward over windows it could not plan). The preset now sizes the
+/// memory within the memory budget: no error, only the note of what the run will take.
+#[test]
+fn the_preset_on_a_400_by_400_grid_passes_its_own_check() {
+    let src = "spec Big {
+        state { x: int in 0..=399, y: int in 0..=399 }
+        let A = x < 20 && y < 20;
+        let B = x > 379 && y > 379;
+        let C = x > 379 && y < 20;
+        task always[0..] (eventually[0..400] A && eventually[0..400] B && eventually[0..400] C);
+        option A; option B; option C;
+        learn { preset: auto }
+    }";
+    let checked = check(src);
+    let errors: Vec<&str> = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| d.code)
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    // What it chose is what `check` says the run takes: no more than the note.
+    assert!(checked.diagnostics.iter().all(|d| d.code == "HSTL180"), "{:?}", checked.diagnostics);
+}

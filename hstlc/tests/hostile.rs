@@ -825,3 +825,66 @@ fn file_names_that_are_not_utf8_are_shown_losslessly() {
     let (_, shown) = run(&[OsStr::new("check"), OsStr::from_bytes(b"gone\xff.hstl")]);
     assert!(shown.contains("cannot read `gone\\xff.hstl`"), "{shown}");
 }
+
+/// Issue 30: `eval` accepted hand-edited tables' `policy.json` files. Each edit is now
+/// refused (exit 2) with what is wrong: a signed hex Q-value, a table for no primitive, a
+/// seed written as a string, the built-in world's slip changed, and a built-in world's name
+/// on another map.
+#[test]
+fn hand_edited_policies_are_refused() {
+    use serde_json::{Value, json};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "t"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let text = std::fs::read_to_string(d.join("t/policy.json")).expect("policy.json");
+    let doc: Value = serde_json::from_str(&text).expect("JSON");
+    let eval = |name: &str, doc: &Value| {
+        write(d, name, serde_json::to_string(doc).expect("JSON"));
+        hstlc_in(d, &["eval", name, "--no-optimum", "--starts", "1", "--steps", "150"], b"")
+    };
+    assert_eq!(eval("ok.json", &doc).status, Some(0));
+    type Edit = Box<dyn Fn(&mut Value)>;
+    let first = |d: &mut Value| -> String {
+        d["q_tables"]["flat"].as_object().expect("tables").keys().next().expect("one").clone()
+    };
+    let edits: Vec<(&str, Edit, &str)> = vec![
+        (
+            "signed",
+            Box::new(move |d| {
+                let k = first(d);
+                let v = d["q_tables"]["flat"][&k][0].as_str().expect("hex").to_string();
+                d["q_tables"]["flat"][&k][0] = json!(format!("-{v}"));
+            }),
+            "not 16 hex digits of an f64's bits",
+        ),
+        (
+            "extra",
+            Box::new(move |d| {
+                let k = first(d);
+                d["q_tables"]["flat"]["Z"] = d["q_tables"]["flat"][&k].clone();
+            }),
+            "has a table for `Z`, which is no primitive option",
+        ),
+        ("seed", Box::new(|d| d["seed"] = json!("3")), "its `seed` is \"3\", not a whole number"),
+        (
+            "slip",
+            Box::new(|d| d["env"]["params"]["slip"] = json!(0.5)),
+            "the world is named `paper`, a built-in world, but its parameters are not",
+        ),
+        (
+            "name",
+            Box::new(|d| d["env"]["name"] = json!("four-rooms")),
+            "the world is named `four-rooms`, a built-in world, but its parameters are not",
+        ),
+    ];
+    for (name, edit, expected) in edits {
+        let mut edited = doc.clone();
+        edit(&mut edited);
+        let run = eval(&format!("{name}.json"), &edited);
+        assert_eq!(run.status, Some(2), "{name}: {}{}", run.stdout, run.stderr);
+        assert!(run.stdout.is_empty(), "{name}: {}", run.stdout);
+        assert!(run.stderr.contains(expected), "{name}: {}", run.stderr);
+    }
+}
