@@ -888,3 +888,41 @@ fn hand_edited_policies_are_refused() {
         assert!(run.stderr.contains(expected), "{name}: {}", run.stderr);
     }
 }
+
+/// Issue 30: when the optimum W* was past its budget, `eval` printed its whole report and
+/// then exited 2. It decides what it can compute first: the error alone, nothing printed.
+#[test]
+fn eval_refuses_an_optimum_past_its_budget_before_it_prints() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(
+        d,
+        "wide.hstl",
+        "spec Wide {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let A = x < 3 && y < 3;
+    let B = x > 11 && y > 11;
+    let C = x > 11 && y < 3;
+    task always[0..] (eventually[0..600] A && eventually[0..600] B && eventually[0..600] C);
+    option A { reach: A, init: !A, terminate: A }
+    option B { reach: B, init: !B, terminate: B }
+    option C { reach: C, init: !C, terminate: C }
+    options { A, B, C }
+    learn { episodes: 2, choices: 3, memory: 1, reward: window }
+}
+",
+    );
+    let run = hstlc_in(d, &["train", "wide.hstl", "--out", "w"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let args = ["eval", "w/policy.json", "--starts", "2", "--steps", "200", "--burn-in", "10"];
+    let run = hstlc_in(d, &args, b"");
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert_eq!(run.stdout, "", "nothing printed before the error");
+    assert!(run.stderr.contains("too many to search"), "{}", run.stderr);
+    assert!(run.stderr.contains("--no-optimum"), "{}", run.stderr);
+    let mut skip = args.to_vec();
+    skip.push("--no-optimum");
+    let run = hstlc_in(d, &skip, b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains("window rate"), "{}", run.stdout);
+}
