@@ -926,3 +926,34 @@ fn eval_refuses_an_optimum_past_its_budget_before_it_prints() {
     assert_eq!(run.status, Some(0), "{}", run.stderr);
     assert!(run.stdout.contains("window rate"), "{}", run.stdout);
 }
+
+/// Issue 30: world-file errors showed Rust escapes (`\u{e9}` for `é`) and lost their line
+/// and column on deeply nested TOML. Letters are shown as they are (control characters
+/// escaped), and every error is placed at `FILE:LINE:COL`.
+#[test]
+fn world_file_errors_show_letters_and_their_place() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    let cases = [
+        (
+            "letter.toml",
+            "map = \"\"\"\n...............\néééééééééééé\n\"\"\"\n".to_string(),
+            "w:3:1:",
+        ),
+        ("kind.toml", "kind = \"sphère\"\n".to_string(), "w:1:8:"),
+        ("deep.toml", format!("a = {}{}\n", "[".repeat(300), "]".repeat(300)), "w:1:"),
+    ];
+    for (name, text, place) in cases {
+        write(d, name, text);
+        let run = hstlc_in(d, &["check", "small.hstl", "--world", name], b"");
+        assert_eq!(run.status, Some(2), "{name}: {}", run.stderr);
+        let place = place.replace("w:", &format!("{name}:"));
+        assert!(run.stderr.contains(&place), "{name}: {}", run.stderr);
+        assert!(!run.stderr.contains("\\u{"), "{name}: {}", run.stderr);
+    }
+    let run = hstlc_in(d, &["check", "small.hstl", "--world", "letter.toml"], b"");
+    assert!(run.stderr.contains("unknown character `é` in the map"), "{}", run.stderr);
+    let run = hstlc_in(d, &["check", "small.hstl", "--world", "kind.toml"], b"");
+    assert!(run.stderr.contains("`sphère`"), "{}", run.stderr);
+}
