@@ -180,7 +180,7 @@ pub struct PlaneWorld {
     /// A lower bound on the free share of the start rectangle.
     start_free: f64,
     /// The obstacles in buckets over the extent (`None`: every move tests them all).
-    index: Option<ObstacleIndex>,
+    index: Option<Box<ObstacleIndex>>,
 }
 
 /// Which part of a configuration an error is about, so a world file can point at it.
@@ -384,7 +384,7 @@ impl PlaneWorld {
         let attempts = (50.0 / found.share).ceil().min(f64::from(u32::MAX)) as u32;
         config.start = Some(start);
         let dirs = (0..config.headings).map(|k| heading_vector(k, config.headings)).collect();
-        let index = ObstacleIndex::build(config.x, config.y, &config.obstacles);
+        let index = ObstacleIndex::build(config.x, config.y, &config.obstacles).map(Box::new);
         Ok(PlaneWorld {
             name: name.to_string(),
             config,
