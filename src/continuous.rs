@@ -32,10 +32,10 @@ use crate::gym::Described;
 use crate::seeds::EVAL_SEED;
 
 /// The most tiles along a variable that a world's step sets (a tile about one step wide).
-pub const MAX_STEP_BINS: usize = 64;
+pub const MAX_STEP_BINS: usize = hstl_lang::budget::MAX_STEP_BINS as usize;
 
 /// Tiles along each variable of `mountain-car` when the spec sets none.
-pub const CAR_BINS: usize = 12;
+pub const CAR_BINS: usize = hstl_lang::budget::CAR_BINS as usize;
 
 /// Runs `$body` with `$w` bound to the continuous world inside `$world` (an error for a
 /// grid).
@@ -63,16 +63,21 @@ pub fn fit_tiles(spec: &mut TaskSpec, checked: &CheckedSpec, world: &AnyWorld) {
     if declared.bins.is_some() {
         return;
     }
+    let Some(fit) = tile_fit(world) else { return };
     for (d, bins) in t.bins.iter_mut().enumerate() {
-        match world {
-            AnyWorld::Plane(p) => {
-                let width = t.hi[d] - t.lo[d];
-                let n = (width / p.step_length()).round();
-                *bins = if n.is_finite() { (n as usize).clamp(2, MAX_STEP_BINS) } else { *bins };
-            }
-            AnyWorld::MountainCar(_) => *bins = CAR_BINS,
-            AnyWorld::Grid(_) => {}
-        }
+        let n = fit.bins(t.hi[d] - t.lo[d], *bins as u64);
+        *bins = usize::try_from(n).unwrap_or(*bins);
+    }
+}
+
+/// How `world` lays tiles along a variable whose `bins` a spec leaves out: the one rule
+/// `check` counts by and training lays them by.
+pub fn tile_fit(world: &AnyWorld) -> Option<hstl_lang::budget::TileFit> {
+    use hstl_lang::budget::TileFit;
+    match world {
+        AnyWorld::Plane(p) => Some(TileFit::Step(p.step_length())),
+        AnyWorld::MountainCar(_) => Some(TileFit::Fixed(hstl_lang::budget::CAR_BINS)),
+        AnyWorld::Grid(_) => None,
     }
 }
 
@@ -106,6 +111,8 @@ pub fn train_world_until<W: hstl_runtime::World>(
     seed: u64,
     progress: impl FnMut(usize, f64) -> ControlFlow<()>,
 ) -> Result<Trained, Error> {
+    // The memory model first: nothing over the budget is allocated.
+    crate::cost::check_approx(spec, world).map_err(|p| Error::Config(p.message))?;
     let mut learner = ApproxLearner::new(spec, world)?;
     let trained = learner.train_until(&mut seeded_rng(seed), progress);
     let agent = ApproxAgent::new(spec, world, learner.weights().clone())?;
@@ -808,7 +815,28 @@ fn replay_core(
         })?;
     let mut spec = crate::lower::task_spec(picked, &source)
         .map_err(|e| Problem::new(e.to_string(), retrain()))?;
+    let trained = doc.get("memory").and_then(|m| m.get("buckets")).and_then(Value::as_u64);
+    let preset_changed = crate::evaluate::preset_memory_changed(
+        &checked,
+        name,
+        trained.unwrap_or(0),
+        spec.learn.memory as u64,
+    );
     fit(&mut spec, picked);
+    // Only a document whose weights have the shape of the memory it records was trained
+    // so; any other is an edit.
+    if let Some(p) = preset_changed {
+        let mut then = spec.clone();
+        then.learn.memory = usize::try_from(trained.unwrap_or(0)).unwrap_or(usize::MAX);
+        let options_len = weights_doc.as_ref().and_then(|w| w.options_len);
+        let shape = hstl_runtime::approx::Model::shape_with(&then, words.actions.len());
+        let fits = shape.ok().and_then(|s| {
+            Some(s.options_features.checked_mul(s.options)?.checked_mul(s.codes)? as u64)
+        });
+        if fits.is_some() && fits == options_len {
+            return Err(p);
+        }
+    }
     // The document's tiling must be the one the spec and the world give.
     let agent0 = zero(&spec)
         .map_err(|e| Problem::new(format!("it does not fit its spec and world: {e}"), retrain()))?;

@@ -4,8 +4,8 @@
 //! whatever world or environment they were given, and `study` runs only as many training
 //! threads as fit in it.
 
-use hstl_lang::budget::{self, Cost, MEMORY_BUDGET, Sizes, bytes_words};
-use hstl_runtime::{Env, TaskSpec};
+use hstl_lang::budget::{self, ApproxSizes, Cost, MAX_WEIGHTS, MEMORY_BUDGET, Sizes, bytes_words};
+use hstl_runtime::{Env, Error, TaskSpec, World};
 
 use crate::Problem;
 
@@ -107,4 +107,50 @@ pub fn check<E: Env>(spec: &TaskSpec, env: &E) -> Result<Cost, Problem> {
 pub fn threads_within_budget(cost: &Cost, reserved: u64, threads: usize) -> usize {
     let fit = MEMORY_BUDGET.saturating_sub(reserved) / cost.train.max(1);
     threads.min(usize::try_from(fit).unwrap_or(usize::MAX)).max(1)
+}
+
+/// The sizes of `spec`'s approximate learner in `world` (its tiling as given: fitted to
+/// the world first, see [`crate::continuous::fit_tiles`]), read off the runtime's own
+/// codings.
+pub fn approx_sizes<W: World>(spec: &TaskSpec, world: &W) -> Result<ApproxSizes, Error> {
+    let s = hstl_runtime::approx::Model::shape_of(spec, world)?;
+    Ok(ApproxSizes {
+        flat_features: s.flat_features as u64,
+        options_features: s.options_features as u64,
+        actions: s.actions as u64,
+        primitives: s.primitives as u64,
+        options: s.options as u64,
+        codes: s.codes as u64,
+    })
+}
+
+/// The cost of training `spec` with the approximate learner in `world`, or why it would not
+/// fit: more than [`MAX_WEIGHTS`] weights or the memory budget, by the count `check`
+/// reports ([`budget::approx_weights`]).
+pub fn check_approx<W: World>(spec: &TaskSpec, world: &W) -> Result<Cost, Problem> {
+    let s = approx_sizes(spec, world).map_err(|e| Problem::new(e.to_string(), None))?;
+    let cost = budget::approx_cost(&s);
+    let weights = budget::approx_weights(&s);
+    let (peak, run) = cost.peak();
+    if peak <= MEMORY_BUDGET && weights <= MAX_WEIGHTS {
+        return Ok(cost);
+    }
+    let over = if weights > MAX_WEIGHTS {
+        format!("more than the {} weights the learner may hold", budget::thousands(MAX_WEIGHTS))
+    } else {
+        format!(
+            "`{run}` would take about {}, more than the {} memory budget",
+            bytes_words(peak),
+            bytes_words(MEMORY_BUDGET)
+        )
+    };
+    Err(Problem::new(
+        format!(
+            "the learned function of `{}` on {} has {}: {over}",
+            spec.name,
+            world.name(),
+            budget::approx_words(&s)
+        ),
+        "use fewer memory values (a smaller `memory: B`, or fewer regions), fewer tiles or tilings (`tiles: { tilings: N, bins: N }`), or fewer options".to_string(),
+    ))
 }

@@ -162,13 +162,17 @@ pub fn replay(text: &str) -> Result<Replay<GridWorld>, Problem> {
 /// [`replay`] of a document already read.
 pub fn replay_grid(document: Document) -> Result<Replay<GridWorld>, Problem> {
     replay_document(document, |policy| {
-        let env = GridWorld::from_params(&policy.env.name, &policy.env.params).map_err(|e| {
-            Problem::new(
-                format!("its world: {e}"),
-                "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)"
-                    .to_string(),
-            )
-        })?;
+        let help = || "the `env` entry must hold the world `hstlc train` wrote (`slip` and `map`)";
+        // Through the one reader of worlds in documents, which also holds a built-in
+        // world's name to that world's parameters.
+        let any = hstl_runtime::world::AnyWorld::from_params(&policy.env.name, &policy.env.params)
+            .map_err(|e| Problem::new(format!("its world: {e}"), help().to_string()))?;
+        let hstl_runtime::world::AnyWorld::Grid(env) = any else {
+            return Err(Problem::new(
+                "its world is not a grid, which the tables of `q_tables` are learned on",
+                help().to_string(),
+            ));
+        };
         if policy.env.params.get("map").is_none() {
             // Written before world files: the open grid it was, in today's terms.
             policy.env = EnvInfo { name: env.name().to_string(), params: env.params() };
@@ -238,7 +242,23 @@ pub fn replay_document<E: Env>(
     let Document { mut policy, source, seed } = document;
     let spec = lowered(&source, &policy.spec)
         .map_err(|m| Problem::new(m, "train the policy again with `hstlc train`".to_string()))?;
+    let trained = policy.memory.as_ref().map_or(0, |m| m.buckets as u64);
+    let preset_changed = preset_memory_changed(
+        &hstl_lang::check(&source),
+        &policy.spec,
+        trained,
+        spec.learn.memory as u64,
+    );
     let env = make_env(&mut policy)?;
+    // Only a document that is a whole policy of the memory it records was trained so; any
+    // other is an edit.
+    if let Some(p) = preset_changed {
+        let mut then = spec.clone();
+        then.learn.memory = trained as usize;
+        if policy.check_against(&then, &env).is_ok() {
+            return Err(p);
+        }
+    }
     let agent = policy.check_against(&spec, &env).map_err(|e| {
         Problem::new(
             e.to_string(),
@@ -252,6 +272,39 @@ pub fn replay_document<E: Env>(
 pub fn spec_of(policy_text: &str, expected: &str) -> Result<TaskSpec, String> {
     let document = read(policy_text).map_err(|p| p.message)?;
     lowered(&document.source, expected)
+}
+
+/// Why a policy trained with `memory: trained` does not replay on its spec, when the
+/// spec's memory is `preset: auto`'s choice (no `memory` written beside it) and the preset
+/// now gives `memory: now`: the preset's sizing changed since the policy was trained (it
+/// is held to the memory budget), and the file is not damaged. `None` otherwise.
+pub fn preset_memory_changed(
+    checked: &hstl_lang::Checked,
+    name: &str,
+    trained: u64,
+    now: u64,
+) -> Option<Problem> {
+    use hstl_lang::syntax::Item;
+    if trained == now {
+        return None;
+    }
+    let spec = checked.specs.iter().find(|s| s.name == name)?;
+    let written = checked.file.specs.iter().find(|s| s.name.name == name)?;
+    let memory_written = written
+        .items
+        .iter()
+        .any(|i| matches!(i, Item::Learn(l) if l.params.iter().any(|p| p.name.name == "memory")));
+    if spec.learn.preset != hstl_lang::Preset::Auto || memory_written {
+        return None;
+    }
+    Some(Problem::new(
+        format!(
+            "it was trained with `memory: {trained}`, which `preset: auto` chose then; its spec's `preset: auto` now gives `memory: {now}` (the preset has changed since, not the file)"
+        ),
+        format!(
+            "train the policy again with `hstlc train`, or write `memory: {trained}` beside `preset: auto` in the spec's `learn` item and train it again to keep the earlier memory"
+        ),
+    ))
 }
 
 /// The spec called `expected` in `source`, checked and lowered.

@@ -297,7 +297,27 @@ pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
 /// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
 /// "(os error N)" tail.
 pub fn read_error(path: &Path, error: &std::io::Error) -> String {
-    format!("cannot read `{}`: {}", escape_controls(&path.display().to_string()), io_reason(error))
+    format!("cannot read `{}`: {}", path_words(path), io_reason(error))
+}
+
+/// A path as messages show it, losslessly: its text as it is, control characters escaped
+/// ([`escape_controls`]), and each byte that is not UTF-8 as `\xff` (where `display()`
+/// shows U+FFFD for every one of them, so that two files print under one name).
+pub fn path_words(path: &Path) -> String {
+    #[cfg(unix)]
+    let bytes = std::os::unix::ffi::OsStrExt::as_bytes(path.as_os_str());
+    #[cfg(not(unix))]
+    let owned = path.to_string_lossy().into_owned().into_bytes();
+    #[cfg(not(unix))]
+    let bytes = owned.as_slice();
+    let mut out = String::with_capacity(bytes.len());
+    for chunk in bytes.utf8_chunks() {
+        out.push_str(&escape_controls(chunk.valid()));
+        for b in chunk.invalid() {
+            out.push_str(&format!("\\x{b:02x}"));
+        }
+    }
+    out
 }
 
 /// `text` with its control characters (and the bidirectional controls, which reorder what

@@ -55,7 +55,7 @@
 
 use hstl_lang::CheckedSpec;
 use hstl_robustness::{
-    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, WindowStream,
+    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor, WindowStream,
 };
 
 use std::fmt;
@@ -196,8 +196,13 @@ pub struct EpisodeMonitor {
     base_slots: usize,
     /// The reward's slot, when it is read off the state alone (no past-time operator).
     reward_slot: Option<usize>,
-    /// The states so far, when the reward formula has a past-time operator.
+    /// The states so far, when the reward formula has a past-time operator and a future
+    /// one (a future window clipped at `t` reads the whole prefix again).
     history: Option<Columns>,
+    /// The reward formula's online monitor, when it has a past-time operator and no future
+    /// one: `rho(formula, t)` is then final once `s_t` is in, and its streaming past
+    /// windows give it in `O(|formula|)` a step (it was `O(t)`: quadratic over an episode).
+    past: Option<OnlineMonitor>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
     /// Each region's slot.
@@ -340,7 +345,9 @@ impl EpisodeMonitor {
         let task = Running::new(&task, vars.len(), &mut slots);
         let base_slots = slots.len();
         let program = Program::new(&slots);
-        let history = reward.has_past().then(|| Columns::new(vars.len()));
+        let pure_past = reward.has_past() && reward.horizon() == Some(0);
+        let history = (reward.has_past() && !pure_past).then(|| Columns::new(vars.len()));
+        let past = pure_past.then(|| OnlineMonitor::new(&reward, vars.len()));
         Ok(EpisodeMonitor {
             vars,
             reward,
@@ -354,6 +361,7 @@ impl EpisodeMonitor {
             base_slots,
             reward_slot,
             history,
+            past,
             regions,
             region_slots,
             tau,
@@ -425,6 +433,9 @@ impl EpisodeMonitor {
         if let Some(h) = &mut self.history {
             h.clear();
         }
+        if let Some(m) = &mut self.past {
+            *m = OnlineMonitor::new(&self.reward, self.vars.len());
+        }
         self.tau.iter_mut().zip(&self.regions).for_each(|(t, r)| *t = r.1);
         if let Some(prefix) = &mut self.prefix {
             prefix.reset();
@@ -494,15 +505,16 @@ impl EpisodeMonitor {
         self.steps += 1;
         self.log.extend_from_slice(state);
         let program = &self.program;
-        let robustness = match (&mut self.history, self.reward_slot) {
+        let robustness = match (&mut self.history, &mut self.past, self.reward_slot) {
             _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
-            (Some(history), _) => {
+            (Some(history), _, _) => {
                 history.push(state);
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }
-            (None, Some(slot)) => program.value(slot),
-            (None, None) => f64::NAN,
+            (None, Some(past), _) => past.push(state).ok().flatten().map_or(f64::NAN, |v| v.value),
+            (None, None, Some(slot)) => program.value(slot),
+            (None, None, None) => f64::NAN,
         };
         let window_kept = if self.regions.is_empty() {
             None

@@ -72,9 +72,25 @@ pub fn run_seed(
     file: &str,
     clock: Clock<'_>,
 ) -> Result<(SeedRun, Trained), Problem> {
+    run_seed_until(spec, env, seed, file, clock, None)
+}
+
+/// [`run_seed`] that ends training after the episode under way once `stop` is set (and
+/// then fails: a study stopped has no figures for the seed).
+pub fn run_seed_until(
+    spec: &TaskSpec,
+    env: &GridWorld,
+    seed: u64,
+    file: &str,
+    clock: Clock<'_>,
+    stop: Option<&AtomicBool>,
+) -> Result<(SeedRun, Trained), Problem> {
     let start = clock();
-    let trained = crate::train::train(spec, env, seed, |_, _| {})
+    let trained = crate::train::train_until(spec, env, seed, |_, _| until(stop))
         .map_err(|e| crate::train::cannot_train(file, &spec.name, &e))?;
+    if stopped(stop) {
+        return Err(stopped_problem());
+    }
     let secs = clock() - start;
     let window = crate::train::window_summary(spec, env, &trained.agent, seed)
         .map_err(|e| Problem::new(e.to_string(), None))?
@@ -115,7 +131,7 @@ pub fn run_seeds(
     let threads =
         crate::cost::threads_within_budget(&cost, kept_bytes, threads.min(seeds.len()).max(1));
     let one = |seed: u64| -> Result<(SeedRun, Option<Kept>), Problem> {
-        let (run, trained) = run_seed(spec, env, seed, file, clock)?;
+        let (run, trained) = run_seed_until(spec, env, seed, file, clock, stop)?;
         let kept = match keep {
             Some(k) if k.budget.load(Ordering::Relaxed) > 0 => {
                 let policy = crate::train::policy_json(&trained.policy, k.source, seed)
@@ -139,6 +155,25 @@ pub fn run_seeds(
 /// `one(seed)` for each of `seeds` on up to `threads` threads, each thread taking the next
 /// seed not yet taken; results in the order of `seeds`. Once `stop` is set, no further
 /// seed starts and the call fails.
+/// Whether `stop` is set.
+fn stopped(stop: Option<&AtomicBool>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// A training progress callback's answer: break once `stop` is set (Ctrl-C in Python), so
+/// that a long seed ends after its episode under way, not at its last one.
+fn until(stop: Option<&AtomicBool>) -> std::ops::ControlFlow<()> {
+    if stopped(stop) {
+        std::ops::ControlFlow::Break(())
+    } else {
+        std::ops::ControlFlow::Continue(())
+    }
+}
+
+fn stopped_problem() -> Problem {
+    Problem::new("the study was stopped before every seed was trained", None)
+}
+
 fn on_threads<T: Send>(
     seeds: &[u64],
     threads: usize,
@@ -197,10 +232,23 @@ pub fn run_continuous_seeds(
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<(SeedRun, Option<f64>)>, Problem> {
     use crate::continuous as c;
+    // Each thread trains one seed at a time: only as many as fit the memory budget (the
+    // continuous study keeps no policies; it writes none).
+    use hstl_runtime::world::AnyWorld;
+    let cost = match world {
+        AnyWorld::Plane(w) => crate::cost::check_approx(spec, w),
+        AnyWorld::MountainCar(w) => crate::cost::check_approx(spec, w),
+        AnyWorld::Grid(_) => Err(Problem::new("a grid world is learned with tables", None)),
+    }
+    .map_err(|p| p.in_file(file))?;
+    let threads = crate::cost::threads_within_budget(&cost, 0, threads.min(seeds.len()).max(1));
     let one = |seed: u64| -> Result<(SeedRun, Option<f64>), Problem> {
         let start = clock();
-        let trained = c::train(spec, world, seed, |_, _| {})
+        let trained = c::train_until(spec, world, seed, |_, _| until(stop))
             .map_err(|e| crate::train::cannot_train(file, &spec.name, &e))?;
+        if stopped(stop) {
+            return Err(stopped_problem());
+        }
         let secs = clock() - start;
         let (window_rate, satisfaction) =
             match c::after_training(spec, world, &trained.agent, seed)? {

@@ -73,15 +73,26 @@ pub fn any_facts(world: &AnyWorld, label: &str) -> Facts {
         AnyWorld::Plane(p) => {
             let ([x0, x1], [y0, y1]) = p.extent();
             let vars = vec![("x".to_string(), x0, x1), ("y".to_string(), y0, y1)];
-            Facts::Box(BoxFacts { label: label.to_string(), vars })
+            Facts::Box(BoxFacts {
+                label: label.to_string(),
+                vars,
+                actions: p.headings() as u64,
+                fit: crate::continuous::tile_fit(world),
+            })
         }
-        AnyWorld::MountainCar(_) => {
+        AnyWorld::MountainCar(car) => {
             use hstl_runtime::MountainCar as C;
             let vars = vec![
                 ("x".to_string(), C::MIN_POSITION, C::MAX_POSITION),
                 ("v".to_string(), -C::MAX_SPEED, C::MAX_SPEED),
             ];
-            Facts::Box(BoxFacts { label: label.to_string(), vars })
+            let actions = hstl_runtime::World::actions(car).len() as u64;
+            Facts::Box(BoxFacts {
+                label: label.to_string(),
+                vars,
+                actions,
+                fit: crate::continuous::tile_fit(world),
+            })
         }
     }
 }

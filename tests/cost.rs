@@ -99,6 +99,61 @@ const REACH_TWO: &str = "spec Two {
 fn memory() {
     the_memory_model_bounds_training_writing_and_reading_a_policy();
     a_large_unknown_field_is_skipped_not_kept();
+    the_memory_model_bounds_a_learned_function();
+}
+
+/// The approximate learner's part of the model (`budget::approx_cost`) over a plane spec:
+/// its weights all made non-zero before `policy.json` is written (the worst case, since the
+/// document lists the non-zero ones), training and writing, then reading back, stay within
+/// the model, and not far below it.
+fn the_memory_model_bounds_a_learned_function() {
+    use hstl::runtime::world::AnyWorld;
+    let world = AnyWorld::builtin("paper-plane").expect("paper-plane");
+    for memory in [2, 6] {
+        let src = format!(
+            "spec P {{ state {{ x: float in 0..=14, y: float in 0..=14 }}
+               let A = x > 3.5 && x < 8.5 && y > 10.5 && y < 13.5;
+               let B = x > 1.5 && x < 4.5 && y > 1.5 && y < 4.5;
+               let C = 9.5 < x < 12.5 && 1.5 < y < 6.5;
+               task always[0..] (eventually[0..40] A && eventually[0..40] B && eventually[0..40] C);
+               option A; option B; option C;
+               learn {{ preset: auto, memory: {memory}, episodes: 1, choices: 2 }} }}"
+        );
+        let loaded = hstl::load::load(&src, None).expect("checks");
+        let mut task = hstl::train::trainable(&loaded.spec, &src, "s.hstl").expect("trainable");
+        hstl::continuous::fit_tiles(&mut task, &loaded.spec, &world);
+        let AnyWorld::Plane(plane) = &world else { unreachable!() };
+        let sizes = hstl::cost::approx_sizes(&task, plane).expect("sizes");
+        let model = hstl_lang::budget::approx_cost(&sizes);
+        let (text, train) = peak_of(|| {
+            let mut trained = hstl::continuous::train(&task, &world, 0, |_, _| {}).expect("trains");
+            let w = &mut trained.agent.weights;
+            for (i, v) in w.flat.iter_mut().flatten().chain(w.options.iter_mut()).enumerate() {
+                *v = 1.0 + i as f64;
+            }
+            hstl::continuous::policy_json(&task, &world, &trained.agent, &src, 0).expect("writes")
+        });
+        let (replay, load) = peak_of(|| hstl::continuous::replay_text(&text).expect("replays"));
+        drop(replay);
+        let bytes = text.len() as u64;
+        let modelled_train = model.train - FIXED_BYTES;
+        let modelled_load = model.load - FIXED_BYTES - model.policy_bytes;
+        let what = format!("learned function, memory {memory}");
+        eprintln!(
+            "{what}: {} weights, train {train} (model {modelled_train}), load {load} (model {modelled_load}), text {bytes} (model {})",
+            hstl_lang::budget::approx_weights(&sizes),
+            model.policy_bytes
+        );
+        assert!(
+            bytes <= model.policy_bytes,
+            "{what}: policy.json {bytes} > {}",
+            model.policy_bytes
+        );
+        assert!(train <= modelled_train, "{what}: train {train} > {modelled_train}");
+        assert!(load <= modelled_load, "{what}: load {load} > {modelled_load}");
+        assert!(modelled_train <= 4 * train, "{what}: train {train}, model {modelled_train}");
+        assert!(modelled_load <= 4 * load, "{what}: load {load}, model {modelled_load}");
+    }
 }
 
 fn the_memory_model_bounds_training_writing_and_reading_a_policy() {

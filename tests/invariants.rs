@@ -100,3 +100,21 @@ fn nothing_above_the_runtime_makes_a_grid_of_its_own() {
         found.join("\n")
     );
 }
+
+/// Issue 30: messages once showed Rust's `Debug` form of lists and values (`["a", "b"]`,
+/// `Circle { cx: 1.0, .. }`); they are worded (`a, b and c`, names in backticks, numbers
+/// as `policy.json` writes them). No `{:?}` outside asserts and panics, in the library
+/// crates and the shells alike; a line that formats a value only to compare it says so
+/// with `// not a message`.
+#[test]
+fn messages_never_show_rust_debug_formatting() {
+    let mut dirs = LIBRARIES.to_vec();
+    dirs.extend(["hstlc/src", "python/src", "hstl-macros/src"]);
+    let found: Vec<String> = offenders(&dirs, &[":?}"])
+        .into_iter()
+        .filter(|l| {
+            !["assert", "panic!", "unreachable!", "// not a message"].iter().any(|w| l.contains(w))
+        })
+        .collect();
+    assert!(found.is_empty(), "word what a message shows:\n{}", found.join("\n"));
+}

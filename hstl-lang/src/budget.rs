@@ -3,7 +3,7 @@
 //! spec asks for unchecked. The limits are documented in LANGUAGE.md ("Limits"); the CLI
 //! holds its flags (`--episodes`) to the same ones.
 
-use crate::check::thousands;
+pub use crate::check::thousands;
 use crate::checked::{CheckedSpec, Reward};
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, ParamValue};
@@ -603,19 +603,25 @@ pub(crate) fn memory(
     src: &str,
     learn: Option<&syntax::Learn>,
     out: &CheckedSpec,
+    world: Option<&crate::world::BoxFacts>,
 ) -> Option<Diagnostic> {
-    let sizes = spec_sizes(src, out)?;
-    let c = cost(&sizes);
-    let (peak, run) = c.peak();
-    if peak <= MEMORY_BUDGET && c.own().0 <= MEMORY_NOTE {
-        return None;
-    }
     let at = learn.map_or(out.name_range.clone(), |l| {
         l.params
             .iter()
             .find(|p| p.name.name == "memory")
             .map_or(l.range.clone(), |p| p.range.clone())
     });
+    if out.is_continuous() {
+        let sizes =
+            approx_spec_sizes(src, out, world.and_then(|w| w.fit), world.map(|w| w.actions))?;
+        return approx_memory(&sizes, at, world.map(|w| w.label.as_str()));
+    }
+    let sizes = spec_sizes(src, out)?;
+    let c = cost(&sizes);
+    let (peak, run) = c.peak();
+    if peak <= MEMORY_BUDGET && c.own().0 <= MEMORY_NOTE {
+        return None;
+    }
     let what = format!(
         "{} states x {} memory values{} x {} options, and `policy.json` of {}",
         thousands(sizes.states),
@@ -653,4 +659,237 @@ pub(crate) fn memory(
             .with_help("fewer memory values, a smaller world or fewer options make it smaller"),
         )
     }
+}
+
+/// At most this many weights in the approximate learner (the runtime's
+/// `hstl_runtime::approx::MAX_WEIGHTS`), whatever the memory budget says.
+pub const MAX_WEIGHTS: u64 = 1 << 25;
+/// The tile coder's layout (the runtime's `approx::tiles`): a tiling is laid out densely up
+/// to this many variables and tiles, else hashed into [`HASHED_TILES`] slots.
+const MAX_DENSE_DIMS: usize = 3;
+const MAX_DENSE_TILES: u64 = 1 << 16;
+const HASHED_TILES: u64 = 1 << 14;
+/// The most tiles along a variable that a plane world's step sets (the facade's
+/// `continuous::MAX_STEP_BINS`).
+pub const MAX_STEP_BINS: u64 = 64;
+/// Tiles along each variable of `mountain-car` when the spec sets none (the facade's
+/// `continuous::CAR_BINS`).
+pub const CAR_BINS: u64 = 12;
+/// The actions `check` counts for a continuous spec whose world it does not know (a
+/// gymnasium environment given at training): the fewest a world has. `train` counts the
+/// world's own.
+pub const UNKNOWN_WORLD_ACTIONS: u64 = 2;
+
+/// How a continuous world lays tiles along a variable whose `bins` the spec leaves out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TileFit {
+    /// A tile about one step wide: `width / step` rounded, from 2 to [`MAX_STEP_BINS`] (a
+    /// plane world).
+    Step(f64),
+    /// This many tiles (`mountain-car`: [`CAR_BINS`]).
+    Fixed(u64),
+}
+
+impl TileFit {
+    /// Tiles along a variable of range `width` (`declared`: what the spec's tile box gives,
+    /// kept when the width over the step is not a finite number).
+    pub fn bins(self, width: f64, declared: u64) -> u64 {
+        match self {
+            TileFit::Step(step) => {
+                let n = (width / step).round();
+                if n.is_finite() { (n as u64).clamp(2, MAX_STEP_BINS) } else { declared }
+            }
+            TileFit::Fixed(n) => n,
+        }
+    }
+}
+
+/// The features of a tile coding with `bins[d]` tiles along each variable and `tilings`
+/// tilings (the runtime's `TileCoder::len`): one tile more along each variable for the
+/// offset, laid out densely over up to 3 variables and 65,536 tiles a tiling, else hashed
+/// into 16,384 slots a tiling. Saturating.
+pub fn tiling_features(bins: &[u64], tilings: u64) -> u64 {
+    let dense = bins.iter().try_fold(1u64, |acc, &b| acc.checked_mul(b.checked_add(1)?));
+    let per_tiling = match dense {
+        Some(n) if bins.len() <= MAX_DENSE_DIMS && n <= MAX_DENSE_TILES => n,
+        _ => HASHED_TILES,
+    };
+    per_tiling.saturating_mul(tilings)
+}
+
+/// The sizes the approximate learner's weights grow with: what [`approx_weights`] and
+/// [`approx_cost`] read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct ApproxSizes {
+    /// Features of the flat levels' tiling (tilings times the slots of one).
+    pub flat_features: u64,
+    /// Features of the options level's coarser tiling.
+    pub options_features: u64,
+    /// Actions of the world.
+    pub actions: u64,
+    /// Primitive options.
+    pub primitives: u64,
+    /// Options of the options set.
+    pub options: u64,
+    /// Codes the options level tells apart: memory values `(B + 1)^k` times `2^goals`.
+    pub codes: u64,
+}
+
+/// The approximate learner's weights: each primitive's per action over the flat tiling,
+/// and each option's per code over the options tiling. The one count `check` reports and
+/// `train` refuses by (saturating).
+pub fn approx_weights(s: &ApproxSizes) -> u64 {
+    let flat = s.flat_features.saturating_mul(s.actions).saturating_mul(s.primitives);
+    let options = s.options_features.saturating_mul(s.options).saturating_mul(s.codes);
+    flat.saturating_add(options)
+}
+
+/// Bytes of one weight in the `policy.json` document as it is built before it is written:
+/// the pair's value in the list (room for the list to double: 64), its two-element array
+/// (80) and the hex digits' string (32).
+const WEIGHT_DOCUMENT: u64 = 176;
+/// Bytes of one weight as written (pretty-printed over four lines, indented).
+const WEIGHT_TEXT: u64 = 72;
+/// Bytes of one weight entry as read back (a pair, in a list that may double).
+const WEIGHT_READ: u64 = 48;
+
+/// The memory model of the approximate learner, its `policy.json` and its evaluation, in
+/// the terms of [`cost`], every weight counted as non-zero (`policy.json` lists those):
+/// training holds the learner's weights and the agent's copy, the document and its text as
+/// it grows; a replay the text, the entries read and three sets of weights.
+/// `hstl/tests/cost.rs` holds the figures against what the runs allocate.
+pub fn approx_cost(s: &ApproxSizes) -> Cost {
+    let w = approx_weights(s);
+    let m = |a: u64, b: u64| a.saturating_mul(b);
+    let learner = m(w, 8);
+    let agent = m(w, 8);
+    let document = m(w, WEIGHT_DOCUMENT);
+    let policy_bytes = m(w, WEIGHT_TEXT);
+    let train = [learner, agent, document, m(policy_bytes, 3), FIXED_BYTES]
+        .iter()
+        .fold(0u64, |a, &b| a.saturating_add(b));
+    let load = [policy_bytes, m(w, WEIGHT_READ), m(learner, 3), FIXED_BYTES]
+        .iter()
+        .fold(0u64, |a, &b| a.saturating_add(b));
+    Cost { policy_bytes, document, learner, agent, train, load, evaluate: load }
+}
+
+/// The sizes of a checked continuous spec's approximate learner, or `None` for a spec the
+/// approximate learner does not run (no options, no tiling, an unbounded variable). The
+/// tiles along a variable are the spec's `bins`, else what `fit` lays for the world
+/// (`None`: the spec's tile box as it is, which is how a gymnasium environment is tiled);
+/// the actions are `actions` (`None`: [`UNKNOWN_WORLD_ACTIONS`]).
+pub fn approx_spec_sizes(
+    src: &str,
+    out: &CheckedSpec,
+    fit: Option<TileFit>,
+    actions: Option<u64>,
+) -> Option<ApproxSizes> {
+    if out.primitives.is_empty() || !out.is_continuous() {
+        return None;
+    }
+    // A spec with options over a float state is tiled (by default, when it says nothing).
+    let tiles = out.learn.tiles.unwrap_or_default();
+    let tile_box = out.tile_box_of(tiles)?;
+    let bins: Vec<u64> = (0..tile_box.bins.len())
+        .map(|d| match (tiles.bins, fit) {
+            (None, Some(f)) => f.bins(tile_box.hi[d] - tile_box.lo[d], tile_box.bins[d]),
+            _ => tile_box.bins[d],
+        })
+        .collect();
+    // The options level's tiling: half the tiles (at least one) and half the tilings
+    // (rounded up), as the runtime's `Model` lays it.
+    let coarse: Vec<u64> = bins.iter().map(|b| (b / 2).max(1)).collect();
+    let conjuncts = out.persistent_conjuncts(src);
+    let counted = out.learn.memory > 0 || out.learn.reward == Reward::Window;
+    let regions = if counted { conjuncts.as_ref().map_or(0, Vec::len) as u64 } else { 0 };
+    let values = if out.learn.memory > 0 && regions > 0 {
+        (out.learn.memory + 1).checked_pow(u32::try_from(regions).ok()?).unwrap_or(u64::MAX)
+    } else {
+        1
+    };
+    let goals = if counted { 0 } else { goals_at_most(out) };
+    Some(ApproxSizes {
+        flat_features: tiling_features(&bins, tile_box.tilings),
+        options_features: tiling_features(&coarse, tile_box.tilings.div_ceil(2)),
+        actions: actions.unwrap_or(UNKNOWN_WORLD_ACTIONS),
+        primitives: out.primitives.len() as u64,
+        options: out.options.len() as u64,
+        codes: values.saturating_mul(1 << goals),
+    })
+}
+
+/// `HSTL084` when the approximate learner of a continuous spec would hold more than
+/// [`MAX_WEIGHTS`] weights or take more than [`MEMORY_BUDGET`], `HSTL180` when more than
+/// [`MEMORY_NOTE`] (see [`memory`]).
+fn approx_memory(
+    sizes: &ApproxSizes,
+    at: std::ops::Range<usize>,
+    world: Option<&str>,
+) -> Option<Diagnostic> {
+    let c = approx_cost(sizes);
+    let weights = approx_weights(sizes);
+    let (peak, run) = c.peak();
+    if peak <= MEMORY_BUDGET && weights <= MAX_WEIGHTS && c.own().0 <= MEMORY_NOTE {
+        return None;
+    }
+    let on = world.map_or(String::new(), |w| format!(" on {w}"));
+    let what = approx_words(sizes);
+    let figures = format!(
+        "train {}, eval {}, `policy.json` up to {}",
+        bytes_words(c.train),
+        bytes_words(c.evaluate),
+        bytes_words(c.policy_bytes)
+    );
+    let help = "use fewer memory values (a smaller `memory: B`, or fewer regions), fewer tiles or tilings (`tiles: { tilings: N, bins: N }`), or fewer options";
+    if weights > MAX_WEIGHTS || peak > MEMORY_BUDGET {
+        let over = if weights > MAX_WEIGHTS {
+            format!("more than the {} weights the learner may hold", thousands(MAX_WEIGHTS))
+        } else {
+            format!(
+                "`{run}` would take about {}, more than the {} memory budget",
+                bytes_words(peak),
+                bytes_words(MEMORY_BUDGET)
+            )
+        };
+        Some(
+            Diagnostic::new(
+                "HSTL084",
+                at,
+                format!("the learned function of this spec{on} has {what}; {figures}: {over}"),
+            )
+            .with_help(help),
+        )
+    } else {
+        let (own, run) = c.own();
+        Some(
+            Diagnostic::new(
+                "HSTL180",
+                at,
+                format!(
+                    "`{run}` of this spec{on} will take about {} of the {} memory budget (the learned function has {what}; {figures})",
+                    bytes_words(own),
+                    bytes_words(MEMORY_BUDGET)
+                ),
+            )
+            .with_help(
+                "fewer memory values, fewer tiles or tilings, or fewer options make it smaller",
+            ),
+        )
+    }
+}
+
+/// `8,912,896 weights (2 primitives x 2 actions x 131,072 features, and 2 options x 64
+/// codes of the memory and goals x 65,536 features)`.
+pub fn approx_words(s: &ApproxSizes) -> String {
+    format!(
+        "{} weights ({} primitives x {} actions x {} features, and {} options x {} codes of the memory and goals x {} features)",
+        thousands(approx_weights(s)),
+        s.primitives,
+        s.actions,
+        thousands(s.flat_features),
+        s.options,
+        thousands(s.codes),
+        thousands(s.options_features)
+    )
 }

@@ -474,7 +474,7 @@ impl Cx<'_> {
             self.diags.extend(crate::budget::learning(self.src, l, &out));
         }
         if self.error_count() == 0
-            && let Some(d) = crate::budget::memory(self.src, learn, &out)
+            && let Some(d) = crate::budget::memory(self.src, learn, &out, self.box_world)
         {
             self.push(d);
         }
@@ -1684,16 +1684,35 @@ impl Cx<'_> {
             crate::preset::learn(horizons.as_deref(), reach, out.is_continuous(), &mut out.learn);
             // The memory the preset sizes from the deadlines, made coarser until the runs
             // fit the memory budget without the note of HSTL180.
-            let over = |out: &CheckedSpec| {
+            // A continuous spec's learned function is counted over the spec's own tile box
+            // (the checked spec is the same whatever the world; `check` against a world
+            // counts that world's tiles and actions).
+            // `note`: above the note of HSTL180 too, not only the budget.
+            let over = |out: &CheckedSpec, note: bool| {
+                let too_big = |c: crate::budget::Cost| {
+                    c.peak().0 > crate::budget::MEMORY_BUDGET
+                        || (note && c.own().0 > crate::budget::MEMORY_NOTE)
+                };
+                if out.is_continuous() {
+                    return crate::budget::approx_spec_sizes(self.src, out, None, None)
+                        .is_some_and(|s| {
+                            crate::budget::approx_weights(&s) > crate::budget::MAX_WEIGHTS
+                                || too_big(crate::budget::approx_cost(&s))
+                        });
+                }
                 crate::budget::spec_sizes(self.src, out)
                     .map(|s| crate::budget::cost(&s))
-                    .is_some_and(|c| {
-                        c.peak().0 > crate::budget::MEMORY_BUDGET
-                            || c.own().0 > crate::budget::MEMORY_NOTE
-                    })
+                    .is_some_and(too_big)
             };
-            while out.learn.memory > 1 && over(out) {
+            while out.learn.memory > 1 && over(out, true) {
                 out.learn.memory -= 1;
+            }
+            // Past the budget with even one bucket a region (a large world, many regions):
+            // no memory, so that the preset never fails the check on its own choice (the
+            // window reward still scores the options; `plan: model` needs the memory and is
+            // left out).
+            if out.learn.memory == 1 && over(out, false) {
+                out.learn.memory = 0;
             }
         }
         let mut seen: HashMap<String, Range<usize>> = HashMap::new();
@@ -2595,7 +2614,8 @@ fn time_decimals(spec: &syntax::Spec) -> u32 {
     most
 }
 
-pub(crate) fn thousands(n: u64) -> String {
+/// `n` with a comma between each group of three digits: `33,554,432`.
+pub fn thousands(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {

@@ -517,7 +517,11 @@ impl CheckedSpec {
     /// [`DEFAULT_BINS`] along a `float` one (training narrows that to the world's step).
     /// `None` without `tiles` or with an unbounded variable.
     pub fn tile_box(&self) -> Option<TileBox> {
-        let t = self.learn.tiles?;
+        self.tile_box_of(self.learn.tiles?)
+    }
+
+    /// [`CheckedSpec::tile_box`] with the tile coding `t`.
+    pub fn tile_box_of(&self, t: Tiles) -> Option<TileBox> {
         let mut b =
             TileBox { tilings: t.tilings, bins: Vec::new(), lo: Vec::new(), hi: Vec::new() };
         for v in &self.state_vars {

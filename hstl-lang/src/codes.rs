@@ -527,10 +527,12 @@ the spec's `int` domain, which bounds the world's cells. `memory: B` over k regi
 met (2^goals, at most 4 goals), and `plan: model` on a reach task plans over the steps to its \
 latest deadline. A goal is also written out in full in `policy.json`, every `let` wherever it \
 is used: at most 1 MiB a goal, which nested lets that each use the one before twice pass \
-quickly.\n\n\
+quickly. On a `float` state it counts the learned function's weights instead (primitives x \
+actions x flat features, and options x memory values x options features; at most 33,554,432 \
+weights), with `policy.json` as if every weight were non-zero.\n\n\
 Example:\n    learn { memory: 30 }   // 225 cells x 31^3 memory values: 6.7 million entries\n\n\
 Fix: fewer memory values (a smaller `memory: B`, or fewer regions), a smaller world, or \
-fewer options; a goal with fewer nested lets.",
+fewer options (on a `float` state, fewer tiles or tilings); a goal with fewer nested lets.",
     },
     CodeInfo {
         code: "HSTL101",

@@ -60,6 +60,11 @@ pub struct BoxFacts {
     pub label: String,
     /// Each state variable: its name and its range `[lo, hi]`, in the world's order.
     pub vars: Vec<(String, f64, f64)>,
+    /// Its actions (headings, pushes).
+    pub actions: u64,
+    /// How it lays tiles along a variable whose `bins` a spec leaves out (`None`: the
+    /// spec's tile box as it is).
+    pub fit: Option<crate::budget::TileFit>,
 }
 
 /// What one spec is checked against.

@@ -102,3 +102,62 @@ fn the_preset_q_learns_where_the_domain_is_not_counted() {
     let expansion = spec.preset_expansion.as_deref().unwrap_or_default();
     assert!(expansion.contains("learn {") && !expansion.contains("plan: model"), "{expansion}");
 }
+
+/// Issue 30: `preset: auto` on a 400 x 400 grid failed on its own choice (HSTL033: its
+/// memory and the window reward over windows it could not plan). The preset now sizes the
+/// memory within the memory budget: no error, only the note of what the run will take.
+#[test]
+fn the_preset_on_a_400_by_400_grid_passes_its_own_check() {
+    let src = "spec Big {
+        state { x: int in 0..=399, y: int in 0..=399 }
+        let A = x < 20 && y < 20;
+        let B = x > 379 && y > 379;
+        let C = x > 379 && y < 20;
+        task always[0..] (eventually[0..400] A && eventually[0..400] B && eventually[0..400] C);
+        option A; option B; option C;
+        learn { preset: auto }
+    }";
+    let checked = check(src);
+    let errors: Vec<&str> = checked
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| d.code)
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    // What it chose is what `check` says the run takes: no more than the note.
+    assert!(checked.diagnostics.iter().all(|d| d.code == "HSTL180"), "{:?}", checked.diagnostics);
+}
+
+/// Issue 30: specs `check` passed that then took gigabytes: `memory: 20` over three regions
+/// (2.7 GB to train, 6.6 GB to evaluate) and a 1024 x 1024 world (4.1 GB to train two
+/// episodes). Both are HSTL084 now, over the memory budget.
+#[test]
+fn specs_that_blew_up_at_run_time_are_refused_by_check() {
+    let three = "spec M {
+        state { x: int in 0..=14, y: int in 0..=14 }
+        let A = x > 3 && x < 9 && y > 10 && y < 14;
+        let B = x > 1 && x < 5 && y > 1 && y < 5;
+        let C = 9 < x < 13 && 1 < y < 7;
+        task always[0..] (eventually[0..40] A && eventually[0..40] B && eventually[0..40] C);
+        option A { reach: A, init: !A, terminate: A }
+        option B { reach: B, init: !B, terminate: B }
+        option C { reach: C, init: !C, terminate: C }
+        options { A, B, C }
+        learn { episodes: 2, choices: 5, memory: 20, reward: window }
+    }";
+    let huge = "spec H {
+        state { x: int in 0..=1023, y: int in 0..=1023 }
+        let A = x < 3 && y < 3;
+        let B = x > 1020 && y > 1020;
+        task always[0..] (eventually[0..4000] A && eventually[0..4000] B);
+        option A { reach: A, init: !A, terminate: A }
+        option B { reach: B, init: !B, terminate: B }
+        options { A, B }
+        learn { episodes: 2, choices: 5 }
+    }";
+    for src in [three, huge] {
+        let codes: Vec<&str> = check(src).diagnostics.iter().map(|d| d.code).collect();
+        assert!(codes.contains(&"HSTL084"), "{codes:?}");
+    }
+}

@@ -52,7 +52,12 @@ impl fmt::Display for CliError {
         match self {
             CliError::Read { path, source } => f.write_str(&hstl::load::read_error(path, source)),
             CliError::Write { path, source } => {
-                write!(f, "cannot write `{}`: {}", path.display(), hstl::load::io_reason(source))
+                write!(
+                    f,
+                    "cannot write `{}`: {}",
+                    hstl::load::path_words(path),
+                    hstl::load::io_reason(source)
+                )
             }
             CliError::Other { message, .. } => f.write_str(message),
         }

@@ -127,6 +127,16 @@ pub fn run(args: &EvalArgs) -> CmdResult {
         .as_ref()
         .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
         .transpose()?;
+    // The optimum W* of a persistent task, solved first: one past its budget is an error
+    // before anything is printed, not after the report.
+    let optimum = if args.no_optimum || spec.regions.is_empty() {
+        None
+    } else {
+        let start = Instant::now();
+        let optimum = evaluate::optimum(&replay, SolveConfig::default())
+            .map_err(|p| CliError::new(p.message, Some(SKIP_OPTIMUM.into())))?;
+        optimum.map(|o| (o, start.elapsed()))
+    };
     outln!(
         "policy of `{}` on {}: {} options, {} greedy runs of {} steps (seed {})",
         spec.name,
@@ -179,25 +189,20 @@ pub fn run(args: &EvalArgs) -> CmdResult {
             "  hand-written baseline (the regions in turn, each by a shortest path around the walls): window rate {rate:.4}"
         )?;
     }
-    if !args.no_optimum {
-        let start = Instant::now();
-        let optimum = evaluate::optimum(&replay, SolveConfig::default())
-            .map_err(|p| CliError::new(p.message, Some(SKIP_OPTIMUM.into())))?;
-        if let Some(optimum) = optimum {
-            let ratio = if hstl::study::ratio_defined(optimum.gain) {
-                format!("W/W* = {:.3}", report.rate / optimum.gain)
-            } else {
-                hstl::study::RATIO_UNDEFINED.to_string()
-            };
-            outln!(
-                "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): {ratio}",
-                optimum.gain.max(0.0),
-                optimum.lower.max(0.0),
-                optimum.upper.max(0.0),
-                start.elapsed().as_secs_f64(),
-                if optimum.converged { "" } else { ", not converged" },
-            )?;
-        }
+    if let Some((optimum, took)) = optimum {
+        let ratio = if hstl::study::ratio_defined(optimum.gain) {
+            format!("W/W* = {:.3}", report.rate / optimum.gain)
+        } else {
+            hstl::study::RATIO_UNDEFINED.to_string()
+        };
+        outln!(
+            "  optimum W* = {:.4} (in [{:.4}, {:.4}], value iteration, {:.1} s{}): {ratio}",
+            optimum.gain.max(0.0),
+            optimum.lower.max(0.0),
+            optimum.upper.max(0.0),
+            took.as_secs_f64(),
+            if optimum.converged { "" } else { ", not converged" },
+        )?;
     }
     write_runs(out, &replay, args.starts, runs)?;
     Ok(Status::Clean)

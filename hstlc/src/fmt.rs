@@ -118,7 +118,7 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
         errln!(
             "note: `{}` had {} other hard link{}: it is now a file of its own, and {} the \
              text before formatting (run `hstlc fmt --write` on {} too)",
-            hstl::load::escape_controls(&path.display().to_string()),
+            hstl::load::path_words(path),
             others,
             if others == 1 { "" } else { "s" },
             if others == 1 { "that name keeps" } else { "those names keep" },

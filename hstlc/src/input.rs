@@ -32,7 +32,7 @@ pub fn read_text(path: &Path, stdin_name: &str, limit: u64, what: &str) -> Resul
             .map_err(|source| CliError::Read { path: PathBuf::from(stdin_name), source })?;
         (name, bytes)
     } else {
-        let name = path.display().to_string();
+        let name = hstl::load::path_words(path);
         let read = |path: &Path| -> std::io::Result<Option<Vec<u8>>> {
             let file = std::fs::File::open(path)?;
             let meta = file.metadata()?;
@@ -57,7 +57,7 @@ pub fn read_text(path: &Path, stdin_name: &str, limit: u64, what: &str) -> Resul
 /// file that a spec names is read by `check` and by the language server on every
 /// keystroke, and opening a named pipe would wait for a writer forever.
 pub fn read_regular_text(path: &Path, limit: u64, what: &str) -> Result<Input, CliError> {
-    let name = path.display().to_string();
+    let name = hstl::load::path_words(path);
     let read_err = |source| CliError::Read { path: path.to_path_buf(), source };
     let file = hstl::load::open_regular(path).map_err(|e| {
         if e.kind() == std::io::ErrorKind::InvalidInput {

@@ -216,7 +216,7 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         }
         skipped.sort();
         for (p, what) in &skipped {
-            let shown = p.display().to_string();
+            let shown = hstl::load::path_words(p);
             errln!(
                 "note: skipped `{}`: {what}, not a regular file",
                 hstl::load::escape_controls(&shown)
@@ -224,7 +224,7 @@ fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         }
         if found.is_empty() {
             return Err(CliError::new(
-                format!("`{}` holds no `.csv` file", path.display()),
+                format!("`{}` holds no `.csv` file", hstl::load::path_words(path)),
                 Some("pass a folder of CSV traces, or the trace files themselves".to_string()),
             ));
         }
@@ -292,7 +292,7 @@ pub(crate) fn note_ignored(ignored: &[String], spec: &CheckedSpec) {
 
 /// The name a trace path is reported by.
 pub(crate) fn trace_name(path: &Path) -> String {
-    if path == Path::new("-") { "<stdin>".to_string() } else { path.display().to_string() }
+    if path == Path::new("-") { "<stdin>".to_string() } else { hstl::load::path_words(path) }
 }
 
 /// The signal of a trace read whole, or its value at step 0.

@@ -76,5 +76,5 @@ pub(crate) use {err, errln, out, outln};
 /// A path as messages show it: its control characters escaped (see
 /// [`hstl::load::escape_controls`]).
 pub fn shown(path: &std::path::Path) -> String {
-    hstl::load::escape_controls(&path.display().to_string()).into_owned()
+    hstl::load::path_words(path)
 }

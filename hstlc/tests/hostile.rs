@@ -789,3 +789,171 @@ fn control_characters_in_names_are_escaped() {
     assert!(!raw(&run), "{:?}", run.stderr);
     assert!(run.stderr.contains("column `\\x1b[31mred` is not"), "{}", run.stderr);
 }
+
+/// Issue 30: file names that are not UTF-8 were shown lossily (every bad byte as U+FFFD),
+/// so two files printed under one name. Each bad byte is shown as `\xff`, in diagnostics,
+/// `fmt --check`'s list and read errors alike.
+#[cfg(unix)]
+#[test]
+fn file_names_that_are_not_utf8_are_shown_losslessly() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let names = [OsStr::from_bytes(b"a\xff.hstl"), OsStr::from_bytes(b"a\xfe.hstl")];
+    for n in names {
+        std::fs::write(d.join(n), "spec  S {state{x:int in 0..=9} task x>1 &&;}\n").expect("file");
+    }
+    let run = |args: &[&OsStr]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .expect("hstlc runs");
+        let all = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (out.status.code(), all)
+    };
+    let (status, shown) = run(&[OsStr::new("check"), names[0], names[1]]);
+    assert_eq!(status, Some(1), "{shown}");
+    assert!(shown.contains("[a\\xff.hstl:1:"), "{shown}");
+    assert!(shown.contains("[a\\xfe.hstl:1:"), "{shown}");
+    assert!(!shown.contains('\u{fffd}'), "{shown}");
+    let (_, shown) = run(&[OsStr::new("check"), OsStr::from_bytes(b"gone\xff.hstl")]);
+    assert!(shown.contains("cannot read `gone\\xff.hstl`"), "{shown}");
+}
+
+/// Issue 30: `eval` accepted hand-edited tables' `policy.json` files. Each edit is now
+/// refused (exit 2) with what is wrong: a signed hex Q-value, a table for no primitive, a
+/// seed written as a string, the built-in world's slip changed, and a built-in world's name
+/// on another map.
+#[test]
+fn hand_edited_policies_are_refused() {
+    use serde_json::{Value, json};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    let run = hstlc_in(d, &["train", "small.hstl", "--out", "t"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let text = std::fs::read_to_string(d.join("t/policy.json")).expect("policy.json");
+    let doc: Value = serde_json::from_str(&text).expect("JSON");
+    let eval = |name: &str, doc: &Value| {
+        write(d, name, serde_json::to_string(doc).expect("JSON"));
+        hstlc_in(d, &["eval", name, "--no-optimum", "--starts", "1", "--steps", "150"], b"")
+    };
+    assert_eq!(eval("ok.json", &doc).status, Some(0));
+    type Edit = Box<dyn Fn(&mut Value)>;
+    let first = |d: &mut Value| -> String {
+        d["q_tables"]["flat"].as_object().expect("tables").keys().next().expect("one").clone()
+    };
+    let edits: Vec<(&str, Edit, &str)> = vec![
+        (
+            "signed",
+            Box::new(move |d| {
+                let k = first(d);
+                let v = d["q_tables"]["flat"][&k][0].as_str().expect("hex").to_string();
+                d["q_tables"]["flat"][&k][0] = json!(format!("-{v}"));
+            }),
+            "not 16 hex digits of an f64's bits",
+        ),
+        (
+            "extra",
+            Box::new(move |d| {
+                let k = first(d);
+                d["q_tables"]["flat"]["Z"] = d["q_tables"]["flat"][&k].clone();
+            }),
+            "has a table for `Z`, which is no primitive option",
+        ),
+        ("seed", Box::new(|d| d["seed"] = json!("3")), "its `seed` is \"3\", not a whole number"),
+        (
+            "slip",
+            Box::new(|d| d["env"]["params"]["slip"] = json!(0.5)),
+            "the world is named `paper`, a built-in world, but its parameters are not",
+        ),
+        (
+            "name",
+            Box::new(|d| d["env"]["name"] = json!("four-rooms")),
+            "the world is named `four-rooms`, a built-in world, but its parameters are not",
+        ),
+    ];
+    for (name, edit, expected) in edits {
+        let mut edited = doc.clone();
+        edit(&mut edited);
+        let run = eval(&format!("{name}.json"), &edited);
+        assert_eq!(run.status, Some(2), "{name}: {}{}", run.stdout, run.stderr);
+        assert!(run.stdout.is_empty(), "{name}: {}", run.stdout);
+        assert!(run.stderr.contains(expected), "{name}: {}", run.stderr);
+    }
+}
+
+/// Issue 30: when the optimum W* was past its budget, `eval` printed its whole report and
+/// then exited 2. It decides what it can compute first: the error alone, nothing printed.
+#[test]
+fn eval_refuses_an_optimum_past_its_budget_before_it_prints() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(
+        d,
+        "wide.hstl",
+        "spec Wide {
+    state { x: int in 0..=14, y: int in 0..=14 }
+    let A = x < 3 && y < 3;
+    let B = x > 11 && y > 11;
+    let C = x > 11 && y < 3;
+    task always[0..] (eventually[0..600] A && eventually[0..600] B && eventually[0..600] C);
+    option A { reach: A, init: !A, terminate: A }
+    option B { reach: B, init: !B, terminate: B }
+    option C { reach: C, init: !C, terminate: C }
+    options { A, B, C }
+    learn { episodes: 2, choices: 3, memory: 1, reward: window }
+}
+",
+    );
+    let run = hstlc_in(d, &["train", "wide.hstl", "--out", "w"], b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let args = ["eval", "w/policy.json", "--starts", "2", "--steps", "200", "--burn-in", "10"];
+    let run = hstlc_in(d, &args, b"");
+    assert_eq!(run.status, Some(2), "{}", run.stderr);
+    assert_eq!(run.stdout, "", "nothing printed before the error");
+    assert!(run.stderr.contains("too many to search"), "{}", run.stderr);
+    assert!(run.stderr.contains("--no-optimum"), "{}", run.stderr);
+    let mut skip = args.to_vec();
+    skip.push("--no-optimum");
+    let run = hstlc_in(d, &skip, b"");
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains("window rate"), "{}", run.stdout);
+}
+
+/// Issue 30: world-file errors showed Rust escapes (`\u{e9}` for `é`) and lost their line
+/// and column on deeply nested TOML. Letters are shown as they are (control characters
+/// escaped), and every error is placed at `FILE:LINE:COL`.
+#[test]
+fn world_file_errors_show_letters_and_their_place() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "small.hstl", SMALL);
+    let cases = [
+        (
+            "letter.toml",
+            "map = \"\"\"\n...............\néééééééééééé\n\"\"\"\n".to_string(),
+            "w:3:1:",
+        ),
+        ("kind.toml", "kind = \"sphère\"\n".to_string(), "w:1:8:"),
+        ("deep.toml", format!("a = {}{}\n", "[".repeat(300), "]".repeat(300)), "w:1:"),
+    ];
+    for (name, text, place) in cases {
+        write(d, name, text);
+        let run = hstlc_in(d, &["check", "small.hstl", "--world", name], b"");
+        assert_eq!(run.status, Some(2), "{name}: {}", run.stderr);
+        let place = place.replace("w:", &format!("{name}:"));
+        assert!(run.stderr.contains(&place), "{name}: {}", run.stderr);
+        assert!(!run.stderr.contains("\\u{"), "{name}: {}", run.stderr);
+    }
+    let run = hstlc_in(d, &["check", "small.hstl", "--world", "letter.toml"], b"");
+    assert!(run.stderr.contains("unknown character `é` in the map"), "{}", run.stderr);
+    let run = hstlc_in(d, &["check", "small.hstl", "--world", "kind.toml"], b"");
+    assert!(run.stderr.contains("`sphère`"), "{}", run.stderr);
+}

@@ -59,7 +59,7 @@ impl ContinuousWorld {
 
     /// The world in the file at `path`, with the CLI's words for every error.
     pub fn read(path: &Path) -> PyResult<ContinuousWorld> {
-        let text = crate::files::read_text(
+        let text = crate::files::read_regular_text(
             path,
             hstl::world::MAX_WORLD_BYTES as u64,
             "world file",
@@ -256,7 +256,7 @@ pub fn _resolve_any_world(py: Python<'_>, arg: &str) -> PyResult<Py<PyAny>> {
                 return Err(world_error(&hstl::world::unknown(arg)));
             }
             let path = Path::new(arg);
-            let text = crate::files::read_text(
+            let text = crate::files::read_regular_text(
                 path,
                 hstl::world::MAX_WORLD_BYTES as u64,
                 "world file",

@@ -136,7 +136,7 @@ pub fn _study_task(
 ) -> PyResult<(String, usize, Option<String>)> {
     let (task, _) = task_in(py, spec.get(), &StudyWorld::of(world)?, episodes)?;
     // The regions' data, only ever compared (never shown).
-    let key = (!task.regions.is_empty()).then(|| format!("{:?}", task.regions));
+    let key = (!task.regions.is_empty()).then(|| format!("{:?}", task.regions)); // not a message
     Ok((task.name, task.learn.episodes, key))
 }
 

@@ -340,3 +340,38 @@ def test_a_seed_s_window_rate_is_evaluate_with_its_evaluation_seed(local):
     policy = hstl.train(SMALL, seed=5, episodes=10)
     report = policy.evaluate(seed=5 ^ hstl.EVAL_SEED, optimum=False)
     assert report["window_rate"] == row["window_rate"]
+
+
+@pytest.mark.parametrize("world", ["paper", "plane"])
+def test_ctrl_c_ends_a_study_within_its_episode_under_way(tmp_path, world):
+    # Issue 30: Ctrl-C only kept further seeds from starting, so a long seed trained to its
+    # end first. Training stops after the episode under way; the call raises
+    # KeyboardInterrupt. A child process, so that a study that does not stop fails the
+    # test at the timeout instead of hanging it; no time is asserted beyond that guard.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    spec = SMALL if world == "paper" else PLANE
+    code = (
+        "import sys, hstl\n"
+        "print('started', flush=True)\n"
+        "try:\n"
+        "    hstl.study(sys.argv[1], seeds=2, episodes=10_000_000, optimum=False)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', flush=True)\n"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code, str(spec)], stdout=subprocess.PIPE, text=True
+    )
+    assert child.stdout is not None
+    assert child.stdout.readline().strip() == "started"
+    time.sleep(1.5)
+    child.send_signal(signal.SIGINT)
+    try:
+        out, _ = child.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        raise AssertionError("the study went on training after Ctrl-C")
+    assert "interrupted" in out, out

@@ -93,9 +93,11 @@ def test_unknown_and_unreadable_worlds_raise_what_hstlc_prints(hstlc, monkeypatc
         assert str(builtin.value) == str(e.value)
 
 
-def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
-    # Opening a named pipe for reading waits for a writer: `World.load` refuses it first, as
-    # `hstlc --world` does. A child process, so that a hang fails the test instead of it.
+@pytest.mark.parametrize("load", ["hstl.World.load", "hstl.ContinuousWorld.load"])
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path, load):
+    # Opening a named pipe for reading waits for a writer: `World.load` and
+    # `ContinuousWorld.load` refuse it first, as `hstlc --world` does (issue 30: the
+    # continuous one waited). A child process, so that a hang fails the test instead of it.
     import subprocess
     import sys
 
@@ -104,7 +106,7 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path):
     code = (
         "import sys, hstl\n"
         "try:\n"
-        "    hstl.World.load(sys.argv[1])\n"
+        f"    {load}(sys.argv[1])\n"
         "except ValueError as e:\n"
         "    print(type(e).__name__, e)\n"
     )

@@ -351,8 +351,15 @@ impl<'a> LegCycle<'a> {
     pub fn new(agent: &'a Agent, cycle: Vec<usize>) -> Result<LegCycle<'a>, Error> {
         if cycle.is_empty() || cycle.iter().any(|&p| p >= agent.flat.len()) {
             return Err(Error::Config(format!(
-                "a leg cycle needs primitive indices below {}, not {cycle:?}",
-                agent.flat.len()
+                "a leg cycle needs one or more primitive indices below {}, not {}",
+                agent.flat.len(),
+                if cycle.is_empty() {
+                    "none".to_string()
+                } else {
+                    crate::words::and_list(
+                        &cycle.iter().map(ToString::to_string).collect::<Vec<_>>(),
+                    )
+                }
             )));
         }
         Ok(LegCycle { agent, cycle, phase: 0, steps: 0 })

@@ -119,7 +119,7 @@ impl GridWorld {
                             Error::Env(format!(
                                 "row {} of the world's `map` holds `{}`, not `.`, `#` or `S`",
                                 i + 1,
-                                c.escape_default()
+                                crate::words::visible_char(c)
                             ))
                         })
                     })

@@ -46,6 +46,7 @@ pub mod progress;
 pub mod reach_avoid;
 pub mod spec;
 mod tables;
+mod words;
 pub mod world;
 
 pub use env::{Cell, Env, EpisodeEnd, GridWorld, Tile, World};

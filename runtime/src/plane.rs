@@ -43,6 +43,9 @@ use crate::env::World;
 use crate::geometry::{self, Xy};
 use crate::{Error, Rng};
 
+mod index;
+use index::ObstacleIndex;
+
 /// A position in a plane world: its state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {
@@ -176,6 +179,8 @@ pub struct PlaneWorld {
     fallback: Point,
     /// A lower bound on the free share of the start rectangle.
     start_free: f64,
+    /// The obstacles in buckets over the extent (`None`: every move tests them all).
+    index: Option<Box<ObstacleIndex>>,
 }
 
 /// Which part of a configuration an error is about, so a world file can point at it.
@@ -379,6 +384,7 @@ impl PlaneWorld {
         let attempts = (50.0 / found.share).ceil().min(f64::from(u32::MAX)) as u32;
         config.start = Some(start);
         let dirs = (0..config.headings).map(|k| heading_vector(k, config.headings)).collect();
+        let index = ObstacleIndex::build(config.x, config.y, &config.obstacles).map(Box::new);
         Ok(PlaneWorld {
             name: name.to_string(),
             config,
@@ -387,6 +393,7 @@ impl PlaneWorld {
             attempts,
             fallback,
             start_free: found.share,
+            index,
         })
     }
 
@@ -454,7 +461,7 @@ impl PlaneWorld {
 
     /// Whether `p` is a free position: in the extent and in no obstacle.
     pub fn is_free(&self, p: Point) -> bool {
-        self.in_extent(p) && !self.config.obstacles.iter().any(|o| o.contains(p))
+        self.in_extent(p) && !self.touches_obstacle(p, p, |o| o.contains(p))
     }
 
     /// Whether the robot may move from `p` straight to `q`: the segment stays in the
@@ -463,7 +470,18 @@ impl PlaneWorld {
         // The extent is convex: the segment stays in it when both ends do.
         self.in_extent(p)
             && self.in_extent(q)
-            && !self.config.obstacles.iter().any(|o| o.touches_segment(p, q))
+            && !self.touches_obstacle(p, q, |o| o.touches_segment(p, q))
+    }
+
+    /// Whether `test` holds for an obstacle, of those near the segment from `p` to `q`
+    /// (the index's buckets), or of all of them; in index order either way, with the same
+    /// answer (see the `index` module).
+    fn touches_obstacle(&self, p: Point, q: Point, test: impl Fn(&Obstacle) -> bool) -> bool {
+        let all = &self.config.obstacles;
+        self.index
+            .as_ref()
+            .and_then(|i| i.any_near(p.xy(), q.xy(), |o| test(&all[o])))
+            .unwrap_or_else(|| all.iter().any(&test))
     }
 
     fn in_extent(&self, p: Point) -> bool {

@@ -696,10 +696,10 @@ impl Policy {
         };
         if memory.len() != doc.regions.len() || memory.iter().any(|&b| b > doc.buckets) {
             return Err(Error::Config(format!(
-                "the memory slice {memory:?} needs one bucket in 0..={} for each of the \
-                 regions {}",
+                "the memory slice {} needs one bucket in 0..={} for each of the regions {}",
+                json_list(memory),
                 doc.buckets,
-                doc.regions.join(", ")
+                crate::words::and_list(&doc.regions)
             )));
         }
         let inside: Vec<std::collections::HashSet<Vec<u64>>> =
@@ -728,7 +728,7 @@ impl Policy {
             Some(doc) => (0..=doc.buckets)
                 .map(|v| {
                     let b = vec![v; doc.regions.len()];
-                    (format!("b = {b:?}"), b)
+                    (format!("b = {}", json_list(&b)), b)
                 })
                 .collect(),
         }
@@ -963,9 +963,10 @@ fn fill_options(
             (Some(m), Some(b)) => {
                 m.code_of_buckets(b).filter(|&c| m.consistent(s, c)).ok_or_else(|| {
                     Error::Policy(format!(
-                        "options_policy gives state {} the memory {b:?}, which is not {} \
+                        "options_policy gives state {} the memory {}, which is not {} \
                          buckets in 0..={} with 0 for the regions the state lies in",
                         e.state,
+                        json_list(b),
                         m.len(),
                         m.buckets
                     ))
@@ -989,9 +990,10 @@ fn fill_options(
             }
             (Some(g), Some(list)) => g.progress.encode(list).ok_or_else(|| {
                 Error::Policy(format!(
-                    "options_policy gives state {} the goals met {list:?}, which are not \
+                    "options_policy gives state {} the goals met {}, which are not \
                      indices of its {} goals",
                     e.state,
+                    json_list(list),
                     g.progress.goals()
                 ))
             })?,
@@ -1003,8 +1005,10 @@ fn fill_options(
         memory.is_none_or(|m| m.consistent(obs / (values * codes), obs / codes % values))
     };
     if let Some(obs) = (0..out.len()).find(|&obs| out[obs] == usize::MAX && possible(obs)) {
-        let memory = memory.map(|m| format!(" with memory {:?}", m.decode(obs / codes % values)));
-        let goals = goals.map(|g| format!(" with goals met {:?}", g.progress.decode(obs % codes)));
+        let memory =
+            memory.map(|m| format!(" with memory {}", json_list(&m.decode(obs / codes % values))));
+        let goals = goals
+            .map(|g| format!(" with goals met {}", json_list(&g.progress.decode(obs % codes))));
         return err(format!(
             "options_policy does not cover state index {}{}{}",
             obs / (values * codes),
@@ -1033,4 +1037,10 @@ fn fill(
         return Err(Error::Policy(format!("{what} does not cover state index {s}")));
     }
     Ok(out)
+}
+
+/// Numbers as `policy.json` writes a list of them: `[0, 3, 1]`.
+fn json_list<T: std::fmt::Display>(values: &[T]) -> String {
+    let parts: Vec<String> = values.iter().map(ToString::to_string).collect();
+    format!("[{}]", parts.join(", "))
 }

@@ -344,7 +344,7 @@ fn document(text: &str) -> Result<Document<'_>, WorldError> {
                 Some("plane") => Kind::Plane,
                 Some(other) => {
                     return Err(WorldError::new(
-                        format!("unknown world kind `{}`", other.escape_default()),
+                        format!("unknown world kind `{}`", crate::words::visible(other)),
                         Some(span),
                         KIND_HELP,
                     ));
@@ -556,9 +556,9 @@ fn map_rows(text: &str, map: &toml::Spanned<String>) -> Result<Vec<Vec<Tile>>, W
         for (at, c) in line.char_indices() {
             let Some(tile) = Tile::from_char(c) else {
                 let what = if c.is_whitespace() {
-                    format!("a blank (`{}`) in the map", c.escape_default())
+                    format!("a blank (`{}`) in the map", crate::words::visible_char(c))
                 } else {
-                    format!("unknown character `{}` in the map", c.escape_default())
+                    format!("unknown character `{}` in the map", crate::words::visible_char(c))
                 };
                 return Err(WorldError::new(
                     what,

@@ -585,7 +585,7 @@ fn memory_slices_pick_one_entry_per_state() {
         assert_eq!(inside_b.memory, Some(vec![b[0], 0, b[2]]));
     }
     let err = policy.options_slice(&[3, 0, 0]).unwrap_err().to_string();
-    assert!(err.contains("one bucket in 0..=2 for each of the regions A, B, C"), "{err}");
+    assert!(err.contains("one bucket in 0..=2 for each of the regions A, B and C"), "{err}");
     // Without memory the one slice is the whole options policy.
     let plain = Policy::new(&Learner::new(&small(false, false), &env).unwrap());
     assert_eq!(plain.memory_slices(), [(String::new(), vec![])]);

@@ -39,6 +39,16 @@ use super::worlds::{WorldCache, path_uri, uri_path};
 /// diagnostics or answers, and the client is told once why.
 pub const MAX_DOCUMENT_BYTES: usize = 4 << 20;
 
+/// Most text, in bytes, of the documents kept analysed at once (16 MiB): an analysis takes
+/// tens of bytes a byte of text, so a client that opens many large documents would grow
+/// the server without bound (12 documents took 3.3 GB). Past it, the analyses used least
+/// recently are dropped, their text kept, and made again when a request needs one.
+pub const MAX_ANALYSED_BYTES: usize = 16 << 20;
+
+/// Most text, in bytes, of every open document together (256 MiB): past it, a document's
+/// text is not kept, and the client is told why, as for one too large to analyse.
+pub const MAX_OPEN_BYTES: usize = 256 << 20;
+
 /// Most lines the server logs about bad input; the rest are counted, not printed.
 const MAX_LOG_LINES: u64 = 1000;
 
@@ -72,6 +82,8 @@ enum State {
     TooLarge(usize),
     /// Analysis failed with an internal error.
     Failed,
+    /// Not kept: the open documents' text passed [`MAX_OPEN_BYTES`] (its size in bytes).
+    NotKept(usize),
 }
 
 struct Document {
@@ -81,6 +93,19 @@ struct Document {
     /// Its key in `Server::stale` while `pending` is set.
     queued: Option<u64>,
     state: State,
+    /// When its analysis was last made or read (`Server::clock`).
+    used: u64,
+}
+
+impl Document {
+    /// The bytes of text it keeps.
+    fn text_bytes(&self) -> usize {
+        let analysed = match &self.state {
+            State::Analysed(a) => a.text.len(),
+            _ => 0,
+        };
+        analysed + self.pending.as_ref().map_or(0, String::len)
+    }
 }
 
 /// Log lines, to standard error or nowhere (the fuzz targets), at most
@@ -130,6 +155,10 @@ pub struct Server {
     /// The world files documents name, read once each.
     worlds: WorldCache,
     log: Log,
+    /// Counts analyses made and read, for [`Document::used`].
+    clock: u64,
+    /// [`MAX_ANALYSED_BYTES`] (smaller in tests).
+    analysed_budget: usize,
 }
 
 type Answer = Result<Vec<u8>, (ErrorCode, String)>;
@@ -146,7 +175,15 @@ impl Server {
             trash: Vec::new(),
             worlds: WorldCache::default(),
             log,
+            clock: 0,
+            analysed_budget: MAX_ANALYSED_BYTES,
         }
+    }
+
+    /// A server that keeps at most `bytes` of text analysed (for tests).
+    #[cfg(test)]
+    pub(crate) fn with_analysed_budget(log: Log, bytes: usize) -> Self {
+        Server { analysed_budget: bytes, ..Server::new(log) }
     }
 
     /// Logs one line.
@@ -275,15 +312,20 @@ impl Server {
         if self.documents.get(uri).is_some_and(|d| d.pending.is_some()) {
             self.analyse(uri, out);
         }
-        let Some(doc) = self.documents.get(uri) else {
+        self.clock += 1;
+        let clock = self.clock;
+        let Some(doc) = self.documents.get_mut(uri) else {
             return Err((
                 ErrorCode::InvalidParams,
                 format!("document `{}` is not open", short(uri.as_str())),
             ));
         };
+        doc.used = clock;
+        let doc = &*doc;
         match &doc.state {
             State::Analysed(a) => Ok(&**a),
             State::TooLarge(n) => Err((ErrorCode::RequestFailed, too_large(uri, *n))),
+            State::NotKept(n) => Err((ErrorCode::RequestFailed, not_kept(uri, *n))),
             State::Failed => Err((
                 ErrorCode::InternalError,
                 format!("internal error while checking `{}`", short(uri.as_str())),
@@ -434,13 +476,37 @@ impl Server {
 
     /// Stores a newer text, replacing one that was never analysed.
     fn store(&mut self, uri: Uri, version: i32, text: String) {
+        // The text the other documents keep: with this one past the limit, it is not kept.
+        let others: usize = self
+            .documents
+            .iter()
+            .filter(|(u, _)| **u != uri)
+            .map(|(_, d)| d.text_bytes())
+            .fold(0, usize::saturating_add);
         let doc = self.documents.entry(uri.clone()).or_insert(Document {
             version,
             pending: None,
             queued: None,
             state: State::Unanalysed,
+            used: 0,
         });
         doc.version = version;
+        if others.saturating_add(text.len()) > MAX_OPEN_BYTES {
+            let bytes = text.len();
+            drop(text);
+            doc.pending = None;
+            if let Some(key) = doc.queued.take() {
+                self.stale.remove(&key);
+            }
+            let was = std::mem::replace(&mut doc.state, State::NotKept(bytes));
+            if !matches!(was, State::NotKept(_)) {
+                let message = not_kept(&uri, bytes);
+                self.log(&message);
+            }
+            self.discard(was);
+            self.trash.clear();
+            return;
+        }
         doc.pending = Some(text);
         if doc.queued.is_none() {
             doc.queued = Some(self.next_stale);
@@ -499,13 +565,70 @@ impl Server {
             State::Analysed(a) => features::diagnostics(a, uri),
             _ => Vec::new(),
         };
+        self.clock += 1;
+        let clock = self.clock;
         if let Some(doc) = self.documents.get_mut(uri) {
             doc.state = next;
+            doc.used = clock;
         }
         out.send(publish(uri, Some(version), diagnostics));
+        self.evict(uri);
         // Free the previous versions once the diagnostics are on their way.
         self.trash.clear();
     }
+
+    /// Drops the analyses used least recently, other than `keep`'s, until the analysed
+    /// text is within [`MAX_ANALYSED_BYTES`]; their text is kept, to be analysed again
+    /// when a request needs it.
+    fn evict(&mut self, keep: &Uri) {
+        let mut analysed: Vec<(u64, usize, Uri)> = self
+            .documents
+            .iter()
+            .filter_map(|(u, d)| match &d.state {
+                State::Analysed(a) => Some((d.used, a.text.len(), u.clone())),
+                _ => None,
+            })
+            .collect();
+        let mut total: usize = analysed.iter().map(|a| a.1).fold(0, usize::saturating_add);
+        if total <= self.analysed_budget {
+            return;
+        }
+        analysed.sort_unstable_by_key(|a| a.0);
+        for (_, bytes, uri) in analysed {
+            if total <= self.analysed_budget {
+                break;
+            }
+            if &uri == keep {
+                continue;
+            }
+            let Some(doc) = self.documents.get_mut(&uri) else { continue };
+            if let State::Analysed(mut a) = std::mem::replace(&mut doc.state, State::Unanalysed) {
+                // A newer text, if any, is the one to analyse next time.
+                let text = std::mem::take(&mut a.text);
+                doc.pending.get_or_insert(text);
+                self.trash.push(a.into_leftovers());
+                total -= bytes;
+            }
+        }
+    }
+
+    /// How many documents are analysed now, and their text's bytes (for tests).
+    #[cfg(test)]
+    pub(crate) fn analysed(&self) -> (usize, usize) {
+        let texts = self.documents.values().filter_map(|d| match &d.state {
+            State::Analysed(a) => Some(a.text.len()),
+            _ => None,
+        });
+        texts.fold((0, 0), |(n, b), t| (n + 1, b + t))
+    }
+}
+
+fn not_kept(uri: &Uri, bytes: usize) -> String {
+    format!(
+        "`{}` ({bytes} bytes) is not kept: the open documents hold more than the {} MiB of text the language server keeps; close some, or check it with `hstlc check`",
+        short(uri.as_str()),
+        MAX_OPEN_BYTES >> 20
+    )
 }
 
 fn too_large(uri: &Uri, bytes: usize) -> String {

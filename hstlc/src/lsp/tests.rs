@@ -785,3 +785,66 @@ fn the_world_a_spec_names() {
     assert_eq!(at["range"]["start"], json!({ "line": line, "character": col }));
     c.shutdown();
 }
+
+/// Issue 30: the server kept every open document analysed (12 documents took 3.3 GB). The
+/// analysed text stays within `MAX_ANALYSED_BYTES` whatever the client opens: the analyses
+/// used least recently are dropped, and a request on one of those documents analyses it
+/// again and answers as before.
+#[test]
+fn the_analysed_documents_stay_within_their_budget() {
+    use super::server::{Log, Server};
+    use super::transport::{Id, Incoming};
+    // The budget scaled down with the documents (16 MiB against 4 MiB documents).
+    const MAX_ANALYSED_BYTES: usize = 200_000;
+    let mut server = Server::with_analysed_budget(Log::quiet(), MAX_ANALYSED_BYTES);
+    let mut out: Vec<u8> = Vec::new();
+    let note =
+        |method: &str, params: Value| Incoming::Notification { method: method.to_string(), params };
+    let init: Value = serde_json::from_str(INIT[0]).unwrap();
+    server.handle(
+        Incoming::Request {
+            id: Id::Number(1.into()),
+            method: "initialize".into(),
+            params: init["params"].clone(),
+        },
+        &mut out,
+    );
+    server.handle(note("initialized", json!({})), &mut out);
+    // Each document about 60 KB of lets.
+    let doc = |k: usize| {
+        let lets: String = (0..2_500).map(|i| format!("    let L{i} = x > {};\n", i % 7)).collect();
+        format!("spec S{k} {{\n    state {{ x: int in 0..=9 }}\n{lets}    task always L1;\n}}\n")
+    };
+    let text = doc(0);
+    assert!(text.len() > 50_000 && text.len() < 70_000, "{}", text.len());
+    let documents = 8;
+    for k in 0..documents {
+        let uri = format!("file:///d{k}.hstl");
+        server.handle(
+            note("textDocument/didOpen", open_doc(&uri, &doc(k))["params"].clone()),
+            &mut out,
+        );
+        while server.has_idle_work() {
+            server.idle_step(&mut out);
+        }
+        let (n, bytes) = server.analysed();
+        assert!(bytes <= MAX_ANALYSED_BYTES, "{n} documents, {bytes} bytes analysed");
+        assert!(n >= 1);
+    }
+    assert!(documents * text.len() > MAX_ANALYSED_BYTES, "the budget is passed");
+    // The first document's analysis was dropped; a hover analyses it again.
+    out.clear();
+    server.handle(
+        Incoming::Request {
+            id: Id::Number(2.into()),
+            method: "textDocument/hover".into(),
+            params: json!({ "textDocument": { "uri": "file:///d0.hstl" },
+                            "position": { "line": 3, "character": 9 } }),
+        },
+        &mut out,
+    );
+    let answer = String::from_utf8_lossy(&out);
+    assert!(answer.contains("let L1 = x > 1"), "{}", &answer[..answer.len().min(500)]);
+    let (_, bytes) = server.analysed();
+    assert!(bytes <= MAX_ANALYSED_BYTES, "{bytes}");
+}

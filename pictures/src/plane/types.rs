@@ -265,9 +265,10 @@ impl Plane {
             };
             if !ok {
                 return Err(PictureError::new(format!(
-                    "obstacle {} ({shape:?}) is not a finite circle of positive radius or a \
+                    "obstacle {} ({}) is not a finite circle of positive radius or a \
                      rectangle with x0 < x1 and y0 < y1",
-                    k + 1
+                    k + 1,
+                    shape_words(shape)
                 )));
             }
         }
@@ -299,4 +300,14 @@ impl Plane {
             )))
         }
     }
+}
+
+/// An obstacle as a world file writes it: `circle [cx, cy, r]`, `rect [x0, y0, x1, y1]`.
+fn shape_words(shape: &Shape) -> String {
+    let (kind, numbers) = match *shape {
+        Shape::Circle { cx, cy, r } => ("circle", vec![cx, cy, r]),
+        Shape::Rect { x0, y0, x1, y1 } => ("rect", vec![x0, y0, x1, y1]),
+    };
+    let numbers: Vec<String> = numbers.iter().map(ToString::to_string).collect();
+    format!("{kind} [{}]", numbers.join(", "))
 }

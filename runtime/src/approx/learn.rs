@@ -94,6 +94,34 @@ pub struct Model {
     pub values: usize,
     /// Steps after which a leg is cut off.
     pub max_steps: usize,
+    shape: Shape,
+}
+
+/// What the count of a model's weights is made of: each primitive's weights per action
+/// over the flat tiling, and each option's per code over the options tiling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shape {
+    /// Features of the flat levels' tiling.
+    pub flat_features: usize,
+    /// Features of the options level's tiling.
+    pub options_features: usize,
+    /// Actions of the world.
+    pub actions: usize,
+    /// Primitives.
+    pub primitives: usize,
+    /// Options.
+    pub options: usize,
+    /// Codes the options level tells apart (`usize::MAX` when they overflow).
+    pub codes: usize,
+}
+
+impl Shape {
+    /// The weights in all, `None` when they overflow.
+    pub fn weights(&self) -> Option<usize> {
+        let flat = self.flat_features.checked_mul(self.actions)?.checked_mul(self.primitives)?;
+        let options = self.options_features.checked_mul(self.options)?.checked_mul(self.codes)?;
+        flat.checked_add(options)
+    }
 }
 
 impl Model {
@@ -169,12 +197,8 @@ impl Model {
         let values =
             memory_values.and_then(|v| v.checked_mul(progress.as_ref().map_or(1, Progress::codes)));
         let legs: Vec<Vec<usize>> = spec.options.iter().map(|o| o.sequence.clone()).collect();
-        let total = values.and_then(|v| {
-            let flat = flat_coder.len().checked_mul(actions)?.checked_mul(reach.len())?;
-            let options = options_coder.len().checked_mul(legs.len())?.checked_mul(v)?;
-            flat.checked_add(options)
-        });
-        let (Some(values), Some(total)) = (values, total) else {
+        let shape = Model::shape_of(spec, world)?;
+        let (Some(values), Some(total)) = (values, shape.weights()) else {
             return Err(Error::Config("the weights would not fit in memory".into()));
         };
         if total > MAX_WEIGHTS {
@@ -204,6 +228,45 @@ impl Model {
             progress,
             values,
             max_steps: spec.learn.max_steps,
+            shape,
+        })
+    }
+
+    /// What the weights' count is made of (see [`Shape`]).
+    pub fn shape(&self) -> Shape {
+        self.shape
+    }
+
+    /// The shape of `spec`'s weights in `world`, without allocating them: what the
+    /// facade counts against the memory budget before it builds a [`Model`].
+    pub fn shape_of<W: World>(spec: &TaskSpec, world: &W) -> Result<Shape, Error> {
+        Model::shape_with(spec, world.actions().len())
+    }
+
+    /// [`Model::shape_of`] in a world of `actions` actions.
+    pub fn shape_with(spec: &TaskSpec, actions: usize) -> Result<Shape, Error> {
+        let Some(tiles) = &spec.learn.tiles else {
+            return Err(Error::Config("the approximate learner needs `tiles` settings".into()));
+        };
+        let flat_coder = coder(tiles, 1, tiles.tilings)?;
+        let options_coder = coder(tiles, 2, tiles.tilings.div_ceil(2))?;
+        let persistent = spec.learn.memory > 0 || spec.learn.reward == RewardKind::Window;
+        let regions = if persistent { spec.regions.len() } else { 0 };
+        let progress = if persistent { None } else { Progress::of_task(&spec.task) };
+        let memory = if spec.learn.memory == 0 {
+            Some(1)
+        } else {
+            u32::try_from(regions).ok().and_then(|k| (spec.learn.memory + 1).checked_pow(k))
+        };
+        let codes =
+            memory.and_then(|v| v.checked_mul(progress.as_ref().map_or(1, Progress::codes)));
+        Ok(Shape {
+            flat_features: flat_coder.len(),
+            options_features: options_coder.len(),
+            actions,
+            primitives: spec.primitives.len(),
+            options: spec.options.len(),
+            codes: codes.unwrap_or(usize::MAX),
         })
     }
 

@@ -22,5 +22,5 @@ pub mod learn;
 pub mod tiles;
 
 pub use agent::{ApproxAgent, GreedyRun, Stepper, WindowSummary, task_robustness};
-pub use learn::{ApproxLearner, Model, Weights};
+pub use learn::{ApproxLearner, Model, Shape, Weights};
 pub use tiles::TileCoder;

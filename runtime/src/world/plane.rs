@@ -400,7 +400,7 @@ fn obstacle(item: &Spanned<Raw>) -> Result<(Obstacle, Located), WorldError> {
         other => {
             let message = format!(
                 "unknown obstacle `{}`: an obstacle is a `circle` or a `rect`",
-                other.escape_default()
+                crate::words::visible(other)
             );
             Err(error(message, key.span(), OBSTACLE_HELP))
         }
