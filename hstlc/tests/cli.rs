@@ -287,6 +287,76 @@ const CASES: &[Case] = &[
         "monitor_decimal_bound_discrete",
         &["monitor", "dense_decimal_discrete.hstl", "--trace", "dense.csv"],
     ),
+    // `--online` over nanosecond stamps, backwards stamps, a gap in nanoseconds, NaN
+    Case {
+        name: "monitor_dense_nanoseconds_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--online"],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_nanoseconds_relative_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--online", "--relative"],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_nanoseconds_complete_online",
+        args: &[
+            "monitor",
+            "dense_ns.hstl",
+            "--trace",
+            "dense_ns.csv",
+            "--online",
+            "--windows",
+            "complete",
+        ],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_max_gap_nanoseconds_online",
+        args: &[
+            "monitor",
+            "dense_ns.hstl",
+            "--trace",
+            "dense_ns.csv",
+            "--online",
+            "--max-gap",
+            "1000000000",
+        ],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_bad_stamp_online",
+        args: &["monitor", "dense.hstl", "--trace", "-", "--online", "--formula", "Soon"],
+        stdin: "t,x,y\n0,1,5\n0.5,2,\n0.25,3,\n",
+    },
+    Case {
+        name: "monitor_dense_mixed_stamps_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "-", "--online"],
+        stdin: "t,x,y\n1700000000000000000,1,5\n1700000000000000000.5,2,\n",
+    },
+    Case {
+        name: "monitor_dense_nan_online",
+        args: &["monitor", "dense_sqrt.hstl", "--trace", "-", "--online"],
+        stdin: "t,x\n0,4\n0.5,9\n1.25,-1\n2,4\n",
+    },
+    Case {
+        name: "monitor_dense_unbounded_online",
+        args: &["monitor", "dense_complete.hstl", "--trace", "-", "--online"],
+        stdin: "t,x\n0,4\n0.5,0\n1.25,2\n",
+    },
+    Case {
+        name: "monitor_dense_unbounded_complete_online",
+        args: &[
+            "monitor",
+            "dense_complete.hstl",
+            "--trace",
+            "-",
+            "--online",
+            "--windows",
+            "complete",
+        ],
+        stdin: "t,x\n0,4\n",
+    },
     case("explain_dense_code", &["explain", "HSTL082"]),
     // train and eval: the errors (successful runs are in tests/train_eval.rs)
     case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
