@@ -20,7 +20,9 @@ use crate::lower::{self, LowerError};
 
 mod dense;
 mod stamps;
-pub use dense::{Dense, DenseLive, DenseProblem, DenseRows, StampColumn, time_text};
+pub use dense::{
+    Dense, DenseLive, DenseLiveState, DenseProblem, DenseRows, StampColumn, time_text,
+};
 pub use stamps::{
     Front, MaxGap, Place, Stamp, StampError, StampOrder, StampRules, TimeAxis, decimal_difference,
     signal_rows,

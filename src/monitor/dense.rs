@@ -722,6 +722,166 @@ impl DenseLive {
     }
 }
 
+/// A [`DenseLive`] monitor's state as plain data ([`DenseLive::snapshot`]): its settings,
+/// the stamp of its last row, the change points it holds back, and its operators' state
+/// ([`DenseMonitor::save`]'s bytes). [`DenseLive::restore`] checks every field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseLiveState {
+    /// The windows change points are given over.
+    pub windows: Windows,
+    /// Whether times are relative to the first stamp.
+    pub relative: bool,
+    /// The gap bound as written, if any.
+    pub max_gap: Option<String>,
+    /// The most values the monitor holds.
+    pub limit: usize,
+    /// The rows given since the trace began.
+    pub rows: usize,
+    /// The last row's stamp as the trace took it (a whole number for stamps beyond 2^53).
+    pub last: Option<Stamp>,
+    /// The first stamp, when stamps are doubles (0 otherwise).
+    pub t0: f64,
+    /// Over complete windows: decided change points not yet known to lie before the
+    /// complete end.
+    pub held: Vec<(f64, f64)>,
+    /// The row where a comparison computed NaN, if one did.
+    pub stopped: Option<usize>,
+    /// The operators' state: [`DenseMonitor::save`]'s bytes.
+    pub monitor: Vec<u8>,
+}
+
+impl DenseLive {
+    /// The monitor's state as plain data, from which [`DenseLive::restore`] continues
+    /// exactly (the same change points, bit for bit, and the same errors).
+    pub fn snapshot(&self) -> DenseLiveState {
+        DenseLiveState {
+            windows: self.windows,
+            relative: self.relative,
+            max_gap: self.rules.gap().map(|g| g.text().to_string()),
+            limit: self.limit,
+            rows: self.rows,
+            last: self.rules.last(),
+            t0: self.t0,
+            held: self.held.clone(),
+            stopped: self.stopped,
+            monitor: self.monitor.save(),
+        }
+    }
+
+    /// The monitor `state` describes, for `dense` (the monitor's formula), worded for
+    /// `front`. Every field is checked against the others and the operators' state: a
+    /// state that no monitor of this formula could have reached is refused, saying what
+    /// does not fit.
+    pub fn restore(
+        dense: &Dense,
+        state: &DenseLiveState,
+        front: Front,
+    ) -> Result<DenseLive, DenseProblem> {
+        let bad = |what: String| DenseProblem {
+            message: format!("the saved monitor state is damaged: {what}"),
+            help: Some(
+                "save the monitor again from a running one (pickle it); a state changed by \
+                 hand, cut short or saved by another formula is refused"
+                    .to_string(),
+            ),
+            row: None,
+            var: None,
+            time: None,
+        };
+        let gap = match &state.max_gap {
+            Some(text) => Some(
+                MaxGap::parse(text, front.max_gap())
+                    .map_err(|p| bad(format!("its gap bound: {}", p.message)))?,
+            ),
+            None => None,
+        };
+        if !(1..=MAX_ONLINE_VALUES).contains(&state.limit) {
+            return Err(bad(format!(
+                "its budget is {} values, and a monitor holds 1 to {MAX_ONLINE_VALUES}",
+                state.limit
+            )));
+        }
+        if state.windows == Windows::Complete && !dense.formula.future_reach().is_finite() {
+            return Err(bad(format!(
+                "it is over complete windows, and {} has an unbounded future operator",
+                dense.what
+            )));
+        }
+        let monitor = DenseMonitor::load(&dense.formula, dense.vars.len(), &state.monitor)
+            .map_err(|e| bad(format!("its operators: {e}")))?;
+        let rows = state.rows;
+        if state.stopped.is_some_and(|s| s != rows) {
+            return Err(bad(format!(
+                "it stopped at row {}, and it has {rows} rows",
+                state.stopped.unwrap_or(0)
+            )));
+        }
+        if (rows == 0) != state.last.is_none() {
+            let last = state.last.map_or_else(|| "none".to_string(), |s| s.to_string());
+            return Err(bad(format!("it has {rows} rows, and its last stamp is {last}")));
+        }
+        if !(state.t0.is_finite() && (rows > 0 || state.t0 == 0.0)) {
+            return Err(bad(format!("its first stamp is {}", state.t0)));
+        }
+        if state.stopped.is_none() {
+            if monitor.rows() != rows {
+                return Err(bad(format!(
+                    "it has {rows} rows, and its operators have taken {}",
+                    monitor.rows()
+                )));
+            }
+            // The last stamp as the operators hold it: relative to the first whole-number
+            // stamp, or the double itself.
+            let fits = match (state.last, monitor.span(), monitor.origin()) {
+                (None, None, _) => true,
+                (Some(Stamp::Int(s)), Some((t0, x)), Some(o)) => {
+                    let rel = s.checked_sub(o).filter(|&d| d >= 0);
+                    state.t0 == 0.0
+                        && t0 == 0.0
+                        && rel.is_some_and(|d| d as f64 == x && (d as f64) as i128 == d)
+                }
+                (Some(Stamp::Real(t)), Some((t0, x)), None) => t == x && state.t0 == t0,
+                _ => false,
+            };
+            if !fits {
+                return Err(bad(
+                    "its stamps (the first and the last row's) do not agree with its operators'"
+                        .to_string(),
+                ));
+            }
+        }
+        // Held points: decided, so at or before the last stamp, after the complete end.
+        let span = monitor.span();
+        let end = span.map(|(_, x)| dense.formula.complete_end(x));
+        let mut prev = f64::NEG_INFINITY;
+        for &(t, v) in &state.held {
+            let inside = span.is_some_and(|(_, x)| t <= x) && end.is_some_and(|e| t >= e);
+            if !(t.is_finite() && t > prev && !v.is_nan() && inside) {
+                return Err(bad(format!(
+                    "a change point it holds back, ({t}, {v}), is not a decided point after the \
+                     complete end, in order"
+                )));
+            }
+            prev = t;
+        }
+        if state.windows == Windows::Clipped && !state.held.is_empty() {
+            return Err(bad("it holds change points back over clipped windows".to_string()));
+        }
+        let prev_at = rows.checked_sub(1).map(Place::Row);
+        Ok(DenseLive {
+            monitor,
+            rules: StampRules::resume(gap, front, state.last, prev_at),
+            windows: state.windows,
+            relative: state.relative,
+            limit: state.limit,
+            rows,
+            t0: state.t0,
+            held: state.held.clone(),
+            stopped: state.stopped,
+        })
+    }
+}
+
 /// The core's `row N: ` prefix dropped (callers say where themselves).
 fn strip_row(message: &str) -> String {
     match message.strip_prefix("row ").and_then(|m| m.split_once(": ")) {

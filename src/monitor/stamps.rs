@@ -279,6 +279,17 @@ impl StampRules {
         Ok(stamp)
     }
 
+    /// Rules that continue a trace whose last row, at `prev_at`, had the stamp `last` (as
+    /// [`StampOrder`] took it).
+    pub fn resume(
+        gap: Option<MaxGap>,
+        front: Front,
+        last: Option<Stamp>,
+        prev_at: Option<Place>,
+    ) -> StampRules {
+        StampRules { order: StampOrder { last }, gap, front, prev_at }
+    }
+
     /// Takes `stamp` (as [`StampRules::check`] returned it) as the row at `at`.
     pub fn take(&mut self, stamp: Stamp, at: Place) {
         // `check` accepted it: the order takes it again without fail.

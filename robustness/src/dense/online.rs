@@ -606,6 +606,11 @@ impl DenseMonitor {
         (!self.t0.is_nan()).then_some((self.t0, self.x))
     }
 
+    /// The rows pushed since the trace began.
+    pub fn rows(&self) -> usize {
+        self.rows.len()
+    }
+
     /// The first whole-number stamp, when rows have whole-number stamps.
     pub fn origin(&self) -> Option<i128> {
         self.rows.origin()
@@ -1129,7 +1134,7 @@ impl DenseMonitor {
             *f = r.value("an operator's frontier")?;
         }
         let held = r.points("the decided change points")?;
-        if held.first().is_some_and(|&(t, _)| !(t > x)) {
+        if held.first().is_some_and(|&(t, _)| t <= x || x.is_nan()) {
             return Err(r.bad("a decided change point comes no later than the last stamp"));
         }
         m.held = held.into();

@@ -312,7 +312,7 @@ impl BoundedUntil {
         }
         let [base, ne, nl, nm, back_start] = counts;
         let rec = base + n;
-        if !(nm <= nl && nl <= ne && ne <= rec && base <= nm.max(1) - 1 && back_start <= ne) {
+        if !(nm <= nl && nl <= ne && ne <= rec && base < nm.max(1) && back_start <= ne) {
             return Err(r.bad(&format!(
                 "a bounded until's positions do not fit together (pieces {base} to {rec}, \
                  M {ne}, L {nl}, m {nm})"
