@@ -347,7 +347,7 @@ def test_online_monitor_pickles_and_copies_mid_stream():
     got = pickled_halves_continue_exactly(spec, trace)
     assert got == as_bits(want)
     for formula in ("Soon", "Fast"):
-        pickled_halves_continue_exactly(spec, trace, formula, max_gap=0.5, relative=True)
+        pickled_halves_continue_exactly(spec, trace, formula, max_gap=2.5, relative=True)
     m = spec.online()
     with pytest.raises(TypeError, match=r"update\(t, state\)"):
         m.update({"x": 1.0, "y": 2.0})
@@ -382,7 +382,7 @@ def test_pickled_monitors_keep_nanosecond_stamps_and_complete_windows(hstlc, tmp
 
 def test_tampered_dense_pickles_are_refused_in_words():
     spec = hstl.Spec.load(CLI_FIXTURES / "dense.hstl")
-    m = spec.online("Soon", max_gap=2)
+    m = spec.online("Soon", max_gap=2.5)
     for t, state in dense_rows(read_csv(irregular_log(3, 40), "t"), 0, 30):
         m.update(t, state)
     restore, (s, formula, state) = m.__reduce__()

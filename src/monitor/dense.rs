@@ -312,7 +312,7 @@ impl Dense {
         }
     }
 
-    /// A stamp [`StampOrder`] refused, at row `row`.
+    /// A stamp [`super::StampOrder`] refused, at row `row`.
     pub fn stamp_problem(&self, e: &StampError, row: usize) -> DenseProblem {
         DenseProblem {
             message: e.message(&self.time),
