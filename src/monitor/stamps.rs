@@ -256,9 +256,9 @@ impl StampRules {
         StampRules { order: StampOrder::default(), gap, front, prev_at: None }
     }
 
-    /// The stamp of the next row (row `row` of the trace, counted from 0, at `at`) as the
-    /// trace takes it, or what is wrong with it; nothing changes until
-    /// [`StampRules::take`].
+    /// The stamp of the next row (row `row` of the trace, counted from 0) as the trace
+    /// takes it, or what is wrong with it (worded with `dense`'s time variable); nothing
+    /// changes until [`StampRules::take`].
     pub fn check(&self, dense: &Dense, stamp: Stamp, row: usize) -> Result<Stamp, DenseProblem> {
         let prev = self.order.last();
         let mut order = self.order.clone();
