@@ -232,3 +232,33 @@ fn damaged_states_are_refused_in_words() {
     // The untouched state restores.
     DenseLive::restore(&d, &good, Front::Python).expect("the good state restores");
 }
+
+/// A monitor stopped by a comparison that computed NaN restores stopped: it refuses rows
+/// until `finish()`, then monitors a new trace, over complete windows too.
+#[test]
+fn stopped_monitors_restore_stopped() {
+    let src = "spec S { state { t: time, x: float } task eventually[0..=1] sqrt(x) > 1; }";
+    let checked = hstl::lang::check(src);
+    let d = Dense::new(&checked.specs[0], None).expect("a dense-time spec");
+    for windows in [Windows::Clipped, Windows::Complete] {
+        let mut live = d.live(None, windows, Front::Python).expect("a monitor");
+        for (t, x) in [(0.0, 4.0), (0.5, 0.0), (2.0, 9.0)] {
+            live.push(&d, Stamp::Real(t), &[Some(x)]).expect("a row");
+        }
+        let nan = live.push(&d, Stamp::Real(2.5), &[Some(-1.0)]).expect_err("NaN");
+        assert!(nan.message.contains("computes NaN"), "{nan}");
+        let mut restored =
+            DenseLive::restore(&d, &live.snapshot(), Front::Python).expect("restores");
+        let want = live.push(&d, Stamp::Real(3.0), &[Some(4.0)]).expect_err("stopped");
+        let got = restored.push(&d, Stamp::Real(3.0), &[Some(4.0)]).expect_err("stopped");
+        assert_eq!(got, want);
+        assert!(got.message.starts_with("the trace stopped at row 3"), "{got}");
+        assert_eq!(restored.finish(&d).expect("the end"), Vec::<(f64, f64)>::new());
+        // A new trace, as the original's.
+        assert_eq!(live.finish(&d).expect("the end"), Vec::<(f64, f64)>::new());
+        for (t, x) in [(0.0, 4.0), (2.0, 0.0)] {
+            let want = live.push(&d, Stamp::Real(t), &[Some(x)]).expect("a row");
+            assert_eq!(restored.push(&d, Stamp::Real(t), &[Some(x)]).expect("a row"), want);
+        }
+    }
+}

@@ -850,12 +850,14 @@ impl DenseLive {
                 ));
             }
         }
-        // Held points: decided, so at or before the last stamp, after the complete end.
+        // Held points: decided, so at or before the last stamp, after the complete end (of
+        // the rows before a row that stopped the trace, whose operators stopped halfway).
         let span = monitor.span();
         let end = span.map(|(_, x)| dense.formula.complete_end(x));
         let mut prev = f64::NEG_INFINITY;
         for &(t, v) in &state.held {
-            let inside = span.is_some_and(|(_, x)| t <= x) && end.is_some_and(|e| t >= e);
+            let inside = state.stopped.is_some()
+                || span.is_some_and(|(_, x)| t <= x) && end.is_some_and(|e| t >= e);
             if !(t.is_finite() && t > prev && !v.is_nan() && inside) {
                 return Err(bad(format!(
                     "a change point it holds back, ({t}, {v}), is not a decided point after the \
