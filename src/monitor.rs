@@ -20,9 +20,12 @@ use crate::lower::{self, LowerError};
 
 mod dense;
 mod stamps;
-pub use dense::{Dense, DenseLive, DenseProblem, StampColumn, time_text};
+pub use dense::{
+    Dense, DenseLive, DenseLiveState, DenseProblem, DenseRows, StampColumn, time_text,
+};
 pub use stamps::{
-    MaxGap, Stamp, StampError, StampOrder, TimeAxis, decimal_difference, signal_rows,
+    Front, MaxGap, Place, Stamp, StampError, StampOrder, StampRules, TimeAxis, decimal_difference,
+    signal_rows,
 };
 
 /// The most threads [`Monitor::signal_batch`] starts, whatever it is asked for.

@@ -464,7 +464,7 @@ a persistent task or a reach task, or remove `plan: model`.",
         severity: E,
         summary: "a second time variable, or a time variable with a range",
         explanation: "A state variable of type `time` names the trace column that holds the \
-time stamps, which makes the spec a dense-time spec (see \"Dense time\" in LANGUAGE.md). A \
+time stamps, which makes the spec a dense-time spec (see \"Time stamps and dense time\" in LANGUAGE.md). A \
 trace has one time column, so a spec has at most one time variable, and stamps are any \
 strictly increasing numbers, so it takes no range.\n\n\
 Example:\n    state { t: time, stamp: time, x: float }\n    state { t: time in 0..=10 }\n\n\

@@ -13,15 +13,16 @@ use std::path::{Path, PathBuf};
 
 use hstl::lang::CheckedSpec;
 use hstl::monitor::{
-    Dense, DenseProblem, MaxGap, TimeAxis, Windows as Semantics, signal_rows, time_text,
+    Dense, DenseLive, DenseProblem, Front, MaxGap, Place, TimeAxis, Windows as Semantics,
+    signal_rows, time_text,
 };
-use hstl::robustness::dense::{DenseTrace, DenseTraceBuilder, DenseTraceError};
+use hstl::robustness::dense::DenseTrace;
 
 use crate::cli_error::CliError;
 use crate::monitor::{MonitorArgs, Windows, columns, note_ignored, read_error, trace_name};
 use crate::output::{errln, outln};
 use crate::trace_csv::{
-    Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, Stamp, StampOrder, TraceRows,
+    Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, TraceRows,
 };
 use crate::{CmdResult, Status};
 
@@ -54,36 +55,21 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         .transpose()?;
     let mut cols = vec![Column { name: monitor.time_var(), kind: ColumnKind::Real }];
     cols.extend(columns(spec));
-    let opts = Options { gap: gap.as_ref(), relative: args.relative, windows };
     if args.online {
-        if windows == Semantics::Complete && !monitor.formula().future_reach().is_finite() {
-            // Over complete windows an unbounded operator reads up to its operand's own
-            // complete end, which only the whole trace gives.
-            return Err(CliError::new(
-                format!(
-                    "{name}: `--online` with `--windows complete` needs bounded future \
-                     operators, and {} has an unbounded one (such as `always`): no value is \
-                     final before the input ends",
-                    args.formula
-                        .as_deref()
-                        .map_or_else(|| "the task".to_string(), |f| format!("`{f}`"))
-                ),
-                Some(
-                    "leave out `--online`: the trace is scored whole, over complete windows, \
-                     with the same result"
-                        .to_string(),
-                ),
-            ));
-        }
-        return online(&monitor, &cols, &traces[0], spec, args.formula.as_deref(), opts);
+        let live = monitor
+            .live(gap, windows, Front::Cli)
+            .map_err(|p| CliError::new(format!("{name}: {}", p.message), p.help))?
+            .relative(args.relative);
+        return online(&monitor, live, &cols, &traces[0], spec);
     }
+    let opts = Options { gap: gap.as_ref(), relative: args.relative };
     let batch = traces.len() > 1 || args.trace.iter().any(|t| t.is_dir());
     let mut scored = Vec::with_capacity(traces.len());
     let mut ignored: Vec<String> = Vec::new();
     // Traces with undetermined times (complete windows), and the times they start at.
     let mut open: Vec<(String, Option<String>)> = Vec::new();
     for path in traces {
-        let read = read_dense(path, &cols, &monitor, opts.gap)?;
+        let read = read_dense(path, &cols, &monitor, opts.gap.cloned())?;
         for n in &read.ignored {
             if !ignored.contains(n) {
                 ignored.push(n.clone());
@@ -180,22 +166,17 @@ fn read_dense(
     path: &Path,
     cols: &[Column<'_>],
     monitor: &Dense,
-    gap: Option<&MaxGap>,
+    gap: Option<MaxGap>,
 ) -> Result<DenseRead, CliError> {
     let name = trace_name(path);
     let mut rows =
         TraceRows::new(open(path)?, cols, Limit::File).map_err(|e| read_error(&name, e))?;
-    let mut builder = DenseTraceBuilder::new(cols.len() - 1);
-    let mut order = StampOrder::default();
+    let mut trace = monitor.rows(gap, Front::Cli);
     let mut cells = vec![None; cols.len() - 1];
     let mut lines = Vec::new();
-    let mut gaps = Gaps::default();
     while let Some(row) =
         rows.next_dense_row(&mut cells, lines.is_empty()).map_err(|e| read_error(&name, e))?
     {
-        let stamp =
-            order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
-        gaps.check(gap, stamp, &row, &name, cols[0].name)?;
         if (lines.len() + 1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
             return Err(CliError::new(
                 format!(
@@ -206,32 +187,26 @@ fn read_dense(
                 Some("monitor a shorter stretch of it: split the file".to_string()),
             ));
         }
-        push(&mut builder, stamp, &cells).map_err(|e| stamp_error(&name, &row, monitor, e))?;
+        trace
+            .push(monitor, row.stamp, &cells, Place::Line(row.line))
+            .map_err(|p| at_row(&name, &row, &p, None))?;
         lines.push(row.line);
     }
     if lines.is_empty() {
         return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
     }
     let ignored = rows.ignored;
-    let trace = builder.build().map_err(|e| CliError::new(format!("{name}: {e}"), None))?;
+    let trace = trace.build(monitor).map_err(|p| CliError::new(format!("{name}: {p}"), p.help))?;
     Ok(DenseRead { trace, ignored, lines })
 }
 
-fn push(
-    b: &mut DenseTraceBuilder,
-    stamp: Stamp,
-    cells: &[Option<f64>],
-) -> Result<(), DenseTraceError> {
-    match stamp {
-        Stamp::Int(s) => b.push_int(s, cells),
-        Stamp::Real(t) => b.push(t, cells),
-    }
-}
-
-/// A stamp the trace cannot take (the reader checked everything else), at its cell.
-fn stamp_error(name: &str, row: &DenseRow, monitor: &Dense, e: DenseTraceError) -> CliError {
-    let p = monitor.problem(hstl::robustness::dense::DenseError::Trace(e));
-    CliError::new(format!("{name}:{}:{}: {}", row.line, row.stamp_column, p.message), p.help)
+/// A problem with the row `row` of the trace `name`, at its stamp's cell (` at time T`
+/// added for a problem about a time, in the time column's scale given its `origin`).
+fn at_row(name: &str, row: &DenseRow, p: &DenseProblem, origin: Option<i128>) -> CliError {
+    CliError::new(
+        format!("{name}:{}:{}: {}{}", row.line, row.stamp_column, p.message, at_time(p, origin)),
+        p.help.clone(),
+    )
 }
 
 /// The monitor's error on a trace read whole, at the line of its row where it has one.
@@ -251,123 +226,64 @@ fn at_time(p: &DenseProblem, origin: Option<i128>) -> String {
     p.time.map_or_else(String::new, |t| format!(" at time {}", time_text(origin, t)))
 }
 
-/// `--online`: each change point printed (and flushed) once no later row can change it;
-/// over complete windows (bounded operators only), once it also lies before the complete
-/// end of the rows so far, and at the end, as the whole trace's `--signal` prints them: the
-/// points before the complete end, then that end with no value.
+/// `--online`: each change point printed (and flushed) as soon as the facade's live
+/// monitor gives it (over complete windows, once it also lies before the complete end of
+/// the rows so far); at the end, the rest, and over complete windows the time from which
+/// the signal is undetermined, with no value.
 fn online(
     monitor: &Dense,
+    mut live: DenseLive,
     cols: &[Column<'_>],
     path: &Path,
     spec: &CheckedSpec,
-    formula: Option<&str>,
-    opts: Options<'_>,
 ) -> CmdResult {
     let name = trace_name(path);
     let mut rows =
         TraceRows::new(open(path)?, cols, Limit::Stream).map_err(|e| read_error(&name, e))?;
     note_ignored(&rows.ignored, spec);
-    let mut live = monitor.online().map_err(|p| CliError::new(format!("{name}: {p}"), p.help))?;
-    let what = formula.map_or_else(|| "the task".to_string(), |f| format!("`{f}`"));
-    let bounded = monitor.formula().future_reach().is_finite();
-    if !bounded {
+    if !monitor.formula().future_reach().is_finite() {
         errln!(
-            "note: {what} has an unbounded future operator (such as `always`): no value is \
+            "note: {} has an unbounded future operator (such as `always`): no value is \
              final before the input ends, so the rows follow at its end, and the stream may \
-             hold at most {MAX_TRACE_VALUES} values"
+             hold at most {} values",
+            monitor.what(),
+            live.limit()
         );
     }
     outln!("t,robustness")?;
-    let complete = opts.windows == Semantics::Complete;
-    // Decided points not yet known to lie before the complete end.
-    let mut held: Vec<(f64, f64)> = Vec::new();
-    let mut order = StampOrder::default();
     let mut cells = vec![None; cols.len() - 1];
-    let mut count = 0usize;
-    let mut gaps = Gaps::default();
-    let mut times = TimeAxis { relative: opts.relative, origin: None, t0: 0.0 };
     while let Some(row) =
-        rows.next_dense_row(&mut cells, count == 0).map_err(|e| read_error(&name, e))?
+        rows.next_dense_row(&mut cells, live.rows() == 0).map_err(|e| read_error(&name, e))?
     {
-        let stamp =
-            order.next(&row, cols[0].name).map_err(|e| read_error(&name, ReadError::Csv(e)))?;
-        gaps.check(opts.gap, stamp, &row, &name, cols[0].name)?;
-        if count == 0
-            && let Stamp::Real(t) = stamp
-        {
-            times.t0 = t;
-        }
-        count += 1;
-        if live.kept().saturating_add(1).saturating_mul(cols.len()) > MAX_TRACE_VALUES {
-            return Err(CliError::new(
-                format!(
-                    "{name}:{}:1: the monitor holds more than {MAX_TRACE_VALUES} values, and \
-                     {what} keeps every row its windows read",
-                    row.line
-                ),
-                Some(
-                    "monitor a formula with bounded windows (`--formula` with a `let`), or end \
-                     the stream sooner"
-                        .to_string(),
-                ),
-            ));
-        }
-        let decided = match stamp {
-            Stamp::Int(s) => live.push_int(s, &cells),
-            Stamp::Real(t) => live.push(t, &cells),
-        }
-        .map_err(|e| {
-            let p = monitor.problem(e);
-            let when = at_time(&p, live.origin());
-            CliError::new(
-                format!("{name}:{}:{}: {}{when}", row.line, row.stamp_column, p.message),
-                p.help,
-            )
-        })?;
-        times.origin = live.origin();
-        if complete {
-            held.extend(decided);
-            let end = live
-                .span()
-                .map_or(f64::NEG_INFINITY, |(_, last)| monitor.formula().complete_end(last));
-            let before = held.partition_point(|&(t, _)| t < end);
-            for (t, v) in held.drain(..before) {
-                outln!("{},{v}", times.text(t))?;
-            }
-        } else {
-            for (t, v) in decided {
-                outln!("{},{v}", times.text(t))?;
-            }
+        let decided = live
+            .push_at(monitor, row.stamp, &cells, Place::Line(row.line))
+            .map_err(|p| at_row(&name, &row, &p, live.origin()))?;
+        let times = live.times();
+        for (t, v) in decided {
+            outln!("{},{v}", times.text(t))?;
         }
     }
-    if count == 0 {
+    if live.rows() == 0 {
         return Err(read_error(&name, ReadError::Csv(rows.no_samples())));
     }
-    let origin = live.origin();
-    let span = live.span();
-    let rest = live.finish().map_err(|e| {
-        let p = monitor.problem(e);
+    let (times, origin) = (live.times(), live.origin());
+    let end = live.complete_end(monitor);
+    let rest = live.finish(monitor).map_err(|p| {
         CliError::new(format!("{name}: {}{}", p.message, at_time(&p, origin)), p.help)
     })?;
-    if let (true, Some((t0, t_last))) = (complete, span) {
-        held.extend(rest);
-        let end = monitor.formula().complete_end(t_last);
-        if end < t_last {
-            let before = held.partition_point(|&(t, _)| t < end);
-            for &(t, v) in &held[..before] {
-                outln!("{},{v}", times.text(t))?;
-            }
-            outln!("{},", times.text(end.max(t0)))?;
-            note_open(&[(name.clone(), (end >= t0).then(|| times.text(end)))], false);
+    for &(t, v) in &rest {
+        if v.is_nan() {
+            // The complete end: the times from it on are undetermined.
+            outln!("{},", times.text(t))?;
         } else {
-            for (t, v) in held {
-                outln!("{},{v}", times.text(t))?;
-            }
+            outln!("{},{v}", times.text(t))?;
         }
-        return Ok(Status::Clean);
     }
-    for (t, v) in rest {
-        outln!("{},{v}", times.text(t))?;
+    if rest.last().is_some_and(|p| p.1.is_nan())
+        && let Some(end) = end
+    {
+        let t0 = rest.last().map_or(end, |p| p.0);
+        note_open(&[(name.clone(), (end >= t0).then(|| times.text(end)))], false);
     }
     Ok(Status::Clean)
 }
@@ -386,38 +302,4 @@ fn csv_field(text: &str) -> String {
 struct Options<'a> {
     gap: Option<&'a MaxGap>,
     relative: bool,
-    windows: Semantics,
-}
-
-/// The previous row's stamp and line, for `--max-gap`.
-#[derive(Default)]
-struct Gaps {
-    last: Option<(Stamp, usize)>,
-}
-
-impl Gaps {
-    /// An error if the gap from the previous row to `row` (with stamp `stamp`) is larger
-    /// than `gap`.
-    fn check(
-        &mut self,
-        gap: Option<&MaxGap>,
-        stamp: Stamp,
-        row: &DenseRow,
-        name: &str,
-        time: &str,
-    ) -> Result<(), CliError> {
-        let Some(gap) = gap else { return Ok(()) };
-        if let Some((prev, line)) = self.last
-            && let Some(width) = gap.exceeded(prev, stamp)
-        {
-            let at = format!(" (line {line})");
-            let p = gap.problem(&width, (prev, &at), stamp, time, "--max-gap ");
-            return Err(CliError::new(
-                format!("{name}:{}:{}: {}", row.line, row.stamp_column, p.message),
-                p.help,
-            ));
-        }
-        self.last = Some((stamp, row.line));
-        Ok(())
-    }
 }

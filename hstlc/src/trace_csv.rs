@@ -8,8 +8,9 @@
 //! skipped; a byte order mark before the header is dropped.
 //!
 //! A dense-time spec's trace ([`TraceRows::next_dense_row`]) has the time column first: each
-//! row's stamp (whole numbers read as integers, others as doubles, see [`StampOrder`]), and
-//! an empty cell of another column is no new sample.
+//! row's stamp (whole numbers read as integers, others as doubles; the facade's
+//! [`hstl::monitor::StampRules`] decide which a trace takes and their order), and an empty
+//! cell of another column is no new sample.
 //!
 //! Limits, checked while reading: a file holds at most [`MAX_TRACE_BYTES`], a line at most
 //! [`MAX_LINE_BYTES`], the trace at most [`MAX_TRACE_VALUES`] values. The reader keeps one
@@ -157,22 +158,6 @@ pub struct DenseRow {
     pub stamp: Stamp,
     /// The 1-based column (in characters) of the stamp.
     pub stamp_column: usize,
-}
-
-/// Reads a trace's stamps as the facade's [`hstl::monitor::StampOrder`] does, its
-/// errors at the stamp's line and column.
-#[derive(Clone, Debug, Default)]
-pub struct StampOrder {
-    order: hstl::monitor::StampOrder,
-}
-
-impl StampOrder {
-    /// The next row's stamp as the trace takes it, or what is wrong with it.
-    pub fn next(&mut self, row: &DenseRow, time: &str) -> Result<Stamp, CsvError> {
-        self.order
-            .next(row.stamp)
-            .map_err(|e| csv(row.line, row.stamp_column, e.message(time), e.help()))
-    }
 }
 
 impl<R: BufRead> TraceRows<'_, R> {

@@ -287,6 +287,76 @@ const CASES: &[Case] = &[
         "monitor_decimal_bound_discrete",
         &["monitor", "dense_decimal_discrete.hstl", "--trace", "dense.csv"],
     ),
+    // `--online` over nanosecond stamps, backwards stamps, a gap in nanoseconds, NaN
+    Case {
+        name: "monitor_dense_nanoseconds_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--online"],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_nanoseconds_relative_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "dense_ns.csv", "--online", "--relative"],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_nanoseconds_complete_online",
+        args: &[
+            "monitor",
+            "dense_ns.hstl",
+            "--trace",
+            "dense_ns.csv",
+            "--online",
+            "--windows",
+            "complete",
+        ],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_max_gap_nanoseconds_online",
+        args: &[
+            "monitor",
+            "dense_ns.hstl",
+            "--trace",
+            "dense_ns.csv",
+            "--online",
+            "--max-gap",
+            "1000000000",
+        ],
+        stdin: "",
+    },
+    Case {
+        name: "monitor_dense_bad_stamp_online",
+        args: &["monitor", "dense.hstl", "--trace", "-", "--online", "--formula", "Soon"],
+        stdin: "t,x,y\n0,1,5\n0.5,2,\n0.25,3,\n",
+    },
+    Case {
+        name: "monitor_dense_mixed_stamps_online",
+        args: &["monitor", "dense_ns.hstl", "--trace", "-", "--online"],
+        stdin: "t,x,y\n1700000000000000000,1,5\n1700000000000000000.5,2,\n",
+    },
+    Case {
+        name: "monitor_dense_nan_online",
+        args: &["monitor", "dense_sqrt.hstl", "--trace", "-", "--online"],
+        stdin: "t,x\n0,4\n0.5,9\n1.25,-1\n2,4\n",
+    },
+    Case {
+        name: "monitor_dense_unbounded_online",
+        args: &["monitor", "dense_complete.hstl", "--trace", "-", "--online"],
+        stdin: "t,x\n0,4\n0.5,0\n1.25,2\n",
+    },
+    Case {
+        name: "monitor_dense_unbounded_complete_online",
+        args: &[
+            "monitor",
+            "dense_complete.hstl",
+            "--trace",
+            "-",
+            "--online",
+            "--windows",
+            "complete",
+        ],
+        stdin: "t,x\n0,4\n",
+    },
     case("explain_dense_code", &["explain", "HSTL082"]),
     // train and eval: the errors (successful runs are in tests/train_eval.rs)
     case("train_no_options", &["train", "no_options.hstl", "--out", "unused"]),
@@ -581,4 +651,53 @@ fn dense_online_rows_are_the_signal() {
         let online = run(&[pick.as_slice(), &["--online"], &complete].concat());
         assert_eq!(online, signal, "{formula:?}, complete windows");
     }
+}
+
+/// `--online` on a dense-time spec runs out of the facade's budget
+/// (`hstl::robustness::MAX_ONLINE_VALUES`, values held times the trace's columns) at the
+/// row where the facade's live monitor does, and says so at that row's line: 600 variables
+/// under unbounded `always`, every one changing at every row, keep 600 pieces a row.
+#[test]
+fn dense_online_budget_error_comes_at_the_facade_row() {
+    use hstl::monitor::{Dense, Front, Stamp, Windows};
+    let n = 600;
+    let vars: Vec<String> = (0..n).map(|i| format!("x{i}")).collect();
+    let spec = format!(
+        "spec B {{ state {{ t: time, {} }} task {}; }}",
+        vars.iter().map(|v| format!("{v}: float")).collect::<Vec<_>>().join(", "),
+        vars.iter().map(|v| format!("always ({v} > 0)")).collect::<Vec<_>>().join(" && ")
+    );
+    let value = |k: usize| if k % 2 == 1 { 1.0 } else { -1.0 };
+    // The facade's row.
+    let checked = hstl::lang::check(&spec);
+    let dense = Dense::new(&checked.specs[0], None).expect("a dense spec");
+    let mut live = dense.live(None, Windows::Clipped, Front::Cli).expect("a live monitor");
+    let (row, problem) = (0..100_000)
+        .find_map(|k| {
+            let cells = vec![Some(value(k)); n];
+            live.push(&dense, Stamp::Int(k as i128), &cells).err().map(|p| (k, p))
+        })
+        .expect("the budget runs out");
+    // The command line on the same rows, one more than it takes.
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("s.hstl"), &spec).expect("write spec");
+    let mut csv = format!("t,{}\n", vars.join(","));
+    for k in 0..=row {
+        let v = value(k).to_string();
+        csv.push_str(&format!("{k},{}\n", vec![v.as_str(); n].join(",")));
+    }
+    std::fs::write(dir.path().join("t.csv"), &csv).expect("write trace");
+    let out = Command::new(env!("CARGO_BIN_EXE_hstlc"))
+        .args(["monitor", "s.hstl", "--trace", "t.csv", "--online"])
+        .current_dir(dir.path())
+        .output()
+        .expect("hstlc runs");
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stdout), "t,robustness\n");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // The header is line 1, row 0 is line 2.
+    let want = format!("error: t.csv:{}:1: {}\n", row + 2, problem.message);
+    assert!(stderr.contains(&want), "{stderr}\nwants {want}");
+    assert!(problem.message.contains(&hstl::robustness::MAX_ONLINE_VALUES.to_string()));
+    assert!(stderr.contains("help: monitor a formula with bounded windows (`--formula` with a `let`), or end the stream sooner"));
 }

@@ -158,13 +158,19 @@ class Spec:
         """A discrete-time spec: an array (traces, steps). A dense-time spec: a list of
         traces in, a list of ``(times, values)`` out, as ``signal`` gives them."""
     def online(
-        self, formula: Optional[str] = None, *, max_gap: MaxGap = None, relative: bool = False
+        self,
+        formula: Optional[str] = None,
+        *,
+        windows: Windows = "clipped",
+        max_gap: MaxGap = None,
+        relative: bool = False,
     ) -> OnlineMonitor:
-        """An online monitor; a dense-time spec's takes ``update(t, state)``."""
+        """An online monitor; a dense-time spec's takes ``update(t, state)``.
+        ``windows="complete"``: values only where every window lies inside the trace."""
 
 class OnlineMonitor:
     """A monitor fed one state at a time; see ``help(hstl.OnlineMonitor)``. It pickles
-    and deep-copies mid-trace (a dense-time one deep-copies but does not pickle yet)."""
+    and deep-copies mid-trace, dense-time ones included."""
 
     @property
     def horizon(self) -> Optional[int]: ...
@@ -191,7 +197,15 @@ class OnlineMonitor:
     def __deepcopy__(self, memo: dict[int, Any]) -> OnlineMonitor: ...
     def __copy__(self) -> OnlineMonitor: ...
     @staticmethod
-    def _restore(spec: Spec, formula: Optional[str], skipped: int, states: Sequence[float]) -> OnlineMonitor: ...
+    def _restore(
+        spec: Spec,
+        formula: Optional[str],
+        skipped: int,
+        states: Sequence[float],
+        windows: Windows = "clipped",
+    ) -> OnlineMonitor: ...
+    @staticmethod
+    def _restore_dense(spec: Spec, formula: Optional[str], state: dict[str, object]) -> OnlineMonitor: ...
 
 #: The most training episodes ``hstl.train`` takes (as ``learn { episodes }``).
 MAX_EPISODES: int

@@ -5,7 +5,7 @@
 //! complete windows) are the facade's, shared with `hstlc monitor`.
 
 use hstl::monitor::{
-    Dense, DenseProblem, MaxGap, Stamp, StampColumn, TimeAxis, TraceError, signal_rows,
+    Dense, DenseProblem, Front, MaxGap, Stamp, StampColumn, TimeAxis, TraceError, signal_rows,
 };
 use hstl::robustness::dense::{DenseSignal, DenseTrace};
 use numpy::{
@@ -155,7 +155,7 @@ pub fn build(
             a.as_slice().map_err(|e| value_error(format!("the array cannot be read: {e}"), None))
         })
         .collect::<PyResult<_>>()?;
-    py.detach(|| dense.trace(stamps.column(), &slices, gap, GAP_FLAG))
+    py.detach(|| dense.trace(stamps.column(), &slices, gap.cloned(), Front::Python))
         .map_err(|p| problem_error(&p, dense, None))
 }
 

@@ -2,13 +2,14 @@
 
 use std::sync::Arc;
 
-use hstl::monitor::{Dense, DenseLive, Online, OnlineState, TimeAxis};
-use pyo3::exceptions::PyTypeError;
+use hstl::monitor::{
+    Dense, DenseLive, DenseLiveState, Front, Online, OnlineState, Stamp, TimeAxis, Windows,
+};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyTuple};
+use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 
 use crate::dense;
-use crate::errors::{trace_error, type_error};
+use crate::errors::{trace_error, type_error, value_error};
 use crate::spec::Spec;
 use crate::trace::state_values;
 
@@ -42,8 +43,15 @@ use crate::trace::state_values;
 /// the last stamp. Together they are `Spec.signal`'s change points, bit for bit. Times are
 /// in the time column's scale (int for whole-number stamps of 2^53 or more), or float
 /// from the first stamp with `relative=True`. Memory is bounded by the windows (at most
-/// `MAX_ONLINE_VALUES` values). A dense monitor deep-copies (`copy.deepcopy`) but does not
-/// pickle yet.
+/// `MAX_ONLINE_VALUES` values). Over `windows="complete"` a change point comes once it
+/// also lies before the complete end of the rows so far, and `finish()` ends with
+/// `(t, nan)` where the undetermined times start.
+///
+/// A dense monitor pickles and copies mid-trace too: by its spec, formula, settings and
+/// its operators' state (every window's pieces and deques, a window's worth each, and the
+/// change points decided but not yet returned), which the copy continues from bit for bit.
+/// A pickled state that was cut short or changed is refused with a `ValueError` saying
+/// what does not fit.
 #[pyclass(module = "hstl")]
 pub struct OnlineMonitor {
     inner: Inner,
@@ -52,28 +60,61 @@ pub struct OnlineMonitor {
 }
 
 enum Inner {
-    Discrete(Online),
-    Dense { monitor: Arc<Dense>, live: DenseLive, relative: bool },
+    Discrete(Online, Windows),
+    Dense { monitor: Arc<Dense>, live: DenseLive },
+}
+
+/// `windows=` as written.
+fn windows_name(w: Windows) -> &'static str {
+    match w {
+        Windows::Clipped => "clipped",
+        Windows::Complete => "complete",
+    }
+}
+
+/// Field `key` of a pickled dense monitor's state, or a `ValueError` naming it and what it
+/// should be.
+fn field<'py, T: for<'a> FromPyObject<'a, 'py>>(
+    state: &Bound<'py, PyDict>,
+    key: &str,
+    what: &str,
+) -> PyResult<T> {
+    let bad = |found: String| {
+        value_error(
+            format!("the pickled monitor state's `{key}` is {found}, not {what}"),
+            Some(
+                "pickle the monitor again from a running one; a state changed by hand is refused"
+                    .into(),
+            ),
+        )
+    };
+    let Some(v) = state.get_item(key)? else { return Err(bad("missing".to_string())) };
+    v.extract::<T>()
+        .map_err(|_| bad(v.repr().map_or_else(|_| "unreadable".to_string(), |r| r.to_string())))
 }
 
 impl OnlineMonitor {
-    pub fn new(inner: Online, spec: Py<Spec>, formula: Option<String>) -> OnlineMonitor {
-        OnlineMonitor { inner: Inner::Discrete(inner), spec, formula }
+    pub fn new(
+        inner: Online,
+        windows: Windows,
+        spec: Py<Spec>,
+        formula: Option<String>,
+    ) -> OnlineMonitor {
+        OnlineMonitor { inner: Inner::Discrete(inner, windows), spec, formula }
     }
 
     pub fn dense(
         monitor: Arc<Dense>,
         live: DenseLive,
-        relative: bool,
         spec: Py<Spec>,
         formula: Option<String>,
     ) -> OnlineMonitor {
-        OnlineMonitor { inner: Inner::Dense { monitor, live, relative }, spec, formula }
+        OnlineMonitor { inner: Inner::Dense { monitor, live }, spec, formula }
     }
 
     fn discrete(&mut self, what: &str) -> PyResult<&mut Online> {
         match &mut self.inner {
-            Inner::Discrete(o) => Ok(o),
+            Inner::Discrete(o, _) => Ok(o),
             Inner::Dense { .. } => Err(type_error(
                 format!("`{what}` is for discrete-time monitors; this one is dense-time"),
                 None,
@@ -106,37 +147,105 @@ impl OnlineMonitor {
 
 #[pymethods]
 impl OnlineMonitor {
-    /// The monitor `__reduce__` describes: `spec.online(formula)`, then the states
-    /// replayed after `skipped` steps.
+    /// The monitor `__reduce__` describes: `spec.online(formula, windows=windows)`, then
+    /// the states replayed after `skipped` steps.
     #[staticmethod]
+    #[pyo3(signature = (spec, formula, skipped, states, windows="clipped"))]
     fn _restore(
         py: Python<'_>,
         spec: &Bound<'_, Spec>,
         formula: Option<String>,
         skipped: usize,
         states: Vec<f64>,
+        windows: &str,
     ) -> PyResult<OnlineMonitor> {
+        let windows =
+            Windows::parse(windows).map_err(|e| value_error(e.to_string(), Some(e.help())))?;
         let mut inner = spec.get().online_of(formula.as_deref())?;
         inner.restore(&OnlineState { skipped, states }).map_err(|e| trace_error(py, &e))?;
-        Ok(OnlineMonitor::new(inner, spec.clone().unbind(), formula))
+        Ok(OnlineMonitor::new(inner, windows, spec.clone().unbind(), formula))
+    }
+
+    /// The dense-time monitor `__reduce__` describes: `spec.online(formula)` restored from
+    /// `state`, a dict of the facade's plain data (every field checked).
+    #[staticmethod]
+    fn _restore_dense(
+        spec: &Bound<'_, Spec>,
+        formula: Option<String>,
+        state: &Bound<'_, PyDict>,
+    ) -> PyResult<OnlineMonitor> {
+        let monitor = spec.get().dense(formula.as_deref())?;
+        let windows: String = field(state, "windows", "\"clipped\" or \"complete\"")?;
+        let windows = Windows::parse(&windows).map_err(|e| {
+            value_error(format!("the pickled monitor state's `windows`: {e}"), Some(e.help()))
+        })?;
+        let last = match state.get_item("last")? {
+            Some(v) if !v.is_none() => Some(dense::stamp(&v).map_err(|e| {
+                value_error(
+                    format!("the pickled monitor state's `last` stamp: {e}"),
+                    Some("pickle the monitor again from a running one".into()),
+                )
+            })?),
+            _ => None,
+        };
+        let bytes: Vec<u8> = field(state, "monitor", "bytes")?;
+        let saved = DenseLiveState {
+            windows,
+            relative: field(state, "relative", "a bool")?,
+            max_gap: field(state, "max_gap", "a string or None")?,
+            limit: field(state, "limit", "a count of values")?,
+            rows: field(state, "rows", "a count of rows")?,
+            last,
+            t0: field(state, "t0", "a number")?,
+            held: field(state, "held", "a list of (time, value) pairs")?,
+            stopped: field(state, "stopped", "a row or None")?,
+            monitor: bytes,
+        };
+        let live = DenseLive::restore(&monitor, &saved, Front::Python)
+            .map_err(|p| dense::problem_error(&p, &monitor, None))?;
+        Ok(OnlineMonitor::dense(monitor, live, spec.clone().unbind(), formula))
     }
 
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let py = slf.py();
         let this = slf.borrow();
-        let Inner::Discrete(inner) = &this.inner else {
-            return Err(PyTypeError::new_err(
-                "a dense-time OnlineMonitor cannot be pickled yet\n  help: `copy.deepcopy` \
-                 copies it; to move it to another process, send the rows since the last \
-                 `finish()` and replay them",
-            ));
-        };
-        let state = inner.snapshot();
-        let args =
-            (this.spec.clone_ref(slf.py()), this.formula.clone(), state.skipped, state.states)
-                .into_pyobject(slf.py())?;
-        Ok((slf.get_type().getattr("_restore")?, args))
+        let spec = this.spec.clone_ref(py);
+        match &this.inner {
+            Inner::Discrete(inner, windows) => {
+                let state = inner.snapshot();
+                let args = (
+                    spec,
+                    this.formula.clone(),
+                    state.skipped,
+                    state.states,
+                    windows_name(*windows),
+                )
+                    .into_pyobject(py)?;
+                Ok((slf.get_type().getattr("_restore")?, args))
+            }
+            Inner::Dense { live, .. } => {
+                let s = live.snapshot();
+                let d = PyDict::new(py);
+                d.set_item("windows", windows_name(s.windows))?;
+                d.set_item("relative", s.relative)?;
+                d.set_item("max_gap", s.max_gap)?;
+                d.set_item("limit", s.limit)?;
+                d.set_item("rows", s.rows)?;
+                match s.last {
+                    Some(Stamp::Int(n)) => d.set_item("last", n)?,
+                    Some(Stamp::Real(t)) => d.set_item("last", t)?,
+                    None => d.set_item("last", py.None())?,
+                }
+                d.set_item("t0", s.t0)?;
+                d.set_item("held", s.held)?;
+                d.set_item("stopped", s.stopped)?;
+                d.set_item("monitor", PyBytes::new(py, &s.monitor))?;
+                let args = (spec, this.formula.clone(), d).into_pyobject(py)?;
+                Ok((slf.get_type().getattr("_restore_dense")?, args))
+            }
+        }
     }
 
     /// Appends one state, a mapping from state variable names to numbers (or a sequence of
@@ -155,7 +264,7 @@ impl OnlineMonitor {
         row: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         match &mut self.inner {
-            Inner::Discrete(inner) => {
+            Inner::Discrete(inner, _) => {
                 if row.is_some() {
                     return Err(type_error(
                         "`update` of a discrete-time monitor takes one state",
@@ -166,7 +275,7 @@ impl OnlineMonitor {
                 let verdict = inner.push(&values).map_err(|e| trace_error(py, &e))?;
                 verdict.map(|v| (v.step, v.value)).into_pyobject(py).map(|o| o.into_any())
             }
-            Inner::Dense { monitor, live, relative } => {
+            Inner::Dense { monitor, live } => {
                 let Some(row) = row else {
                     return Err(type_error(
                         format!(
@@ -182,7 +291,7 @@ impl OnlineMonitor {
                 let decided = live
                     .push(monitor, stamp, &cells)
                     .map_err(|p| dense::problem_error(&p, monitor, Some(&live.axis(false))))?;
-                Ok(Self::points(py, live.axis(*relative), decided)?.into_any())
+                Ok(Self::points(py, live.times(), decided)?.into_any())
             }
         }
     }
@@ -199,14 +308,18 @@ impl OnlineMonitor {
     /// ...]`). The monitor then starts a new trace.
     fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         match &mut self.inner {
-            Inner::Discrete(inner) => {
+            Inner::Discrete(inner, windows) => {
+                let verdicts = match windows {
+                    Windows::Clipped => inner.finish(),
+                    Windows::Complete => inner.finish_complete(),
+                };
                 let rows: Vec<(usize, f64)> =
-                    inner.finish().into_iter().map(|v| (v.step, v.value)).collect();
+                    verdicts.into_iter().map(|v| (v.step, v.value)).collect();
                 PyList::new(py, rows)
             }
-            Inner::Dense { monitor, live, relative } => {
+            Inner::Dense { monitor, live } => {
                 // The axis of the trace that ends (`finish` starts a new one).
-                let (axis, plain) = (live.axis(*relative), live.axis(false));
+                let (axis, plain) = (live.times(), live.axis(false));
                 let rest = live
                     .finish(monitor)
                     .map_err(|p| dense::problem_error(&p, monitor, Some(&plain)))?;
@@ -220,7 +333,7 @@ impl OnlineMonitor {
     #[getter]
     fn horizon(&self) -> Option<usize> {
         match &self.inner {
-            Inner::Discrete(inner) => inner.horizon(),
+            Inner::Discrete(inner, _) => inner.horizon(),
             Inner::Dense { .. } => None,
         }
     }
@@ -229,7 +342,7 @@ impl OnlineMonitor {
     #[getter]
     fn steps(&self) -> usize {
         match &self.inner {
-            Inner::Discrete(inner) => inner.steps(),
+            Inner::Discrete(inner, _) => inner.steps(),
             Inner::Dense { live, .. } => live.rows(),
         }
     }
@@ -238,7 +351,7 @@ impl OnlineMonitor {
     #[getter]
     fn state_vars(&self) -> Vec<String> {
         match &self.inner {
-            Inner::Discrete(inner) => inner.state_vars().to_vec(),
+            Inner::Discrete(inner, _) => inner.state_vars().to_vec(),
             Inner::Dense { monitor, .. } => monitor.state_vars().to_vec(),
         }
     }
@@ -247,7 +360,7 @@ impl OnlineMonitor {
     #[getter]
     fn time_var(&self) -> Option<String> {
         match &self.inner {
-            Inner::Discrete(_) => None,
+            Inner::Discrete(..) => None,
             Inner::Dense { monitor, .. } => Some(monitor.time_var().to_string()),
         }
     }
@@ -255,12 +368,10 @@ impl OnlineMonitor {
     /// A copy mid-trace.
     fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyDict>) -> OnlineMonitor {
         let inner = match &self.inner {
-            Inner::Discrete(o) => Inner::Discrete(o.clone()),
-            Inner::Dense { monitor, live, relative } => Inner::Dense {
-                monitor: Arc::clone(monitor),
-                live: live.clone(),
-                relative: *relative,
-            },
+            Inner::Discrete(o, w) => Inner::Discrete(o.clone(), *w),
+            Inner::Dense { monitor, live } => {
+                Inner::Dense { monitor: Arc::clone(monitor), live: live.clone() }
+            }
         };
         OnlineMonitor { inner, spec: self.spec.clone_ref(py), formula: self.formula.clone() }
     }
@@ -271,7 +382,7 @@ impl OnlineMonitor {
 
     fn __repr__(&self) -> String {
         match &self.inner {
-            Inner::Discrete(inner) => {
+            Inner::Discrete(inner, _) => {
                 let h = inner.horizon().map_or("unbounded".to_string(), |h| h.to_string());
                 format!("<hstl.OnlineMonitor horizon {h}, {} steps>", inner.steps())
             }

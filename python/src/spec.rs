@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use hstl::lang::{CheckedSpec, Location};
-use hstl::monitor::{Dense, Monitor};
+use hstl::monitor::{Dense, Front, Monitor};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -558,31 +558,38 @@ impl Spec {
     /// a time; see `hstl.OnlineMonitor`.
     ///
     /// For a dense-time spec it takes `update(t, state)` rows (see `hstl.OnlineMonitor`);
-    /// `max_gap` and `relative` are as for `signal`.
-    #[pyo3(signature = (formula=None, *, max_gap=None, relative=false))]
+    /// `max_gap` and `relative` are as for `signal`. `windows="complete"` gives a value
+    /// only where every window it needs lies inside the trace (`hstlc monitor --online
+    /// --windows complete`): a dense-time monitor gives each change point once it also lies
+    /// before the complete end of the rows so far, and `finish()` ends with `(t, nan)`
+    /// where the undetermined times start; a discrete-time one gives at `finish()` the
+    /// verdicts of the steps whose windows lie inside the trace.
+    #[pyo3(signature = (formula=None, *, windows="clipped", max_gap=None, relative=false))]
     fn online(
         slf: &Bound<'_, Self>,
         formula: Option<&str>,
+        windows: &str,
         max_gap: Option<&Bound<'_, PyAny>>,
         relative: bool,
     ) -> PyResult<OnlineMonitor> {
         let this = slf.get();
+        let windows = windows_of(windows)?;
         if this.spec.is_dense() {
             let monitor = this.dense(formula)?;
             let live = monitor
-                .live(dense::max_gap(max_gap)?, dense::GAP_FLAG)
-                .map_err(|p| dense::problem_error(&p, &monitor, None))?;
+                .live(dense::max_gap(max_gap)?, windows, Front::Python)
+                .map_err(|p| dense::problem_error(&p, &monitor, None))?
+                .relative(relative);
             return Ok(OnlineMonitor::dense(
                 monitor,
                 live,
-                relative,
                 slf.clone().unbind(),
                 formula.map(String::from),
             ));
         }
         this.discrete_only(max_gap, relative)?;
         let inner = this.online_of(formula)?;
-        Ok(OnlineMonitor::new(inner, slf.clone().unbind(), formula.map(String::from)))
+        Ok(OnlineMonitor::new(inner, windows, slf.clone().unbind(), formula.map(String::from)))
     }
 
     fn __reduce__<'py>(

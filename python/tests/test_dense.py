@@ -9,6 +9,7 @@ import csv
 import io
 import json
 import math
+import multiprocessing
 import pickle
 import random
 import struct
@@ -282,26 +283,72 @@ def test_complete_windows(hstlc):
     assert times.tolist() == [0.0] and math.isnan(values[0])
 
 
-def test_online_monitor_copies_and_refuses_pickle():
+def as_bits(points) -> list:
+    """Change points to the bit: an int time as itself, a float time and every value as
+    its bits (so NaN, the undetermined mark of complete windows, compares)."""
+    return [(t if isinstance(t, int) else ("f", bits(t)), bits(v)) for t, v in points]
+
+
+def dense_rows(trace: dict, start: int, end: int) -> list:
+    """Rows `start..end` of an array trace as `update(t, state)` arguments (an int stamp
+    stays an int)."""
+    t = trace["t"].tolist()
+    names = [k for k in trace if k != "t"]
+    return [(t[k], {n: float(trace[n][k]) for n in names}) for k in range(start, end)]
+
+
+def continue_dense(args) -> list:
+    """In a spawned process: the pickled monitor's change points over the rest of the
+    rows, then `finish()`."""
+    blob, rows = args
+    m = pickle.loads(blob)
+    out = []
+    for t, state in rows:
+        out += m.update(t, state)
+    return as_bits(out + m.finish())
+
+
+def pickled_halves_continue_exactly(spec, trace, formula=None, **opts):
+    """The monitor pickled (every protocol) and deep-copied after each of a few rows, then
+    continued: the same change points to the bit as the monitor that was never
+    interrupted; and once in a spawned process."""
+    n = len(trace["t"])
+    m = spec.online(formula, **opts)
+    want = []
+    for t, state in dense_rows(trace, 0, n):
+        want += m.update(t, state)
+    want = as_bits(want + m.finish())
+    for cut in sorted({0, 1, n // 3, n // 2, n - 1, n}):
+        m = spec.online(formula, **opts)
+        head = []
+        for t, state in dense_rows(trace, 0, cut):
+            head += m.update(t, state)
+        copies = [copy.deepcopy(m)] + [pickle.loads(pickle.dumps(m, p)) for p in range(2, pickle.HIGHEST_PROTOCOL + 1)]
+        for twin in copies + [m]:
+            assert twin.steps == cut and twin.time_var == "t"
+            rest = []
+            for t, state in dense_rows(trace, cut, n):
+                rest += twin.update(t, state)
+            assert as_bits(head + rest + twin.finish()) == want, (formula, opts, cut)
+    m = spec.online(formula, **opts)
+    head = []
+    for t, state in dense_rows(trace, 0, n // 2):
+        head += m.update(t, state)
+    with multiprocessing.get_context("spawn").Pool(1) as pool:
+        (rest,) = pool.map(continue_dense, [(pickle.dumps(m), dense_rows(trace, n // 2, n))])
+    assert as_bits(head) + rest == want
+    return want
+
+
+def test_online_monitor_pickles_and_copies_mid_stream():
     spec = hstl.Spec.load(CLI_FIXTURES / "dense.hstl")
     trace = read_csv(irregular_log(7, 120), "t")
     want = list(zip(*[a.tolist() for a in spec.signal(trace)]))
+    got = pickled_halves_continue_exactly(spec, trace)
+    assert got == as_bits(want)
+    for formula in ("Soon", "Fast"):
+        pickled_halves_continue_exactly(spec, trace, formula, max_gap=2.5, relative=True)
     m = spec.online()
-    assert m.time_var == "t" and m.horizon is None
-    got, half = [], len(trace["t"]) // 2
-    for k in range(half):
-        got += m.update(float(trace["t"][k]), [trace["x"][k], trace["y"][k]])
-    twin = copy.deepcopy(m)
-    rest_a, rest_b = [], []
-    for k in range(half, len(trace["t"])):
-        row = {"x": trace["x"][k], "y": trace["y"][k]}
-        rest_a += m.update(float(trace["t"][k]), row)
-        rest_b += twin.update(float(trace["t"][k]), row)
-    rest_a += m.finish()
-    rest_b += twin.finish()
-    assert got + rest_a == want and got + rest_b == want
-    with pytest.raises(TypeError, match="cannot be pickled yet"):
-        pickle.dumps(m)
     with pytest.raises(TypeError, match=r"update\(t, state\)"):
         m.update({"x": 1.0, "y": 2.0})
     with pytest.raises(ValueError, match=r"row 0 \(counted from 0\), column `y`: `y` has no sample"):
@@ -309,6 +356,76 @@ def test_online_monitor_copies_and_refuses_pickle():
     assert m.steps == 0
     with pytest.raises(TypeError, match="for discrete-time monitors"):
         m.provisional()
+
+
+def test_pickled_monitors_keep_nanosecond_stamps_and_complete_windows(hstlc, tmp_path):
+    spec = hstl.Spec.parse(NS_SPEC)
+    base = 2**62 + 123_456_789
+    rng = random.Random(3)
+    stamps, xs, k = [], [], 0
+    for _ in range(80):
+        k += rng.randint(1, 400_000_000)
+        stamps.append(base + k)
+        xs.append(rng.choice([-1.0, 0.5, 2.0, 3.0]))
+    trace = {"t": np.array(stamps, dtype=np.int64), "x": np.array(xs)}
+    got = pickled_halves_continue_exactly(spec, trace)
+    assert all(isinstance(t, int) and t > 2**62 for t, _ in got)
+    assert got == as_bits(list(zip(*[a.tolist() for a in spec.signal(trace)])))
+    complete = pickled_halves_continue_exactly(spec, trace, windows="complete")
+    (tmp_path / "s.hstl").write_text(NS_SPEC)
+    (tmp_path / "log.csv").write_text("t,x\n" + "".join(f"{s},{x}\n" for s, x in zip(stamps, xs)))
+    cli = cli_rows(hstlc, "s.hstl", "--trace", "log.csv", "--online", "--windows", "complete", cwd=tmp_path)
+    assert complete == [(int(t), bits(float(v)) if v else bits(math.nan)) for t, v in cli]
+    assert math.isnan(struct.unpack("<d", struct.pack("<q", complete[-1][1]))[0])
+    pickled_halves_continue_exactly(spec, trace, windows="complete", relative=True, max_gap=400_000_000)
+
+
+def test_tampered_dense_pickles_are_refused_in_words():
+    spec = hstl.Spec.load(CLI_FIXTURES / "dense.hstl")
+    m = spec.online("Soon", max_gap=2.5)
+    for t, state in dense_rows(read_csv(irregular_log(3, 40), "t"), 0, 30):
+        m.update(t, state)
+    restore, (s, formula, state) = m.__reduce__()
+    restore(s, formula, state)  # the state as saved restores
+
+    def refused(change, kind=ValueError, match="."):
+        tampered = dict(state)
+        change(tampered)
+        with pytest.raises(kind, match=match) as info:
+            restore(s, formula, tampered)
+        text = str(info.value)
+        assert "Some(" not in text and "Err(" not in text and "DenseProblem" not in text, text
+        return text
+
+    blob = state["monitor"]
+    # Cut short, one byte changed, a huge count, garbage: the checksum.
+    for cut in range(0, len(blob), 13):
+        refused(lambda d: d.update(monitor=blob[:cut]), match="cut short|no saved dense-time monitor")
+    flipped = bytearray(blob)
+    flipped[64] ^= 0xFF
+    refused(lambda d: d.update(monitor=bytes(flipped)), match="checksum")
+    huge = bytearray(blob)
+    huge[56:64] = struct.pack("<Q", 2**63)
+    refused(lambda d: d.update(monitor=bytes(huge)), match="checksum")
+    # The plain fields: wrong types, NaN, stamps that go back, sizes beyond what is held.
+    refused(lambda d: d.update(rows="many"), match="`rows` is 'many', not a count of rows")
+    refused(lambda d: d.update(rows=-1), match="`rows` is -1")
+    refused(lambda d: d.update(rows=2**70), match="`rows`")
+    refused(lambda d: d.update(rows=31), match="damaged: it has 31 rows")
+    refused(lambda d: d.update(t0=math.nan), match="first stamp")
+    refused(lambda d: d.update(last=state["last"] - 1.0), match="stamps .* do not agree")
+    refused(lambda d: d.update(last=math.nan), match="do not agree")
+    refused(lambda d: d.update(last="soon"), match="`last` stamp")
+    refused(lambda d: d.update(limit=2**62), match="budget")
+    refused(lambda d: d.update(max_gap="-1"), match="gap bound")
+    refused(lambda d: d.update(windows="open"), match="`windows`")
+    refused(lambda d: d.update(held=[(1.0, math.nan)]), match="clipped|in order")
+    refused(lambda d: d.update(held="x"), match="`held`")
+    refused(lambda d: d.update(stopped=3), match="stopped at row 3")
+    refused(lambda d: d.pop("monitor"), match="`monitor` is missing")
+    # Another formula's state.
+    with pytest.raises(ValueError, match="another formula"):
+        restore(s, "Fast", state)
 
 
 def test_the_dense_logs_example_monitors_a_ros2_bag_and_a_can_log(tmp_path, capsys):

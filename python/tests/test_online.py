@@ -54,3 +54,27 @@ def test_repr_and_state_vars():
     monitor = SPEC.online("A")
     assert monitor.state_vars == ["x", "y"]
     assert repr(monitor) == "<hstl.OnlineMonitor horizon 0, 0 steps>"
+
+
+@pytest.mark.filterwarnings("ignore:.*unused `let`:hstl.SpecWarning")
+def test_complete_windows_give_the_determined_steps_and_pickle():
+    import math
+    import pickle
+
+    spec = hstl.Spec.parse(
+        "spec W { state { x: int in 0..=14, y: int in 0..=14 }"
+        " let A = eventually[0..=12] (x > 3 && y > 10); task always[0..=40] A; }"
+    )
+    want = spec.signal(TRACE, "A", windows="complete").tolist()
+    determined = [(t, v) for t, v in enumerate(want) if not math.isnan(v)]
+    assert len(determined) < len(want)
+    monitor = spec.online("A", windows="complete")
+    got = []
+    for k, (x, y) in enumerate(TRACE):
+        v = monitor.update({"x": x, "y": y})
+        got += [] if v is None else [v]
+        if k == 250:
+            monitor = pickle.loads(pickle.dumps(monitor))
+    assert got + monitor.finish() == determined
+    with pytest.raises(ValueError, match="unknown windows"):
+        spec.online(windows="open")

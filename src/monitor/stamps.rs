@@ -8,7 +8,7 @@ use std::fmt;
 use crate::Problem;
 use hstl_robustness::dense::{DenseSignal, DenseTraceBuilder, DenseTraceError, TimeScale};
 
-use super::dense::time_text;
+use super::dense::{Dense, DenseProblem, time_text};
 
 /// A row's time stamp as given: a whole number (digits in a CSV cell, an integer numpy
 /// column) or a double.
@@ -164,6 +164,158 @@ impl StampOrder {
     /// The first stamp as taken, once one was.
     pub fn last(&self) -> Option<Stamp> {
         self.last
+    }
+}
+
+/// Which front end a message is for: how it names its settings (`--max-gap ` or
+/// `max_gap=`, `--formula` or `formula=`) and how a user ends a stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Front {
+    /// `hstlc monitor`.
+    Cli,
+    /// The Python package.
+    Python,
+}
+
+impl Front {
+    /// The gap setting, as errors quote it before its value (`--max-gap 0.5`, `max_gap=0.5`).
+    pub fn max_gap(self) -> &'static str {
+        match self {
+            Front::Cli => "--max-gap ",
+            Front::Python => "max_gap=",
+        }
+    }
+
+    /// The setting that picks a `let` to monitor.
+    pub fn formula(self) -> &'static str {
+        match self {
+            Front::Cli => "`--formula`",
+            Front::Python => "`formula=`",
+        }
+    }
+
+    /// How a user ends a stream early.
+    pub fn end_sooner(self) -> &'static str {
+        match self {
+            Front::Cli => "end the stream sooner",
+            Front::Python => "call `finish()` sooner",
+        }
+    }
+
+    /// Online monitoring over complete windows, as the user asked for it.
+    pub fn online_complete(self) -> &'static str {
+        match self {
+            Front::Cli => "`--online` with `--windows complete`",
+            Front::Python => "`online(windows=\"complete\")`",
+        }
+    }
+
+    /// How to score a whole trace over complete windows instead.
+    pub fn whole_complete(self) -> &'static str {
+        match self {
+            Front::Cli => "leave out `--online`",
+            Front::Python => "score the whole trace with `signal(trace, windows=\"complete\")`",
+        }
+    }
+}
+
+/// Where a row is, as the front end counts: a row of a table (counted from 0) or a line of
+/// a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Place {
+    /// A row, counted from 0.
+    Row(usize),
+    /// A line of a file, counted from 1.
+    Line(usize),
+}
+
+impl fmt::Display for Place {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Place::Row(r) => write!(f, "row {r}"),
+            Place::Line(l) => write!(f, "line {l}"),
+        }
+    }
+}
+
+/// The rules a dense-time trace's rows are read by, one row at a time, for every reader
+/// (a CSV file, numpy columns, rows pushed online): each stamp as [`StampOrder`] takes it,
+/// and a gap larger than `--max-gap` / `max_gap=` refused, naming the previous row.
+#[derive(Clone, Debug)]
+pub struct StampRules {
+    order: StampOrder,
+    gap: Option<MaxGap>,
+    front: Front,
+    /// Where the previous row is.
+    prev_at: Option<Place>,
+}
+
+impl StampRules {
+    /// Rules with at most `gap` between consecutive stamps, worded for `front`.
+    pub fn new(gap: Option<MaxGap>, front: Front) -> StampRules {
+        StampRules { order: StampOrder::default(), gap, front, prev_at: None }
+    }
+
+    /// The stamp of the next row (row `row` of the trace, counted from 0) as the trace
+    /// takes it, or what is wrong with it (worded with `dense`'s time variable); nothing
+    /// changes until [`StampRules::take`].
+    pub fn check(&self, dense: &Dense, stamp: Stamp, row: usize) -> Result<Stamp, DenseProblem> {
+        let prev = self.order.last();
+        let mut order = self.order.clone();
+        let stamp = order.next(stamp).map_err(|e| dense.stamp_problem(&e, row))?;
+        if let (Some(gap), Some(p)) = (&self.gap, prev)
+            && let Some(width) = gap.exceeded(p, stamp)
+        {
+            let at = self.prev_at.map_or_else(String::new, |at| format!(" ({at})"));
+            let p = gap.problem(&width, (p, &at), stamp, dense.time_var(), self.front.max_gap());
+            return Err(DenseProblem {
+                message: p.message,
+                help: p.help,
+                row: Some(row),
+                var: None,
+                time: None,
+            });
+        }
+        Ok(stamp)
+    }
+
+    /// Rules that continue a trace whose last row, at `prev_at`, had the stamp `last` (as
+    /// [`StampOrder`] took it).
+    pub fn resume(
+        gap: Option<MaxGap>,
+        front: Front,
+        last: Option<Stamp>,
+        prev_at: Option<Place>,
+    ) -> StampRules {
+        StampRules { order: StampOrder { last }, gap, front, prev_at }
+    }
+
+    /// Takes `stamp` (as [`StampRules::check`] returned it) as the row at `at`.
+    pub fn take(&mut self, stamp: Stamp, at: Place) {
+        // `check` accepted it: the order takes it again without fail.
+        let _ = self.order.next(stamp);
+        self.prev_at = Some(at);
+    }
+
+    /// The last stamp taken, if any.
+    pub fn last(&self) -> Option<Stamp> {
+        self.order.last()
+    }
+
+    /// The gap bound, if any.
+    pub fn gap(&self) -> Option<&MaxGap> {
+        self.gap.as_ref()
+    }
+
+    /// The front end the messages are worded for.
+    pub fn front(&self) -> Front {
+        self.front
+    }
+
+    /// Starts a new trace (the settings kept).
+    pub fn restart(&mut self) {
+        self.order = StampOrder::default();
+        self.prev_at = None;
     }
 }
 

@@ -39,11 +39,13 @@
 mod minmax;
 mod offline;
 mod online;
+mod saved;
 mod signal;
 mod trace;
 mod until;
 
 pub use online::DenseMonitor;
+pub use saved::{SavedStateError, resum};
 pub use signal::DenseSignal;
 pub use trace::{DenseTrace, DenseTraceBuilder, DenseTraceError};
 

@@ -441,4 +441,30 @@ impl DenseTraceBuilder {
     pub(crate) fn origin(&self) -> Option<i128> {
         self.trace.origin
     }
+
+    /// The last whole-number stamp pushed, when stamps are whole numbers.
+    pub(crate) fn last_int(&self) -> Option<i128> {
+        self.last_int
+    }
+
+    /// A builder that has taken `rows` rows, of which it holds the last: stamp `t` (relative
+    /// to `origin` for whole-number stamps, the last of which was `last_int`) and
+    /// `values`. The caller checked that they fit together.
+    pub(crate) fn resumed(
+        rows: usize,
+        t: f64,
+        values: &[f64],
+        origin: Option<i128>,
+        last_int: Option<i128>,
+    ) -> DenseTraceBuilder {
+        DenseTraceBuilder {
+            trace: DenseTrace {
+                times: vec![t],
+                columns: values.iter().map(|&v| vec![v]).collect(),
+                origin,
+            },
+            last_int,
+            dropped: rows - 1,
+        }
+    }
 }

@@ -24,6 +24,7 @@
 //! (the sign of a zero included).
 
 use super::minmax::{max, min};
+use super::saved::{Reader, SavedStateError, Writer};
 use std::collections::VecDeque;
 
 const INF: f64 = f64::INFINITY;
@@ -123,6 +124,16 @@ impl BoundedUntil {
             swept: false,
             last: None,
         }
+    }
+
+    /// The lower bound `a`.
+    pub(crate) fn a(&self) -> f64 {
+        self.a
+    }
+
+    /// The upper bound `b`.
+    pub(crate) fn b(&self) -> f64 {
+        self.b
     }
 
     /// The next piece: from `t` on, `f` is `fv` and `g` is `gv`.
@@ -233,6 +244,148 @@ impl BoundedUntil {
             None => run,
         }
     }
+}
+
+impl Pieces {
+    pub(crate) fn save(&self, w: &mut Writer) {
+        w.points(self.f.iter());
+        w.points(self.g.iter());
+        w.f64(self.cur.0);
+        w.f64(self.cur.1);
+    }
+
+    pub(crate) fn load(r: &mut Reader<'_>) -> Result<Pieces, SavedStateError> {
+        let f = r.points("an until's left operand")?.into();
+        let g = r.points("an until's right operand")?.into();
+        let cur = (r.value("an until's left value")?, r.value("an until's right value")?);
+        Ok(Pieces { f, g, cur })
+    }
+}
+
+impl BoundedUntil {
+    pub(crate) fn save(&self, w: &mut Writer) {
+        w.count(self.p.len());
+        for &(t, f, g) in &self.p {
+            w.f64(t);
+            w.f64(f);
+            w.f64(g);
+        }
+        for n in [self.base, self.ne, self.nl, self.nm, self.back_start] {
+            w.count(n);
+        }
+        w.count(self.minf.len());
+        for &(k, f) in &self.minf {
+            w.count(k);
+            w.f64(f);
+        }
+        w.count(self.front.len());
+        for &(f, u) in &self.front {
+            w.f64(f);
+            w.f64(u);
+        }
+        w.f64(self.back.0);
+        w.f64(self.back.1);
+        w.word(u64::from(self.swept));
+        w.opt_f64(self.last);
+    }
+
+    /// The sweep of `until[a..=b]` as [`BoundedUntil::save`] wrote it; the monotone deque
+    /// and the folds are checked against their recomputation from the pieces.
+    pub(crate) fn load(
+        r: &mut Reader<'_>,
+        a: f64,
+        b: f64,
+    ) -> Result<BoundedUntil, SavedStateError> {
+        let what = "a bounded until's pieces";
+        let n = r.count(3, what)?;
+        let mut p = VecDeque::with_capacity(n);
+        for _ in 0..n {
+            let t = r.time(what)?;
+            if p.back().is_some_and(|&(q, _, _): &(f64, f64, f64)| t <= q) {
+                return Err(r.bad("a bounded until's pieces: the times do not increase"));
+            }
+            p.push_back((t, r.value(what)?, r.value(what)?));
+        }
+        let mut counts = [0usize; 5];
+        for c in &mut counts {
+            *c = r.index(usize::MAX >> 2, "a bounded until's position")?;
+        }
+        let [base, ne, nl, nm, back_start] = counts;
+        let rec = base + n;
+        if !(nm <= nl && nl <= ne && ne <= rec && base < nm.max(1) && back_start <= ne) {
+            return Err(r.bad(&format!(
+                "a bounded until's positions do not fit together (pieces {base} to {rec}, \
+                 M {ne}, L {nl}, m {nm})"
+            )));
+        }
+        let mut until = BoundedUntil::new(a, b);
+        until.p = p;
+        until.base = base;
+        until.ne = ne;
+        until.nl = nl;
+        until.nm = nm;
+        until.back_start = back_start;
+        let k = r.count(2, "a bounded until's minimum")?;
+        let mut minf = VecDeque::with_capacity(k);
+        for _ in 0..k {
+            let i = r.index(usize::MAX >> 2, "a bounded until's minimum")?;
+            minf.push_back((i, r.value("a bounded until's minimum")?));
+        }
+        // The min of `f` over pieces `m..L` as the sweep keeps it.
+        let mut want: VecDeque<(usize, f64)> = VecDeque::new();
+        for i in nm.max(1) - 1..nl.max(1) - 1 {
+            let fv = until.at(i).1;
+            while want.back().is_some_and(|&(_, q)| q >= fv) {
+                want.pop_back();
+            }
+            want.push_back((i, fv));
+        }
+        if !same(&minf, &want) {
+            return Err(r.bad("a bounded until's minimum is not that of its pieces"));
+        }
+        until.minf = minf;
+        let k = r.count(2, "a bounded until's runs")?;
+        let mut front = Vec::with_capacity(k);
+        for _ in 0..k {
+            front.push((r.value("a bounded until's runs")?, r.value("a bounded until's runs")?));
+        }
+        let back = (r.value("a bounded until's run")?, r.value("a bounded until's run")?);
+        // The queue holds pieces `L..=M`: the runs from `L` to `back_start`, then the back.
+        if back_start.checked_sub(front.len()) != Some(nl.max(1) - 1) {
+            return Err(r.bad("a bounded until's runs do not cover its window"));
+        }
+        let mut run = (INF, f64::NEG_INFINITY);
+        for (q, &saved) in front.iter().enumerate() {
+            let (_, fv, gv) = until.at(back_start - 1 - q);
+            run = join(piece(fv, gv), run);
+            if !same_pair(run, saved) {
+                return Err(r.bad("a bounded until's runs are not those of its pieces"));
+            }
+        }
+        let mut run = (INF, f64::NEG_INFINITY);
+        for j in back_start..ne {
+            let (_, fv, gv) = until.at(j);
+            run = join(run, piece(fv, gv));
+        }
+        if !same_pair(run, back) {
+            return Err(r.bad("a bounded until's last run is not that of its pieces"));
+        }
+        until.front = front;
+        until.back = back;
+        until.swept = r.flag("whether a bounded until swept")?;
+        until.last = r.opt_value("a bounded until's last value")?;
+        Ok(until)
+    }
+}
+
+/// Two runs equal to the bit.
+fn same_pair(x: (f64, f64), y: (f64, f64)) -> bool {
+    x.0.to_bits() == y.0.to_bits() && x.1.to_bits() == y.1.to_bits()
+}
+
+/// Two monotone deques equal to the bit.
+pub(crate) fn same(x: &VecDeque<(usize, f64)>, y: &VecDeque<(usize, f64)>) -> bool {
+    x.len() == y.len() && x.iter().zip(y).all(|(p, q)| p.0 == q.0 && p.1.to_bits() == q.1.to_bits())
 }
 
 #[cfg(test)]
