@@ -70,16 +70,7 @@ pub fn fit_tiles(spec: &mut TaskSpec, checked: &CheckedSpec, world: &AnyWorld) {
     }
 }
 
-/// How `world` lays tiles along a variable whose `bins` a spec leaves out: the one rule
-/// `check` counts by and training lays them by.
-pub fn tile_fit(world: &AnyWorld) -> Option<hstl_lang::budget::TileFit> {
-    use hstl_lang::budget::TileFit;
-    match world {
-        AnyWorld::Plane(p) => Some(TileFit::Step(p.step_length())),
-        AnyWorld::MountainCar(_) => Some(TileFit::Fixed(hstl_lang::budget::CAR_BINS)),
-        AnyWorld::Grid(_) => None,
-    }
-}
+pub use crate::world::tile_fit;
 
 /// A trained learned function and what training measured.
 #[derive(Clone, Debug)]

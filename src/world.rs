@@ -77,7 +77,7 @@ pub fn any_facts(world: &AnyWorld, label: &str) -> Facts {
                 label: label.to_string(),
                 vars,
                 actions: p.headings() as u64,
-                fit: crate::continuous::tile_fit(world),
+                fit: tile_fit(world),
             })
         }
         AnyWorld::MountainCar(car) => {
@@ -87,12 +87,7 @@ pub fn any_facts(world: &AnyWorld, label: &str) -> Facts {
                 ("v".to_string(), -C::MAX_SPEED, C::MAX_SPEED),
             ];
             let actions = hstl_runtime::World::actions(car).len() as u64;
-            Facts::Box(BoxFacts {
-                label: label.to_string(),
-                vars,
-                actions,
-                fit: crate::continuous::tile_fit(world),
-            })
+            Facts::Box(BoxFacts { label: label.to_string(), vars, actions, fit: tile_fit(world) })
         }
     }
 }
@@ -230,4 +225,15 @@ pub fn from_file(text: &str, file: &str, stem: &str) -> Result<GridWorld, Proble
 /// The built-in worlds' names, quoted and listed.
 fn builtin_names() -> String {
     builtin_list()
+}
+
+/// How `world` lays tiles along a variable whose `bins` a spec leaves out: the one rule
+/// `check` counts by and training lays them by.
+pub fn tile_fit(world: &AnyWorld) -> Option<hstl_lang::budget::TileFit> {
+    use hstl_lang::budget::TileFit;
+    match world {
+        AnyWorld::Plane(p) => Some(TileFit::Step(p.step_length())),
+        AnyWorld::MountainCar(_) => Some(TileFit::Fixed(hstl_lang::budget::CAR_BINS)),
+        AnyWorld::Grid(_) => None,
+    }
 }
