@@ -29,7 +29,6 @@ const CRATES: [&str; 9] = [
 const KNOWN_CIRCLES: &[(&str, &[&str], &str)] = &[
     ("hstl-lang/src", &["budget", "check", "lints", "world"], "issue 29: check/ is being split"),
     ("hstl-lang/src", &["codes", "diagnostic"], "issue 29: a diagnostic looks its severity up"),
-    ("hstlc/src", &["monitor", "monitor_dense"], "issue 29: the dense path reads the CSV helpers"),
     (
         "python/src",
         &["dense", "errors", "files", "online", "spec", "trace"],
@@ -41,7 +40,6 @@ const KNOWN_CIRCLES: &[(&str, &[&str], &str)] = &[
         "issue 29: the kernels' primitives live in offline",
     ),
     ("runtime/src", &["learn", "plan", "plan_reach"], "issue 29: greedy helpers shared both ways"),
-    ("src", &["monitor::dense", "monitor::stamps"], "issue 29: the stamps' wording reads dense"),
 ];
 
 /// A module's path inside its crate (`["plan_reach", "choices"]`; the root is empty).

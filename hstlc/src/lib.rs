@@ -14,6 +14,7 @@ pub mod input;
 pub mod lsp;
 mod monitor;
 mod monitor_dense;
+mod monitor_input;
 mod output;
 mod render;
 mod spec_file;

@@ -19,7 +19,7 @@ use hstl::monitor::{
 use hstl::robustness::dense::DenseTrace;
 
 use crate::cli_error::CliError;
-use crate::monitor::{MonitorArgs, Windows, columns, note_ignored, read_error, trace_name};
+use crate::monitor_input::{MonitorArgs, Windows, columns, note_ignored, read_error, trace_name};
 use crate::output::{errln, outln};
 use crate::trace_csv::{
     Column, ColumnKind, DenseRow, Limit, MAX_TRACE_VALUES, ReadError, TraceRows,

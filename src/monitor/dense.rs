@@ -11,6 +11,7 @@ use hstl_robustness::dense::{
     DenseError, DenseFormula, DenseMonitor, DenseSignal, DenseTrace, DenseTraceBuilder, TimeScale,
 };
 
+pub use super::stamps::time_text;
 use super::stamps::{Front, MaxGap, Place, Stamp, StampError, StampRules, TimeAxis};
 use super::{MAX_BATCH_THREADS, Windows};
 use crate::lower::{self, LowerError};
@@ -892,26 +893,29 @@ fn strip_row(message: &str) -> String {
     }
 }
 
-/// A time of a signal as the trace's time column writes it: `t` itself for decimal
-/// stamps, `origin + t` for whole-number stamps (exactly, in integer arithmetic for the
-/// whole part: nanoseconds since the epoch stay exact).
-pub fn time_text(origin: Option<i128>, t: f64) -> String {
-    let Some(origin) = origin else { return t.to_string() };
-    if !t.is_finite() || t < 0.0 {
-        return t.to_string();
-    }
-    let whole = t.trunc();
-    // Every double at or above 2^53 is whole; below it the cast is exact.
-    let Some(w) = (whole < 1.7e38).then_some(whole as i128) else { return t.to_string() };
-    let int = origin + w;
-    if whole == t {
-        return int.to_string();
-    }
-    // `t` has a fraction, so it is below 2^53: its shortest decimal's digits after the point.
-    let shortest = t.to_string();
-    match shortest.split_once('.') {
-        Some((_, frac)) => format!("{int}.{frac}"),
-        None => shortest,
+/// Checking a stamp is worded with the dense spec's names, so it lives with [`Dense`].
+impl StampRules {
+    /// The stamp of the next row (row `row` of the trace, counted from 0) as the trace
+    /// takes it, or what is wrong with it (worded with `dense`'s time variable); nothing
+    /// changes until [`StampRules::take`].
+    pub fn check(&self, dense: &Dense, stamp: Stamp, row: usize) -> Result<Stamp, DenseProblem> {
+        let prev = self.order.last();
+        let mut order = self.order.clone();
+        let stamp = order.next(stamp).map_err(|e| dense.stamp_problem(&e, row))?;
+        if let (Some(gap), Some(p)) = (&self.gap, prev)
+            && let Some(width) = gap.exceeded(p, stamp)
+        {
+            let at = self.prev_at.map_or_else(String::new, |at| format!(" ({at})"));
+            let p = gap.problem(&width, (p, &at), stamp, dense.time_var(), self.front.max_gap());
+            return Err(DenseProblem {
+                message: p.message,
+                help: p.help,
+                row: Some(row),
+                var: None,
+                time: None,
+            });
+        }
+        Ok(stamp)
     }
 }
 

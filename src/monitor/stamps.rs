@@ -8,8 +8,6 @@ use std::fmt;
 use crate::Problem;
 use hstl_robustness::dense::{DenseSignal, DenseTraceBuilder, DenseTraceError, TimeScale};
 
-use super::dense::{Dense, DenseProblem, time_text};
-
 /// A row's time stamp as given: a whole number (digits in a CSV cell, an integer numpy
 /// column) or a double.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -243,40 +241,17 @@ impl fmt::Display for Place {
 /// and a gap larger than `--max-gap` / `max_gap=` refused, naming the previous row.
 #[derive(Clone, Debug)]
 pub struct StampRules {
-    order: StampOrder,
-    gap: Option<MaxGap>,
-    front: Front,
+    pub(super) order: StampOrder,
+    pub(super) gap: Option<MaxGap>,
+    pub(super) front: Front,
     /// Where the previous row is.
-    prev_at: Option<Place>,
+    pub(super) prev_at: Option<Place>,
 }
 
 impl StampRules {
     /// Rules with at most `gap` between consecutive stamps, worded for `front`.
     pub fn new(gap: Option<MaxGap>, front: Front) -> StampRules {
         StampRules { order: StampOrder::default(), gap, front, prev_at: None }
-    }
-
-    /// The stamp of the next row (row `row` of the trace, counted from 0) as the trace
-    /// takes it, or what is wrong with it (worded with `dense`'s time variable); nothing
-    /// changes until [`StampRules::take`].
-    pub fn check(&self, dense: &Dense, stamp: Stamp, row: usize) -> Result<Stamp, DenseProblem> {
-        let prev = self.order.last();
-        let mut order = self.order.clone();
-        let stamp = order.next(stamp).map_err(|e| dense.stamp_problem(&e, row))?;
-        if let (Some(gap), Some(p)) = (&self.gap, prev)
-            && let Some(width) = gap.exceeded(p, stamp)
-        {
-            let at = self.prev_at.map_or_else(String::new, |at| format!(" ({at})"));
-            let p = gap.problem(&width, (p, &at), stamp, dense.time_var(), self.front.max_gap());
-            return Err(DenseProblem {
-                message: p.message,
-                help: p.help,
-                row: Some(row),
-                var: None,
-                time: None,
-            });
-        }
-        Ok(stamp)
     }
 
     /// Rules that continue a trace whose last row, at `prev_at`, had the stamp `last` (as
@@ -553,6 +528,29 @@ fn sub_digits(a: &[u8], b: &[u8]) -> Vec<u8> {
         }
     }
     out
+}
+
+/// A time of a signal as the trace's time column writes it: `t` itself for decimal
+/// stamps, `origin + t` for whole-number stamps (exactly, in integer arithmetic for the
+/// whole part: nanoseconds since the epoch stay exact).
+pub fn time_text(origin: Option<i128>, t: f64) -> String {
+    let Some(origin) = origin else { return t.to_string() };
+    if !t.is_finite() || t < 0.0 {
+        return t.to_string();
+    }
+    let whole = t.trunc();
+    // Every double at or above 2^53 is whole; below it the cast is exact.
+    let Some(w) = (whole < 1.7e38).then_some(whole as i128) else { return t.to_string() };
+    let int = origin + w;
+    if whole == t {
+        return int.to_string();
+    }
+    // `t` has a fraction, so it is below 2^53: its shortest decimal's digits after the point.
+    let shortest = t.to_string();
+    match shortest.split_once('.') {
+        Some((_, frac)) => format!("{int}.{frac}"),
+        None => shortest,
+    }
 }
 
 #[cfg(test)]

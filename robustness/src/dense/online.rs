@@ -995,7 +995,7 @@ impl Op {
 /// The formula's fingerprint: a saved state is only read back by the formula that saved
 /// it.
 fn fingerprint(formula: &DenseFormula) -> u64 {
-    saved::fnv(format!("{formula:?}").as_bytes())
+    saved::fnv(format!("{formula:?}").as_bytes()) // not a message: a fingerprint
 }
 
 impl DenseMonitor {
