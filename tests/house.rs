@@ -31,8 +31,9 @@ const KNOWN_CIRCLES: &[(&str, &[&str], &str)] = &[
     ("hstl-lang/src", &["codes", "diagnostic"], "issue 29: a diagnostic looks its severity up"),
     (
         "python/src",
-        &["dense", "errors", "files", "online", "spec", "trace"],
-        "issue 29: the shell's conversions and its classes",
+        &["online", "spec"],
+        "`Spec.online` makes an `OnlineMonitor`, which holds its `Spec` to pickle: two classes \
+         that name each other (pyo3 takes one `#[pymethods]` block a class)",
     ),
     (
         "robustness/src",

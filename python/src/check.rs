@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
+use crate::diagnostic::Diagnostic;
 use crate::errors::{self, diagnostics_of, value_error};
-use crate::spec::Diagnostic;
 use crate::world::World;
 
 /// Every diagnostic of a spec file or text (errors, warnings and notes, in source order),

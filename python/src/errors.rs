@@ -16,7 +16,7 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyType;
 
-use crate::spec::Diagnostic;
+use crate::diagnostic::Diagnostic;
 
 /// `message`, and the hint on a line of its own.
 pub fn with_help(message: impl Into<String>, help: Option<String>) -> String {

@@ -11,6 +11,7 @@ mod check;
 mod cli;
 mod continuous;
 mod dense;
+mod diagnostic;
 mod errors;
 mod files;
 mod gym;
@@ -29,7 +30,7 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<spec::Spec>()?;
-    m.add_class::<spec::Diagnostic>()?;
+    m.add_class::<diagnostic::Diagnostic>()?;
     m.add_class::<online::OnlineMonitor>()?;
     m.add_class::<world::World>()?;
     m.add_class::<world::Generator>()?;
