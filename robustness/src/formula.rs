@@ -5,6 +5,10 @@
 //! added twice gets the same id, so a `let` used twice is one node and is computed once.
 //! Every walk over a formula is a forward loop over [`Formula::nodes`]; nothing here or in
 //! the evaluators recurses in proportion to the formula, however deep it is.
+//!
+//! One file: the node types, the builder and the walks keep one invariant together (nodes
+//! in topological order, each hash-consed once, in a canonical order), which every
+//! constructor and every walk here relies on; split, it would be private to none of them.
 
 use std::collections::HashMap;
 use std::fmt;
