@@ -33,6 +33,7 @@ pub mod env;
 mod error;
 pub mod eval;
 mod geometry;
+mod greedy;
 pub mod grid;
 pub mod learn;
 pub mod memory;

@@ -53,9 +53,9 @@
 use std::cell::Cell;
 use std::fmt;
 
+use crate::Error;
 use crate::eval::{Controller, Decision, RegionTable};
 use crate::moves::Moves;
-use crate::Error;
 
 /// How the solver runs and how much it may use.
 #[derive(Clone, Copy, Debug, PartialEq)]
