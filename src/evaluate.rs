@@ -30,7 +30,8 @@ use hstl_runtime::eval::{
     AgentController, EntryCycle, RegionTable, WindowConfig, WindowReport, rollout, sample_runs,
     window_rate,
 };
-use hstl_runtime::optimum::{Moves, Optimum, SolveConfig, solve};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{Optimum, SolveConfig, solve};
 use hstl_runtime::policy::EnvInfo;
 use hstl_runtime::{Agent, Env, GridWorld, Policy, TaskSpec, seeded_rng};
 

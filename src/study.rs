@@ -10,7 +10,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use hstl_lang::CheckedSpec;
 use hstl_runtime::eval::RegionTable;
-use hstl_runtime::optimum::{Moves, SolveConfig, solve};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{SolveConfig, solve};
 use hstl_runtime::{Agent, GridWorld, RewardKind, TaskSpec, seeded_rng};
 
 use crate::Problem;

@@ -415,7 +415,7 @@ pub fn reach_avoid_summary(
     agent: &Agent,
     seed: u64,
 ) -> Result<Option<ReachAvoidSummary>, Error> {
-    use hstl_runtime::optimum::Moves;
+    use hstl_runtime::moves::Moves;
     use hstl_runtime::reach_avoid::{ReachAvoid, solve_reach_avoid};
     let Some(task) = ReachAvoid::of_spec(spec, env, WindowConfig::default().steps)? else {
         return Ok(None);

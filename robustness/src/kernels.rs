@@ -30,7 +30,7 @@
 
 use std::ops::Range;
 
-use crate::offline::{
+use crate::primitives::{
     Lattice, Max, Min, block_until, piece_len, shift_left, suffix_fold, van_herk,
 };
 use crate::{Bound, Interval};

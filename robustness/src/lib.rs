@@ -30,6 +30,7 @@ pub mod kernels;
 pub mod nan;
 pub mod offline;
 pub mod online;
+mod primitives;
 pub mod reference;
 pub mod segment;
 pub mod state;

@@ -12,7 +12,8 @@
 //! on its own (quadratic in the segment's length).
 
 use crate::formula::{Node, expr_value};
-use crate::offline::{Evaluator, Lattice, Max, Min, Runner, Source};
+use crate::offline::{Evaluator, Runner, Source};
+use crate::primitives::{Lattice, Max, Min};
 use crate::{CmpOp, Formula, FormulaBuilder, NodeId, Trace, reference};
 
 /// Scores segments of a trace against one task, reusing its buffers between calls.
@@ -213,7 +214,7 @@ impl TabularScorer {
                 by_node[v] = std::mem::take(&mut tables[j]);
             }
         }
-        TabularScorer { plan, tables: by_node, persistent, past, runner: Runner::tabular() }
+        TabularScorer { plan, tables: by_node, persistent, past, runner: Runner::default() }
     }
 
     fn signal(&mut self, seg: &[usize]) -> Vec<f64> {
@@ -281,66 +282,6 @@ impl TabularScorer {
         }
         self.runner.put(sig);
     }
-}
-
-/// `buf[t]` becomes the `L`-fold of `buf[t + a ..= t + a + len - 1]` (clipped at the end),
-/// with `2 <= len <= n` and `a < n`: the blocks, folds and combinations of the evaluator's
-/// van Herk/Gil-Werman kernel, in the same order and so with the same bits (signed zeros
-/// included), in straight loops for the short segments of option executions.
-pub(crate) fn van_herk<L: Lattice>(
-    buf: &mut [f64],
-    a: usize,
-    len: usize,
-    pre: &mut Vec<f64>,
-    suf: &mut Vec<f64>,
-) {
-    let n = buf.len();
-    if a == 0 && len == n {
-        // One block (a segment no longer than the window): every window is a suffix of
-        // it, and the first also takes the block's prefix fold, as below.
-        let p_last = buf.iter().fold(L::ID, |acc, &x| L::acc(acc, x));
-        let mut acc = L::ID;
-        for x in buf.iter_mut().rev() {
-            acc = L::acc(acc, *x);
-            *x = acc;
-        }
-        buf[0] = L::acc(buf[0], p_last);
-        return;
-    }
-    // Both are overwritten in full below: only their lengths matter.
-    pre.resize(n, 0.0);
-    pre.truncate(n);
-    suf.resize(n, 0.0);
-    suf.truncate(n);
-    for ((x, p), s) in buf.chunks(len).zip(pre.chunks_mut(len)).zip(suf.chunks_mut(len)) {
-        let (p, s) = (&mut p[..x.len()], &mut s[..x.len()]);
-        let mut acc = L::ID;
-        for j in 0..x.len() {
-            acc = L::acc(acc, x[j]);
-            p[j] = acc;
-        }
-        let mut acc = L::ID;
-        for j in (0..x.len()).rev() {
-            acc = L::acc(acc, x[j]);
-            s[j] = acc;
-        }
-    }
-    // Window `s ..= s + len - 1`, `s = t + a`: the suffix of `s`'s block and the prefix of
-    // the next block; clipped windows reach at most into the last block.
-    let span = len - 1;
-    let full = n.saturating_sub(span + a);
-    let (pre, suf) = (&pre[..], &suf[..]);
-    for ((o, &s), &p) in buf[..full].iter_mut().zip(&suf[a..]).zip(&pre[(a + span).min(n)..]) {
-        *o = L::acc(s, p);
-    }
-    let last_block = (n - 1) / len * len;
-    let mid = last_block.clamp(full + a, n);
-    let p_last = pre[n - 1];
-    for (o, &s) in buf[full..mid - a].iter_mut().zip(&suf[full + a..mid]) {
-        *o = L::acc(s, p_last);
-    }
-    buf[mid - a..n - a].copy_from_slice(&suf[mid..]);
-    buf[n - a..].fill(L::ID);
 }
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {

@@ -16,7 +16,7 @@
 //! recurses, and a shared node is computed once.
 
 use crate::formula::{Node, expr_value};
-use crate::offline::{Lattice, Max, Min};
+use crate::primitives::{Lattice, Max, Min};
 use crate::{Bound, Formula, Interval};
 use std::collections::VecDeque;
 

@@ -13,7 +13,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use hstl_runtime::GridWorld;
 use hstl_runtime::env::Env;
 use hstl_runtime::eval::RegionTable;
-use hstl_runtime::optimum::{Moves, SolveConfig, solve, solve_windows};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{SolveConfig, solve, solve_windows};
 use hstl_runtime::reach_avoid::{ReachAvoid, solve_reach_avoid};
 use world_map::{FOUR_ROOMS, MapWorld};
 

@@ -22,7 +22,8 @@ use std::time::Instant;
 use hstl_runtime::eval::{
     AgentController, EntryCycle, LegCycle, RegionTable, WindowConfig, window_rate,
 };
-use hstl_runtime::optimum::{Moves, SolveConfig, solve};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{SolveConfig, solve};
 use hstl_runtime::{GridWorld, Learner, TaskSpec, seeded_rng};
 
 /// Seconds this thread has spent on a CPU (Linux `schedstat`), which a busy machine

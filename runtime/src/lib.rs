@@ -19,6 +19,7 @@
 //! - [`progress`]: the goals of a task that is not persistent, which the options level of
 //!   both learners sees beside the state once a run has met them.
 //! - [`eval`]: greedy rollouts, sample runs and the window rate.
+//! - [`moves`]: a grid world's moves as plain data, the world model of the exact solvers.
 //! - [`optimum`]: the exact optimal window rate `W*` of a persistent task on any grid world.
 //! - [`reach_avoid`]: the exact optimal probability of a reach-avoid task.
 //! - [`world`]: world files (TOML: grid maps with walls and start cells, and plane worlds)
@@ -32,10 +33,12 @@ pub mod env;
 mod error;
 pub mod eval;
 mod geometry;
+mod greedy;
 pub mod grid;
 pub mod learn;
 pub mod memory;
 pub mod mountain_car;
+pub mod moves;
 pub mod optimum;
 pub mod plan;
 mod plan_reach;

@@ -234,7 +234,7 @@ impl ReachPlanner {
                 let step: Vec<Option<usize>> = (0..states)
                     .map(|s| {
                         let row = &flat[p][s * actions..][..actions];
-                        let a = crate::learn::argmax(row);
+                        let a = crate::greedy::argmax(row);
                         (!moves[s * actions + a].is_empty()).then_some(a)
                     })
                     .collect();
@@ -363,10 +363,10 @@ impl LegTask<'_> {
             q[h - 1..]
                 .iter()
                 .map(|qh| &qh[s * actions..][..actions])
-                .find(|row| row[crate::learn::argmax(row)] > 0.0)
+                .find(|row| row[crate::greedy::argmax(row)] > 0.0)
         };
         let policy = |h: usize| -> Vec<Option<usize>> {
-            (0..states).map(|s| row_of(h, s).map(crate::learn::argmax)).collect()
+            (0..states).map(|s| row_of(h, s).map(crate::greedy::argmax)).collect()
         };
         let table = |h: usize, keep_out: Option<&(Vec<Option<usize>>, Vec<f64>)>| -> Vec<f64> {
             let mut table = vec![UNTRIED; states * actions];
@@ -443,7 +443,7 @@ impl LegTask<'_> {
         let chosen = (0..states)
             .map(|s| {
                 let row = &rows[s * actions..][..actions];
-                let best = crate::learn::argmax(row);
+                let best = crate::greedy::argmax(row);
                 (row[best] > 0.0).then_some(best)
             })
             .collect();

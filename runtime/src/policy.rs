@@ -30,7 +30,7 @@ use serde_json::{Map, Value};
 
 pub use crate::policy_parts::{HexTable, State};
 
-use crate::learn::{argmax, best_of};
+use crate::greedy::{argmax, best_of};
 use crate::memory::Memory;
 use crate::progress::StateGoals;
 use crate::tables::Tables;

@@ -22,7 +22,7 @@ use std::fmt;
 use hstl_robustness::{Bound, Formula, Node, reference};
 
 use crate::eval::{Controller, Decision, rollout};
-use crate::optimum::Moves;
+use crate::moves::Moves;
 use crate::{Env, Rng, TaskSpec};
 
 /// A task of the reach-avoid form `eventually[0..T] Goal && always[I] !R1 && ...`, read off

@@ -4,7 +4,8 @@
 #[path = "common/world_map.rs"]
 mod world_map;
 
-use hstl_runtime::optimum::{Moves, Optimum, SolveConfig, solve_windows};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{Optimum, SolveConfig, solve_windows};
 use hstl_runtime::{Error, seeded_rng};
 use rand::RngExt;
 use world_map::{FOUR_ROOMS, MapWorld};

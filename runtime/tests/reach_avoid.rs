@@ -3,7 +3,7 @@
 
 use hstl_runtime::env::{Cell, Env};
 use hstl_runtime::eval::rollout;
-use hstl_runtime::optimum::Moves;
+use hstl_runtime::moves::Moves;
 use hstl_runtime::reach_avoid::{ReachAvoid, solve_reach_avoid};
 use hstl_runtime::robustness::{Bound, Expr, Formula, Interval};
 use hstl_runtime::{Error, GridWorld, seeded_rng};

@@ -9,7 +9,8 @@ use hstl_runtime::env::{Cell, Env};
 use hstl_runtime::eval::{
     AgentController, AgentProgress, Controller, RegionTable, WindowConfig, rollout, window_rate,
 };
-use hstl_runtime::optimum::{Moves, SolveConfig, solve};
+use hstl_runtime::moves::Moves;
+use hstl_runtime::optimum::{SolveConfig, solve};
 use hstl_runtime::robustness::Formula;
 use hstl_runtime::{Error, GridWorld, Learner, Policy, QTables, TaskSpec, seeded_rng};
 

@@ -407,7 +407,7 @@ impl Model {
         scratch.resize(self.actions, 0.0);
         self.flat_values(&weights.flat[p], f, scratch);
         mask(scratch, blocked);
-        crate::learn::argmax(scratch)
+        crate::greedy::argmax(scratch)
     }
 
     /// Which actions the world blocks at `state`, into `out`.

@@ -12,7 +12,7 @@
 //! judged by its success probability; where a round never decides, the values stay.
 
 use super::TAIL_STEPS;
-use crate::learn::{argmax, best_of};
+use crate::greedy::{argmax, best_of};
 use crate::reach_avoid::ReachAvoid;
 use crate::tables::Tables;
 

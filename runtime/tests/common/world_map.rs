@@ -3,7 +3,7 @@
 //! and benches of the optimum. (The runtime's own `GridWorld` gains walls separately.)
 #![allow(dead_code)]
 
-use hstl_runtime::optimum::Moves;
+use hstl_runtime::moves::Moves;
 
 /// A map's free cells and moves.
 pub struct MapWorld {

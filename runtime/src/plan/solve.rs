@@ -1,167 +1,23 @@
-//! `learn { plan: model }`: the options values of a persistent task planned instead of
-//! Q-learned (LANGUAGE.md, "Planning the options level").
-//!
-//! Q-learning the options level needs a sample of every (state, memory, option) it values;
-//! on the case study that is 225 states times 729 memory values, and 1,200 episodes leave
-//! most of them rarely seen. But of what an option earns, only the leg's travel is
-//! unknown: the counters `tau_j` and the window reward follow from the spec. So the learner
-//! records the transitions it sees (a tabular model of the environment), and after
-//! training computes from them, under each option's greedy leg, how many steps the leg
-//! takes from each state (`f[s][d]`) and which cell of its region it arrives in (`g[s][c]`).
-//! Value iteration then runs over the states where a leg arrives, each with the exact
-//! counters of the regions it is not in, and the options table is filled for every state
-//! and memory code from the counters in the middle of each bucket.
-//!
-//! [`PlanSize`] is public: the front end holds specs to the same limits.
-//!
-//! An option `o` that enters region `j` from state `s` with counters `tau` and arrives
-//! after `d` steps earns `sum_{m=1..d} gamma^(m-1) psi(m)`: `psi(m) = 1` for `m < d`
-//! while every `tau_i + m < N_i`, and at `m = d` while every `tau_i + d < N_i`, `i != j`
-//! (`tau_j` is then 0). Its value is the expectation over `d` and the arrival cell `c` of
-//! that reward plus `gamma^d V_c(tau')`, with `tau'_i = min(tau_i + d, N_i)`. The model
-//! leaves out regions a leg crosses on its way (their counters are not reset) and the
-//! steps it lingers in the region it starts from.
+//! The plan itself: each option's leg made the quickest way into its region under the
+//! counted transitions, value iteration over the states where legs arrive with the exact
+//! counters of the other regions, and the options table filled for every memory code.
+//! One file because the legs, the reward and future parts and the sweeps share private
+//! types (`Leg`, `Grids`, `Values`); its tests check those parts against literal sums.
 
-use crate::learn::argmax;
+use super::size::{PlanSize, RARE_ARRIVAL, WINDOWS_OF_DURATION};
+use crate::greedy::argmax;
 use crate::memory::Memory;
 use crate::tables::Tables;
 use crate::{Error, LearnParams};
 
-/// At most this many numbers in the planner's tables (durations, arrival cells, values).
-pub const MAX_PLAN_VALUES: usize = 1 << 26;
-/// At most this many operations in a sweep of value iteration, or in filling the table.
-pub const MAX_PLAN_WORK: usize = 1 << 31;
 /// Value iteration stops when no value moves by more than this...
 const TOLERANCE: f64 = 1e-5;
 /// ... or after this many sweeps.
 const MAX_SWEEPS: usize = 2000;
 /// The value of an untried action in a leg's table of [`Planner::quickest_legs`].
 pub(crate) const UNTRIED: f64 = -1e12;
-/// Arrival cells less likely than this (given an arrival) are left out of a leg's model.
-const RARE_ARRIVAL: f64 = 1e-3;
 /// The probability of a leg's longer durations that its value may leave out.
 const TAIL: f64 = 1e-7;
-/// Durations of a leg are modelled up to this many times the longest window.
-const WINDOWS_OF_DURATION: usize = 4;
-
-/// The transitions seen in training: for each state and action, the states it led to and
-/// how often.
-#[derive(Clone, Debug)]
-pub(crate) struct Model {
-    actions: usize,
-    /// `next[s * actions + a]`: (next state, count).
-    next: Vec<Vec<(usize, u32)>>,
-    /// `starts[s]`: the episodes that started in `s`.
-    starts: Vec<u32>,
-}
-
-impl Model {
-    /// An empty model of `states` states and `actions` actions.
-    pub fn new(states: usize, actions: usize) -> Model {
-        Model { actions, next: vec![Vec::new(); states * actions], starts: vec![0; states] }
-    }
-
-    /// Counts an episode that starts in `s`.
-    pub fn start(&mut self, s: usize) {
-        if let Some(c) = self.starts.get_mut(s) {
-            *c = c.saturating_add(1);
-        }
-    }
-
-    /// `starts()[s]`: the episodes counted as starting in `s`.
-    pub fn starts(&self) -> &[u32] {
-        &self.starts
-    }
-
-    /// Counts one step `s -a-> next`.
-    #[inline]
-    pub fn record(&mut self, s: usize, a: usize, next: usize) {
-        let row = &mut self.next[s * self.actions + a];
-        match row.iter_mut().find(|(n, _)| *n == next) {
-            Some((_, c)) => *c = c.saturating_add(1),
-            None => row.push((next, 1)),
-        }
-    }
-
-    /// `moves[s * actions + a]`: the estimated distribution of the state after `a` in `s`
-    /// (empty if never tried), which both of the planner's steps read.
-    pub fn moves(&self) -> Vec<Vec<(usize, f64)>> {
-        self.next
-            .iter()
-            .map(|row| {
-                let total: f64 = row.iter().map(|&(_, c)| f64::from(c)).sum();
-                row.iter().map(|&(n, c)| (n, f64::from(c) / total)).collect()
-            })
-            .collect()
-    }
-}
-
-/// The sizes that bound the planner's memory and time: the front end holds a spec to the
-/// same limits (`hstl_lang::budget::plan_exceeded`, one arithmetic: `tests/limits.rs`).
-#[derive(Clone, Copy, Debug)]
-pub struct PlanSize<'a> {
-    /// The environment's states.
-    pub states: usize,
-    /// The states in each region of the task.
-    pub cells: &'a [usize],
-    /// Each region's window `N_j`.
-    pub horizons: &'a [usize],
-    /// The options, one per region.
-    pub options: usize,
-    /// The memory buckets `B`.
-    pub buckets: usize,
-    /// `max_steps`, where a leg is cut off.
-    pub max_steps: usize,
-}
-
-impl PlanSize<'_> {
-    /// Why planning would pass [`MAX_PLAN_VALUES`] or [`MAX_PLAN_WORK`], or `None`.
-    pub fn exceeded(&self) -> Option<String> {
-        let PlanSize { states, cells, horizons, options, buckets, max_steps } = *self;
-        let longest = horizons.iter().copied().max().unwrap_or(1);
-        let max_duration = max_steps.min(WINDOWS_OF_DURATION.saturating_mul(longest)).max(1);
-        let total = cells.iter().try_fold(0usize, |a, &c| a.checked_add(c));
-        let grid = |skip: usize| -> Option<usize> {
-            (0..horizons.len())
-                .filter(|&j| j != skip)
-                .try_fold(1usize, |acc, j| acc.checked_mul(horizons[j].checked_add(1)?))
-        };
-        let sizes = [
-            states.checked_mul(max_duration + 1).and_then(|v| v.checked_mul(options)),
-            total.and_then(|t| states.checked_mul(t)),
-            total.and_then(|t| t.checked_mul(grid(usize::MAX)?)),
-        ];
-        if sizes.iter().any(|v| v.is_none_or(|v| v > MAX_PLAN_VALUES)) {
-            return Some(format!(
-                "over {states} states, {} regions with windows of up to {longest} steps needs \
-                 more than {MAX_PLAN_VALUES} planned values; use fewer regions or shorter \
-                 windows, or `plan: off`",
-                horizons.len()
-            ));
-        }
-        // The work of a value iteration sweep and of filling the options table: every
-        // state a leg starts from, times the cells it may arrive in (at most 1 /
-        // RARE_ARRIVAL of them once the rare ones are dropped), times a grid of counters.
-        let widest = cells.iter().copied().max().unwrap_or(0).min((1.0 / RARE_ARRIVAL) as usize);
-        let arrivals = (0..horizons.len()).filter_map(grid).max();
-        let values =
-            u32::try_from(horizons.len()).ok().and_then(|k| buckets.checked_add(1)?.checked_pow(k));
-        let work = [
-            total.and_then(|t| t.checked_mul(options)?.checked_mul(widest)?.checked_mul(arrivals?)),
-            arrivals
-                .and_then(|a| a.checked_mul(widest)?.checked_add(values?))
-                .and_then(|v| v.checked_mul(states)?.checked_mul(options)),
-        ];
-        if work.iter().any(|v| v.is_none_or(|v| v > MAX_PLAN_WORK)) {
-            return Some(format!(
-                "over {states} states and regions of up to {widest} cells with windows of up \
-                 to {longest} steps needs more than {MAX_PLAN_WORK} operations per sweep; use \
-                 smaller regions, fewer regions or shorter windows, or `plan: off`"
-            ));
-        }
-        None
-    }
-}
 
 /// What planning needs that training does not change: the options' regions and the sizes
 /// of the tables, checked against [`MAX_PLAN_VALUES`] before training starts.
