@@ -307,7 +307,7 @@ fn whole(e: &CExpr) -> Option<i64> {
 /// domain times the comparisons is within the finite-domain checks' budget.
 pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec<Diagnostic>) {
     let Some(size) = spec.domain_size() else { return };
-    if spec.state_vars.is_empty() || size > crate::check::MAX_DOMAIN_STATES {
+    if spec.state_vars.is_empty() || size > crate::limits::MAX_DOMAIN_STATES {
         return;
     }
     let mut atoms: Vec<(&CExpr, &CExpr, &std::ops::Range<usize>)> = Vec::new();
@@ -333,7 +333,8 @@ pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec
         }
         stack.extend(f.operands());
     }
-    if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::check::MAX_DOMAIN_WORK {
+    if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::limits::MAX_DOMAIN_WORK
+    {
         return;
     }
     atoms.sort_by_key(|(_, _, r)| r.start);
