@@ -785,23 +785,7 @@ pub(super) fn time_decimals(spec: &syntax::Spec) -> u32 {
         }
     }
     while let Some(f) = stack.pop() {
-        let (interval, kids): (Option<&syntax::Interval>, Vec<&Formula>) = match &f.kind {
-            FormulaKind::Always(i, g)
-            | FormulaKind::Eventually(i, g)
-            | FormulaKind::Once(i, g)
-            | FormulaKind::Historically(i, g) => (i.as_ref(), vec![g]),
-            FormulaKind::Until(a, i, b) | FormulaKind::Since(a, i, b) => (i.as_ref(), vec![a, b]),
-            FormulaKind::Not(g)
-            | FormulaKind::Paren(g)
-            | FormulaKind::Prev(g)
-            | FormulaKind::Next(g) => (None, vec![g]),
-            FormulaKind::Implies(a, b) => (None, vec![a, b]),
-            FormulaKind::And(v) | FormulaKind::Or(v) => (None, v.iter().collect()),
-            FormulaKind::True
-            | FormulaKind::False
-            | FormulaKind::Name(_)
-            | FormulaKind::Compare { .. } => (None, Vec::new()),
-        };
+        let (interval, kids) = (f.kind.interval(), f.operands());
         if let Some(i) = interval {
             for n in std::iter::once(&i.start).chain(&i.end) {
                 if let Some((_, d)) = decimal(&n.text)
