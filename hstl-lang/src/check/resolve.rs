@@ -1,7 +1,7 @@
 //! Resolution and lowering: state variables, domains, lets, intervals, formulas and
 //! expressions of a spec into their checked forms.
 //!
-//! About 850 lines: lowering formulas and expressions and checking the lets they use are
+//! About 830 lines: lowering formulas and expressions and checking the lets they use are
 //! one recursive pass over the same names, kept together rather than split mid-recursion.
 
 use super::*;
@@ -546,56 +546,12 @@ impl Cx<'_> {
                 CFormulaKind::And(parts)
             }
             FormulaKind::Not(g) => CFormulaKind::Not(Box::new(self.formula(g))),
-            FormulaKind::Always(i, g) => {
-                let iv = self.interval(i);
-                let g = self.formula(g);
-                match iv {
-                    Some(iv) => CFormulaKind::Always(iv, Box::new(g)),
-                    None => return invalid,
-                }
-            }
-            FormulaKind::Eventually(i, g) => {
-                let iv = self.interval(i);
-                let g = self.formula(g);
-                match iv {
-                    Some(iv) => CFormulaKind::Eventually(iv, Box::new(g)),
-                    None => return invalid,
-                }
-            }
-            FormulaKind::Until(a, i, b) => {
-                let a = self.formula(a);
-                let iv = self.interval(i);
-                let b = self.formula(b);
-                match iv {
-                    Some(iv) => CFormulaKind::Until(iv, Box::new(a), Box::new(b)),
-                    None => return invalid,
-                }
-            }
-            FormulaKind::Once(i, g) => {
-                let iv = self.interval(i);
-                let g = self.formula(g);
-                match iv {
-                    Some(iv) => CFormulaKind::Once(iv, Box::new(g)),
-                    None => return invalid,
-                }
-            }
-            FormulaKind::Historically(i, g) => {
-                let iv = self.interval(i);
-                let g = self.formula(g);
-                match iv {
-                    Some(iv) => CFormulaKind::Historically(iv, Box::new(g)),
-                    None => return invalid,
-                }
-            }
-            FormulaKind::Since(a, i, b) => {
-                let a = self.formula(a);
-                let iv = self.interval(i);
-                let b = self.formula(b);
-                match iv {
-                    Some(iv) => CFormulaKind::Since(iv, Box::new(a), Box::new(b)),
-                    None => return invalid,
-                }
-            }
+            FormulaKind::Always(i, g) => self.windowed(i, g, CFormulaKind::Always),
+            FormulaKind::Eventually(i, g) => self.windowed(i, g, CFormulaKind::Eventually),
+            FormulaKind::Until(a, i, b) => self.windowed2(a, i, b, CFormulaKind::Until),
+            FormulaKind::Once(i, g) => self.windowed(i, g, CFormulaKind::Once),
+            FormulaKind::Historically(i, g) => self.windowed(i, g, CFormulaKind::Historically),
+            FormulaKind::Since(a, i, b) => self.windowed2(a, i, b, CFormulaKind::Since),
             FormulaKind::Prev(g) if self.dense => {
                 self.no_dense_step(f, "prev");
                 self.formula(g);
@@ -615,6 +571,33 @@ impl Cx<'_> {
             }
         };
         CFormula { kind, range }
+    }
+
+    /// A windowed operator of one operand: its interval checked, then its operand, built
+    /// by `make`; `Invalid` when the interval did not check.
+    fn windowed(
+        &mut self,
+        i: &Option<syntax::Interval>,
+        g: &Formula,
+        make: fn(Interval, Box<CFormula>) -> CFormulaKind,
+    ) -> CFormulaKind {
+        let iv = self.interval(i);
+        let g = self.formula(g);
+        iv.map_or(CFormulaKind::Invalid, |iv| make(iv, Box::new(g)))
+    }
+
+    /// A windowed operator of two operands (`until`, `since`), checked left to right.
+    fn windowed2(
+        &mut self,
+        a: &Formula,
+        i: &Option<syntax::Interval>,
+        b: &Formula,
+        make: fn(Interval, Box<CFormula>, Box<CFormula>) -> CFormulaKind,
+    ) -> CFormulaKind {
+        let a = self.formula(a);
+        let iv = self.interval(i);
+        let b = self.formula(b);
+        iv.map_or(CFormulaKind::Invalid, |iv| make(iv, Box::new(a), Box::new(b)))
     }
 
     pub(super) fn unknown(&mut self, id: &syntax::Ident, formula: bool) {
