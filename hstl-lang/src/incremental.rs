@@ -18,7 +18,8 @@
 use std::ops::Range;
 
 use crate::diagnostic::Diagnostic;
-use crate::format::{Kind, lex};
+use crate::format::lex;
+use crate::parser::TokKind as Kind;
 use crate::parser::{Parsed, parse};
 use crate::syntax::*;
 
