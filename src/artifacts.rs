@@ -328,27 +328,12 @@ fn task_lets(spec: &CheckedSpec) -> Vec<(usize, bool)> {
                 }
             }
             CFormulaKind::Not(a) => stack.push((a, negated.map(|n| !n))),
-            CFormulaKind::Always(_, a)
-            | CFormulaKind::Eventually(_, a)
-            | CFormulaKind::Once(_, a)
-            | CFormulaKind::Historically(_, a)
-            | CFormulaKind::Prev(a)
-            | CFormulaKind::Next(a) => stack.push((a, negated)),
-            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
-                stack.extend(v.iter().rev().map(|g| (g, negated)))
-            }
             CFormulaKind::Implies(a, b) => {
                 stack.push((b, negated));
                 stack.push((a, None));
             }
-            CFormulaKind::Until(_, a, b) | CFormulaKind::Since(_, a, b) => {
-                stack.push((b, negated));
-                stack.push((a, negated));
-            }
-            CFormulaKind::True
-            | CFormulaKind::False
-            | CFormulaKind::Cmp(..)
-            | CFormulaKind::Invalid => {}
+            // Every other operand keeps the polarity; pushed last first, to visit in order.
+            _ => stack.extend(f.operands().into_iter().rev().map(|g| (g, negated))),
         }
     }
     order.into_iter().map(|i| (i, seen[i] == (false, true))).collect()

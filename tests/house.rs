@@ -28,7 +28,12 @@ const CRATES: [&str; 9] = [
 /// The circles that are still there, each with why. The test fails on a circle not listed
 /// here and on a listed one that is gone, so the list stays the truth.
 const KNOWN_CIRCLES: &[(&str, &[&str], &str)] = &[
-    ("hstl-lang/src", &["budget", "check", "lints", "world"], "issue 29: check/ is being split"),
+    (
+        "hstl-lang/src",
+        &["budget", "check", "check::learn", "check::resolve", "world"],
+        "`world` holds both the facts the checker reads (`budget` too) and the \
+         `check_in_world` entry points that run the checker: to be split in two",
+    ),
     ("hstl-lang/src", &["codes", "diagnostic"], "issue 29: a diagnostic looks its severity up"),
     (
         "python/src",
@@ -54,8 +59,6 @@ const LONG_FILE: usize = 800;
 /// that is no longer long.
 const LONG_FILES_TO_SPLIT: &[&str] = &[
     "hstl-lang/src/budget.rs",
-    "hstl-lang/src/check.rs",
-    "hstl-lang/src/checked.rs",
     "robustness/src/dense/online.rs",
     "robustness/src/offline.rs",
     "runtime/src/approx/learn.rs",

@@ -3,10 +3,10 @@
 //! spec asks for unchecked. The limits are documented in LANGUAGE.md ("Limits"); the CLI
 //! holds its flags (`--episodes`) to the same ones.
 
-pub use crate::check::thousands;
 use crate::checked::{CheckedSpec, Reward};
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{self, ParamValue};
+pub use crate::wording::thousands;
 
 /// At most this many training episodes (the learning curve keeps one value each).
 pub const MAX_EPISODES: u64 = 10_000_000;

@@ -618,22 +618,11 @@ impl CheckedSpec {
     /// Whether a formula has no temporal operator, also not through lets.
     pub fn is_state_formula(&self, f: &CFormula) -> bool {
         match &f.kind {
-            CFormulaKind::True | CFormulaKind::False | CFormulaKind::Cmp(..) => true,
+            kind if kind.is_temporal() => false,
             CFormulaKind::Invalid => false,
             CFormulaKind::Let(i) => self.lets.get(*i).is_some_and(|l| l.kind == LetKind::State),
-            CFormulaKind::Not(a) => self.is_state_formula(a),
-            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
-                v.iter().all(|g| self.is_state_formula(g))
-            }
-            CFormulaKind::Implies(a, b) => self.is_state_formula(a) && self.is_state_formula(b),
-            CFormulaKind::Always(..)
-            | CFormulaKind::Eventually(..)
-            | CFormulaKind::Until(..)
-            | CFormulaKind::Once(..)
-            | CFormulaKind::Historically(..)
-            | CFormulaKind::Since(..)
-            | CFormulaKind::Prev(..)
-            | CFormulaKind::Next(..) => false,
+            // `true`, `false` and comparisons have no operands: state formulas.
+            _ => f.operands().into_iter().all(|g| self.is_state_formula(g)),
         }
     }
 
@@ -738,24 +727,7 @@ impl CFormula {
 pub fn visit_lets(f: &CFormula, visit: &mut dyn FnMut(usize)) {
     match &f.kind {
         CFormulaKind::Let(i) => visit(*i),
-        CFormulaKind::Not(a)
-        | CFormulaKind::Always(_, a)
-        | CFormulaKind::Eventually(_, a)
-        | CFormulaKind::Once(_, a)
-        | CFormulaKind::Historically(_, a)
-        | CFormulaKind::Prev(a)
-        | CFormulaKind::Next(a) => visit_lets(a, visit),
-        CFormulaKind::And(v) | CFormulaKind::Or(v) => v.iter().for_each(|g| visit_lets(g, visit)),
-        CFormulaKind::Implies(a, b)
-        | CFormulaKind::Until(_, a, b)
-        | CFormulaKind::Since(_, a, b) => {
-            visit_lets(a, visit);
-            visit_lets(b, visit);
-        }
-        CFormulaKind::True
-        | CFormulaKind::False
-        | CFormulaKind::Cmp(..)
-        | CFormulaKind::Invalid => {}
+        _ => f.operands().into_iter().for_each(|g| visit_lets(g, visit)),
     }
 }
 

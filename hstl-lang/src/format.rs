@@ -23,7 +23,7 @@
 //! formatted: [`format()`] returns the parser's diagnostics instead.
 
 use crate::diagnostic::Diagnostic;
-use crate::parser::{self, TokKind, parse};
+use crate::parser::{self, Tok, TokKind as Kind, parse};
 use crate::syntax::{
     CommentKind, FieldValue, File, Formula, FormulaKind, Item, OptionsKind, Param, ParamValue,
 };
@@ -51,49 +51,10 @@ pub fn format(src: &str) -> Result<String, Vec<Diagnostic>> {
     Ok(emit(src, &toks, &plan))
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Kind {
-    Word,
-    Number,
-    Punct,
-    Doc,
-    LineComment,
-    BlockComment,
-    Other,
-}
-
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Tok {
-    pub(crate) kind: Kind,
-    pub(crate) start: usize,
-    pub(crate) end: usize,
-}
-
-impl Tok {
-    pub(crate) fn is_comment(self) -> bool {
-        matches!(self.kind, Kind::LineComment | Kind::BlockComment)
-    }
-}
-
-/// The parser's tokens, with its comments as tokens too, in source order.
+/// The parser's tokens (the one lexer), with its comments as tokens too, in source order.
 pub(crate) fn lex(src: &str) -> Vec<Tok> {
     let mut comments = Vec::new();
-    let tokens = parser::lex(src, &mut comments, &mut Vec::new());
-    let mut toks: Vec<Tok> = tokens
-        .iter()
-        .map(|t| {
-            let kind = match t.kind {
-                TokKind::Word => Kind::Word,
-                TokKind::Number => Kind::Number,
-                TokKind::Punct => Kind::Punct,
-                TokKind::Doc => Kind::Doc,
-                // A string is one word as far as the space around it goes.
-                TokKind::Str => Kind::Word,
-                TokKind::Other => Kind::Other,
-            };
-            Tok { kind, start: t.start, end: t.end }
-        })
-        .collect();
+    let mut toks = parser::lex(src, &mut comments, &mut Vec::new());
     // Doc comments are tokens already.
     toks.extend(comments.iter().filter_map(|c| {
         let kind = match c.kind {
@@ -327,7 +288,8 @@ fn minus_is_prefix(src: &str, prev: Option<Tok>) -> bool {
         Some(p) => {
             let text = &src[p.start..p.end];
             match p.kind {
-                Kind::Number => false,
+                // A string is one word as far as the space around it goes: no keyword.
+                Kind::Number | Kind::Str => false,
                 Kind::Word => matches!(
                     text,
                     "always"

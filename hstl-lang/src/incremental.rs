@@ -18,7 +18,8 @@
 use std::ops::Range;
 
 use crate::diagnostic::Diagnostic;
-use crate::format::{Kind, lex};
+use crate::format::lex;
+use crate::parser::TokKind as Kind;
 use crate::parser::{Parsed, parse};
 use crate::syntax::*;
 
@@ -571,8 +572,8 @@ fn shift_interval(iv: &mut Option<Interval>, d: isize) {
 }
 
 fn shift_formula(f: &mut Formula, d: isize) {
+    // The parts that are not operands or intervals; those follow, for every kind.
     match &mut f.kind {
-        FormulaKind::True | FormulaKind::False => {}
         FormulaKind::Name(id) => sh(&mut id.range, d),
         FormulaKind::Compare { first, rest } => {
             shift_expr(first, d);
@@ -581,27 +582,13 @@ fn shift_formula(f: &mut Formula, d: isize) {
                 shift_expr(e, d);
             }
         }
-        FormulaKind::Not(a)
-        | FormulaKind::Paren(a)
-        | FormulaKind::Prev(a)
-        | FormulaKind::Next(a) => shift_formula(a, d),
-        FormulaKind::Always(iv, a)
-        | FormulaKind::Eventually(iv, a)
-        | FormulaKind::Once(iv, a)
-        | FormulaKind::Historically(iv, a) => {
-            shift_interval(iv, d);
-            shift_formula(a, d);
-        }
-        FormulaKind::Until(a, iv, b) | FormulaKind::Since(a, iv, b) => {
-            shift_formula(a, d);
-            shift_interval(iv, d);
-            shift_formula(b, d);
-        }
-        FormulaKind::And(v) | FormulaKind::Or(v) => v.iter_mut().for_each(|g| shift_formula(g, d)),
-        FormulaKind::Implies(a, b) => {
-            shift_formula(a, d);
-            shift_formula(b, d);
-        }
+        _ => {}
+    }
+    if let Some(iv) = f.kind.interval_mut() {
+        shift_interval(iv, d);
+    }
+    for g in f.operands_mut() {
+        shift_formula(g, d);
     }
     sh(&mut f.range, d);
 }

@@ -57,12 +57,15 @@ pub mod codes;
 pub mod diagnostic;
 pub mod format;
 pub mod incremental;
+pub mod limits;
 pub mod lints;
 pub mod parser;
 pub mod position;
 pub mod preset;
 pub mod render;
+pub mod suggest;
 pub mod syntax;
+pub mod wording;
 pub mod world;
 
 pub use check::{Checked, check, check_parsed};

@@ -118,21 +118,7 @@ fn refers_to_state(f: &CFormula, lets: &[bool]) -> bool {
                 }
             }
             CFormulaKind::Cmp(_, a, b) => exprs.extend([a, b]),
-            CFormulaKind::Not(g)
-            | CFormulaKind::Always(_, g)
-            | CFormulaKind::Eventually(_, g)
-            | CFormulaKind::Once(_, g)
-            | CFormulaKind::Historically(_, g)
-            | CFormulaKind::Prev(g)
-            | CFormulaKind::Next(g) => {
-                formulas.push(g);
-            }
-            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => formulas.extend(gs),
-            CFormulaKind::Implies(a, b)
-            | CFormulaKind::Until(_, a, b)
-            | CFormulaKind::Since(_, a, b) => {
-                formulas.extend([&**a, &**b]);
-            }
+            _ => formulas.extend(f.operands()),
         }
     }
     while let Some(e) = exprs.pop() {
@@ -169,25 +155,7 @@ pub(crate) fn inclusive_int_bounds(spec: &CheckedSpec, src: &str, out: &mut Vec<
                 chain_warning(spec, src, f, parts, out);
             }
             CFormulaKind::Cmp(..) => chain_warning(spec, src, f, std::slice::from_ref(f), out),
-            CFormulaKind::Not(g)
-            | CFormulaKind::Always(_, g)
-            | CFormulaKind::Eventually(_, g)
-            | CFormulaKind::Once(_, g)
-            | CFormulaKind::Historically(_, g)
-            | CFormulaKind::Prev(g)
-            | CFormulaKind::Next(g) => {
-                stack.push(g);
-            }
-            CFormulaKind::And(gs) | CFormulaKind::Or(gs) => stack.extend(gs),
-            CFormulaKind::Implies(a, b)
-            | CFormulaKind::Until(_, a, b)
-            | CFormulaKind::Since(_, a, b) => {
-                stack.extend([&**a, &**b]);
-            }
-            CFormulaKind::True
-            | CFormulaKind::False
-            | CFormulaKind::Let(_)
-            | CFormulaKind::Invalid => {}
+            _ => stack.extend(f.operands()),
         }
     }
 }
@@ -307,7 +275,7 @@ fn whole(e: &CExpr) -> Option<i64> {
 /// domain times the comparisons is within the finite-domain checks' budget.
 pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec<Diagnostic>) {
     let Some(size) = spec.domain_size() else { return };
-    if spec.state_vars.is_empty() || size > crate::check::MAX_DOMAIN_STATES {
+    if spec.state_vars.is_empty() || size > crate::limits::MAX_DOMAIN_STATES {
         return;
     }
     let mut atoms: Vec<(&CExpr, &CExpr, &std::ops::Range<usize>)> = Vec::new();
@@ -333,7 +301,8 @@ pub(crate) fn undefined_expressions(spec: &CheckedSpec, src: &str, out: &mut Vec
         }
         stack.extend(f.operands());
     }
-    if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::check::MAX_DOMAIN_WORK {
+    if atoms.is_empty() || size.saturating_mul(atoms.len() as u64) > crate::limits::MAX_DOMAIN_WORK
+    {
         return;
     }
     atoms.sort_by_key(|(_, _, r)| r.start);

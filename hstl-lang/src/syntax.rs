@@ -332,6 +332,86 @@ pub struct Formula {
     pub range: Range<usize>,
 }
 
+impl Formula {
+    /// The direct operands of this node, in source order: the one place that lists which
+    /// kinds have which operands, so that walks over the tree need not.
+    pub fn operands(&self) -> Vec<&Formula> {
+        match &self.kind {
+            FormulaKind::Not(a)
+            | FormulaKind::Always(_, a)
+            | FormulaKind::Eventually(_, a)
+            | FormulaKind::Once(_, a)
+            | FormulaKind::Historically(_, a)
+            | FormulaKind::Prev(a)
+            | FormulaKind::Next(a)
+            | FormulaKind::Paren(a) => vec![a],
+            FormulaKind::And(v) | FormulaKind::Or(v) => v.iter().collect(),
+            FormulaKind::Implies(a, b)
+            | FormulaKind::Until(a, _, b)
+            | FormulaKind::Since(a, _, b) => {
+                vec![a, b]
+            }
+            FormulaKind::True
+            | FormulaKind::False
+            | FormulaKind::Name(_)
+            | FormulaKind::Compare { .. } => Vec::new(),
+        }
+    }
+
+    /// [`Formula::operands`], mutable.
+    pub fn operands_mut(&mut self) -> Vec<&mut Formula> {
+        match &mut self.kind {
+            FormulaKind::Not(a)
+            | FormulaKind::Always(_, a)
+            | FormulaKind::Eventually(_, a)
+            | FormulaKind::Once(_, a)
+            | FormulaKind::Historically(_, a)
+            | FormulaKind::Prev(a)
+            | FormulaKind::Next(a)
+            | FormulaKind::Paren(a) => vec![a],
+            FormulaKind::And(v) | FormulaKind::Or(v) => v.iter_mut().collect(),
+            FormulaKind::Implies(a, b)
+            | FormulaKind::Until(a, _, b)
+            | FormulaKind::Since(a, _, b) => {
+                vec![a, b]
+            }
+            FormulaKind::True
+            | FormulaKind::False
+            | FormulaKind::Name(_)
+            | FormulaKind::Compare { .. } => Vec::new(),
+        }
+    }
+}
+
+impl FormulaKind {
+    /// The interval slot of a temporal operator that takes one (`None` for other kinds);
+    /// the slot itself holds `None` when the interval was left out.
+    pub fn interval_mut(&mut self) -> Option<&mut Option<Interval>> {
+        match self {
+            FormulaKind::Always(i, _)
+            | FormulaKind::Eventually(i, _)
+            | FormulaKind::Once(i, _)
+            | FormulaKind::Historically(i, _)
+            | FormulaKind::Until(_, i, _)
+            | FormulaKind::Since(_, i, _) => Some(i),
+            _ => None,
+        }
+    }
+
+    /// The interval of a temporal operator, when it has one written.
+    pub fn interval(&self) -> Option<&Interval> {
+        match self {
+            FormulaKind::Always(i, _)
+            | FormulaKind::Eventually(i, _)
+            | FormulaKind::Once(i, _)
+            | FormulaKind::Historically(i, _)
+            | FormulaKind::Until(_, i, _)
+            | FormulaKind::Since(_, i, _) => i.as_ref(),
+            _ => None,
+        }
+    }
+}
+
 /// The kinds of formula.
 #[derive(Clone, Debug, PartialEq)]
 pub enum FormulaKind {

@@ -488,7 +488,7 @@ impl Splitter<'_, '_> {
             }
             let word = &self.src[t.start..t.end];
             if let Some(kw) =
-                crate::check::closest(word, KEYWORDS.iter().copied(), &mut u64::MAX.clone())
+                crate::suggest::closest(word, KEYWORDS.iter().copied(), &mut u64::MAX.clone())
             {
                 return Some(format!("did you mean `{kw}`?"));
             }

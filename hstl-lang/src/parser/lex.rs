@@ -13,6 +13,10 @@ pub(crate) enum TokKind {
     /// A string literal, quotes included (closed or not: an open one ends at the line's end).
     Str,
     Other,
+    /// A `//` comment: only in the formatter's stream (the parser keeps comments apart).
+    LineComment,
+    /// A `/* */` comment: likewise.
+    BlockComment,
 }
 
 /// A token: its kind and byte range.
@@ -21,6 +25,13 @@ pub(crate) struct Tok {
     pub(crate) kind: TokKind,
     pub(crate) start: usize,
     pub(crate) end: usize,
+}
+
+impl Tok {
+    /// Whether the token is a comment (which only the formatter's stream holds).
+    pub(crate) fn is_comment(self) -> bool {
+        matches!(self.kind, TokKind::LineComment | TokKind::BlockComment)
+    }
 }
 
 /// The lexer's message for a string without its closing quote.

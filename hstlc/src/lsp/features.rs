@@ -259,29 +259,12 @@ fn formula_names(f: &Formula, out: &mut Vec<(Range<usize>, String, bool)>) {
     while let Some(node) = stack.pop() {
         match node {
             Node::Formula(f) => match &f.kind {
-                FormulaKind::True | FormulaKind::False => {}
                 FormulaKind::Name(id) => out.push((id.range.clone(), id.name.clone(), true)),
                 FormulaKind::Compare { first, rest } => {
                     stack.extend(rest.iter().rev().map(|(_, _, e)| Node::Expr(e)));
                     stack.push(Node::Expr(first));
                 }
-                FormulaKind::Not(a)
-                | FormulaKind::Always(_, a)
-                | FormulaKind::Eventually(_, a)
-                | FormulaKind::Once(_, a)
-                | FormulaKind::Historically(_, a)
-                | FormulaKind::Prev(a)
-                | FormulaKind::Next(a)
-                | FormulaKind::Paren(a) => stack.push(Node::Formula(a)),
-                FormulaKind::Until(a, _, b)
-                | FormulaKind::Since(a, _, b)
-                | FormulaKind::Implies(a, b) => {
-                    stack.push(Node::Formula(b));
-                    stack.push(Node::Formula(a));
-                }
-                FormulaKind::And(v) | FormulaKind::Or(v) => {
-                    stack.extend(v.iter().rev().map(Node::Formula));
-                }
+                _ => stack.extend(f.operands().into_iter().rev().map(Node::Formula)),
             },
             Node::Expr(e) => match &e.kind {
                 ExprKind::Number(_) => {}

@@ -1,7 +1,7 @@
 //! The plan itself: each option's leg made the quickest way into its region under the
 //! counted transitions, value iteration over the states where legs arrive with the exact
 //! counters of the other regions, and the options table filled for every memory code.
-//! One file because the legs, the reward and future parts and the sweeps share private
+//! One file: the legs, the reward and future parts and the sweeps share private
 //! types (`Leg`, `Grids`, `Values`); its tests check those parts against literal sums.
 
 use super::size::{PlanSize, RARE_ARRIVAL, WINDOWS_OF_DURATION};

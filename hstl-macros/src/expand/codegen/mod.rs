@@ -149,22 +149,11 @@ impl<'a> Gen<'a> {
     fn valid(&self, f: &CFormula) -> bool {
         match &f.kind {
             CFormulaKind::Invalid => false,
-            CFormulaKind::True | CFormulaKind::False => true,
             CFormulaKind::Let(i) => self.let_valid.get(*i).copied().unwrap_or(false),
             CFormulaKind::Cmp(_, a, b) => valid_expr(a) && valid_expr(b),
-            CFormulaKind::Not(a) | CFormulaKind::Always(_, a) | CFormulaKind::Eventually(_, a) => {
-                self.valid(a)
-            }
-            CFormulaKind::And(v) | CFormulaKind::Or(v) => {
-                !v.is_empty() && v.iter().all(|g| self.valid(g))
-            }
-            CFormulaKind::Once(_, a)
-            | CFormulaKind::Historically(_, a)
-            | CFormulaKind::Prev(a)
-            | CFormulaKind::Next(a) => self.valid(a),
-            CFormulaKind::Implies(a, b)
-            | CFormulaKind::Until(_, a, b)
-            | CFormulaKind::Since(_, a, b) => self.valid(a) && self.valid(b),
+            CFormulaKind::And(v) | CFormulaKind::Or(v) if v.is_empty() => false,
+            // `true` and `false` have no operands: valid.
+            _ => f.operands().into_iter().all(|g| self.valid(g)),
         }
     }
 }

@@ -126,6 +126,7 @@ impl Gen<'_> {
         name: &TokenStream,
     ) -> TokenStream {
         let hstl = &self.root;
+        let online = self.online(state);
         let data = match index {
             Some(i) => quote! {{
                 let mut __b = #hstl::robustness::FormulaBuilder::new();
@@ -270,51 +271,61 @@ impl Gen<'_> {
                     #robustness
                 }
 
-                /// Monitors the formula on states pushed one at a time (the runtime's
-                /// streaming monitor over [`formula`]).
-                #[derive(Clone, Debug)]
-                pub struct Online {
-                    monitor: #hstl::robustness::OnlineMonitor,
+                #online
+            }
+        }
+    }
+
+    /// The `Online` monitor of a formula module, the same for every formula: the runtime's
+    /// streaming monitor over the module's `formula()`.
+    fn online(&self, state: &TokenStream) -> TokenStream {
+        let hstl = &self.root;
+        quote! {
+            /// Monitors the formula on states pushed one at a time (the runtime's
+            /// streaming monitor over [`formula`]).
+            #[derive(Clone, Debug)]
+            pub struct Online {
+                monitor: #hstl::robustness::OnlineMonitor,
+            }
+
+            impl Online {
+                /// A monitor at step 0.
+                pub fn new() -> Online {
+                    Online { monitor: #hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
                 }
 
-                impl Online {
-                    /// A monitor at step 0.
-                    pub fn new() -> Online {
-                        Online { monitor: #hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
-                    }
-
-                    /// Appends one state; returns the verdict it completes, if any.
-                    pub fn push(&mut self, state: &#state) -> ::core::option::Option<#hstl::robustness::Verdict> {
-                        // The row always has VARS values, so the monitor cannot refuse it.
-                        self.monitor.push(&state.values()).ok().flatten()
-                    }
-
-                    /// The value the first open step would get if the trace ended now.
-                    pub fn provisional(&mut self) -> ::core::option::Option<f64> {
-                        self.monitor.provisional()
-                    }
-
-                    /// Ends the trace: the verdicts of every open step; the monitor then
-                    /// starts a new trace.
-                    pub fn finish(&mut self) -> ::std::vec::Vec<#hstl::robustness::Verdict> {
-                        self.monitor.finish()
-                    }
-
-                    /// Steps a verdict lags behind the last pushed state; `None` when
-                    /// unbounded.
-                    pub fn horizon(&self) -> ::core::option::Option<usize> {
-                        self.monitor.horizon()
-                    }
+                /// Appends one state; returns the verdict it completes, if any.
+                pub fn push(&mut self, state: &#state) -> ::core::option::Option<#hstl::robustness::Verdict> {
+                    // The row always has VARS values, so the monitor cannot refuse it.
+                    self.monitor.push(&state.values()).ok().flatten()
                 }
 
-                impl ::core::default::Default for Online {
-                    fn default() -> Online {
-                        Online::new()
-                    }
+                /// The value the first open step would get if the trace ended now.
+                pub fn provisional(&mut self) -> ::core::option::Option<f64> {
+                    self.monitor.provisional()
+                }
+
+                /// Ends the trace: the verdicts of every open step; the monitor then
+                /// starts a new trace.
+                pub fn finish(&mut self) -> ::std::vec::Vec<#hstl::robustness::Verdict> {
+                    self.monitor.finish()
+                }
+
+                /// Steps a verdict lags behind the last pushed state; `None` when
+                /// unbounded.
+                pub fn horizon(&self) -> ::core::option::Option<usize> {
+                    self.monitor.horizon()
+                }
+            }
+
+            impl ::core::default::Default for Online {
+                fn default() -> Online {
+                    Online::new()
                 }
             }
         }
     }
+
     /// The formula's horizon as the runtime computes it (`Formula::horizon`): the steps
     /// after `t` that `rho(f, t)` reads; `None` when unbounded (or past `usize`).
     pub(super) fn horizon(&self, f: &CFormula) -> Option<usize> {
@@ -389,6 +400,7 @@ impl Gen<'_> {
         data: TokenStream,
     ) -> TokenStream {
         let hstl = &self.root;
+        let online = self.online(state);
         let kernels = quote!(#hstl::robustness::kernels::Kernels);
         let empty = lit_f64(self.empty_value(f));
         let at = format_ident!("__at_{}", i);
@@ -421,48 +433,7 @@ impl Gen<'_> {
                     trace.first().map_or(#empty, at)
                 }
 
-                /// Monitors the formula on states pushed one at a time (the runtime's
-                /// streaming monitor over [`formula`]).
-                #[derive(Clone, Debug)]
-                pub struct Online {
-                    monitor: #hstl::robustness::OnlineMonitor,
-                }
-
-                impl Online {
-                    /// A monitor at step 0.
-                    pub fn new() -> Online {
-                        Online { monitor: #hstl::robustness::OnlineMonitor::new(&formula(), <#state>::VARS) }
-                    }
-
-                    /// Appends one state; returns the verdict it completes, if any.
-                    pub fn push(&mut self, state: &#state) -> ::core::option::Option<#hstl::robustness::Verdict> {
-                        // The row always has VARS values, so the monitor cannot refuse it.
-                        self.monitor.push(&state.values()).ok().flatten()
-                    }
-
-                    /// The value the first open step would get if the trace ended now.
-                    pub fn provisional(&mut self) -> ::core::option::Option<f64> {
-                        self.monitor.provisional()
-                    }
-
-                    /// Ends the trace: the verdicts of every open step; the monitor then
-                    /// starts a new trace.
-                    pub fn finish(&mut self) -> ::std::vec::Vec<#hstl::robustness::Verdict> {
-                        self.monitor.finish()
-                    }
-
-                    /// Steps a verdict lags behind the last pushed state; `None` when
-                    /// unbounded.
-                    pub fn horizon(&self) -> ::core::option::Option<usize> {
-                        self.monitor.horizon()
-                    }
-                }
-
-                impl ::core::default::Default for Online {
-                    fn default() -> Online {
-                        Online::new()
-                    }
-                }
+                #online
             }
         }
     }
