@@ -8,8 +8,13 @@
 //! clipped alike. For a persistent task `always[0..] f` with `hor(f) = H`, the suffix from
 //! `i` takes the minimum of `rho(f, u)` over `i <= u <= max(i, m - 1 - H)`: one backward
 //! running minimum gives all of them. A task with a past-time operator reads the states
-//! before `t` too, so a suffix is not the segment's tail there: each suffix is then scored
-//! on its own (quadratic in the segment's length).
+//! before `t` too, so a suffix is not the segment's tail there, but only near its start:
+//! when every past window is bounded, `f`'s value in the suffix from `i` equals its value
+//! in the segment from step `i + R` on, where `R` is `f`'s reach back (see
+//! [`start_reach`]). Each suffix then evaluates its first `R + H` steps alone and takes
+//! the rest from the one running minimum: `O(m (R + H))` for a segment of `m` steps. A
+//! task without a horizon, or with an unbounded past window, scores each suffix on its
+//! own, quadratic in the segment's length.
 
 use crate::formula::{Node, expr_value};
 use crate::offline::{Evaluator, Runner, Source};
@@ -22,6 +27,8 @@ pub struct SegmentScorer {
     task: Formula,
     /// For a task `always[0..] f` with a finite horizon of `f`: `f` and that horizon.
     body: Option<(Formula, usize)>,
+    /// For a task that reads the past: `f`'s [`start_reach`] (`None`: unbounded).
+    reach: Option<usize>,
     eval: Evaluator,
 }
 
@@ -29,7 +36,8 @@ impl SegmentScorer {
     /// A scorer for `task`.
     pub fn new(task: &Formula) -> SegmentScorer {
         let body = reference::persistent_body(task).map(|(f, h)| (task.sub(f), h));
-        SegmentScorer { task: task.clone(), body, eval: Evaluator::new() }
+        let reach = body.as_ref().and_then(|(f, _)| start_reach(f));
+        SegmentScorer { task: task.clone(), body, reach, eval: Evaluator::new() }
     }
     /// The reward of one option execution whose states are `segment`; NaN when empty.
     pub fn reward(&mut self, segment: &Trace) -> f64 {
@@ -60,6 +68,15 @@ impl SegmentScorer {
     fn suffix_rewards_of_columns(&mut self, cols: &[&[f64]], m: usize, out: &mut Vec<f64>) {
         out.clear();
         if self.task.has_past() {
+            if let (Some((body, h)), Some(reach)) = (&self.body, self.reach) {
+                let (h, eval) = (*h, &mut self.eval);
+                let sig = eval.signal_of_columns(body, cols, m).to_vec();
+                past_persistent_suffixes(m, h, reach, &sig, out, |i, n, k| {
+                    let head: Vec<&[f64]> = cols.iter().map(|c| &c[i..i + n]).collect();
+                    first_min(&eval.signal_of_columns(body, &head, n)[..k])
+                });
+                return;
+            }
             for i in 0..m {
                 let tail: Vec<&[f64]> = cols.iter().map(|c| &c[i..m]).collect();
                 let r = self.reward_of_columns(&tail, m - i);
@@ -107,8 +124,11 @@ pub struct TabularScorer {
     tables: Vec<Vec<f64>>,
     /// The horizon of `f` when the task is `always[0..] f`.
     persistent: Option<usize>,
-    /// The task has a past-time operator: suffixes are scored one by one.
+    /// The task has a past-time operator: suffixes differ from the segment near their
+    /// start.
     past: bool,
+    /// The plan's [`start_reach`] when the task is persistent (`None`: unbounded).
+    reach: Option<usize>,
     runner: Runner,
 }
 
@@ -214,7 +234,8 @@ impl TabularScorer {
                 by_node[v] = std::mem::take(&mut tables[j]);
             }
         }
-        TabularScorer { plan, tables: by_node, persistent, past, runner: Runner::default() }
+        let reach = persistent.and_then(|_| start_reach(&plan));
+        TabularScorer { plan, tables: by_node, persistent, past, reach, runner: Runner::default() }
     }
 
     fn signal(&mut self, seg: &[usize]) -> Vec<f64> {
@@ -254,6 +275,17 @@ impl TabularScorer {
         let m = segment.len();
         out.clear();
         if self.past {
+            if let (Some(h), Some(reach)) = (self.persistent, self.reach) {
+                let sig = self.signal(segment);
+                past_persistent_suffixes(m, h, reach, &sig, out, |i, n, k| {
+                    let head = self.signal(&segment[i..i + n]);
+                    let r = first_min(&head[..k]);
+                    self.runner.put(head);
+                    r
+                });
+                self.runner.put(sig);
+                return;
+            }
             for i in 0..m {
                 let r = self.reward(&segment[i..]);
                 out.push(r);
@@ -282,6 +314,79 @@ impl TabularScorer {
         }
         self.runner.put(sig);
     }
+}
+
+/// How many steps after a segment's start `f`'s value may differ from its value over a
+/// longer history: at every step `t >= i + start_reach(f)` of the suffix from `i`, `f`
+/// reads no step before `i`, and so has the segment's value. `None` when a past window is
+/// unbounded. An upper bound: a larger reach only costs time.
+pub(crate) fn start_reach(f: &Formula) -> Option<usize> {
+    let mut reach: Vec<Option<usize>> = Vec::with_capacity(f.len());
+    let window = |i: &crate::Interval| crate::formula::window_end(i);
+    for node in f.nodes() {
+        let of = |k: &NodeId| reach[k.index()];
+        let r = match node {
+            // `f` at `t` reads its operand from `t + a` on.
+            Node::Always(i, g) | Node::Eventually(i, g) => of(g).map(|r| r.saturating_sub(i.start)),
+            Node::Until(i, g, h) => {
+                of(g).and_then(|g| of(h).map(|h| g.max(h.saturating_sub(i.start))))
+            }
+            Node::Next(g) => of(g).map(|r| r.saturating_sub(1)),
+            // `f` at `t` reads its operands from `t - b` on.
+            Node::Once(i, g) | Node::Historically(i, g) => {
+                window(i).and_then(|b| of(g)?.checked_add(b))
+            }
+            Node::Since(i, g, h) => window(i).and_then(|b| of(g)?.max(of(h)?).checked_add(b)),
+            Node::Prev(g) => of(g).and_then(|r| r.checked_add(1)),
+            _ => node.children().try_fold(0usize, |acc, k| reach[k].map(|r| acc.max(r))),
+        };
+        reach.push(r);
+    }
+    reach[f.root().index()]
+}
+
+/// `out[i]`: the reward of the suffix from `i` of a segment of `m` steps for the task
+/// `always[0..] f`, `f` of horizon `h` and [`start_reach`] `reach`, given `f`'s signal
+/// `sig` over the whole segment. `head(i, n, k)`: the least of `f`'s first `k` values over
+/// the `n` steps from `i`; each of those values reads at most `h` steps ahead, so `n =
+/// k + h` steps (or the rest of the segment) give them exactly.
+fn past_persistent_suffixes(
+    m: usize,
+    h: usize,
+    reach: usize,
+    sig: &[f64],
+    out: &mut Vec<f64>,
+    mut head: impl FnMut(usize, usize, usize) -> f64,
+) {
+    out.clear();
+    if m == 0 {
+        return;
+    }
+    // The steps up to `cut` count in every suffix that reaches it; `tail[u]`: the least of
+    // `sig[u..=cut]`, `+inf` past `cut`.
+    let cut = (m - 1).saturating_sub(h);
+    let mut tail = vec![f64::INFINITY; cut + 2];
+    for u in (0..=cut).rev() {
+        tail[u] = tail[u + 1].min(sig[u]);
+    }
+    for i in 0..m {
+        // A suffix shorter than the horizon keeps only its step 0.
+        let short = m - 1 - i < h;
+        let counted = if short { 1 } else { cut - i + 1 };
+        let k = counted.min(reach);
+        let rest = match (short, k) {
+            (false, _) => tail[i + k],
+            (true, 0) => f64::INFINITY.min(sig[i]),
+            (true, _) => f64::INFINITY,
+        };
+        let r = if k == 0 { rest } else { head(i, (m - i).min(k.saturating_add(h)), k).min(rest) };
+        out.push(r);
+    }
+}
+
+/// The least of `values`, from `+inf` as the reference folds.
+fn first_min(values: &[f64]) -> f64 {
+    values.iter().fold(f64::INFINITY, |a, b| a.min(*b))
 }
 
 fn columns(trace: &Trace) -> Vec<&[f64]> {
@@ -354,6 +459,93 @@ mod tests {
             Formula::and(vec![]),
             alw(window(0, Inclusive(3)), Formula::bool(true)),
         ]
+        .into_iter()
+        .chain(bounded_past_tasks())
+        .collect()
+    }
+
+    /// Persistent tasks whose body reads a bounded past: the suffix rewards take the
+    /// segment's signal from `start_reach` steps after each suffix's start.
+    fn bounded_past_tasks() -> Vec<Formula> {
+        use Bound::{Exclusive, Inclusive};
+        use CmpOp::{Gt, Lt};
+        let once = |i, f| Formula::once(i, f);
+        let hist = |i, f| Formula::historically(i, f);
+        vec![
+            // Reach 4: seen above 7 within the last four steps, at every step.
+            alw(Interval::ALL, once(window(0, Inclusive(4)), x(Gt, 7.0))),
+            // Reach 3, horizon 5: a response that also looks back.
+            alw(
+                Interval::ALL,
+                Formula::implies(
+                    hist(window(1, Exclusive(4)), x(Lt, 5.0)),
+                    ev(window(0, Inclusive(5)), x(Gt, 6.0)),
+                ),
+            ),
+            // Reach 0: the past is read only where the suffix has it.
+            alw(Interval::ALL, ev(window(3, Inclusive(6)), Formula::prev(x(Gt, 4.0)))),
+            // A suffix's first steps decide its minimum: each errs if read with history.
+            alw(
+                Interval::ALL,
+                Formula::or(vec![once(window(0, Inclusive(4)), x(Gt, 7.0)), x(Lt, 1.0)]),
+            ),
+            alw(Interval::ALL, Formula::or(vec![Formula::prev(x(Gt, 4.0)), x(Gt, 6.0)])),
+            // A past window inside a future one, and `since`.
+            alw(
+                Interval::ALL,
+                ev(
+                    window(1, Inclusive(2)),
+                    Formula::since(window(0, Inclusive(3)), x(Lt, 9.0), x(Gt, 6.0)),
+                ),
+            ),
+        ]
+    }
+
+    #[test]
+    fn start_reach_counts_the_steps_a_suffix_reads_before_its_start() {
+        use Bound::{Inclusive, Unbounded};
+        let p = x(CmpOp::Gt, 1.0);
+        let reach = |f: Formula| start_reach(&f);
+        assert_eq!(reach(p.clone()), Some(0));
+        assert_eq!(reach(ev(window(0, Inclusive(9)), p.clone())), Some(0));
+        assert_eq!(reach(Formula::prev(p.clone())), Some(1));
+        assert_eq!(reach(Formula::once(window(2, Inclusive(5)), p.clone())), Some(5));
+        assert_eq!(reach(Formula::once(window(0, Unbounded), p.clone())), None);
+        let nested = Formula::historically(window(0, Inclusive(3)), Formula::prev(p.clone()));
+        assert_eq!(reach(nested.clone()), Some(4));
+        assert_eq!(reach(ev(window(2, Inclusive(7)), nested.clone())), Some(2));
+        assert_eq!(reach(ev(window(6, Inclusive(7)), nested)), Some(0));
+        let since = Formula::since(window(0, Inclusive(2)), Formula::prev(p.clone()), p.clone());
+        assert_eq!(reach(since), Some(3));
+        let until = Formula::until(window(3, Inclusive(4)), Formula::prev(p.clone()), p);
+        assert_eq!(reach(until), Some(1));
+    }
+
+    #[test]
+    fn past_suffix_rewards_equal_the_reference_on_long_segments() {
+        use Bound::Unbounded;
+        let mut lcg: u64 = 0x2026;
+        let mut next = move || {
+            lcg =
+                lcg.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            ((lcg >> 33) % 11) as f64
+        };
+        let unbounded = alw(Interval::ALL, Formula::once(window(0, Unbounded), x(CmpOp::Gt, 8.0)));
+        for task in bounded_past_tasks().into_iter().chain([unbounded]) {
+            // Short segments, where a suffix's start decides its minimum, and long ones.
+            let lengths = (0..=24).flat_map(|len| [len; 12]).chain([40, 250]);
+            for len in lengths {
+                let rows: Vec<f64> = (0..len).map(|_| next()).collect();
+                let trace = Trace::from_columns(vec![rows]).unwrap();
+                let mut got = Vec::new();
+                SegmentScorer::new(&task).suffix_rewards(&trace, &mut got);
+                for (i, g) in got.iter().enumerate() {
+                    let tail = Trace::from_columns(vec![trace.column(0)[i..].to_vec()]).unwrap();
+                    let want = reference::segment_reward(&task, &tail);
+                    assert_eq!(g.to_bits(), want.to_bits(), "{task:?}, length {len}, suffix {i}");
+                }
+            }
+        }
     }
 
     /// The fast tabular scorer gives [`SegmentScorer`]'s values on the segment's states,
