@@ -630,4 +630,19 @@ Example:\n    learn { memory: 20 }   // 225 cells x 21^3 memory values: 2.1 mill
 Fix: nothing is wrong; fewer memory values, a smaller world or fewer options make it \
 smaller.",
     },
+    CodeInfo {
+        code: "HSTL190",
+        name: "unbounded-past-in-long-runs",
+        severity: W,
+        summary: "a past window without an end in a task trained with runs over 10,000 steps",
+        explanation: "The options level rewards each option run by the task's robustness over \
+the run, and credits every suffix of the run as a run of its own (the paper's intra-option \
+credit). A past window reads the steps before `t` down to the run's start, so a suffix is \
+not the run's tail there. A bounded window (`once[0..=k]`) differs only in the first `k` \
+steps of each suffix, and scoring a run stays linear in its length. A window without an end \
+reads back to each suffix's own start: every suffix is scored on its own, `max_steps^2` \
+evaluations for one run, which at `max_steps: 100000` is minutes per run.\n\n\
+Example:\n    task always[0..] (once[0..] alarm > 0 -> speed < 5);\n    learn { max_steps: 100000 }\n\n\
+Fix: give the window an end (`once[0..=500]`), or keep `max_steps` at 10,000 or less.",
+    },
 ];

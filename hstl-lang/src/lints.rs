@@ -1,11 +1,12 @@
 //! Checks that keep a spec from failing later, in `train` or in files it names, or from
 //! meaning something else than it seems: `HSTL050` (a reach formula that refers to no
 //! state variable), `HSTL104` (a task that refers to none), `HSTL051` (a name longer than [`MAX_NAME_CHARS`]) and `HSTL150`
-//! (`<=` or `>=` against a whole number on an `int` variable), and `HSTL060` (an expression
-//! that is NaN on a state of the declared `int` domain).
+//! (`<=` or `>=` against a whole number on an `int` variable), `HSTL060` (an expression
+//! that is NaN on a state of the declared `int` domain), and `HSTL190` (a past window
+//! without an end where option runs are long).
 
 use crate::checked::{
-    CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Terminate, VarType,
+    Bound, CExpr, CExprKind, CFormula, CFormulaKind, CheckedSpec, CmpOp, Terminate, VarType,
 };
 use crate::diagnostic::Diagnostic;
 use crate::syntax;
@@ -396,5 +397,66 @@ fn value(e: &CExpr, s: &[f64]) -> Result<f64, (std::ops::Range<usize>, String)> 
         CExprKind::Div(a, b) => binary(a, b, |a, b| a / b, "/"),
         // An invalid part was reported already.
         CExprKind::Invalid => Ok(0.0),
+    }
+}
+
+/// Option runs longer than this many steps make a quadratic suffix scoring worth a word:
+/// `10^4` steps are `10^8` evaluations a run.
+pub const LONG_RUN_STEPS: u64 = 10_000;
+
+/// `HSTL190` (a warning) for a past window without an end (`once`, `historically`,
+/// `since`) in a task rewarded by segment when runs may be longer than [`LONG_RUN_STEPS`]:
+/// such a window reads back to each run's start, so training scores every suffix of a run
+/// on its own, quadratic in its length, where a bounded window keeps it linear. Walks the
+/// task and the lets it uses with a stack, each let once.
+pub(crate) fn unbounded_past_in_long_runs(spec: &CheckedSpec, out: &mut Vec<Diagnostic>) {
+    let learn = &spec.learn;
+    let Some(task) = &spec.task else { return };
+    if learn.max_steps <= LONG_RUN_STEPS || learn.reward != crate::checked::Reward::Segment {
+        return;
+    }
+    let mut seen = vec![false; spec.lets.len()];
+    let mut stack = vec![&task.formula];
+    while let Some(f) = stack.pop() {
+        let (name, interval) = match &f.kind {
+            CFormulaKind::Once(i, _) => ("once", i),
+            CFormulaKind::Historically(i, _) => ("historically", i),
+            CFormulaKind::Since(i, ..) => ("since", i),
+            CFormulaKind::Let(k) => {
+                if let Some(l) = spec.lets.get(*k)
+                    && !std::mem::replace(&mut seen[*k], true)
+                {
+                    stack.push(&l.formula);
+                }
+                continue;
+            }
+            _ => {
+                stack.extend(f.operands());
+                continue;
+            }
+        };
+        stack.extend(f.operands());
+        if interval.end != Bound::Unbounded {
+            continue;
+        }
+        let steps = learn.max_steps;
+        out.push(
+            Diagnostic::new(
+                "HSTL190",
+                f.range.clone(),
+                format!(
+                    "`{name}` without an end reads back to the start of each option run: \
+                     training scores every suffix of a run on its own, up to {} evaluations a \
+                     run at `max_steps: {steps}`",
+                    crate::wording::thousands(steps.saturating_mul(steps))
+                ),
+            )
+            .with_help(format!(
+                "give the window an end, such as `{name}[{}..={}]`: a bounded past window keeps \
+                 each run linear in its length",
+                interval.start,
+                interval.start.saturating_add(100)
+            )),
+        );
     }
 }

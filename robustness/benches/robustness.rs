@@ -83,6 +83,30 @@ fn suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
     });
 }
 
+/// A persistent task that reads the past, over every suffix of a 2,000-step segment: a
+/// bounded past window (linear in the segment) against one without an end (quadratic).
+fn past_suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
+    use hstl_robustness::{Bound, CmpOp, Expr, Interval, segment::SegmentScorer};
+    let seg = walk::walk(2000, rng);
+    let gt = |v, k: f64| Formula::cmp(Expr::var(v), CmpOp::Gt, Expr::constant(k));
+    let task = |end| {
+        let seen = Formula::once(Interval { start: 0, end }, gt(0, 10.0));
+        let soon =
+            Formula::eventually(Interval { start: 0, end: Bound::Inclusive(10) }, gt(1, 3.0));
+        Formula::always(Interval::ALL, Formula::implies(seen, soon))
+    };
+    let mut out = Vec::new();
+    for (name, end) in [("bounded_20", Bound::Inclusive(20)), ("unbounded", Bound::Unbounded)] {
+        let mut scorer = SegmentScorer::new(&task(end));
+        c.bench_function(&format!("suffix_rewards/past_{name}_2000"), |b| {
+            b.iter(|| {
+                scorer.suffix_rewards(black_box(&seg), &mut out);
+                black_box(out[0])
+            })
+        });
+    }
+}
+
 fn benches(c: &mut Criterion) {
     let mut rng = walk::SplitMix64(walk::SEED);
     let trace = walk::walk(walk::STEPS, &mut rng);
@@ -112,6 +136,7 @@ fn benches(c: &mut Criterion) {
     );
     step_zero(c, &trace);
     suffix_rewards(c, &mut rng);
+    past_suffix_rewards(c, &mut rng);
 }
 
 criterion_group!(robustness, benches);

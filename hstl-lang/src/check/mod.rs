@@ -171,6 +171,7 @@ pub(crate) fn check_parsed_in<'w>(
         crate::lints::constant_formulas(&checked, &mut diags);
         crate::lints::inclusive_int_bounds(&checked, src, &mut diags);
         crate::lints::undefined_expressions(&checked, src, &mut diags);
+        crate::lints::unbounded_past_in_long_runs(&checked, &mut diags);
         specs.push(checked);
     }
     let diagnostics = diagnostic::finish(diags, MAX_DIAGNOSTICS, src.len());
