@@ -552,7 +552,7 @@ impl Monitor {
     }
 
     /// The number of steps, when the samples have one per state variable and step.
-    fn lengths(&self, samples: &Samples<'_>) -> Result<usize, TraceError> {
+    pub fn lengths(&self, samples: &Samples<'_>) -> Result<usize, TraceError> {
         let len = match samples {
             Samples::Columns(cols) => {
                 if cols.len() != self.vars.len() {

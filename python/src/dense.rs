@@ -134,9 +134,9 @@ pub fn hold<'py>(
     Ok((stamps, arrays))
 }
 
-/// Builds the trace (GIL released) from what [`hold`] took.
+/// Builds the trace from what [`hold`] took, copying it out of the arrays with the GIL held.
 pub fn build(
-    py: Python<'_>,
+    _py: Python<'_>,
     held: &(Stamps, Vec<Bound<'_, PyArrayDyn<f64>>>),
     dense: &Dense,
     gap: Option<&MaxGap>,
@@ -155,7 +155,10 @@ pub fn build(
             a.as_slice().map_err(|e| value_error(format!("the array cannot be read: {e}"), None))
         })
         .collect::<PyResult<_>>()?;
-    py.detach(|| dense.trace(stamps.column(), &slices, gap.cloned(), Front::Python))
+    // With the GIL held (`_py`): no other Python thread writes to the arrays while the
+    // trace is checked and copied out of them.
+    dense
+        .trace(stamps.column(), &slices, gap.cloned(), Front::Python)
         .map_err(|p| problem_error(&p, dense, None))
 }
 

@@ -15,6 +15,7 @@ mod diagnostic;
 mod errors;
 mod files;
 mod gym;
+mod interrupt;
 mod online;
 mod policy;
 mod reward;

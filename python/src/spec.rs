@@ -13,8 +13,9 @@ use pyo3::types::PyTuple;
 use crate::dense;
 use crate::diagnostic::Diagnostic;
 use crate::errors::{self, batch_error, diagnostics_of, lower_error, trace_error, value_error};
+use crate::interrupt;
 use crate::online::OnlineMonitor;
-use crate::trace::{hold, hold_batch};
+use crate::trace::{Copied, hold, hold_batch};
 
 /// A checked hstl spec: its state variables, its `let`s and its task, ready to monitor
 /// traces.
@@ -347,7 +348,11 @@ impl Spec {
             let gap = dense::max_gap(max_gap)?;
             let held = dense::hold(trace, columns, &monitor)?;
             let trace = dense::build(py, &held, &monitor, gap.as_ref())?;
-            let value = py.detach(|| monitor.robustness_in(&trace, windows)).map_err(|p| {
+            let values = trace.len().saturating_mul(held.1.len() + 1);
+            let (value, trace, monitor) = interrupt::run(py, values, move || {
+                (monitor.robustness_in(&trace, windows), trace, monitor)
+            })?;
+            let value = value.map_err(|p| {
                 let axis = hstl::monitor::TimeAxis {
                     relative: false,
                     origin: trace.origin(),
@@ -361,7 +366,19 @@ impl Spec {
         let monitor = self.monitor(formula)?;
         let held = hold(trace, columns, &monitor)?;
         let samples = held.samples()?;
-        py.detach(|| monitor.robustness_in(&samples, windows)).map_err(|e| trace_error(py, &e))
+        // Over clipped windows only the steps up to the horizon are read, and copied.
+        let steps = match windows {
+            hstl::monitor::Windows::Clipped => {
+                monitor.samples_read(monitor.lengths(&samples).map_err(|e| trace_error(py, &e))?)
+            }
+            hstl::monitor::Windows::Complete => usize::MAX,
+        };
+        let copied = Copied::prefix(&samples, steps);
+        let (value, copied) = interrupt::run(py, copied.values(), move || {
+            (monitor.robustness_in(&copied.samples(), windows), copied)
+        })?;
+        copied.recycle();
+        value.map_err(|e| trace_error(py, &e))
     }
 
     /// The robustness signal of the trace: a float64 array with one value per step, the
@@ -395,7 +412,11 @@ impl Spec {
             let gap = dense::max_gap(max_gap)?;
             let held = dense::hold(trace, columns, &monitor)?;
             let trace = dense::build(py, &held, &monitor, gap.as_ref())?;
-            let (signal, end) = py.detach(|| monitor.signal_in(&trace, windows)).map_err(|p| {
+            let values = trace.len().saturating_mul(held.1.len() + 1);
+            let (done, trace, monitor) = interrupt::run(py, values, move || {
+                (monitor.signal_in(&trace, windows), trace, monitor)
+            })?;
+            let (signal, end) = done.map_err(|p| {
                 let axis = hstl::monitor::TimeAxis {
                     relative: false,
                     origin: trace.origin(),
@@ -408,10 +429,12 @@ impl Spec {
         }
         self.discrete_only(max_gap, relative)?;
         let monitor = self.monitor(formula)?;
-        let held = hold(trace, columns, &monitor)?;
-        let samples = held.samples()?;
-        let signal =
-            py.detach(|| monitor.signal_in(&samples, windows)).map_err(|e| trace_error(py, &e))?;
+        let copied = hold(trace, columns, &monitor)?.copied()?;
+        let (signal, copied) = interrupt::run(py, copied.values(), move || {
+            (monitor.signal_in(&copied.samples(), windows), copied)
+        })?;
+        copied.recycle();
+        let signal = signal.map_err(|e| trace_error(py, &e))?;
         Ok(PyArray1::from_vec(py, signal).into_any())
     }
 
@@ -452,11 +475,15 @@ impl Spec {
         self.discrete_only(max_gap, relative)?;
         let monitor = self.monitor(formula)?;
         let held = hold_batch(traces, columns, &monitor)?;
-        let samples = held.samples()?;
-        let n = samples.len();
-        let (out, steps) = py
-            .detach(|| monitor.signal_batch_in(&samples, threads, windows))
-            .map_err(|e| batch_error(py, &e))?;
+        let copied = held.copied()?;
+        let n = copied.len();
+        let values = copied.iter().map(Copied::values).sum();
+        let (done, copied) = interrupt::run(py, values, move || {
+            let samples: Vec<_> = copied.iter().map(Copied::samples).collect();
+            (monitor.signal_batch_in(&samples, threads, windows), copied)
+        })?;
+        copied.into_iter().for_each(Copied::recycle);
+        let (out, steps) = done.map_err(|e| batch_error(py, &e))?;
         // An array of no traces still has steps.
         let steps = if n == 0 { held.shape_steps().unwrap_or(0) } else { steps };
         Ok(PyArray1::from_vec(py, out).reshape([n, steps])?.into_any())

@@ -4,8 +4,8 @@
 //! pandas DataFrame, a numpy structured array: anything with `keys()` and `[name]`), or a
 //! 2-D array of shape (steps, columns) whose columns are named by `columns` (by default the
 //! spec's state variables, in order). Contiguous float64 arrays are read in place; anything
-//! else numpy converts to float64 once. The arrays stay borrowed (read-only) while the
-//! facade reads them with the GIL released.
+//! else numpy converts to float64 once. The samples are copied out while the GIL is held
+//! ([`Copied`]), so that what the facade scores with the GIL released is what it checked.
 
 use hstl::monitor::{Monitor, Samples, TraceError};
 use numpy::{
@@ -69,7 +69,104 @@ impl Held<'_> {
     }
 }
 
+/// A trace's samples copied out of its arrays while the GIL is held: once it is released,
+/// another Python thread may write to the arrays, and the facade must score the values it
+/// checked. The copies go into buffers kept from earlier calls on the same thread
+/// ([`Copied::recycle`]): fresh memory costs a page fault every 4 KiB, three times the
+/// evaluation of a simple task; kept buffers cost a memory copy.
+pub enum Copied {
+    /// One column per state variable, in the spec's order.
+    Columns(Vec<Vec<f64>>),
+    /// Row-major samples, as [`Samples::Rows`].
+    Rows { data: Vec<f64>, width: usize, picks: Vec<usize> },
+}
+
+/// At most this many values of buffers are kept for the next copy on a thread (32 MiB).
+const SPARE_VALUES: usize = 1 << 22;
+
+thread_local! {
+    /// Buffers of earlier copies on this thread, for the next.
+    static SPARE: std::cell::RefCell<Vec<Vec<f64>>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// A copy of `values` in a kept buffer when there is one.
+fn copy_of(values: &[f64]) -> Vec<f64> {
+    let mut out = SPARE.with(|s| s.borrow_mut().pop()).unwrap_or_default();
+    out.clear();
+    out.extend_from_slice(values);
+    out
+}
+
+impl Copied {
+    /// A copy of `samples`.
+    pub fn of(samples: &Samples<'_>) -> Copied {
+        Copied::prefix(samples, usize::MAX)
+    }
+
+    /// A copy of the first `steps` steps of `samples` (all of them when there are fewer),
+    /// for a call that reads no further.
+    pub fn prefix(samples: &Samples<'_>, steps: usize) -> Copied {
+        match samples {
+            Samples::Columns(cols) => {
+                Copied::Columns(cols.iter().map(|c| copy_of(&c[..steps.min(c.len())])).collect())
+            }
+            Samples::Rows { data, width, picks } => {
+                let end = steps.saturating_mul(*width).min(data.len());
+                Copied::Rows { data: copy_of(&data[..end]), width: *width, picks: picks.clone() }
+            }
+        }
+    }
+
+    /// The samples, borrowed from the copy.
+    pub fn samples(&self) -> Samples<'_> {
+        match self {
+            Copied::Columns(cols) => Samples::Columns(cols.iter().map(Vec::as_slice).collect()),
+            Copied::Rows { data, width, picks } => {
+                Samples::Rows { data, width: *width, picks: picks.clone() }
+            }
+        }
+    }
+
+    /// How many values the copy holds.
+    pub fn values(&self) -> usize {
+        match self {
+            Copied::Columns(cols) => cols.iter().map(Vec::len).sum(),
+            Copied::Rows { data, .. } => data.len(),
+        }
+    }
+
+    /// Keeps the copy's buffers for the next copy on this thread, up to [`SPARE_VALUES`].
+    pub fn recycle(self) {
+        let buffers = match self {
+            Copied::Columns(cols) => cols,
+            Copied::Rows { data, .. } => vec![data],
+        };
+        SPARE.with(|s| {
+            let mut spare = s.borrow_mut();
+            let mut kept: usize = spare.iter().map(Vec::capacity).sum();
+            for b in buffers {
+                if kept + b.capacity() <= SPARE_VALUES {
+                    kept += b.capacity();
+                    spare.push(b);
+                }
+            }
+        });
+    }
+}
+
+impl Held<'_> {
+    /// The samples, copied while the GIL is held.
+    pub fn copied(&self) -> PyResult<Copied> {
+        Ok(Copied::of(&self.samples()?))
+    }
+}
+
 impl HeldBatch<'_> {
+    /// Each trace's samples, copied while the GIL is held.
+    pub fn copied(&self) -> PyResult<Vec<Copied>> {
+        Ok(self.samples()?.iter().map(Copied::of).collect())
+    }
+
     /// The steps the batch's shape gives, when it has a shape (an array of no traces still
     /// has steps).
     pub fn shape_steps(&self) -> Option<usize> {

@@ -1,0 +1,54 @@
+//! Long calls that Ctrl-C ends. The work runs on a thread of its own while the calling
+//! thread, holding the GIL only for a moment every [`SIGNAL_EVERY`], runs Python's signal
+//! handlers: a `KeyboardInterrupt` ends the call at once. The work then finishes on its own
+//! thread and its result is dropped; it holds only what was moved into it.
+
+use std::sync::mpsc;
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+use crate::errors::value_error;
+
+/// How often a watched call runs Python's signal handlers.
+pub const SIGNAL_EVERY: Duration = Duration::from_millis(100);
+
+/// Work over fewer values than this runs on the calling thread with the GIL released: it
+/// ends within a few milliseconds, and a thread of its own would cost more than it saves.
+pub const WATCHED_VALUES: usize = 1 << 20;
+
+/// Runs `work` with the GIL released, on a thread of its own when it reads `values` or
+/// more values, so that Ctrl-C (or any signal handler that raises) ends the call.
+pub fn run<T: Send + 'static>(
+    py: Python<'_>,
+    values: usize,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> PyResult<T> {
+    if values < WATCHED_VALUES {
+        return Ok(py.detach(work));
+    }
+    let (tx, rx) = mpsc::channel();
+    std::thread::Builder::new()
+        .name("hstl-evaluate".into())
+        .spawn(move || {
+            // The receiver is gone when the call was interrupted: nothing to send to.
+            let _ = tx.send(work());
+        })
+        .map_err(|e| value_error(format!("cannot start a thread to evaluate on: {e}"), None))?;
+    let mut rx = rx;
+    loop {
+        // The receiver goes along and back: it may not be shared with the GIL released.
+        let (back, got) = py.detach(move || {
+            let got = rx.recv_timeout(SIGNAL_EVERY);
+            (rx, got)
+        });
+        rx = back;
+        match got {
+            Ok(done) => return Ok(done),
+            Err(mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(value_error("the evaluating thread failed", None));
+            }
+        }
+    }
+}
