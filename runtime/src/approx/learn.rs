@@ -36,6 +36,7 @@ use hstl_robustness::{Formula, StateEval, Trace};
 use rand::RngExt;
 
 use super::tiles::TileCoder;
+use crate::episode::{Choices, explores, gamma_powers_to, train_episodes};
 use crate::progress::{GoalTracker, Progress};
 use crate::spec::{LevelParams, RewardKind, Terminate, TileParams};
 use crate::{Error, Rng, TaskSpec, World};
@@ -580,16 +581,13 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         mut progress: impl FnMut(usize, f64) -> ControlFlow<()>,
     ) -> Trained {
         let before = self.weights.steps;
-        let mut curve = Vec::with_capacity(self.spec.learn.episodes);
         let mut run = Run::default();
         let mut scratch = Scratch::default();
-        for episode in 0..self.spec.learn.episodes {
-            let reward = self.episode(rng, &mut run, &mut scratch);
-            curve.push(reward);
-            if progress(episode, reward).is_break() {
-                break;
-            }
-        }
+        let curve = train_episodes(
+            self.spec.learn.episodes,
+            || self.episode(rng, &mut run, &mut scratch),
+            &mut progress,
+        );
         Trained { curve, steps: self.weights.steps - before }
     }
 
@@ -602,19 +600,15 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             s.goals.read(progress);
         }
         let mut total = 0.0;
-        // Once every goal is met, the episode goes on to the task's horizon, as a greedy
-        // run does: the options level learns to keep the rest where the run then is (with
-        // one option it has nothing to learn).
-        let hold = match &self.model.progress {
-            Some(p) if self.model.legs.len() > 1 => {
-                Some((p.all_met(), crate::progress::run_steps(&self.spec.task) - 1))
-            }
-            _ => None,
-        };
+        let choices = Choices::new(
+            self.spec.learn.choices,
+            self.model.progress.as_ref().map(Progress::all_met),
+            self.model.legs.len(),
+            &self.spec.task,
+        );
         let mut steps = 0;
         for choice in 0.. {
-            let holding = hold.is_some_and(|(all, h)| s.goals.met() == all && steps < h);
-            if choice >= self.spec.learn.choices && !holding {
+            if !choices.go_on(choice, s.goals.met(), steps) {
                 break;
             }
             let o = self.choose_option(rng, s);
@@ -632,10 +626,9 @@ impl<'w, W: World> ApproxLearner<'w, W> {
     }
 
     fn choose_option(&mut self, rng: &mut Rng, s: &mut Scratch) -> usize {
-        let eps = self.spec.learn.options.epsilon_at(self.weights.choices);
-        self.weights.choices += 1;
+        let explore = explores(&self.spec.learn.options, None, &mut self.weights.choices, rng);
         self.model.available(&mut self.eval, &s.x, &mut s.available);
-        if rng.random::<f64>() < eps {
+        if explore {
             return s.available[rng.random_range(0..s.available.len())];
         }
         self.model.options_coder.features(&s.x, &mut s.g);
@@ -674,9 +667,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         model.flat_coder.features(&s.x, &mut s.f);
         for &p in &model.legs[o] {
             for _ in 0..model.max_steps {
-                let eps = flat.epsilon_at(self.weights.steps);
-                self.weights.steps += 1;
-                let a = if rng.random::<f64>() < eps {
+                let a = if explores(&flat, None, &mut self.weights.steps, rng) {
                     random_unblocked(&s.blocked, rng)
                 } else {
                     model.greedy_action(&self.weights, p, &s.f, &s.blocked, &mut s.q)
@@ -779,10 +770,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
             .iter()
             .map(|&b| model.option_value(&self.weights, run.codes[k], b, end_g))
             .fold(f64::NEG_INFINITY, f64::max);
-        if self.gamma_powers.len() <= k {
-            let last = self.gamma_powers.len();
-            self.gamma_powers.extend((last..=k).map(|i| params.gamma.powi(i as i32)));
-        }
+        gamma_powers_to(&mut self.gamma_powers, params.gamma, k);
         let n = model.options_coder.len();
         let step = params.alpha / t as f64;
         for j in 0..k {
