@@ -52,7 +52,6 @@ const LONG_FILE: usize = 800;
 /// that is no longer long.
 const LONG_FILES_TO_SPLIT: &[&str] = &[
     "robustness/src/dense/online.rs",
-    "runtime/src/approx/learn.rs",
     "src/continuous.rs",
     "src/monitor.rs",
     "src/monitor/dense.rs",
