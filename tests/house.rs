@@ -53,8 +53,6 @@ const LONG_FILE: usize = 800;
 const LONG_FILES_TO_SPLIT: &[&str] = &[
     "robustness/src/dense/online.rs",
     "src/continuous.rs",
-    "src/monitor.rs",
-    "src/monitor/dense.rs",
     "src/reward.rs",
     "hstlc/src/lsp/features.rs",
     "python/src/policy.rs",
