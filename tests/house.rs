@@ -53,7 +53,6 @@ const LONG_FILE: usize = 800;
 const LONG_FILES_TO_SPLIT: &[&str] = &[
     "robustness/src/dense/online.rs",
     "src/continuous.rs",
-    "src/reward.rs",
     "hstlc/src/lsp/features.rs",
     "python/src/policy.rs",
 ];
