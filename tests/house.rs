@@ -52,7 +52,6 @@ const LONG_FILE: usize = 800;
 /// that is no longer long.
 const LONG_FILES_TO_SPLIT: &[&str] = &[
     "robustness/src/dense/online.rs",
-    "src/continuous.rs",
     "hstlc/src/lsp/features.rs",
     "python/src/policy.rs",
 ];
