@@ -2,7 +2,7 @@
 //! `hstlc explain CODE` prints [`CodeInfo::explanation`]. Codes are stable: new ones are
 //! added at the end.
 
-use crate::diagnostic::Severity;
+use crate::severity::Severity;
 
 /// One diagnostic code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

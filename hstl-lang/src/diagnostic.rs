@@ -2,24 +2,7 @@
 
 use std::ops::Range;
 
-/// How bad a diagnostic is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Severity {
-    /// The spec is still usable.
-    Warning,
-    /// The spec cannot be used.
-    Error,
-}
-
-impl Severity {
-    /// `"error"` or `"warning"`, as every text and machine format spells it.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Severity::Error => "error",
-            Severity::Warning => "warning",
-        }
-    }
-}
+pub use crate::severity::Severity;
 
 /// A secondary source location that matters to a diagnostic, such as a first definition.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

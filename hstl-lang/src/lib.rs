@@ -63,12 +63,15 @@ pub mod parser;
 pub mod position;
 pub mod preset;
 pub mod render;
+pub mod severity;
 pub mod suggest;
 pub mod syntax;
 pub mod wording;
 pub mod world;
 
-pub use check::{Checked, check, check_parsed};
+pub use check::{
+    Checked, check, check_in_world, check_parsed, check_parsed_in_world, check_parsed_with_worlds,
+};
 
 /// The largest spec text the tools read, in bytes (64 MiB): `hstlc` and the macro's
 /// `include "path"` refuse a larger file before reading all of it.
@@ -79,7 +82,4 @@ pub use format::format;
 pub use parser::{KEYWORDS, Parsed, parse};
 pub use position::{LineIndex, Location, Position};
 pub use render::{FileDiagnostics, render_concise, render_plain};
-pub use world::{
-    BoxFacts, SpecWorld, WorldFacts, WorldProblem, check_in_world, check_parsed_in_world,
-    check_parsed_with_worlds, world_item,
-};
+pub use world::{BoxFacts, SpecWorld, WorldFacts, WorldProblem, world_item};

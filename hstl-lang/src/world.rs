@@ -1,10 +1,12 @@
-//! Checking a spec against the grid world it is trained in.
+//! What the checks know of the world a spec is trained in: the facts the checker reads.
 //!
 //! A spec names its world with an item `world "NAME_OR_PATH";` (a built-in world's name, or
 //! a world file's path relative to the spec file). The front end reads no file: the caller
 //! (the CLI, the language server, Python) finds the world each spec names, or the one a
 //! command line imposes, and passes it as plain data ([`SpecWorld`], [`WorldFacts`]) to
-//! [`check_parsed_with_worlds`]. A spec checked [`SpecWorld::Alone`] gets no world facts and
+//! [`crate::check_parsed_with_worlds`]; the entry points that run the checker against a
+//! world live with the checker ([`crate::check`](mod@crate::check)), so that this file, which
+//! the checker reads, reads nothing of the checker. A spec checked [`SpecWorld::Alone`] gets no world facts and
 //! no world diagnostics: a custom Rust or gymnasium environment is a world no check can see.
 //!
 //! Against a world, every check of [`crate::check()`] runs, plus these, on each spec that
@@ -20,11 +22,10 @@
 //! With a world the state fits, the finite-domain checks (`HSTL018`, `HSTL020`, `HSTL102`,
 //! `HSTL103`) range over the free cells only: walls are not states.
 
-use crate::check::{Checked, check_parsed_in};
+use crate::budget::tiles::TileFit;
 use crate::checked::{CheckedSpec, Domain, VarType};
 use crate::diagnostic::Diagnostic;
 use crate::syntax::{Item, Spec, WorldItem};
-use crate::{Parsed, parse};
 
 /// What the checks know of a grid world.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -64,7 +65,7 @@ pub struct BoxFacts {
     pub actions: u64,
     /// How it lays tiles along a variable whose `bins` a spec leaves out (`None`: the
     /// spec's tile box as it is).
-    pub fit: Option<crate::budget::TileFit>,
+    pub fit: Option<TileFit>,
 }
 
 /// What one spec is checked against.
@@ -78,29 +79,6 @@ pub enum SpecWorld<'w> {
     Box(&'w BoxFacts),
     /// The world the spec names, which could not be had.
     Unavailable(&'w WorldProblem),
-}
-
-/// Parses and checks `src` as [`crate::check()`] does, and checks each spec with options
-/// against `world`, whatever world the spec names (a command line's `--world`). Never fails
-/// and never panics.
-pub fn check_in_world(src: &str, world: &WorldFacts) -> Checked {
-    check_parsed_in(src, parse(src), &|_| SpecWorld::Facts(world))
-}
-
-/// [`check_in_world`] on a text that is already parsed (see [`crate::check_parsed`]): what
-/// an editor that re-parses only what changed calls.
-pub fn check_parsed_in_world(src: &str, parsed: Parsed, world: &WorldFacts) -> Checked {
-    check_parsed_in(src, parsed, &|_| SpecWorld::Facts(world))
-}
-
-/// Checks a parsed text with each spec against the world `world_of` gives for it (usually
-/// the one its [`world_item`] names, found by the caller). Never fails and never panics.
-pub fn check_parsed_with_worlds<'w>(
-    src: &str,
-    parsed: Parsed,
-    world_of: &dyn Fn(&Spec) -> SpecWorld<'w>,
-) -> Checked {
-    check_parsed_in(src, parsed, world_of)
 }
 
 /// The spec's `world` item (the first, if it has several: the others are reported).

@@ -158,7 +158,7 @@ struct Inner {
     horizon: Vec<Option<usize>>,
     /// `state[i]`: node `i` has no temporal operator below it.
     state: Vec<bool>,
-    plan: crate::offline::Plan,
+    plan: crate::offline::plan::Plan,
 }
 
 /// An arithmetic expression over the state variables of one sample: a DAG of expression
@@ -714,7 +714,7 @@ impl Formula {
             horizon.push(h);
             state.push(s);
         }
-        let plan = crate::offline::Plan::new(&nodes, root as usize, &horizon, &state);
+        let plan = crate::offline::plan::Plan::new(&nodes, root as usize, &horizon, &state);
         Formula { inner: std::sync::Arc::new(Inner { nodes, root, horizon, state, plan }) }
     }
 
@@ -805,7 +805,7 @@ impl Formula {
         &self.inner.state
     }
 
-    pub(crate) fn plan(&self) -> &crate::offline::Plan {
+    pub(crate) fn plan(&self) -> &crate::offline::plan::Plan {
         &self.inner.plan
     }
 

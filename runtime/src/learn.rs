@@ -44,11 +44,12 @@ use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
 use crate::env::EpisodeEnd;
+use crate::episode::{Choices, explores, floor_from, gamma_powers_to, train_episodes};
 use crate::greedy::{argmax, best_of, max_of};
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
 use crate::plan_reach::{OptionsLayout, ReachPlanner};
-use crate::progress::{GoalTracker, StateGoals, run_steps};
+use crate::progress::{GoalTracker, StateGoals};
 use crate::spec::{Intra, LearnParams, LevelParams, Plan, RewardKind};
 use crate::tables::Tables;
 use crate::{Env, Error, Rng, TaskSpec};
@@ -357,18 +358,14 @@ impl<'e, E: Env> Learner<'e, E> {
             self.q.flat = flat;
             self.q.options = options;
         }
-        let episodes = self.spec.learn.episodes;
-        let mut curve = Vec::with_capacity(episodes);
         let steps_before = self.q.steps;
         let mut run = Run::default();
         let mut rewards = Vec::new();
-        for episode in 0..episodes {
-            let reward = self.episode(rng, &mut run, &mut rewards);
-            curve.push(reward);
-            if progress(episode, reward).is_break() {
-                break;
-            }
-        }
+        let curve = train_episodes(
+            self.spec.learn.episodes,
+            || self.episode(rng, &mut run, &mut rewards),
+            &mut progress,
+        );
         self.plan();
         Trained { curve, steps: self.q.steps - steps_before }
     }
@@ -421,19 +418,15 @@ impl<'e, E: Env> Learner<'e, E> {
         }
         self.begin(s);
         let mut total = 0.0;
-        // Once every goal is met, the episode goes on to the task's horizon, as a greedy
-        // run does: the options level learns to keep the rest where the run then is (with
-        // one option it has nothing to learn).
-        let hold = match &self.goals {
-            Some(g) if self.tables.legs.len() > 1 => {
-                Some((g.progress.all_met(), run_steps(&self.spec.task) - 1))
-            }
-            _ => None,
-        };
+        let choices = Choices::new(
+            self.spec.learn.choices,
+            self.goals.as_ref().map(|g| g.progress.all_met()),
+            self.tables.legs.len(),
+            &self.spec.task,
+        );
         let mut steps = 0;
         for choice in 0.. {
-            let holding = hold.is_some_and(|(all, h)| self.tracker.met() == all && steps < h);
-            if choice >= self.spec.learn.choices && !holding {
+            if !choices.go_on(choice, self.tracker.met(), steps) {
                 break;
             }
             let o = self.choose_option(s, rng);
@@ -473,10 +466,9 @@ impl<'e, E: Env> Learner<'e, E> {
     }
 
     fn choose_option(&mut self, s: usize, rng: &mut Rng) -> usize {
-        let eps = self.spec.learn.options.epsilon_at(self.q.choices);
-        self.q.choices += 1;
+        let explore = explores(&self.spec.learn.options, None, &mut self.q.choices, rng);
         let available = &self.tables.available[s];
-        if rng.random::<f64>() < eps {
+        if explore {
             return available[rng.random_range(0..available.len())];
         }
         let n = self.tables.legs.len();
@@ -529,14 +521,7 @@ impl<'e, E: Env> Learner<'e, E> {
             run.leg_starts.push(run.states.len() - 1);
             let term = &tables.term[p];
             for _ in 0..max_steps {
-                // At and past the floor `epsilon_at` is `min_epsilon` (or a value equal to
-                // it): the comparison below is the same.
-                let eps = match *flat_floor {
-                    Some(floor) if q.steps >= floor => flat.min_epsilon,
-                    _ => flat.epsilon_at(q.steps),
-                };
-                q.steps += 1;
-                let a = if rng.random::<f64>() < eps {
+                let a = if explores(&flat, *flat_floor, &mut q.steps, rng) {
                     rng.random_range(0..actions)
                 } else {
                     argmax(&q.flat[p][s * actions..][..actions])
@@ -662,10 +647,7 @@ impl<'e, E: Env> Learner<'e, E> {
             .iter()
             .map(|&b| self.q.options[end_row + b])
             .fold(f64::NEG_INFINITY, f64::max);
-        if self.gamma_powers.len() <= k {
-            let last = self.gamma_powers.len();
-            self.gamma_powers.extend((last..=k).map(|i| params.gamma.powi(i as i32)));
-        }
+        gamma_powers_to(&mut self.gamma_powers, params.gamma, k);
         let remaining = self.spec.learn.intra == Intra::Remaining;
         let mut leg = 0;
         for (j, (&s, &reward)) in run.states[..k].iter().zip(rewards).enumerate() {
@@ -729,23 +711,6 @@ impl<E: Env> Learner<'_, E> {
             }
         }
     }
-}
-
-/// The least `n` with `epsilon - decay * n <= min_epsilon`, from which
-/// [`LevelParams::epsilon_at`] is `min_epsilon`, or `None` when no `u64` reaches it. With
-/// `decay >= 0` (validated) the expression does not increase with `n`: every rounded
-/// operation is monotone.
-fn floor_from(level: &LevelParams) -> Option<u64> {
-    let at_floor = |n: u64| level.epsilon - level.decay * n as f64 <= level.min_epsilon;
-    if !at_floor(u64::MAX) {
-        return None;
-    }
-    let (mut lo, mut hi) = (0, u64::MAX);
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if at_floor(mid) { hi = mid } else { lo = mid + 1 }
-    }
-    Some(lo)
 }
 
 /// The flat update of every primitive after the step from cell `cell` (state times

@@ -30,6 +30,7 @@
 pub mod approx;
 pub mod draw;
 pub mod env;
+mod episode;
 mod error;
 pub mod eval;
 mod geometry;

@@ -472,15 +472,6 @@ impl Cx<'_> {
     }
 }
 
-/// The preset a `learn` item names: `auto` when its first `preset` parameter is `auto`, the
-/// paper's otherwise (a bad value is reported where the `learn` item is checked).
-pub(super) fn preset_of(l: &syntax::Learn) -> Preset {
-    match l.params.iter().find(|p| p.name.name == "preset").map(|p| &p.value) {
-        Some(ParamValue::Word(w)) if w.name == "auto" => Preset::Auto,
-        _ => Preset::Paper,
-    }
-}
-
 pub(super) fn value_range(v: &ParamValue) -> Range<usize> {
     match v {
         ParamValue::Number(n) => n.range.clone(),

@@ -56,16 +56,17 @@ mod domain;
 mod learn;
 mod options;
 mod resolve;
+mod time;
 
-use self::{learn::*, resolve::*};
+use self::time::time_decimals;
 use crate::suggest::{closest, some_names};
 use crate::wording::{plural, state_text};
 
+pub use self::time::MAX_TIME_BOUND;
 pub use crate::limits::{MAX_DOMAIN_STATES, MAX_DOMAIN_WORK};
 pub use crate::suggest::{MAX_SUGGEST_CHARS, SUGGEST_BUDGET};
 pub use crate::wording::thousands;
 pub use options::expand;
-pub use resolve::MAX_TIME_BOUND;
 
 /// At most this many diagnostics are reported per file.
 pub const MAX_DIAGNOSTICS: usize = 200;
@@ -115,6 +116,33 @@ pub fn check(src: &str) -> Checked {
 /// it without parsing the whole text). Never fails and never panics.
 pub fn check_parsed(src: &str, parsed: crate::parser::Parsed) -> Checked {
     check_parsed_in(src, parsed, &|_| SpecWorld::Alone)
+}
+
+/// Parses and checks `src` as [`crate::check()`] does, and checks each spec with options
+/// against `world`, whatever world the spec names (a command line's `--world`). Never fails
+/// and never panics.
+pub fn check_in_world(src: &str, world: &WorldFacts) -> Checked {
+    check_parsed_in(src, parse(src), &|_| SpecWorld::Facts(world))
+}
+
+/// [`check_in_world`] on a text that is already parsed (see [`check_parsed`]): what
+/// an editor that re-parses only what changed calls.
+pub fn check_parsed_in_world(
+    src: &str,
+    parsed: crate::parser::Parsed,
+    world: &WorldFacts,
+) -> Checked {
+    check_parsed_in(src, parsed, &|_| SpecWorld::Facts(world))
+}
+
+/// Checks a parsed text with each spec against the world `world_of` gives for it (usually
+/// the one its [`crate::world_item`] names, found by the caller). Never fails and never panics.
+pub fn check_parsed_with_worlds<'w>(
+    src: &str,
+    parsed: crate::parser::Parsed,
+    world_of: &dyn Fn(&syntax::Spec) -> SpecWorld<'w>,
+) -> Checked {
+    check_parsed_in(src, parsed, world_of)
 }
 
 /// [`check_parsed`], with each spec checked against the world `world_of` gives for it.
@@ -441,5 +469,14 @@ impl Cx<'_> {
             }
         }
         out
+    }
+}
+
+/// The preset a `learn` item names: `auto` when its first `preset` parameter is `auto`, the
+/// paper's otherwise (a bad value is reported where the `learn` item is checked).
+fn preset_of(l: &syntax::Learn) -> Preset {
+    match l.params.iter().find(|p| p.name.name == "preset").map(|p| &p.value) {
+        Some(ParamValue::Word(w)) if w.name == "auto" => Preset::Auto,
+        _ => Preset::Paper,
     }
 }

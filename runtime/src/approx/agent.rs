@@ -9,7 +9,7 @@
 
 use hstl_robustness::{StateEval, Trace};
 
-use super::learn::{Model, Weights};
+use super::model::{Model, Weights};
 use crate::progress::GoalTracker;
 use crate::spec::Switch;
 use crate::{Error, Rng, TaskSpec, World};

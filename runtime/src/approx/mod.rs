@@ -19,8 +19,10 @@
 
 pub mod agent;
 pub mod learn;
+mod model;
 pub mod tiles;
 
 pub use agent::{ApproxAgent, GreedyRun, Stepper, WindowSummary, task_robustness};
-pub use learn::{ApproxLearner, Model, Shape, Weights};
+pub use learn::ApproxLearner;
+pub use model::{Model, Shape, Weights};
 pub use tiles::TileCoder;

@@ -16,7 +16,7 @@
 //! before. The obstacles it does give are in index order, so the tests run in the same
 //! order as over the whole list.
 
-use super::Obstacle;
+use super::obstacle::Obstacle;
 
 /// Below this many obstacles every move tests them all: an index would not pay.
 const MIN_INDEXED: usize = 16;

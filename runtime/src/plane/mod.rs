@@ -40,94 +40,19 @@ use serde_json::{Value, json};
 
 use crate::draw;
 use crate::env::World;
-use crate::geometry::{self, Xy};
+use crate::geometry::Xy;
 use crate::{Error, Rng};
 
+mod errors;
 mod index;
+mod obstacle;
+mod start;
+
+pub use errors::num;
+pub(crate) use errors::*;
 use index::ObstacleIndex;
-
-/// A position in a plane world: its state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Point {
-    /// Left to right.
-    pub x: f64,
-    /// Bottom to top.
-    pub y: f64,
-}
-
-impl Point {
-    fn xy(self) -> Xy {
-        (self.x, self.y)
-    }
-}
-
-/// An obstacle of a plane world, a closed set: its edge is part of it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Obstacle {
-    /// The closed disk of centre `(cx, cy)` and radius `r`.
-    Circle {
-        /// The centre's x.
-        cx: f64,
-        /// The centre's y.
-        cy: f64,
-        /// The radius, positive.
-        r: f64,
-    },
-    /// The closed rectangle `[x0, x1] x [y0, y1]`.
-    Rect {
-        /// The left edge.
-        x0: f64,
-        /// The bottom edge.
-        y0: f64,
-        /// The right edge, greater than `x0`.
-        x1: f64,
-        /// The top edge, greater than `y0`.
-        y1: f64,
-    },
-}
-
-impl Obstacle {
-    /// Whether the point `p` is in the obstacle (its edge included).
-    pub fn contains(&self, p: Point) -> bool {
-        match *self {
-            Obstacle::Circle { cx, cy, r } => geometry::in_disk(p.xy(), (cx, cy), r),
-            Obstacle::Rect { x0, y0, x1, y1 } => geometry::in_rect(p.xy(), [x0, y0, x1, y1]),
-        }
-    }
-
-    /// Whether the closed segment from `p` to `q` touches the obstacle, decided exactly for
-    /// these doubles: a segment that grazes a corner or runs along an edge touches it,
-    /// whatever the rounding. `p == q` is the point. Exact while the products of
-    /// coordinate differences neither overflow nor underflow (numbers between about
-    /// 1e-140 and 1e140, or zero); past that, a doubtful case counts as touching.
-    pub fn touches_segment(&self, p: Point, q: Point) -> bool {
-        match *self {
-            Obstacle::Circle { cx, cy, r } => {
-                geometry::segment_touches_disk(p.xy(), q.xy(), (cx, cy), r)
-            }
-            Obstacle::Rect { x0, y0, x1, y1 } => {
-                geometry::segment_touches_rect(p.xy(), q.xy(), [x0, y0, x1, y1])
-            }
-        }
-    }
-
-    /// The obstacle as a world file and `policy.json` write it: `{"circle": [cx, cy, r]}`
-    /// or `{"rect": [x0, y0, x1, y1]}`.
-    pub fn to_json(&self) -> Value {
-        match *self {
-            Obstacle::Circle { cx, cy, r } => json!({ "circle": [cx, cy, r] }),
-            Obstacle::Rect { x0, y0, x1, y1 } => json!({ "rect": [x0, y0, x1, y1] }),
-        }
-    }
-
-    /// Its numbers, as written.
-    fn numbers(&self) -> Vec<f64> {
-        match *self {
-            Obstacle::Circle { cx, cy, r } => vec![cx, cy, r],
-            Obstacle::Rect { x0, y0, x1, y1 } => vec![x0, y0, x1, y1],
-        }
-    }
-}
+pub use obstacle::{Obstacle, Point};
+use start::free_boxes;
 
 /// What a plane world is made of, as a world file gives it.
 #[derive(Clone, Debug, PartialEq)]
@@ -181,68 +106,6 @@ pub struct PlaneWorld {
     start_free: f64,
     /// The obstacles in buckets over the extent (`None`: every move tests them all).
     index: Option<Box<ObstacleIndex>>,
-}
-
-/// Which part of a configuration an error is about, so a world file can point at it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Field {
-    /// The extent along x: the pair, or one bound.
-    X(Option<usize>),
-    /// The extent along y.
-    Y(Option<usize>),
-    Step,
-    Headings,
-    Slip,
-    Noise,
-    /// The obstacles as a whole.
-    Obstacles,
-    /// One obstacle, or one of its numbers.
-    Obstacle(usize, Option<usize>),
-    /// The start rectangle, or one of its numbers.
-    Start(Option<usize>),
-}
-
-/// A configuration that gives no world: what is wrong, where, and how to fix it.
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct ConfigError {
-    pub field: Field,
-    pub message: String,
-    pub help: &'static str,
-}
-
-pub(crate) const EXTENT_HELP: &str =
-    "write the extent as two finite numbers, lower first, such as `x = [0.0, 20.0]`";
-pub(crate) const STEP_HELP: &str =
-    "write how far the chosen heading moves the robot in one step, such as `step = 0.5`";
-pub(crate) const HEADINGS_HELP: &str = "write `headings = 4` for E N W S, `headings = 8` for E NE \
-                                        N NW W SW S SE, or another count from 3 to 64";
-pub(crate) const SLIP_HELP: &str = "write a probability such as `slip = 0.1`: one of the other \
-                                    headings is taken instead with this probability";
-pub(crate) const NOISE_HELP: &str = "write the standard deviation of the noise on each \
-                                     coordinate of a move, such as `noise = 0.05`, or 0 for none";
-pub(crate) const CIRCLE_HELP: &str =
-    "write a circle as `{ circle = [cx, cy, r] }` with finite numbers and a positive radius r";
-pub(crate) const RECT_HELP: &str = "write a rectangle as `{ rect = [x0, y0, x1, y1] }`, lower \
-                                    left corner first, with x0 < x1 and y0 < y1";
-pub(crate) const START_HELP: &str = "write the start rectangle as `start = [x0, y0, x1, y1]`, \
-                                     lower left corner first, inside the extent";
-const FREE_HELP: &str = "move the start rectangle (`start = [x0, y0, x1, y1]`) to where the \
-                         obstacles leave room, or make the obstacles smaller";
-
-/// A number as messages show it: plain for moderate magnitudes, with an exponent beyond
-/// (`1e300`, `5e-324`), read back to the same double either way.
-pub fn num(v: f64) -> String {
-    let a = v.abs();
-    if v.is_finite() && a != 0.0 && !(1e-5..1e16).contains(&a) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
-}
-
-fn list(values: &[f64]) -> String {
-    let parts: Vec<String> = values.iter().map(|&v| num(v)).collect();
-    format!("[{}]", parts.join(", "))
 }
 
 impl PlaneWorld {
@@ -688,117 +551,5 @@ impl World for PlaneWorld {
         let Some(&(ux, uy)) = self.dirs.get(action) else { return true };
         let step = self.config.step;
         !self.segment_is_free(*state, Point { x: state.x + step * ux, y: state.y + step * uy })
-    }
-}
-
-/// What the quadtree found in a start rectangle.
-struct Found {
-    /// A lower bound on the free share of the rectangle.
-    share: f64,
-    /// The centre of the largest free box.
-    largest: Option<Point>,
-    /// Whether every box was classified (the share is then exact).
-    complete: bool,
-}
-
-/// How many boxes the quadtree may classify, and how many box-obstacle tests it may make.
-const MAX_BOXES: usize = 1 << 16;
-const MAX_TESTS: usize = 1 << 22;
-
-/// Cuts `rect` into boxes free of every obstacle, inside one, or cut further, breadth
-/// first within the budgets above (see the module docs).
-fn free_boxes(rect: [f64; 4], obstacles: &[Obstacle]) -> Found {
-    // Each box with its share of `rect` and the obstacles that touch it without covering it.
-    let mut queue = std::collections::VecDeque::new();
-    queue.push_back((rect, 1.0f64, (0..obstacles.len() as u32).collect::<Vec<u32>>()));
-    let (mut share, mut largest, mut best) = (0.0, None, 0.0);
-    let (mut boxes, mut tests) = (0usize, 0usize);
-    while let Some((b, part, near)) = queue.pop_front() {
-        if boxes >= MAX_BOXES || tests >= MAX_TESTS {
-            return Found { share, largest, complete: false };
-        }
-        boxes += 1;
-        tests += near.len();
-        let mut touching = Vec::new();
-        let mut inside = false;
-        for &i in &near {
-            match relation(b, &obstacles[i as usize]) {
-                Relation::Apart => {}
-                Relation::Inside => {
-                    inside = true;
-                    break;
-                }
-                Relation::Across => touching.push(i),
-            }
-        }
-        if inside {
-            continue;
-        }
-        if touching.is_empty() {
-            share += part;
-            if part > best {
-                best = part;
-                largest = Some(Point { x: mid(b[0], b[2]), y: mid(b[1], b[3]) });
-            }
-            continue;
-        }
-        // Cut along each axis that still has room between its ends.
-        let (mx, my) = (mid(b[0], b[2]), mid(b[1], b[3]));
-        let xs: &[[f64; 2]] =
-            if mx > b[0] && mx < b[2] { &[[b[0], mx], [mx, b[2]]] } else { &[[b[0], b[2]]] };
-        let ys: &[[f64; 2]] =
-            if my > b[1] && my < b[3] { &[[b[1], my], [my, b[3]]] } else { &[[b[1], b[3]]] };
-        let pieces = xs.len() * ys.len();
-        if pieces == 1 {
-            // Too small to cut: neither free nor covered as far as doubles can tell.
-            continue;
-        }
-        for x in xs {
-            for y in ys {
-                queue.push_back(([x[0], y[0], x[1], y[1]], part / pieces as f64, touching.clone()));
-            }
-        }
-    }
-    Found { share, largest, complete: true }
-}
-
-fn mid(lo: f64, hi: f64) -> f64 {
-    lo / 2.0 + hi / 2.0
-}
-
-enum Relation {
-    /// The box and the obstacle do not touch.
-    Apart,
-    /// The box lies in the obstacle.
-    Inside,
-    /// Neither, as far as the tests tell.
-    Across,
-}
-
-/// How the closed box `b` lies to an obstacle.
-fn relation(b: [f64; 4], o: &Obstacle) -> Relation {
-    match *o {
-        Obstacle::Rect { x0, y0, x1, y1 } => {
-            if b[2] < x0 || b[0] > x1 || b[3] < y0 || b[1] > y1 {
-                Relation::Apart
-            } else if x0 <= b[0] && b[2] <= x1 && y0 <= b[1] && b[3] <= y1 {
-                Relation::Inside
-            } else {
-                Relation::Across
-            }
-        }
-        Obstacle::Circle { cx, cy, r } => {
-            // The point of the box nearest the centre decides whether they touch.
-            let near = (cx.clamp(b[0], b[2]), cy.clamp(b[1], b[3]));
-            if !geometry::in_disk(near, (cx, cy), r) {
-                return Relation::Apart;
-            }
-            let corners = [(b[0], b[1]), (b[2], b[1]), (b[2], b[3]), (b[0], b[3])];
-            if corners.iter().all(|&p| geometry::in_disk(p, (cx, cy), r)) {
-                Relation::Inside
-            } else {
-                Relation::Across
-            }
-        }
     }
 }

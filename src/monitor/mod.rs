@@ -9,20 +9,23 @@
 //! [`Online`] takes one state at a time. A dense-time spec (one with a `time` variable) is
 //! monitored by [`Dense`] instead, over time-stamped samples.
 
-use std::fmt;
 use std::sync::{Mutex, PoisonError};
 
 use hstl_lang::{CheckedSpec, Domain, VarType};
 use hstl_robustness::nan::NanCheck;
-use hstl_robustness::{self as rob, Evaluator, OnlineMonitor, Verdict, offline};
+use hstl_robustness::{self as rob, Evaluator, offline};
 
 use crate::lower::{self, LowerError};
 
 mod dense;
+mod errors;
+mod online;
 mod stamps;
 pub use dense::{
     Dense, DenseLive, DenseLiveState, DenseProblem, DenseRows, StampColumn, time_text,
 };
+pub use errors::{BatchError, TraceError, UnknownWindows};
+pub use online::{Online, OnlineState};
 pub use stamps::{
     Front, MaxGap, Place, Stamp, StampError, StampOrder, StampRules, TimeAxis, decimal_difference,
     signal_rows,
@@ -104,106 +107,6 @@ pub enum Samples<'a> {
     },
 }
 
-/// A trace or a state that cannot be scored.
-#[derive(Clone, Debug, PartialEq)]
-pub enum TraceError {
-    /// The trace lacks a state variable.
-    Missing {
-        /// The state variable.
-        var: String,
-        /// The names the trace has, where the caller knows them.
-        known: Option<Vec<String>>,
-        /// The spec's state variables, in order.
-        vars: Vec<String>,
-    },
-    /// Two state variables have different numbers of samples.
-    Ragged {
-        /// The first state variable.
-        first: String,
-        /// Its samples.
-        first_len: usize,
-        /// The state variable whose length differs.
-        var: String,
-        /// Its samples.
-        len: usize,
-    },
-    /// The trace has no samples.
-    Empty,
-    /// A sample is NaN.
-    NotANumber {
-        /// The state variable.
-        var: String,
-        /// The step, counted from 0.
-        step: usize,
-    },
-    /// A sample of an `int` state variable is not a whole number, or outside its range.
-    NotInDomain {
-        /// The state variable.
-        var: String,
-        /// The step, counted from 0.
-        step: usize,
-        /// The sample.
-        value: f64,
-        /// The variable's declared range, if any.
-        range: Option<(i64, i64)>,
-    },
-    /// An expression of the formula computes NaN on a step (`sqrt` of a negative, `0 / 0`,
-    /// `inf - inf`, ...): robustness has no value there.
-    Undefined {
-        /// The step, counted from 0.
-        step: usize,
-        /// The innermost expression that is NaN, or the comparison, in hstl syntax.
-        expr: String,
-        /// The operation that gave NaN, with its operands (`the square root of -1`).
-        operation: String,
-    },
-    /// A state (for the online monitor) has the wrong number of values.
-    Width {
-        /// The spec's state variables, in order.
-        vars: Vec<String>,
-        /// The number of values given.
-        found: usize,
-    },
-    /// Row-major data whose rows are too short for the picks, or not whole.
-    Layout {
-        /// Values in the data.
-        len: usize,
-        /// Values per row.
-        width: usize,
-    },
-    /// The online monitor would pass its memory budget: `steps` states wait for verdicts
-    /// that the formula's horizon (`None`: unbounded) holds back.
-    Budget {
-        /// The states kept.
-        steps: usize,
-        /// The formula's horizon in steps.
-        horizon: Option<usize>,
-        /// The most values the monitor keeps.
-        limit: usize,
-    },
-}
-
-/// A trace of a batch that cannot be scored.
-#[derive(Clone, Debug, PartialEq)]
-pub enum BatchError {
-    /// Trace `trace` (counted from 0) is not a valid trace.
-    Trace {
-        /// Its index in the batch.
-        trace: usize,
-        /// What is wrong with it.
-        error: TraceError,
-    },
-    /// Trace `trace` has `steps` steps where trace 0 has `first_steps`.
-    Steps {
-        /// Its index in the batch.
-        trace: usize,
-        /// Its steps.
-        steps: usize,
-        /// The steps of trace 0.
-        first_steps: usize,
-    },
-}
-
 /// How the windows at the end of a finite trace count (`hstlc monitor --windows`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Windows {
@@ -224,64 +127,6 @@ impl Windows {
             _ => Err(UnknownWindows(name.to_string())),
         }
     }
-}
-
-/// A `windows` choice that is neither `clipped` nor `complete`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct UnknownWindows(pub String);
-
-impl UnknownWindows {
-    /// How to fix it.
-    pub fn help(&self) -> String {
-        "pass \"clipped\" (windows cut at the end of the trace, the default) or \"complete\" \
-         (only steps whose windows lie inside the trace)"
-            .to_string()
-    }
-}
-
-impl fmt::Display for UnknownWindows {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "unknown windows `{}`", self.0)
-    }
-}
-
-impl std::error::Error for UnknownWindows {}
-
-/// An online monitor over named state variables: one state at a time, NaN refused.
-#[derive(Clone, Debug)]
-pub struct Online {
-    vars: Vec<String>,
-    domains: Vec<ValueDomain>,
-    nan_prone: NanProne,
-    inner: OnlineMonitor,
-    /// The steps before the states `inner` was given: a restored monitor's.
-    offset: usize,
-    /// The last states of the trace, for a formula with a past-time operator (whose
-    /// verdicts read states the monitor no longer holds): what a snapshot replays.
-    log: Option<History>,
-}
-
-/// The states a snapshot of a past-time formula replays: every state from the first whose
-/// values a verdict still to come can read (the formula's lookback before the first open
-/// step), or every state of the trace when that reach is unbounded.
-#[derive(Clone, Debug)]
-struct History {
-    /// States, row after row.
-    states: Vec<f64>,
-    /// The step of the first state in `states`.
-    first: usize,
-    /// How many states to keep; `None`: all.
-    keep: Option<usize>,
-}
-
-/// An online monitor's state as plain data ([`Online::snapshot`]): the states it replays
-/// and the steps before them.
-#[derive(Clone, Debug, PartialEq)]
-pub struct OnlineState {
-    /// The steps before `states`, whose verdicts were all given.
-    pub skipped: usize,
-    /// States, row after row (one value per state variable).
-    pub states: Vec<f64>,
 }
 
 impl Monitor {
@@ -521,26 +366,6 @@ impl Monitor {
         }
     }
 
-    /// An online monitor of this formula.
-    pub fn online(&self) -> Online {
-        Online {
-            vars: self.vars.clone(),
-            domains: self.domains.clone(),
-            nan_prone: self.nan_prone.clone(),
-            inner: OnlineMonitor::new(&self.formula, self.vars.len()),
-            offset: 0,
-            log: self.formula.has_past().then(|| History {
-                states: Vec::new(),
-                first: 0,
-                // The first open step is at most `H` back, and reads at most `lookback`
-                // before it.
-                keep: lookback(&self.formula)
-                    .zip(self.formula.horizon())
-                    .map(|(l, h)| l.saturating_add(h).saturating_add(1)),
-            }),
-        }
-    }
-
     /// The evaluator's length error in the spec's names (the checks before it should
     /// have caught it).
     fn ragged(&self, cols: &[&[f64]], e: rob::TraceError) -> TraceError {
@@ -644,159 +469,6 @@ impl Monitor {
     }
 }
 
-impl Online {
-    /// The state variables, in the order [`Online::push`] takes their values.
-    pub fn state_vars(&self) -> &[String] {
-        &self.vars
-    }
-
-    /// The formula's horizon `H`; `None` when unbounded (no verdict before
-    /// [`Online::finish`]).
-    pub fn horizon(&self) -> Option<usize> {
-        self.inner.horizon()
-    }
-
-    /// The number of states pushed since creation or the last [`Online::finish`].
-    pub fn steps(&self) -> usize {
-        self.offset + self.inner.steps()
-    }
-
-    /// The monitor's state as plain data: the states from the first step without a
-    /// verdict on (at most `H` for a bounded formula; every state of the trace for an
-    /// unbounded one), or for a formula with a past-time operator also the states before
-    /// it that its past windows read (every state when they are unbounded), and how many
-    /// steps came before. [`Online::restore`] on a monitor of the same formula continues
-    /// exactly from it.
-    pub fn snapshot(&self) -> OnlineState {
-        if let Some(log) = &self.log {
-            return OnlineState { skipped: log.first, states: log.states.clone() };
-        }
-        let columns = self.inner.open_columns();
-        let open = columns.first().map_or(0, |c| c.len());
-        let states = (0..open).flat_map(|t| columns.iter().map(move |c| c[t])).collect();
-        OnlineState { skipped: self.steps() - open, states }
-    }
-
-    /// Starts a new trace and replays `state`, so the monitor continues where the one
-    /// that gave the snapshot was (same formula). States it would refuse are refused and
-    /// leave it at a new trace.
-    pub fn restore(&mut self, state: &OnlineState) -> Result<(), TraceError> {
-        self.finish();
-        let width = self.vars.len();
-        if width == 0 || !state.states.len().is_multiple_of(width) {
-            return Err(TraceError::Layout { len: state.states.len(), width });
-        }
-        for row in state.states.chunks(width) {
-            // The verdicts of replayed steps were given before the snapshot.
-            if let Err(e) = self.push(row) {
-                self.finish();
-                return Err(e);
-            }
-        }
-        self.offset = state.skipped;
-        if let Some(log) = &mut self.log {
-            log.first = state.skipped;
-        }
-        Ok(())
-    }
-
-    /// Appends one state (`state[i]` is state variable `i`) and returns the verdict it
-    /// completes: the final `rho(f, t)` for `t = steps - 1 - H`, once `H + 1` states are
-    /// in. A state with NaN is refused and changes nothing.
-    pub fn push(&mut self, state: &[f64]) -> Result<Option<Verdict>, TraceError> {
-        if state.len() != self.vars.len() {
-            return Err(TraceError::Width { vars: self.vars.clone(), found: state.len() });
-        }
-        if let Some(var) = state.iter().position(|v| v.is_nan()) {
-            return Err(TraceError::NotANumber { var: self.vars[var].clone(), step: self.steps() });
-        }
-        if let Some(var) = state.iter().zip(&self.domains).position(|(&v, d)| !d.holds(v)) {
-            let range = match self.domains[var] {
-                ValueDomain::Int(range) => range,
-                ValueDomain::Real => None,
-            };
-            let (var_name, step) = (self.vars[var].clone(), self.steps());
-            return Err(TraceError::NotInDomain { var: var_name, step, value: state[var], range });
-        }
-        self.nan_prone.check_state(state, self.steps())?;
-        let verdict = self.inner.push(state).map_err(|e| match e {
-            rob::TraceError::Budget { steps, horizon, limit } => {
-                TraceError::Budget { steps, horizon, limit }
-            }
-            _ => TraceError::Width { vars: self.vars.clone(), found: state.len() },
-        })?;
-        if let Some(log) = &mut self.log {
-            log.states.extend_from_slice(state);
-            let width = state.len().max(1);
-            let held = log.states.len() / width;
-            // Drop the oldest states now and then: amortised O(1), at most twice `keep`.
-            if let Some(keep) = log.keep
-                && held >= 2 * keep.max(32)
-            {
-                let drop = held - keep;
-                log.states.drain(..drop * width);
-                log.first += drop;
-            }
-        }
-        Ok(verdict.map(|v| Verdict { step: v.step + self.offset, ..v }))
-    }
-
-    /// What `rho(f, t)` at the first step without a verdict would be if the trace ended
-    /// now; `None` when every step pushed has its verdict. Not final.
-    pub fn provisional(&mut self) -> Option<f64> {
-        self.inner.provisional()
-    }
-
-    /// Ends the trace: the verdicts of every step still open, windows clipped at the end.
-    /// The monitor then starts a new trace at step 0.
-    pub fn finish(&mut self) -> Vec<Verdict> {
-        let out = self.inner.finish();
-        self.new_trace(out)
-    }
-
-    /// Ends the trace over complete windows: the verdicts of the open steps whose windows
-    /// all lie inside the trace (none for a bounded formula); later steps are undetermined.
-    /// The monitor then starts a new trace at step 0.
-    pub fn finish_complete(&mut self) -> Vec<Verdict> {
-        let out = self.inner.finish_complete();
-        self.new_trace(out)
-    }
-
-    /// The verdicts `out` numbered from the trace's start; the monitor at a new trace.
-    fn new_trace(&mut self, out: Vec<Verdict>) -> Vec<Verdict> {
-        let offset = std::mem::take(&mut self.offset);
-        if let Some(log) = &mut self.log {
-            log.states.clear();
-            log.first = 0;
-        }
-        out.into_iter().map(|v| Verdict { step: v.step + offset, ..v }).collect()
-    }
-}
-
-/// How many steps before `t` the robustness at `t` may read (`None`: unbounded): a past
-/// window `[a..b]` adds `b`, `prev` one step; a future operator's operands count as they
-/// are.
-fn lookback(f: &rob::Formula) -> Option<usize> {
-    use rob::{Bound, Node};
-    let mut back: Vec<Option<usize>> = Vec::with_capacity(f.nodes().len());
-    for node in f.nodes() {
-        let kids = node.children().try_fold(0usize, |a, k| back[k].map(|b| a.max(b)));
-        let reach = |i: &rob::Interval| match i.end {
-            Bound::Unbounded => None,
-            Bound::Inclusive(b) => Some(b),
-            Bound::Exclusive(b) => Some(b.saturating_sub(1)),
-        };
-        back.push(match node {
-            Node::Historically(i, _) | Node::Once(i, _) | Node::Since(i, _, _) => {
-                kids.zip(reach(i)).map(|(k, b)| k.saturating_add(b))
-            }
-            Node::Prev(_) => kids.map(|k| k.saturating_add(1)),
-            _ => kids,
-        });
-    }
-    back.last().copied().flatten()
-}
-
 impl NanProne {
     pub(crate) fn of(formula: &rob::Formula, vars: &[String]) -> NanProne {
         NanProne::of_all(&[formula], vars)
@@ -877,126 +549,6 @@ impl NanProne {
     }
 }
 
-impl TraceError {
-    /// How to fix it, where one fits.
-    pub fn help(&self) -> Option<String> {
-        Some(match self {
-            TraceError::Missing { known: Some(known), vars, .. } => format!(
-                "the trace has {}; the spec's state variables are {}",
-                quote_list(known),
-                quote_list(vars)
-            ),
-            TraceError::Missing { known: None, vars, .. } => {
-                format!("the spec's state variables are {}", quote_list(vars))
-            }
-            TraceError::Ragged { .. } => {
-                "give every state variable one sample per step".to_string()
-            }
-            TraceError::Empty => "give every state variable at least one sample".to_string(),
-            TraceError::NotANumber { .. } => "robustness has no meaning for NaN: drop the \
-                step or give it a number (`inf` and `-inf` are allowed)"
-                .to_string(),
-            TraceError::Width { vars, .. } => {
-                format!("give one value per state variable, in the order {}", quote_list(vars))
-            }
-            TraceError::NotInDomain { var, range: Some((lo, hi)), value, .. }
-                if value.is_finite() && value.fract() == 0.0 =>
-            {
-                format!(
-                    "the spec declares `{var}: int in {lo}..={hi}`: widen the range or fix the trace"
-                )
-            }
-            TraceError::NotInDomain { var, .. } => {
-                format!("`{var}` is an `int` state variable: give whole numbers such as `3`")
-            }
-            TraceError::Undefined { .. } => "robustness has no meaning for NaN: write the \
-                expression so that it is defined on every state the trace can hold (for \
-                example `sqrt(abs(x))`), or fix the trace"
-                .to_string(),
-            TraceError::Layout { .. } => return None,
-            TraceError::Budget { .. } => "a verdict waits until the formula's window has passed: \
-                monitor the whole trace offline instead (without `--online`), or shorten the \
-                window"
-                .to_string(),
-        })
-    }
-}
-
-impl fmt::Display for TraceError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            TraceError::Missing { var, .. } => write!(f, "missing state variable `{var}`"),
-            TraceError::Ragged { first, first_len, var, len } => write!(
-                f,
-                "state variable `{var}` has {}, but `{first}` has {}",
-                samples_word(*len),
-                samples_word(*first_len)
-            ),
-            TraceError::Empty => f.write_str("the trace has no samples"),
-            TraceError::NotANumber { var, step } => write!(f, "`{var}` is NaN at step {step}"),
-            TraceError::Undefined { step, expr, operation } => {
-                write!(f, "`{expr}` is NaN at step {step}: {operation}")
-            }
-            TraceError::NotInDomain { var, step, value, range: Some((lo, hi)) }
-                if value.is_finite() && value.fract() == 0.0 =>
-            {
-                write!(f, "`{var}` is {value} at step {step}, outside its range {lo}..={hi}")
-            }
-            TraceError::NotInDomain { var, step, value, .. } => {
-                write!(f, "`{var}` is {value} at step {step}, not a whole number")
-            }
-            TraceError::Width { vars, found } => write!(
-                f,
-                "the state has {found} value{}, the spec has {} state variable{}",
-                if *found == 1 { "" } else { "s" },
-                vars.len(),
-                if vars.len() == 1 { "" } else { "s" }
-            ),
-            TraceError::Layout { len, width } => {
-                write!(f, "{len} samples do not make whole rows of {width}")
-            }
-            TraceError::Budget { steps, horizon, limit } => {
-                let window = match horizon {
-                    Some(h) => format!("the formula looks {h} steps ahead"),
-                    None => "the formula has an unbounded operator".to_string(),
-                };
-                write!(
-                    f,
-                    "the online monitor holds {steps} states without a verdict ({window}), \
-                     and one more would pass its budget of {limit} values"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for TraceError {}
-
-impl BatchError {
-    /// How to fix it, where one fits.
-    pub fn help(&self) -> Option<String> {
-        match self {
-            BatchError::Trace { error, .. } => error.help(),
-            BatchError::Steps { .. } => {
-                Some("cut or pad the traces to one length, or score each with `signal`".to_string())
-            }
-        }
-    }
-}
-
-impl fmt::Display for BatchError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            BatchError::Trace { trace, error } => write!(f, "trace {trace}: {error}"),
-            BatchError::Steps { trace, steps, first_steps } => {
-                write!(f, "trace {trace} has {steps} steps, but trace 0 has {first_steps}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for BatchError {}
-
 /// The first `len` steps of the samples as columns: borrowed as they are, or for row-major
 /// data copied into `scratch`.
 fn columns<'s>(
@@ -1026,15 +578,4 @@ fn first_nan(values: &[f64]) -> Option<usize> {
         let any = block.iter().fold(false, |acc, v| acc | (v != v));
         any.then(|| b * BLOCK + block.iter().position(|v| v.is_nan()).unwrap_or(0))
     })
-}
-
-fn samples_word(n: usize) -> String {
-    if n == 1 { "1 sample".to_string() } else { format!("{n} samples") }
-}
-
-fn quote_list(names: &[String]) -> String {
-    if names.is_empty() {
-        return "none".to_string();
-    }
-    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }
