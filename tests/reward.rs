@@ -70,6 +70,30 @@ impl Draws {
     }
 }
 
+impl Draws {
+    /// A formula with future and past operators in any nesting (`next` and `prev` too).
+    fn mixed_formula(&mut self, depth: u32) -> String {
+        if depth == 0 || self.below(8) == 0 {
+            return self.formula(0);
+        }
+        let mut f = |d: &mut Draws| d.mixed_formula(depth - 1);
+        match self.below(12) {
+            0 => format!("!{}", f(self)),
+            1 => format!("({} && {})", f(self), f(self)),
+            2 => format!("({} || {})", f(self), f(self)),
+            3 => format!("always{} {}", self.interval(), f(self)),
+            4 => format!("eventually{} {}", self.interval(), f(self)),
+            5 => format!("({} until{} {})", f(self), self.interval(), f(self)),
+            6 => format!("next {}", f(self)),
+            7 => format!("once{} {}", self.interval(), f(self)),
+            8 => format!("historically{} {}", self.interval(), f(self)),
+            9 => format!("({} since{} {})", f(self), self.interval(), f(self)),
+            10 => format!("prev {}", f(self)),
+            _ => format!("({} -> {})", f(self), f(self)),
+        }
+    }
+}
+
 fn spec_text(task: &str) -> String {
     format!("spec T {{ state {{ x: float, y: float }} task {task}; }}")
 }
@@ -139,6 +163,21 @@ fn random_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
     let mut draws = Draws(2016);
     for _ in 0..400 {
         let task = draws.formula(3);
+        let len = 1 + draws.below(25) as usize;
+        let mut values = || (0..len).map(|_| draws.below(9) as f64 - 3.0).collect::<Vec<_>>();
+        let (x, y) = (values(), values());
+        check_prefixes(&task, &x, &y);
+    }
+}
+
+/// Future operators over past ones (the reward read at the last step: online), past ones
+/// over future ones (the prefix evaluated again), and both mixed: every step's reward is
+/// the offline signal's, bit for bit.
+#[test]
+fn random_past_and_future_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
+    let mut draws = Draws(2026);
+    for _ in 0..400 {
+        let task = draws.mixed_formula(4);
         let len = 1 + draws.below(25) as usize;
         let mut values = || (0..len).map(|_| draws.below(9) as f64 - 3.0).collect::<Vec<_>>();
         let (x, y) = (values(), values());

@@ -27,6 +27,7 @@ pub mod complete;
 pub mod dense;
 pub mod formula;
 pub mod kernels;
+pub mod last_step;
 pub mod nan;
 pub mod offline;
 pub mod online;

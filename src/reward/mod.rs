@@ -9,7 +9,10 @@
 //!   region) it is the value of the full trace's signal at `t`; a temporal operator sees
 //!   only the present (`eventually[0..40] A` is `A` at `t`, `eventually[5..9] A` is
 //!   `-inf`). A formula with a past-time operator (`once[0..10] A`) reads the states before
-//!   `s_t` too: it is evaluated over the states so far, `O(t)` a step;
+//!   `s_t` too: its streaming online monitor gives it, `O(|formula|)` a step, once the
+//!   future operators above its past ones are replaced by their value at the last step
+//!   ([`hstl_robustness::last_step`]); only a future operator under a past one (`once[0..5]
+//!   eventually[0..3] A`) makes it evaluated over the states so far, `O(t)` a step;
 //! - the **task's robustness** `rho(task, 0)` over `s_0 ..= s_t`, the value
 //!   `hstlc monitor` prints for the trace so far;
 //! - for a persistent task (`always[0..] (eventually[0..N1] R1 && ...)`), whether the
@@ -27,7 +30,8 @@
 //! Cost per state: everything read off the new state alone (the reward without a
 //! past-time operator, the regions, the state formulas of the task's parts) is one pass
 //! over one flat DAG holding them all, each shared node once, `O(|formula|)`; a reward
-//! with a past-time operator is `O(t |formula|)`. The task's
+//! with a past-time operator is `O(|formula|)` through its online monitor, and
+//! `O(t |formula|)` with a future operator under a past one. The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
 //! distributes over `&&` (`eventually` over `||`); `always[I] f` with `f` a state formula
@@ -54,7 +58,7 @@
 //! ```
 
 use hstl_lang::CheckedSpec;
-use hstl_robustness::{Evaluator, Formula, OnlineMonitor};
+use hstl_robustness::{Evaluator, Formula, OnlineMonitor, last_step};
 
 use std::fmt;
 
@@ -198,15 +202,17 @@ pub struct EpisodeMonitor {
     /// regions' and the task's, the rest `prefix`'s.
     slots: Vec<(Formula, bool)>,
     base_slots: usize,
-    /// The reward's slot, when it is read off the state alone (no past-time operator).
+    /// The reward's slot, when it is read off the state alone (no past-time operator, or
+    /// none left at the last step).
     reward_slot: Option<usize>,
-    /// The states so far, when the reward formula has a past-time operator and a future
-    /// one (a future window clipped at `t` reads the whole prefix again).
+    /// The states so far, when the reward formula has a future operator under a past one
+    /// (a future window clipped at `t` read from an earlier step reads the prefix again).
     history: Option<Columns>,
-    /// The reward formula's online monitor, when it has a past-time operator and no future
-    /// one: `rho(formula, t)` is then final once `s_t` is in, and its streaming past
+    /// The online monitor of the reward formula at the last step
+    /// ([`last_step::at_last_step`]), when it has a past-time operator and no future one
+    /// under it: `rho(formula, t)` is then final once `s_t` is in, and its streaming past
     /// windows give it in `O(|formula|)` a step (it was `O(t)`: quadratic over an episode).
-    past: Option<OnlineMonitor>,
+    past: Option<(Formula, OnlineMonitor)>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
     /// Each region's slot.
@@ -258,7 +264,18 @@ impl EpisodeMonitor {
         // The slots: every scored formula is evaluated on each state (its comparisons are
         // the ones a NaN is looked for in), the reward's and the regions' read back.
         let mut slots: Vec<(Formula, bool)> = vec![(task.clone(), false), (reward.clone(), false)];
-        let reward_slot = (!reward.has_past()).then_some(1);
+        // The reward is read at the newest state only: its future operators that no past
+        // one reads are what they are at the trace's last step, so a past operator inside
+        // a future one is scored online too, and one inside an empty window not at all.
+        let at_end = reward.has_past().then(|| last_step::at_last_step(&reward));
+        let reward_slot = match &at_end {
+            None => Some(1),
+            Some(f) if !f.has_past() => {
+                slots.push((f.clone(), false));
+                Some(slots.len() - 1)
+            }
+            Some(_) => None,
+        };
         let region_slots = regions
             .iter()
             .map(|(f, _)| {
@@ -269,9 +286,11 @@ impl EpisodeMonitor {
         let task = Running::new(&task, vars.len(), &mut slots);
         let base_slots = slots.len();
         let program = Program::new(&slots);
-        let pure_past = reward.has_past() && reward.horizon() == Some(0);
-        let history = (reward.has_past() && !pure_past).then(|| Columns::new(vars.len()));
-        let past = pure_past.then(|| OnlineMonitor::new(&reward, vars.len()));
+        let past = at_end.filter(|f| f.has_past() && f.horizon() == Some(0)).map(|f| {
+            let m = OnlineMonitor::new(&f, vars.len());
+            (f, m)
+        });
+        let history = (reward_slot.is_none() && past.is_none()).then(|| Columns::new(vars.len()));
         Ok(EpisodeMonitor {
             vars,
             reward,
@@ -357,8 +376,8 @@ impl EpisodeMonitor {
         if let Some(h) = &mut self.history {
             h.clear();
         }
-        if let Some(m) = &mut self.past {
-            *m = OnlineMonitor::new(&self.reward, self.vars.len());
+        if let Some((f, m)) = &mut self.past {
+            *m = OnlineMonitor::new(f, self.vars.len());
         }
         self.tau.iter_mut().zip(&self.regions).for_each(|(t, r)| *t = r.1);
         if let Some(prefix) = &mut self.prefix {
@@ -436,7 +455,9 @@ impl EpisodeMonitor {
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }
-            (None, Some(past), _) => past.push(state).ok().flatten().map_or(f64::NAN, |v| v.value),
+            (None, Some((_, past)), _) => {
+                past.push(state).ok().flatten().map_or(f64::NAN, |v| v.value)
+            }
             (None, None, Some(slot)) => program.value(slot),
             (None, None, None) => f64::NAN,
         };
