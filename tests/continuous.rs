@@ -502,9 +502,17 @@ fn a_policy_trained_in_a_described_environment_replays_against_its_spaces() {
             Err(e) => assert!(!e.message.ends_with('.') && e.help.is_some(), "{}", e.message),
         }
     }
-    // A bound nothing else in the document determines is read as written: the environment
-    // a replay is then given must have it (the Python package compares the two).
-    match c::replay_text_any(&text.replacen("-0.07", "-0.08", 1)) {
+    // A bound nothing else in the document determines: the checksum refuses it edited;
+    // in a document without one (written before checksums) it is read as written, and the
+    // environment a replay is then given must have it (the Python package compares them).
+    let bound = text.replacen("-0.07", "-0.08", 1);
+    match c::replay_text_any(&bound) {
+        Err(e) => assert!(e.message.contains("changed after it was written"), "{}", e.message),
+        Ok(_) => panic!("an edited bound was read"),
+    }
+    let mut unsummed: Value = serde_json::from_str(&bound).expect("JSON");
+    unsummed.as_object_mut().expect("an object").remove("checksum");
+    match c::replay_text_any(&unsummed.to_string()) {
         Ok(c::AnyReplay::Gym(r)) => assert_eq!(r.env.low, vec![-1.2, -0.08]),
         _ => panic!("an edited bound reads as written"),
     }

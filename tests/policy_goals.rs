@@ -108,6 +108,7 @@ fn edited_goals_are_refused_with_their_reason() {
     ];
     for (what, edit, want) in cases {
         let mut doc: Value = serde_json::from_str(&text).expect("JSON");
+        unsummed(&mut doc);
         edit(&mut doc);
         let edited = serde_json::to_string(&doc).expect("JSON");
         let e = evaluate::replay(&edited).err().unwrap_or_else(|| panic!("{what}: accepted"));
@@ -116,6 +117,7 @@ fn edited_goals_are_refused_with_their_reason() {
     // An entry moved to the other set of goals met: that observation is then listed twice
     // and the one it left is missing.
     let mut doc: Value = serde_json::from_str(&text).expect("JSON");
+    unsummed(&mut doc);
     let all = doc["options_policy"].as_array().expect("entries");
     let first = all.iter().position(|e| e["goals_met"] == Value::from(Vec::<usize>::new()));
     let i = first.expect("an entry with no goal met");
@@ -180,4 +182,10 @@ fn a_goal_too_long_to_write_out_is_refused_before_anything_runs() {
     let goals = trained.policy.goals.expect("a goal");
     assert_eq!(goals.len(), 1);
     assert!(goals[0].len() > 1 << 8, "the lets written out: {} bytes", goals[0].len());
+}
+
+/// Takes out the document's checksum, which refuses any edit before the fields' own checks
+/// (held in `hstlc/tests/hostile.rs`): each edit here meets the check of its field.
+fn unsummed(doc: &mut Value) {
+    doc.as_object_mut().expect("an object").remove("checksum");
 }

@@ -76,7 +76,7 @@ impl Draws {
         if depth == 0 || self.below(8) == 0 {
             return self.formula(0);
         }
-        let mut f = |d: &mut Draws| d.mixed_formula(depth - 1);
+        let f = |d: &mut Draws| d.mixed_formula(depth - 1);
         match self.below(12) {
             0 => format!("!{}", f(self)),
             1 => format!("({} && {})", f(self), f(self)),

@@ -879,14 +879,73 @@ fn hand_edited_policies_are_refused() {
             "the world is named `four-rooms`, a built-in world, but its parameters are not",
         ),
     ];
-    for (name, edit, expected) in edits {
+    // Each edit with the document's `checksum` taken out (as a document written before
+    // checksums has none): the field's own check says what is wrong.
+    for (name, edit, expected) in &edits {
         let mut edited = doc.clone();
+        edited.as_object_mut().expect("an object").remove("checksum");
         edit(&mut edited);
         let run = eval(&format!("{name}.json"), &edited);
         assert_eq!(run.status, Some(2), "{name}: {}{}", run.stdout, run.stderr);
         assert!(run.stdout.is_empty(), "{name}: {}", run.stdout);
         assert!(run.stderr.contains(expected), "{name}: {}", run.stderr);
     }
+    // With the checksum, an edit of the document's own fields is caught by it first.
+    let changed = "the document was changed after it was written";
+    for (name, edit, expected) in &edits {
+        let mut edited = doc.clone();
+        edit(&mut edited);
+        let run = eval(&format!("{name}-summed.json"), &edited);
+        assert_eq!(run.status, Some(2), "{name}: {}{}", run.stdout, run.stderr);
+        // The hex value does not parse, and the seed is no field of the document's own.
+        let want = if matches!(*name, "signed" | "seed") { *expected } else { changed };
+        assert!(run.stderr.contains(want), "{name}: {}", run.stderr);
+    }
+}
+
+/// Issue 30: a policy trained on a world from a file holds that world whole, its slip
+/// included, and nothing else knew it: an edited slip was evaluated as written. The
+/// document's checksum refuses it; without the edit the same document evaluates.
+#[test]
+fn an_edited_slip_of_a_world_from_a_file_is_refused() {
+    use serde_json::{Value, json};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "room.toml", "map = \"\"\"\nS....\n.....\n.....\n\"\"\"\nslip = 0.2\n");
+    write(
+        d,
+        "room.hstl",
+        "spec Room {
+    state { x: int in 0..=4, y: int in 0..=2 }
+    world \"room.toml\";
+    let A = x < 1;
+    let B = x > 3;
+    task always[0..] (eventually[0..20] A && eventually[0..20] B);
+    option A { reach: A, init: !A, terminate: A }
+    option B { reach: B, init: !B, terminate: B }
+    options { A, B }
+    learn { episodes: 5, choices: 5 }
+}
+",
+    );
+    let run = hstlc_in(d, &["train", "room.hstl", "--out", "t"], b"");
+    assert_eq!(run.status, Some(0), "{}{}", run.stdout, run.stderr);
+    let text = std::fs::read_to_string(d.join("t/policy.json")).expect("policy.json");
+    let mut doc: Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(doc["env"]["params"]["slip"], json!(0.2), "{}", &text[..300]);
+    let args = ["--no-optimum", "--starts", "1", "--steps", "150"];
+    let eval = |name: &str, doc: &Value| {
+        write(d, name, serde_json::to_string(doc).expect("JSON"));
+        let mut all = vec!["eval", name];
+        all.extend(args);
+        hstlc_in(d, &all, b"")
+    };
+    assert_eq!(eval("same.json", &doc).status, Some(0));
+    doc["env"]["params"]["slip"] = json!(0.0);
+    let run = eval("slip.json", &doc);
+    assert_eq!(run.status, Some(2), "{}{}", run.stdout, run.stderr);
+    assert!(run.stderr.contains("the document was changed after it was written"), "{}", run.stderr);
+    assert!(run.stderr.contains("train again"), "{}", run.stderr);
 }
 
 /// Issue 30: when the optimum W* was past its budget, `eval` printed its whole report and

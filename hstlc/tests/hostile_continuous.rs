@@ -309,3 +309,40 @@ fn hand_edited_learned_policies_are_refused_in_words() {
     assert_eq!(run.status, Some(2));
     assert!(run.stderr.contains("not a valid policy.json: EOF while parsing"), "{}", run.stderr);
 }
+
+/// Issue 30: a learned function's document holds its world whole (slip and noise
+/// included) and its weights, and an edit every check lets through (the slip, one weight's
+/// value) was evaluated as written. The document's `checksum` refuses both; the document
+/// as written, reformatted, still evaluates.
+#[test]
+fn an_edited_slip_or_weight_of_a_learned_function_is_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    write(d, "w.toml", plane("[0.0, 14.0]", "1.0", "slip = 0.2\n"));
+    write(d, "s.hstl", spec("w.toml", "0..=14"));
+    let run = hstlc(d, &["train", "s.hstl", "--out", "out", "--seed", "1"]);
+    assert_eq!(run.status, Some(0), "{}", run.stderr);
+    let text = std::fs::read_to_string(d.join("out/policy.json")).expect("policy.json");
+    let doc: Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(doc["env"]["params"]["slip"], json!(0.2));
+    let eval = |name: &str, doc: &Value| {
+        write(d, name, serde_json::to_string(doc).expect("JSON"));
+        hstlc(d, &["eval", name, "--starts", "1", "--steps", "50", "--burn-in", "0"])
+    };
+    assert_eq!(eval("compact.json", &doc).status, Some(0));
+    let mut slip = doc.clone();
+    slip["env"]["params"]["slip"] = json!(0.0);
+    let mut weight = doc.clone();
+    let first = weight["weights"]["flat"]["A"][0][1].as_str().expect("hex").to_string();
+    let other = f64::from_bits(u64::from_str_radix(&first, 16).expect("hex")) + 1.0;
+    weight["weights"]["flat"]["A"][0][1] = json!(format!("{:016x}", other.to_bits()));
+    for (name, edited) in [("slip", slip), ("weight", weight)] {
+        let run = eval(&format!("{name}.json"), &edited);
+        assert_eq!(run.status, Some(2), "{name}: {}{}", run.stdout, run.stderr);
+        assert!(
+            run.stderr.contains("the document was changed after it was written"),
+            "{name}: {}",
+            run.stderr
+        );
+    }
+}

@@ -28,6 +28,7 @@
 //! Every random draw comes from one [`Rng`] (ChaCha8) that the caller seeds and passes in.
 
 pub mod approx;
+pub mod digest;
 pub mod draw;
 pub mod env;
 mod episode;

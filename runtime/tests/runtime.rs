@@ -231,8 +231,11 @@ fn policy_json_round_trips_bit_for_bit() {
 fn bad_policy_documents_say_what_is_wrong() {
     let env = GridWorld::default();
     let learner = Learner::new(&small(false, false), &env).unwrap();
-    let good: serde_json::Value =
+    let summed: serde_json::Value =
         serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap();
+    // Without its checksum (as written before checksums), so that each field's own check
+    // is what refuses it.
+    let good = unsummed(summed.clone());
     type Break = fn(&mut serde_json::Value);
     let cases: [(&str, Break); 7] = [
         ("missing field `spec`", |d| {
@@ -254,8 +257,27 @@ fn bad_policy_documents_say_what_is_wrong() {
             .and_then(|p| p.q_tables().and_then(|_| p.agent(&env)))
             .unwrap_err();
         assert!(err.to_string().contains(want), "{want}: {err}");
+        // With the checksum, any edit that still parses is refused by it.
+        let mut doc = summed.clone();
+        change(&mut doc);
+        if let Err(err) = Policy::from_json(&doc.to_string()) {
+            let err = err.to_string();
+            let parse = want.starts_with("missing field") || want.starts_with("not 16 hex");
+            assert!(parse || err.contains("was changed after it was written"), "{want}: {err}");
+        } else {
+            panic!("{want}: an edited document with its checksum was read");
+        }
     }
+    // The document as written, reformatted, reads back: the checksum is of its fields.
+    let pretty = serde_json::to_string_pretty(&summed).unwrap();
+    assert_eq!(Policy::from_json(&pretty).unwrap(), Policy::new(&learner));
     assert!(Policy::from_json("{").unwrap_err().to_string().contains("EOF"));
+}
+
+/// A document without its `checksum` field.
+fn unsummed(mut doc: serde_json::Value) -> serde_json::Value {
+    doc.as_object_mut().expect("an object").remove("checksum").expect("a checksum");
+    doc
 }
 
 #[test]
@@ -600,8 +622,7 @@ fn bad_memory_policy_documents_say_what_is_wrong() {
     let mut spec = small_memory();
     spec.learn.memory = 2;
     let learner = Learner::new(&spec, &env).unwrap();
-    let good: serde_json::Value =
-        serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap();
+    let good = unsummed(serde_json::from_str(&Policy::new(&learner).to_json().unwrap()).unwrap());
     type Break = fn(&mut serde_json::Value);
     let cases: [(&str, Break); 7] = [
         ("without memory; a memory policy gives", |d| {
@@ -777,7 +798,9 @@ fn switch_step_is_kept_in_policy_json_and_checked_against_the_spec() {
     // Training is the same either way: only greedy runs differ.
     assert_eq!(bits(learner.q()), bits(plain.q()));
     // A document stripped of its `switch` no longer matches the spec it names.
-    let stripped = Policy::from_json(&text.replace("\n  \"switch\": \"step\",", "")).unwrap();
+    let stripped = text.replace("\n  \"switch\": \"step\",", "");
+    let stripped = unsummed(serde_json::from_str(&stripped).unwrap()).to_string();
+    let stripped = Policy::from_json(&stripped).unwrap();
     let err = stripped.check_against(&spec, &env).unwrap_err().to_string();
     assert_eq!(
         err,

@@ -192,6 +192,14 @@ fn policy_doc(
     doc.insert("choices".into(), json!(w.choices));
     doc.insert("spec_source".into(), json!(source));
     doc.insert("seed".into(), json!(seed));
+    // The digest of the weights as the readers will see them, from the weights themselves.
+    let nonzero = read::nonzero;
+    let checksum = read::digest(&doc, |d| {
+        let lens = (Some(w.flat.first().map_or(0, Vec::len) as u64), Some(w.options.len() as u64));
+        let flat = spec.primitives.iter().zip(&w.flat).map(|(p, v)| (p.name.as_str(), nonzero(v)));
+        read::digest_weights(d, lens, Some(flat.collect()), Some(nonzero(&w.options)));
+    });
+    doc.insert("checksum".into(), json!(checksum));
     serde_json::to_string_pretty(&Value::Object(doc)).map_err(|e| Error::Config(e.to_string()))
 }
 

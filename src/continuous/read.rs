@@ -3,6 +3,7 @@
 //! values counted against a budget.
 
 use super::*;
+use hstl_runtime::digest::Digest;
 
 /// A list of sparse entries as a document gives it (`None`: not a list), each `(index,
 /// bits)`, or `None` where it is not `[INDEX, "16 hex digits"]`.
@@ -36,6 +37,89 @@ impl SparseWeights {
     }
 }
 
+/// The digest `policy.json`'s `checksum` holds for a learned function: FNV-1a over each
+/// top-level entry but `checksum` and `weights` as compact JSON with its name, in name
+/// order, then what `weights` feeds in ([`SparseWeights::digest`], or the writer's same
+/// bytes from the weights themselves). A document reformatted reads back; one with a value
+/// changed does not.
+pub(super) fn digest(
+    doc: &serde_json::Map<String, Value>,
+    weights: impl FnOnce(&mut Digest),
+) -> String {
+    let mut d = Digest::new();
+    for (key, value) in doc.iter().filter(|(k, _)| *k != "checksum" && *k != "weights") {
+        d.bytes(key.as_bytes());
+        // Writing into a digest cannot fail.
+        let _ = serde_json::to_writer(&mut d, value);
+    }
+    weights(&mut d);
+    d.hex()
+}
+
+/// One list of weight entries, each `(index, bits)` (`None`: an entry that is not one).
+pub(super) type EntryIter<'a> = Box<dyn Iterator<Item = Option<(u64, u64)>> + 'a>;
+
+/// The weights' part of [`digest`]: the two sizes, each option's entries in name order,
+/// the options level's entries; an entry is its index and bits.
+pub(super) fn digest_weights(
+    d: &mut Digest,
+    lens: (Option<u64>, Option<u64>),
+    flat: Option<Vec<(&str, EntryIter<'_>)>>,
+    options: Option<EntryIter<'_>>,
+) {
+    let entries = |d: &mut Digest, list: EntryIter<'_>| {
+        for x in list {
+            match x {
+                Some((i, bits)) => {
+                    d.bytes(&i.to_le_bytes());
+                    d.bytes(&bits.to_le_bytes());
+                }
+                None => d.bytes(b"?"),
+            }
+        }
+    };
+    for len in [lens.0, lens.1] {
+        d.bytes(&len.map_or([0xff; 8], u64::to_le_bytes));
+    }
+    if let Some(mut flat) = flat {
+        flat.sort_by(|a, b| a.0.cmp(b.0));
+        for (name, list) in flat {
+            d.bytes(name.as_bytes());
+            d.bytes(b"=");
+            entries(d, list);
+        }
+    }
+    if let Some(options) = options {
+        d.bytes(b"options=");
+        entries(d, options);
+    }
+}
+
+/// The entries of one list as [`digest_weights`] reads them.
+fn entry_list(e: &Entries) -> EntryIter<'_> {
+    Box::new(e.iter().flatten().copied())
+}
+
+/// The nonzero weights of `v` as the document lists them, for [`digest_weights`].
+pub(super) fn nonzero(v: &[f64]) -> EntryIter<'_> {
+    Box::new(
+        v.iter()
+            .enumerate()
+            .filter(|(_, x)| x.to_bits() != 0)
+            .map(|(i, x)| Some((i as u64, x.to_bits()))),
+    )
+}
+
+impl SparseWeights {
+    /// Feeds the weights as the document gives them into [`digest`].
+    pub(super) fn digest(&self, d: &mut Digest) {
+        let list = entry_list;
+        let flat =
+            self.flat.as_ref().map(|f| f.iter().map(|(n, e)| (n.as_str(), list(e))).collect());
+        digest_weights(d, (self.flat_len, self.options_len), flat, self.options.as_ref().map(list));
+    }
+}
+
 /// `[INDEX, "16 hex digits"]` as `(index, bits)`.
 fn entry(e: &Value) -> Option<(u64, u64)> {
     let pair = e.as_array().filter(|p| p.len() == 2)?;
@@ -58,7 +142,8 @@ const MAX_ENTRY_VALUES: usize = 8;
 
 /// The top-level entries a learned function's `policy.json` has besides `weights`; any
 /// other is skipped as it is read.
-const HEADER_KEYS: [&str; 13] = [
+const HEADER_KEYS: [&str; 14] = [
+    "checksum",
     "spec",
     "env",
     "state_vars",

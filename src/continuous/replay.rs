@@ -2,7 +2,7 @@
 //! spec and world (or the gymnasium spaces it records), its evaluation, and its greedy runs
 //! as CSV.
 
-use super::read::{SparseWeights, TopLevel};
+use super::read::{SparseWeights, TopLevel, digest};
 use super::*;
 
 /// A `policy.json` of a learned function, checked whole against its spec and world.
@@ -37,6 +37,27 @@ pub fn replay_text(text: &str) -> Result<Replay, Problem> {
         .and_then(|parts| de.end().map(|()| parts))
         .map_err(|e| Problem::new(format!("not a valid policy.json: {e}"), Some(edited.into())))?;
     replay_parts(&doc, weights)
+}
+
+/// Refuses a document whose `checksum` is not the digest of its entries ([`digest`]); a
+/// document without one (written before checksums existed) is read as it is.
+fn check_sum(doc: &Value, weights: Option<&SparseWeights>) -> Result<(), Problem> {
+    let (Some(map), Some(written)) = (doc.as_object(), doc.get("checksum")) else {
+        return Ok(());
+    };
+    let none = SparseWeights::default();
+    let own = digest(map, |d| weights.unwrap_or(&none).digest(d));
+    if written.as_str() == Some(own.as_str()) {
+        return Ok(());
+    }
+    let written = written.as_str().map_or_else(|| written.to_string(), str::to_string);
+    Err(Problem::new(
+        format!(
+            "the document was changed after it was written: its `checksum` is {written}, its \
+             entries give {own}"
+        ),
+        Some("train again, or restore the file as it was written".into()),
+    ))
 }
 
 /// A learned function's `policy.json` trained in a gymnasium environment (see
@@ -82,6 +103,7 @@ pub fn replay_text_any(text: &str) -> Result<AnyReplay, Problem> {
         .and_then(Value::as_array)
         .map(|l| l.iter().filter_map(Value::as_str).map(str::to_string).collect())
         .unwrap_or_default();
+    let sum = check_sum(&doc, weights.as_ref());
     let described = Described::from_params(name, vars, params.unwrap_or(&Value::Null))?;
     let words = EnvWords::of(&described);
     let Parts { spec, agent, source, seed } = replay_core(
@@ -91,6 +113,7 @@ pub fn replay_text_any(text: &str) -> Result<AnyReplay, Problem> {
         |_, _| {},
         |spec| zero_of(spec, &described).and_then(|z| ApproxAgent::new(spec, &described, z)),
     )?;
+    sum?;
     Ok(AnyReplay::Gym(GymReplay { spec, env: described, agent, source, seed }))
 }
 
@@ -98,6 +121,9 @@ pub fn replay_text_any(text: &str) -> Result<AnyReplay, Problem> {
 fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Replay, Problem> {
     let edited =
         || "the file was edited or damaged: train the policy again with `hstlc train`".to_string();
+    // The entries' own checks first, whose words say what is wrong; the checksum last,
+    // for an edit they all let through (a world's slip, a weight's value).
+    let sum = check_sum(doc, weights_doc.as_ref());
     let env = doc.get("env").ok_or_else(|| Problem::new("it has no `env` entry", edited()))?;
     let world_name = env.get("name").and_then(Value::as_str).unwrap_or("");
     let params = env.get("params").cloned().unwrap_or(Value::Null);
@@ -118,6 +144,7 @@ fn replay_parts(doc: &Value, weights_doc: Option<SparseWeights>) -> Result<Repla
         |spec| with_world!(&world, w => zero_of(spec, w).and_then(|z| ApproxAgent::new(spec, w, z))),
     )?;
     let Parts { spec, agent, source, seed } = parts;
+    sum?;
     Ok(Replay { spec, world, agent, source, seed })
 }
 

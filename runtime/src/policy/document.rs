@@ -6,11 +6,23 @@ use super::*;
 impl Policy {
     /// The document as JSON, indented down to the entries of its lists and maps; each
     /// entry (a policy row, a state, a Q-table) is written on one line.
+    ///
+    /// The last field, `checksum`, is a digest of the document's own fields as written
+    /// ([`Policy::checksum`]): a reader refuses a document whose fields were changed after
+    /// it was written.
     pub fn to_json(&self) -> Result<String, Error> {
-        let mut out = Vec::new();
-        let mut ser = serde_json::Serializer::with_formatter(&mut out, Shallow::default());
+        self.to_json_with(&[])
+    }
+
+    /// The digest `policy.json`'s `checksum` holds: FNV-1a (64 bits) over the document's
+    /// own fields as [`Policy::to_json`] writes them without `checksum` and extra fields,
+    /// as 16 hexadecimal digits. Computed by writing the document into the digest, never
+    /// into memory.
+    pub fn checksum(&self) -> Result<String, Error> {
+        let mut digest = crate::digest::Digest::new();
+        let mut ser = serde_json::Serializer::with_formatter(&mut digest, Shallow::default());
         self.serialize(&mut ser).map_err(|e| Error::Policy(e.to_string()))?;
-        String::from_utf8(out).map_err(|e| Error::Policy(e.to_string()))
+        Ok(digest.hex())
     }
 
     /// The document as [`Policy::to_json`] writes it, with `extra` fields (such as the spec's
@@ -26,13 +38,14 @@ impl Policy {
         }
         let mut fields = Map::new();
         for (name, value) in extra {
-            if Policy::FIELDS.contains(name) || fields.contains_key(*name) {
+            if Policy::FIELDS.contains(name) || *name == CHECKSUM || fields.contains_key(*name) {
                 return Err(Error::Policy(format!(
                     "the extra field {name} is already in the document; give it another name"
                 )));
             }
             fields.insert((*name).to_string(), value.clone());
         }
+        fields.insert(CHECKSUM.to_string(), Value::String(self.checksum()?));
         let mut out = Vec::new();
         let mut ser = serde_json::Serializer::with_formatter(&mut out, Shallow::default());
         WithExtra { policy: self, extra: fields }
@@ -58,9 +71,24 @@ impl Policy {
         let mut de = serde_json::Deserializer::from_str(text);
         let read = serde::Deserializer::deserialize_map(&mut de, DocumentVisitor { extra })
             .and_then(|doc| de.end().map(|()| doc));
-        read.map_err(|e| Error::Policy(e.to_string()))
+        let (policy, extras, written) = read.map_err(|e| Error::Policy(e.to_string()))?;
+        // A document written before checksums existed has none, and is read as it is.
+        if let Some(written) = written {
+            let own = policy.checksum()?;
+            if own != written {
+                return Err(Error::Policy(format!(
+                    "the document was changed after it was written: its `checksum` is \
+                     {written}, its fields give {own}; train again, or restore the file as \
+                     it was written"
+                )));
+            }
+        }
+        Ok((policy, extras))
     }
 }
+
+/// The field that holds [`Policy::checksum`], written last.
+const CHECKSUM: &str = "checksum";
 
 /// The one pass over a document that [`Policy::from_json_with`] makes.
 struct DocumentVisitor<'a> {
@@ -68,7 +96,8 @@ struct DocumentVisitor<'a> {
 }
 
 impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
-    type Value = (Policy, Map<String, Value>);
+    /// The policy, the extra fields asked for, and the `checksum` when there is one.
+    type Value = (Policy, Map<String, Value>, Option<String>);
 
     fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("a policy.json document, an object")
@@ -92,6 +121,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
         let (mut primitives, mut memory, mut options_policy, mut flat_policies) =
             (None, None, None, None);
         let (mut goals, mut max_steps, mut switch, mut q_tables) = (None, None, None, None);
+        let mut checksum = None;
         let mut extras = Map::new();
         while let Some(key) = map.next_key::<String>()? {
             match key.as_str() {
@@ -108,6 +138,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
                 "max_steps" => set(&mut max_steps, map.next_value()?, &key)?,
                 "switch" => set(&mut switch, map.next_value()?, &key)?,
                 "q_tables" => set(&mut q_tables, map.next_value()?, &key)?,
+                CHECKSUM => set(&mut checksum, map.next_value::<String>()?, &key)?,
                 k if self.extra.contains(&k) => {
                     if extras.contains_key(k) {
                         return Err(A::Error::custom(format!("the field `{k}` is given twice")));
@@ -136,7 +167,7 @@ impl<'de> serde::de::Visitor<'de> for DocumentVisitor<'_> {
             switch: switch.unwrap_or_default(),
             q_tables: q_tables.ok_or_else(|| A::Error::missing_field("q_tables"))?,
         };
-        Ok((policy, extras))
+        Ok((policy, extras, checksum))
     }
 }
 
