@@ -3,6 +3,8 @@
 //! batch of 1,000 traces x 1,000 steps on 1 and 2 threads), the native side of
 //! `bench/python/bench.py`.
 //!
+//! `STLReward`'s episode scoring too (`reward/`).
+//!
 //! `cargo bench -p hstl --bench monitor -- --warm-up-time 1 --measurement-time 3`
 
 #[path = "../robustness/benches/walk.rs"]
@@ -77,5 +79,31 @@ fn benches(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(monitor, benches);
+/// `STLReward`'s per-step scoring over an episode of 5,000 steps, for a reward with a past
+/// operator inside a future one (scored online since the reward is read at the last step;
+/// it evaluated the whole prefix each step before).
+fn reward(c: &mut Criterion) {
+    let src = "spec R { state { x: float, y: float } \
+               let Recent = eventually[0..=5] once[0..=10] x > 8; \
+               task always[0..] eventually[0..40] x > 8; }";
+    let spec = hstl::load::load(src, None).expect("the spec checks").spec;
+    let trace = walk::walk(5_000, &mut walk::SplitMix64(walk::SEED));
+    let (x, y) = (trace.column(0), trace.column(1));
+    let mut g = c.benchmark_group("reward");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(x.len() as u64));
+    g.bench_function("past_inside_future_5000", |b| {
+        b.iter(|| {
+            let mut episode =
+                hstl::reward::EpisodeMonitor::new(&spec, src, Some("Recent")).expect("a reward");
+            let mut sum = 0.0;
+            for (x, y) in x.iter().zip(y) {
+                sum += episode.push(&[*x, *y]).expect("a state").reward;
+            }
+            black_box(sum)
+        })
+    });
+}
+
+criterion_group!(monitor, benches, reward);
 criterion_main!(monitor);
