@@ -103,3 +103,39 @@ pub(crate) fn gamma_powers_to(powers: &mut Vec<f64>, gamma: f64, k: usize) {
         powers.extend((last..=k).map(|i| gamma.powi(i as i32)));
     }
 }
+
+/// `out[j]`: the window reward of the suffix of a run from position `j`, `R_j = psi(j + 1) +
+/// gamma R_{j + 1}` with `R_k = 0` (`k = psi.len() - 1`): the discounted count of the
+/// suffix's steps whose windows are all kept.
+pub(crate) fn window_suffix_rewards(psi: &[bool], gamma: f64, out: &mut Vec<f64>) {
+    let k = psi.len() - 1;
+    out.clear();
+    out.resize(k + 1, 0.0);
+    for j in (0..k).rev() {
+        let kept = if psi[j + 1] { 1.0 } else { 0.0 };
+        out[j] = kept + gamma * out[j + 1];
+    }
+}
+
+/// The segment rewards of every suffix of a run along which goals were met: `met[j]` is the
+/// goals-met code at position `j`, and `score(code, into)` fills `into[j]` with the reward of
+/// every suffix against the conjuncts still open under `code` (`k + 1` values). The
+/// positions under the run's first code take its scores, each later stretch under one code
+/// the scores under that code (`other` is a buffer).
+pub(crate) fn goal_suffix_rewards(
+    met: &[usize],
+    k: usize,
+    out: &mut Vec<f64>,
+    other: &mut Vec<f64>,
+    mut score: impl FnMut(usize, &mut Vec<f64>),
+) {
+    score(met.first().copied().unwrap_or(0), out);
+    let mut j = 0;
+    while let Some(offset) = met.get(j..).and_then(|m| m.iter().position(|&x| x != m[0])) {
+        j += offset;
+        let code = met[j];
+        score(code, other);
+        let until = met[j..].iter().position(|&m| m != code).map_or(k + 1, |e| j + e);
+        out[j..until].copy_from_slice(&other[j..until]);
+    }
+}

@@ -44,7 +44,7 @@ use hstl_robustness::segment::TabularScorer;
 use rand::RngExt;
 
 use crate::env::EpisodeEnd;
-use crate::episode::{Choices, explores, floor_from, gamma_powers_to, train_episodes};
+use crate::episode::{self, Choices, explores, floor_from, gamma_powers_to, train_episodes};
 use crate::greedy::{argmax, best_of, max_of};
 use crate::memory::Memory;
 use crate::plan::{Model, Planner};
@@ -681,33 +681,13 @@ impl<E: Env> Learner<'_, E> {
                         into.resize(k + 1, 0.0);
                     }
                 };
-                score(run.met.first().copied().unwrap_or(0), out);
                 // Goals met along the run: the positions after score against the rest.
-                let mut j = 0;
                 let mut other = std::mem::take(&mut self.other_rewards);
-                while let Some(offset) =
-                    run.met.get(j..).and_then(|m| m.iter().position(|&x| x != m[0]))
-                {
-                    j += offset;
-                    let met = run.met[j];
-                    score(met, &mut other);
-                    let until =
-                        run.met[j..].iter().position(|&m| m != met).map_or(k + 1, |e| j + e);
-                    out[j..until].copy_from_slice(&other[j..until]);
-                }
+                episode::goal_suffix_rewards(&run.met, k, out, &mut other, &mut score);
                 self.other_rewards = other;
             }
             Reward::Window => {
-                // R_j = psi(j + 1) + gamma R_{j+1}, R_k = 0: the sum over the suffix's steps
-                // of gamma^(m-1) psi(j + m).
-                let gamma = self.spec.learn.options.gamma;
-                let k = run.states.len() - 1;
-                out.clear();
-                out.resize(k + 1, 0.0);
-                for j in (0..k).rev() {
-                    let psi = if run.psi[j + 1] { 1.0 } else { 0.0 };
-                    out[j] = psi + gamma * out[j + 1];
-                }
+                episode::window_suffix_rewards(&run.psi, self.spec.learn.options.gamma, out);
             }
         }
     }

@@ -37,7 +37,7 @@ use rand::RngExt;
 
 use super::model::mask;
 pub use super::model::{MAX_WEIGHTS, Model, Shape, Weights};
-use crate::episode::{Choices, explores, gamma_powers_to, train_episodes};
+use crate::episode::{self, Choices, explores, gamma_powers_to, train_episodes};
 use crate::progress::{GoalTracker, Progress};
 use crate::spec::{LevelParams, RewardKind};
 use crate::{Error, Rng, TaskSpec, World};
@@ -285,12 +285,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
     fn suffix_rewards(&mut self, run: &Run<W::State>, out: &mut Vec<f64>, other: &mut Vec<f64>) {
         let k = run.states.len() - 1;
         if self.scorers.is_empty() {
-            let gamma = self.spec.learn.options.gamma;
-            out.clear();
-            out.resize(k + 1, 0.0);
-            for j in (0..k).rev() {
-                out[j] = f64::from(u8::from(run.psi[j + 1])) + gamma * out[j + 1];
-            }
+            episode::window_suffix_rewards(&run.psi, self.spec.learn.options.gamma, out);
             return;
         }
         let vars = self.model.vars.len();
@@ -308,17 +303,8 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                 into.resize(k + 1, 0.0);
             }
         };
-        let first = run.met.first().copied().unwrap_or(0);
-        score(first, out);
         // Goals met along the run: the positions after score against the rest.
-        let mut j = 0;
-        while let Some(offset) = run.met[j..].iter().position(|&m| m != run.met[j]) {
-            j += offset;
-            let met = run.met[j];
-            score(met, other);
-            let until = run.met[j..].iter().position(|&m| m != met).map_or(k + 1, |e| j + e);
-            out[j..until].copy_from_slice(&other[j..until]);
-        }
+        episode::goal_suffix_rewards(&run.met, k, out, other, &mut score);
     }
 
     fn update_options(&mut self, o: usize, run: &Run<W::State>, s: &mut Scratch) {
