@@ -1,8 +1,12 @@
 //! Long calls that Ctrl-C ends. The work runs on a thread of its own while the calling
 //! thread, holding the GIL only for a moment every [`SIGNAL_EVERY`], runs Python's signal
-//! handlers: a `KeyboardInterrupt` ends the call at once. The work then finishes on its own
-//! thread and its result is dropped; it holds only what was moved into it.
+//! handlers: a `KeyboardInterrupt` ends the call at once. The work's thread is then told to
+//! stop ([`hstl::robustness::cancel`]): the offline evaluator stops at its next group or
+//! piece, other work finishes; either way its result is dropped, and it holds only what was
+//! moved into it.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
 
@@ -28,9 +32,12 @@ pub fn run<T: Send + 'static>(
         return Ok(py.detach(work));
     }
     let (tx, rx) = mpsc::channel();
+    let stop = Arc::new(AtomicBool::new(false));
+    let raised = Arc::clone(&stop);
     std::thread::Builder::new()
         .name("hstl-evaluate".into())
         .spawn(move || {
+            let _watch = hstl::robustness::cancel::stop_on(raised);
             // The receiver is gone when the call was interrupted: nothing to send to.
             let _ = tx.send(work());
         })
@@ -45,7 +52,13 @@ pub fn run<T: Send + 'static>(
         rx = back;
         match got {
             Ok(done) => return Ok(done),
-            Err(mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                if let Err(e) = py.check_signals() {
+                    // The offline evaluator stops at its next group or piece.
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(e);
+                }
+            }
             Err(mpsc::RecvTimeoutError::Disconnected) => {
                 return Err(value_error("the evaluating thread failed", None));
             }

@@ -44,7 +44,10 @@ def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path) -> None:
         "    spec.signal(trace)\n"
         "    print('finished', flush=True)\n"
         "except KeyboardInterrupt:\n"
-        "    print(f'interrupted {time.perf_counter() - start:.3f}', flush=True)\n"
+        "    took = time.perf_counter() - start\n"
+        "    cpu = time.process_time()\n"
+        "    time.sleep(1.0)\n"
+        "    print(f'interrupted {took:.3f} {time.process_time() - cpu:.3f}', flush=True)\n"
     )
     path = tmp_path / "chain.hstl"
     path.write_text(chain_spec(2000))
@@ -62,6 +65,8 @@ def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path) -> None:
     assert words[:1] == ["interrupted"], out
     # The evaluation takes ten times longer than this: the call ended on the signal.
     assert float(words[1]) < 6.0, out
+    # And the evaluation stopped too: the second after it took next to no CPU time.
+    assert float(words[2]) < 0.5, out
 
 
 def test_a_nan_written_by_another_thread_never_reaches_the_result() -> None:

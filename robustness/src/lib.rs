@@ -23,6 +23,7 @@
 //!
 //! All evaluators give the same values; [`offline`] states the NaN policy they share.
 
+pub mod cancel;
 pub mod complete;
 pub mod dense;
 pub mod formula;

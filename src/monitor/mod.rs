@@ -347,10 +347,16 @@ impl Monitor {
             }
         };
         let run = &run;
+        // The helpers stop with this thread when its evaluations are cancelled.
+        let flag = hstl_robustness::cancel::current();
+        let helper = || {
+            let _watch = flag.clone().map(hstl_robustness::cancel::stop_on);
+            run()
+        };
         let mut failed = std::thread::scope(|scope| {
             // A thread the OS refuses is no error: the others, and this one, take its share.
             let helpers: Vec<_> = (1..workers)
-                .filter_map(|_| std::thread::Builder::new().spawn_scoped(scope, run).ok())
+                .filter_map(|_| std::thread::Builder::new().spawn_scoped(scope, helper).ok())
                 .collect();
             let mut failed = run();
             for h in helpers {

@@ -99,6 +99,9 @@ impl Runner {
         self.ext_left.clear();
         self.ext_left.extend_from_slice(&plan.ext_reads);
         for g in &plan.groups {
+            if crate::cancel::requested() {
+                return vec![f64::NAN; n];
+            }
             let root = g.root;
             let piece = match f.horizons()[root] {
                 Some(h) if !f.states()[root] && !f.nodes()[root].is_past() => piece_len(h),
@@ -111,6 +114,9 @@ impl Runner {
                 let mut out = self.take(n);
                 let mut lo = 0;
                 while lo < n {
+                    if crate::cancel::requested() {
+                        return vec![f64::NAN; n];
+                    }
                     let hi = (lo + piece).min(n);
                     let end = hi.saturating_add(h).min(n);
                     let v = self.group(f, g, src, lo, end - lo, hi == n);
