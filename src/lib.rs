@@ -34,7 +34,6 @@ pub mod load;
 pub mod lower;
 pub mod monitor;
 pub mod outfile;
-mod problem;
 pub mod reference;
 pub mod reward;
 pub mod seeds;
@@ -42,7 +41,7 @@ pub mod study;
 pub mod train;
 pub mod world;
 
-pub use problem::Problem;
+pub use hstl_files::Problem;
 
 pub use hstl_lang as lang;
 pub use hstl_robustness as robustness;

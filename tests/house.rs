@@ -13,12 +13,13 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Every crate's source folder.
-const CRATES: [&str; 9] = [
+const CRATES: [&str; 10] = [
     "hstl-lang/src",
     "hstl-macros/src",
     "robustness/src",
     "runtime/src",
     "pictures/src",
+    "files/src",
     "outdir/src",
     "src",
     "hstlc/src",

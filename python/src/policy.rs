@@ -1,7 +1,7 @@
 //! `hstl.Policy`: a trained policy, its `policy.json`, replays and evaluation.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 use hstl::Problem;
@@ -391,7 +391,7 @@ impl Policy {
     /// same folder, then renamed), byte for byte what `hstlc train` writes for the same
     /// spec, world, seed and episodes.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| write_whole(&path, self.text.as_bytes()))
+        py.detach(|| hstl_files::write::replace(&path, self.text.as_bytes()))
             .map_err(|e| errors::write_error(&path, &e))
     }
 
@@ -924,20 +924,4 @@ fn in_ranges(spec: &TaskSpec, vars: &[String], values: &[f64]) -> PyResult<()> {
 /// A state's values as a lookup key (`-0` read as `0`).
 fn key(values: &[f64]) -> Vec<u64> {
     values.iter().map(|v| (v + 0.0).to_bits()).collect()
-}
-
-/// Writes `bytes` to `path` whole or not at all: a temporary file beside it, then renamed.
-fn write_whole(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let name = path.file_name().map_or("policy.json".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
-    let renamed = written.and_then(|()| std::fs::rename(&tmp, path));
-    if renamed.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    renamed
 }
