@@ -71,7 +71,6 @@ const LONG_FILES_TO_SPLIT: &[&str] = &[
     "src/monitor/dense.rs",
     "src/reward.rs",
     "hstlc/src/lsp/features.rs",
-    "python/src/policy.rs",
 ];
 
 /// A module's path inside its crate (`["plan_reach", "choices"]`; the root is empty).

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 
 use crate::continuous::ContinuousWorld;
 use crate::errors::{self, problem_error, value_error};
-use crate::gym::{BoxEnv, PyEnv, Spaces};
+use crate::gym::{BoxEnv, Spaces, failure_error, py_env};
 use crate::policy::Policy;
 use crate::spec::Spec;
 use crate::world::World;
@@ -84,7 +84,7 @@ pub fn _train_env(
     let spec = spec.get();
     let task = trainable(&spec.spec, spec, episodes)?;
     let spaces = Spaces { name, observations, observation_start, actions, action_start };
-    let pyenv = PyEnv::new(env, valuation, spaces, &task)?;
+    let pyenv = py_env(env, valuation, spaces, &task)?;
     let (trained, failure, pyenv) = py.detach(move || {
         let mut reporter = Reporter::new(progress.as_ref(), task.learn.episodes);
         let trained = train_until(&task, &pyenv, seed, |e, r| {
@@ -92,7 +92,7 @@ pub fn _train_env(
         });
         (trained, reporter.failure, pyenv)
     });
-    if let Some(e) = pyenv.take_error().or(failure) {
+    if let Some(e) = pyenv.take_error().map(failure_error).or(failure) {
         return Err(e);
     }
     let trained = trained.map_err(|e| cannot_train_env(&spec.filename, spec, &e))?;

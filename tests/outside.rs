@@ -1,0 +1,190 @@
+//! An environment stepped from outside (`hstl::outside`, what the Python package's
+//! gymnasium adapter runs): a corridor of ten observations numbered from 100, whose two
+//! calls are plain Rust here. It trains as a native environment would, the same seed
+//! giving the same Q-tables; every step the learner counts is a call; what the calls give
+//! that does not fit the spaces or the spec stops the run with the words users see; and
+//! the trained `policy.json` replays against the states it lists (`hstl::replayed`).
+
+use std::cell::{Cell, RefCell};
+use std::ops::ControlFlow;
+
+use hstl::outside::{Calls, DiscreteEnv, Failure, Spaces};
+use hstl::replayed::{Replayed, StateIndex};
+use hstl::runtime::{EpisodeEnd, TaskSpec};
+
+const SPEC: &str = "spec ReachEnd {
+    state { x: int in 0..=9 }
+    let End = x > 8;
+    task eventually[0..30] End;
+    option End;
+    learn { episodes: 60, choices: 20 }
+}";
+
+/// Observations `100..110`; action 1 moves right, action 0 left; the right end
+/// terminates. `bad` makes a call give a wrong observation or fail from the given reset on.
+struct Corridor {
+    at: Cell<i64>,
+    resets: Cell<u64>,
+    steps: Cell<u64>,
+    seeds: RefCell<Vec<u64>>,
+    bad: Option<(u64, Bad)>,
+}
+
+#[derive(Clone, Copy)]
+enum Bad {
+    Outside,
+    Fails,
+}
+
+impl Corridor {
+    fn new(bad: Option<(u64, Bad)>) -> Corridor {
+        Corridor {
+            at: Cell::new(100),
+            resets: Cell::new(0),
+            steps: Cell::new(0),
+            seeds: RefCell::new(Vec::new()),
+            bad,
+        }
+    }
+}
+
+impl Calls for Corridor {
+    type Error = String;
+
+    fn reset(&self, seed: u64) -> Result<i64, String> {
+        self.resets.set(self.resets.get() + 1);
+        self.seeds.borrow_mut().push(seed);
+        self.at.set(100 + (seed % 5) as i64);
+        match self.bad {
+            Some((n, Bad::Outside)) if self.resets.get() >= n => Ok(7),
+            Some((n, Bad::Fails)) if self.resets.get() >= n => Err("the robot fell".into()),
+            _ => Ok(self.at.get()),
+        }
+    }
+
+    fn step(&self, action: i64) -> Result<(i64, Option<EpisodeEnd>), String> {
+        self.steps.set(self.steps.get() + 1);
+        let next = if action == 1 { self.at.get() + 1 } else { self.at.get() - 1 };
+        self.at.set(next.clamp(100, 109));
+        let end = (self.at.get() == 109).then_some(EpisodeEnd::Terminated);
+        Ok((self.at.get(), end))
+    }
+}
+
+fn spec() -> TaskSpec {
+    let checked = hstl::lang::check(SPEC);
+    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+    hstl::lower::task_spec(&checked.specs[0], SPEC).expect("lowers")
+}
+
+fn spaces(observations: usize) -> Spaces {
+    Spaces {
+        name: "Corridor-v0".into(),
+        observations,
+        observation_start: 100,
+        actions: 2,
+        action_start: 0,
+    }
+}
+
+fn env(bad: Option<(u64, Bad)>) -> DiscreteEnv<Corridor> {
+    DiscreteEnv::new(Corridor::new(bad), spaces(10), &spec(), |o| Ok(vec![(o - 100) as f64]))
+        .unwrap_or_else(|e| panic!("{e:?}"))
+}
+
+fn train(env: &DiscreteEnv<Corridor>, seed: u64) -> hstl::train::Trained {
+    hstl::train::train_until(&spec(), env, seed, |_, _| {
+        if env.failed() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+    })
+    .expect("trains")
+}
+
+#[test]
+fn it_trains_like_a_native_env_and_replays_against_the_states_it_lists() {
+    let (a, b) = (env(None), env(None));
+    let (ta, tb) = (train(&a, 5), train(&b, 5));
+    assert!(a.take_error().is_none());
+    // The same seed: the same seeds passed to `reset`, the same document.
+    assert_eq!(a.spaces(), b.spaces());
+    assert_eq!(ta.policy.to_json().expect("json"), tb.policy.to_json().expect("json"));
+    // Every step the learner counted was a call of `step`.
+    assert_eq!(ta.steps, a.calls().steps.get());
+    assert_eq!(*a.calls().seeds.borrow(), *b.calls().seeds.borrow());
+    // Every cell left of the end moves right.
+    assert!(ta.agent.flat[0][..9].iter().all(|&x| x == 1), "{:?}", ta.agent.flat[0]);
+
+    let text = hstl::train::policy_json(&ta.policy, SPEC, 5).expect("json");
+    let replayed = Replayed::read(&text).expect("replays");
+    let Replayed::Listed(_, listed) = &replayed else { panic!("not a gymnasium replay") };
+    assert_eq!(listed, &spaces(10));
+    let index = StateIndex::of(&replayed);
+    assert_eq!(replayed.state_index(&index, &[3.0]).expect("state"), 3);
+    assert_eq!(replayed.state_index(&index, &[-0.0]).expect("state"), 0);
+    assert_eq!(
+        replayed.state_index(&index, &[12.0]).expect_err("no such state").message,
+        "the policy has no state x = 12"
+    );
+    assert_eq!(replayed.observation_index(104).map(Result::ok), Some(Some(4)));
+    assert_eq!(
+        replayed.observation_index(110).map(|r| r.expect_err("outside").message),
+        Some("observation 110 is outside Discrete(10, start=100)".to_string())
+    );
+    // The environment must be the one trained on.
+    let other = Spaces { actions: 3, ..spaces(10) };
+    let p = listed.check_same(&other).expect_err("other spaces");
+    assert_eq!(
+        p.message,
+        "the policy was trained on `Corridor-v0` (Discrete(10, start=100) observations, \
+         Discrete(2) actions); `env` is `Corridor-v0` (Discrete(10, start=100) observations, \
+         Discrete(3) actions)"
+    );
+}
+
+#[test]
+fn what_does_not_fit_stops_the_run_in_words() {
+    // (the environment's fault, the words)
+    let outside = env(Some((3, Bad::Outside)));
+    train(&outside, 1);
+    match outside.take_error() {
+        Some(Failure::Refused(p)) => {
+            assert_eq!(
+                p.message,
+                "env.reset gave the observation 7, outside Discrete(10, start=100)"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    let fails = env(Some((2, Bad::Fails)));
+    train(&fails, 1);
+    assert!(matches!(fails.take_error(), Some(Failure::Call(e)) if e == "the robot fell"));
+    // Taken once.
+    assert!(fails.take_error().is_none());
+
+    let spec = spec();
+    let made = |n: usize, valuation: &dyn Fn(i64) -> Vec<f64>| {
+        DiscreteEnv::new(Corridor::new(None), spaces(n), &spec, |o| Ok(valuation(o))).err().map(
+            |e| match e {
+                Failure::Refused(p) => p.message,
+                Failure::Call(e) => e,
+            },
+        )
+    };
+    let cases: [(usize, &dyn Fn(i64) -> Vec<f64>, &str); 4] = [
+        (
+            0,
+            &|o| vec![(o - 100) as f64],
+            "the environment has 0 observations; the learner's tables take 1 to",
+        ),
+        (10, &|_| vec![1.0], "observations 100 and 101 have the same valuation"),
+        (
+            10,
+            &|o| vec![(o - 99) as f64],
+            "valuation(109) gives `x` = 10, outside its declared domain 0..=9",
+        ),
+        (10, &|_| vec![1.0, 2.0], "valuation(100) gives 2 values; the spec has 1 state variables"),
+    ];
+    for (n, valuation, want) in cases {
+        let got = made(n, valuation).expect("refused");
+        assert!(got.starts_with(want), "{got}");
+    }
+}
