@@ -140,6 +140,9 @@ fn it_trains_like_a_native_env_and_replays_against_the_states_it_lists() {
     );
 }
 
+/// An observation's values.
+type Valuation = dyn Fn(i64) -> Vec<f64>;
+
 #[test]
 fn what_does_not_fit_stops_the_run_in_words() {
     // (the environment's fault, the words)
@@ -169,7 +172,7 @@ fn what_does_not_fit_stops_the_run_in_words() {
             },
         )
     };
-    let cases: [(usize, &dyn Fn(i64) -> Vec<f64>, &str); 4] = [
+    let cases: [(usize, &Valuation, &str); 4] = [
         (
             0,
             &|o| vec![(o - 100) as f64],
