@@ -13,7 +13,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Every crate's source folder.
-const CRATES: [&str; 10] = [
+const CRATES: [&str; 11] = [
     "hstl-lang/src",
     "hstl-macros/src",
     "robustness/src",
@@ -21,6 +21,7 @@ const CRATES: [&str; 10] = [
     "pictures/src",
     "files/src",
     "outdir/src",
+    "ide/src",
     "src",
     "hstlc/src",
     "python/src",
@@ -70,7 +71,6 @@ const LONG_FILES_TO_SPLIT: &[&str] = &[
     "src/monitor.rs",
     "src/monitor/dense.rs",
     "src/reward.rs",
-    "hstlc/src/lsp/features.rs",
 ];
 
 /// A module's path inside its crate (`["plan_reach", "choices"]`; the root is empty).
