@@ -1,7 +1,8 @@
 //! The file handling of hstl's shells, written once: bounded reads ([`read`]: a file read
 //! within a stated size, never to its end first; a named pipe or a device refused before a
-//! byte is read where a reader asks for a regular file) and whole-file writes ([`write`]:
-//! a temporary file beside the target, synced, then renamed over it). The command line
+//! byte is read where a reader asks for a regular file) and whole-file writes
+//! ([`write`](mod@write): a temporary file beside the target, synced, then renamed over
+//! it). The command line
 //! (`hstlc`), the `hstl!` macro, the Python package and the output folders
 //! (`hstl-outdir`) all read and write through here, so that they refuse the same inputs in
 //! the same words. File names in messages are lossless ([`words::path_words`]).

@@ -6,7 +6,7 @@
 //! - [`analysis`]: one version of a document, parsed and checked (each spec against the
 //!   world it names), and the index of every name written in it.
 //! - [`worlds`]: the worlds documents name, read once and again when their file changes.
-//! - [`hover`]: what a name, an operator, a `world` item or `preset` means.
+//! - [`hover`](mod@hover): what a name, an operator, a `world` item or `preset` means.
 //! - [`navigate`]: definition, references and the outline.
 //! - [`complete`]: completion, keywords and names.
 
