@@ -388,6 +388,277 @@ impl<C: Calls> Env for DiscreteEnv<C> {
     }
 }
 
+/// The calls of an environment with a bounded `Box` observation space and `Discrete`
+/// actions, stepped from outside.
+pub trait BoxCalls {
+    /// The calls' own error (a Python exception).
+    type Error;
+    /// The caller's own form of an observation, which [`BoxCalls::valuation`] reads.
+    type Obs;
+    /// Resets the environment with `seed`: its first observation, and the observation's
+    /// numbers (flattened). `call` names the call in messages.
+    fn reset(&self, seed: u64, call: &str) -> Result<(Self::Obs, Vec<f64>), Self::Error>;
+    /// Takes the environment's action `action` (its own number): the next observation, its
+    /// numbers, and whether the step terminated or truncated the episode.
+    fn step(&self, action: i64, call: &str) -> Result<(Self::Obs, Vec<f64>, bool), Self::Error>;
+    /// The state variables' values of `obs` by the caller's valuation, or None when there
+    /// is none (the state is then the observation's numbers, in order).
+    fn valuation(&self, obs: &Self::Obs, call: &str) -> Option<Result<Vec<f64>, Self::Error>>;
+}
+
+/// An environment with a bounded `Box` observation space and `Discrete` actions, stepped
+/// through [`BoxCalls`], as a [`World`](hstl_runtime::World) of the approximate learner:
+/// its state is the valuation of the last observation.
+///
+/// Each `reset` seeds the environment with a seed drawn from the learner's one generator.
+/// Every observation is checked: its size, that each number is inside the `Box`, and that
+/// the valuation gives each state variable a finite value inside the range the spec
+/// declares (the tiling's). A step that reports `terminated` or `truncated` leaves the
+/// robot in that state, without a call, until the learner's next episode resets it. The
+/// first failure stops the run: later calls return at once, and the caller takes it.
+pub struct BoxEnv<C: BoxCalls> {
+    calls: C,
+    described: crate::gym::Described,
+    /// The spec's declared range of each state variable.
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    current: RefCell<Vec<f64>>,
+    absorbed: Cell<bool>,
+    /// `step` calls so far, for messages.
+    steps: Cell<u64>,
+    error: RefCell<Option<Failure<C::Error>>>,
+}
+
+impl<C: BoxCalls> BoxEnv<C> {
+    /// The environment `calls` (its spaces as `described` records them) for `spec`;
+    /// `valued` says whether the calls have a valuation (without one, the observation's
+    /// numbers are the state variables' values in order, so their counts must agree).
+    pub fn new(
+        calls: C,
+        valued: bool,
+        described: crate::gym::Described,
+        spec: &TaskSpec,
+    ) -> Result<BoxEnv<C>, Problem> {
+        let vars = &described.vars;
+        if !valued && described.low.len() != vars.len() {
+            return Err(Problem::new(
+                format!(
+                    "the observation has {} components and spec `{}` {} state variables ({}), so \
+                     they cannot be read in order",
+                    described.low.len(),
+                    spec.name,
+                    vars.len(),
+                    vars.join(", ")
+                ),
+                format!(
+                    "pass valuation=, a function from an observation to the state variables, \
+                     such as `lambda o: {{{}}}`",
+                    vars.iter()
+                        .enumerate()
+                        .map(|(i, v)| format!("\"{v}\": o[{i}]"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        let (lo, hi) = match &spec.learn.tiles {
+            Some(t) => (t.lo.clone(), t.hi.clone()),
+            None => (vec![f64::NEG_INFINITY; vars.len()], vec![f64::INFINITY; vars.len()]),
+        };
+        Ok(BoxEnv {
+            calls,
+            described,
+            lo,
+            hi,
+            current: RefCell::new(Vec::new()),
+            absorbed: Cell::new(false),
+            steps: Cell::new(0),
+            error: RefCell::new(None),
+        })
+    }
+
+    /// The spaces as `policy.json` records them.
+    pub fn described(&self) -> &crate::gym::Described {
+        &self.described
+    }
+
+    /// The first failure of the run, if any (taken: a later call sees none).
+    pub fn take_error(&self) -> Option<Failure<C::Error>> {
+        self.error.borrow_mut().take()
+    }
+
+    /// Whether a failure stopped the run.
+    pub fn failed(&self) -> bool {
+        self.error.borrow().is_some()
+    }
+
+    fn fail(&self, e: Failure<C::Error>) {
+        let mut slot = self.error.borrow_mut();
+        if slot.is_none() {
+            *slot = Some(e);
+        }
+    }
+
+    /// The state of the observation `obs` with the numbers `values`, every number checked;
+    /// `call` names where it came from.
+    fn state_of(
+        &self,
+        obs: &C::Obs,
+        values: Vec<f64>,
+        call: &str,
+    ) -> Result<Vec<f64>, Failure<C::Error>> {
+        let d = &self.described;
+        let num = hstl_runtime::plane::num;
+        if values.len() != d.low.len() {
+            return Err(Problem::new(
+                format!(
+                    "{call} gave an observation of {} components; its `Box` has {}",
+                    values.len(),
+                    d.low.len()
+                ),
+                "give the environment an observation space that its observations fit".to_string(),
+            )
+            .into());
+        }
+        for (i, &v) in values.iter().enumerate() {
+            if !(v >= d.low[i] && v <= d.high[i]) {
+                return Err(Problem::new(
+                    format!(
+                        "{call} gave an observation whose component {i} is {}, outside its `Box` \
+                         [{}, {}]",
+                        num(v),
+                        num(d.low[i]),
+                        num(d.high[i])
+                    ),
+                    "the learner tiles the `Box`: bound the observation space so that it \
+                     holds every observation (or clip the observations)"
+                        .to_string(),
+                )
+                .into());
+            }
+        }
+        let state = match self.calls.valuation(obs, call) {
+            None => values,
+            Some(row) => {
+                let row = row.map_err(Failure::Call)?;
+                if row.len() != d.vars.len() {
+                    return Err(Problem::new(
+                        format!(
+                            "valuation gives {} values; the spec has {} state variables",
+                            row.len(),
+                            d.vars.len()
+                        ),
+                        format!("return a dict of {}", d.vars.join(", ")),
+                    )
+                    .into());
+                }
+                row
+            }
+        };
+        for (i, &x) in state.iter().enumerate() {
+            if !(x >= self.lo[i] && x <= self.hi[i]) {
+                return Err(Problem::new(
+                    format!(
+                        "after {call}, `{}` = {} is outside its declared range {}..={}",
+                        d.vars[i],
+                        num(x),
+                        num(self.lo[i]),
+                        num(self.hi[i])
+                    ),
+                    "declare the range the observations take, or fix the valuation".to_string(),
+                )
+                .into());
+            }
+        }
+        Ok(state)
+    }
+
+    fn call_reset(&self, seed: u64) -> Result<Vec<f64>, Failure<C::Error>> {
+        let call = "env.reset";
+        let (obs, values) = self.calls.reset(seed, call).map_err(Failure::Call)?;
+        self.state_of(&obs, values, call)
+    }
+
+    fn call_step(&self, action: usize) -> Result<(Vec<f64>, bool), Failure<C::Error>> {
+        let action = self.described.action_start + action as i64;
+        let call = format!("env.step (call {})", self.steps.get() + 1);
+        let (obs, values, ended) = self.calls.step(action, &call).map_err(Failure::Call)?;
+        self.steps.set(self.steps.get() + 1);
+        Ok((self.state_of(&obs, values, &call)?, ended))
+    }
+
+    /// The current state; zeros inside the ranges before the first reset succeeded.
+    fn current_or_zeros(&self) -> Vec<f64> {
+        let current = self.current.borrow();
+        if current.len() == self.described.vars.len() {
+            current.clone()
+        } else {
+            self.lo.iter().map(|&l| if l.is_finite() { l } else { 0.0 }).collect()
+        }
+    }
+}
+
+impl<C: BoxCalls> hstl_runtime::World for BoxEnv<C> {
+    type State = Vec<f64>;
+
+    fn name(&self) -> &str {
+        &self.described.name
+    }
+
+    fn params(&self) -> Value {
+        self.described.params()
+    }
+
+    fn state_vars(&self) -> Vec<String> {
+        self.described.vars.clone()
+    }
+
+    fn actions(&self) -> Vec<String> {
+        hstl_runtime::World::actions(&self.described)
+    }
+
+    fn valuation(&self, state: &Vec<f64>, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend_from_slice(state);
+    }
+
+    fn reset(&self, rng: &mut Rng) -> Vec<f64> {
+        // Drawn even after a failure, so that the generator's draws do not depend on it.
+        let seed: u64 = rng.random();
+        if !self.failed() {
+            match self.call_reset(seed) {
+                Ok(s) => {
+                    *self.current.borrow_mut() = s;
+                    self.absorbed.set(false);
+                }
+                Err(e) => self.fail(e),
+            }
+        }
+        self.current_or_zeros()
+    }
+
+    fn step(&self, state: &Vec<f64>, action: usize, _rng: &mut Rng) -> Vec<f64> {
+        if self.failed() || self.absorbed.get() || action >= self.described.actions {
+            return state.clone();
+        }
+        if *state != *self.current.borrow() {
+            self.fail(Failure::Refused(Problem::new(
+                "the learner stepped from a state the environment is not in",
+                None,
+            )));
+            return state.clone();
+        }
+        match self.call_step(action) {
+            Ok((next, ended)) => {
+                *self.current.borrow_mut() = next;
+                self.absorbed.set(ended);
+            }
+            Err(e) => self.fail(e),
+        }
+        self.current_or_zeros()
+    }
+}
+
 /// The states a `policy.json` lists (those of its first flat policy, in index order), as
 /// an environment: what a policy trained on a gymnasium environment is checked against.
 /// It cannot move: a replay that steps needs the environment itself.

@@ -191,3 +191,94 @@ fn what_does_not_fit_stops_the_run_in_words() {
         assert!(got.starts_with(want), "{got}");
     }
 }
+
+/// A one-dimensional `Box` environment: observations `[p]` with `p` in `0..=10`, the
+/// state `x` declared in `0..=4`; each step moves `p` by the action's value and gives what
+/// `obs` then says (`None`: the position).
+struct Line {
+    at: Cell<f64>,
+    obs: Option<Vec<f64>>,
+    valued: Option<Vec<f64>>,
+}
+
+impl hstl::outside::BoxCalls for Line {
+    type Error = String;
+    type Obs = Vec<f64>;
+
+    fn reset(&self, _seed: u64, _call: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
+        self.at.set(1.0);
+        Ok((vec![1.0], vec![1.0]))
+    }
+
+    fn step(&self, action: i64, _call: &str) -> Result<(Vec<f64>, Vec<f64>, bool), String> {
+        self.at.set(self.at.get() + action as f64);
+        let numbers = self.obs.clone().unwrap_or_else(|| vec![self.at.get()]);
+        Ok((numbers.clone(), numbers, false))
+    }
+
+    fn valuation(&self, _obs: &Vec<f64>, _call: &str) -> Option<Result<Vec<f64>, String>> {
+        self.valued.clone().map(Ok)
+    }
+}
+
+#[test]
+fn a_box_environment_checks_every_observation_in_words() {
+    use hstl::runtime::World;
+    let src = "spec L {
+    state { x: float in 0..=4 }
+    let Far = x > 3;
+    task eventually[0..20] Far;
+    option Far;
+    learn { preset: auto }
+}";
+    let checked = hstl::lang::check(src);
+    assert!(!checked.has_errors(), "{:?}", checked.diagnostics);
+    let spec = hstl::lower::task_spec(&checked.specs[0], src).expect("lowers");
+    let described = || {
+        hstl::gym::Described::new("Line-v0", vec!["x".into()], vec![0.0], vec![10.0], 3, -1)
+            .expect("described")
+    };
+    // (what the step gives, the refusal)
+    let cases: [(Option<Vec<f64>>, &str); 3] = [
+        (None, ""),
+        (
+            Some(vec![1.0, 2.0]),
+            "env.step (call 1) gave an observation of 2 components; its `Box` has 1",
+        ),
+        (
+            Some(vec![11.0]),
+            "env.step (call 1) gave an observation whose component 0 is 11, outside its `Box` [0, 10]",
+        ),
+    ];
+    for (obs, want) in cases {
+        let calls = Line { at: Cell::new(0.0), obs, valued: None };
+        let env = hstl::outside::BoxEnv::new(calls, false, described(), &spec).expect("made");
+        let mut rng = hstl::runtime::seeded_rng(3);
+        let start = env.reset(&mut rng);
+        assert_eq!(start, [1.0]);
+        // Action 2 is the environment's action 1: one step right.
+        let next = env.step(&start, 2, &mut rng);
+        match env.take_error() {
+            None => {
+                assert_eq!(want, "");
+                assert_eq!(next, [2.0]);
+            }
+            Some(Failure::Refused(p)) => assert_eq!(p.message, want),
+            Some(Failure::Call(e)) => panic!("{e}"),
+        }
+    }
+    // A valuation of the wrong size, at the first observation.
+    let calls = Line { at: Cell::new(0.0), obs: None, valued: Some(vec![1.0, 1.0]) };
+    let env = hstl::outside::BoxEnv::new(calls, true, described(), &spec).expect("made");
+    env.reset(&mut hstl::runtime::seeded_rng(3));
+    let Some(Failure::Refused(p)) = env.take_error() else { panic!("not refused") };
+    assert_eq!(p.message, "valuation gives 2 values; the spec has 1 state variables");
+    // The declared range: a position of 5 is inside the `Box` but outside `x`'s range.
+    let calls = Line { at: Cell::new(0.0), obs: Some(vec![5.0]), valued: None };
+    let env = hstl::outside::BoxEnv::new(calls, false, described(), &spec).expect("made");
+    let mut rng = hstl::runtime::seeded_rng(3);
+    let start = env.reset(&mut rng);
+    env.step(&start, 2, &mut rng);
+    let Some(Failure::Refused(p)) = env.take_error() else { panic!("not refused") };
+    assert_eq!(p.message, "after env.step (call 1), `x` = 5 is outside its declared range 0..=4");
+}

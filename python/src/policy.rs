@@ -17,7 +17,7 @@ use pyo3::types::{PyDict, PyInt, PyTuple};
 
 use crate::continuous::ContinuousWorld;
 use crate::errors::{self, policy_error, problem_error, value_error};
-use crate::gym::{BoxEnv, Spaces, failure_error, py_env};
+use crate::gym::{Spaces, box_env, failure_error, py_env};
 use crate::spec::Spec;
 use crate::trace::state_values;
 use crate::world::World;
@@ -512,11 +512,11 @@ impl Policy {
                     .tiles()
                     .ok_or_else(|| value_error("the policy holds no learned function", None))?;
                 self.replayed.check_box_env(&described).map_err(|p| problem_error(&p))?;
-                let boxed = BoxEnv::new(env, valuation, described, spec)?;
+                let boxed = box_env(env, valuation, described, spec)?;
                 let (result, boxed) =
                     py.detach(move || (continuous::evaluate_in(spec, agent, &boxed, runs), boxed));
                 if let Some(e) = boxed.take_error() {
-                    return Err(e);
+                    return Err(failure_error(e));
                 }
                 (result.map_err(|p| problem_error(&p))?, None)
             }
