@@ -153,6 +153,27 @@ pub enum Failure<E> {
     Refused(Problem),
 }
 
+/// The first failure of a run, kept until taken.
+struct FirstFailure<E>(RefCell<Option<Failure<E>>>);
+
+impl<E> FirstFailure<E> {
+    fn take(&self) -> Option<Failure<E>> {
+        self.0.borrow_mut().take()
+    }
+
+    fn failed(&self) -> bool {
+        self.0.borrow().is_some()
+    }
+
+    /// Keeps `e` unless a failure is kept already.
+    fn keep(&self, e: Failure<E>) {
+        let mut slot = self.0.borrow_mut();
+        if slot.is_none() {
+            *slot = Some(e);
+        }
+    }
+}
+
 impl<E> From<Problem> for Failure<E> {
     fn from(p: Problem) -> Self {
         Failure::Refused(p)
@@ -172,7 +193,7 @@ pub struct DiscreteEnv<C: Calls> {
     absorbed: Cell<bool>,
     /// How the last step ended the episode, if it did.
     end: Cell<Option<EpisodeEnd>>,
-    error: RefCell<Option<Failure<C::Error>>>,
+    error: FirstFailure<C::Error>,
 }
 
 impl<C: Calls> DiscreteEnv<C> {
@@ -261,7 +282,7 @@ impl<C: Calls> DiscreteEnv<C> {
             current: Cell::new(0),
             absorbed: Cell::new(false),
             end: Cell::new(None),
-            error: RefCell::new(None),
+            error: FirstFailure(RefCell::new(None)),
         })
     }
 
@@ -277,19 +298,16 @@ impl<C: Calls> DiscreteEnv<C> {
 
     /// The first failure of the run, if any (taken: a later call sees none).
     pub fn take_error(&self) -> Option<Failure<C::Error>> {
-        self.error.borrow_mut().take()
+        self.error.take()
     }
 
     /// Whether a failure stopped the run.
     pub fn failed(&self) -> bool {
-        self.error.borrow().is_some()
+        self.error.failed()
     }
 
     fn fail(&self, e: Failure<C::Error>) {
-        let mut slot = self.error.borrow_mut();
-        if slot.is_none() {
-            *slot = Some(e);
-        }
+        self.error.keep(e)
     }
 
     fn call_reset(&self, seed: u64) -> Result<usize, Failure<C::Error>> {
@@ -426,7 +444,7 @@ pub struct BoxEnv<C: BoxCalls> {
     absorbed: Cell<bool>,
     /// `step` calls so far, for messages.
     steps: Cell<u64>,
-    error: RefCell<Option<Failure<C::Error>>>,
+    error: FirstFailure<C::Error>,
 }
 
 impl<C: BoxCalls> BoxEnv<C> {
@@ -473,7 +491,7 @@ impl<C: BoxCalls> BoxEnv<C> {
             current: RefCell::new(Vec::new()),
             absorbed: Cell::new(false),
             steps: Cell::new(0),
-            error: RefCell::new(None),
+            error: FirstFailure(RefCell::new(None)),
         })
     }
 
@@ -484,19 +502,16 @@ impl<C: BoxCalls> BoxEnv<C> {
 
     /// The first failure of the run, if any (taken: a later call sees none).
     pub fn take_error(&self) -> Option<Failure<C::Error>> {
-        self.error.borrow_mut().take()
+        self.error.take()
     }
 
     /// Whether a failure stopped the run.
     pub fn failed(&self) -> bool {
-        self.error.borrow().is_some()
+        self.error.failed()
     }
 
     fn fail(&self, e: Failure<C::Error>) {
-        let mut slot = self.error.borrow_mut();
-        if slot.is_none() {
-            *slot = Some(e);
-        }
+        self.error.keep(e)
     }
 
     /// The state of the observation `obs` with the numbers `values`, every number checked;
