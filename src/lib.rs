@@ -34,15 +34,16 @@ pub mod load;
 pub mod lower;
 pub mod monitor;
 pub mod outfile;
-mod problem;
+pub mod outside;
 pub mod reference;
+pub mod replayed;
 pub mod reward;
 pub mod seeds;
 pub mod study;
 pub mod train;
 pub mod world;
 
-pub use problem::Problem;
+pub use hstl_files::Problem;
 
 pub use hstl_lang as lang;
 pub use hstl_robustness as robustness;

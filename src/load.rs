@@ -6,7 +6,6 @@
 //! [`read_error`] words a failed read the same way for both.
 
 use std::fmt;
-use std::path::Path;
 
 use hstl_lang::{CheckedSpec, Diagnostic};
 
@@ -251,108 +250,8 @@ impl fmt::Display for UnknownCode {
 
 impl std::error::Error for UnknownCode {}
 
-/// Opens `path` for reading when it is a regular file. A folder is an error of kind
-/// `IsADirectory`; a named pipe, a device or a socket one of kind `InvalidInput` whose
-/// message says what it is ("a named pipe, not a regular file"), before a byte is read: a
-/// file that a spec names (its `world` item) is read by `check` and by the language server
-/// on every keystroke, and opening a named pipe for reading waits for a writer, forever if
-/// none comes. The file is opened without waiting and then looked at.
-pub fn open_regular(path: &Path) -> std::io::Result<std::fs::File> {
-    #[cfg(unix)]
-    let file = {
-        use std::os::unix::fs::OpenOptionsExt;
-        std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path)?
-    };
-    #[cfg(not(unix))]
-    let file = std::fs::File::open(path)?;
-    let meta = file.metadata()?;
-    if meta.is_dir() {
-        return Err(std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a folder"));
-    }
-    if meta.is_file() {
-        return Ok(file);
-    }
-    #[cfg(unix)]
-    let kind = {
-        use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
-        if t.is_fifo() {
-            "a named pipe"
-        } else if t.is_char_device() || t.is_block_device() {
-            "a device"
-        } else if t.is_socket() {
-            "a socket"
-        } else {
-            "a special file"
-        }
-    };
-    #[cfg(not(unix))]
-    let kind = "a special file";
-    Err(std::io::Error::new(
-        std::io::ErrorKind::InvalidInput,
-        format!("{kind}, not a regular file"),
-    ))
-}
-
-/// `` cannot read `PATH`: REASON ``, the OS reason in lower case without its
-/// "(os error N)" tail.
-pub fn read_error(path: &Path, error: &std::io::Error) -> String {
-    format!("cannot read `{}`: {}", path_words(path), io_reason(error))
-}
-
-/// A path as messages show it, losslessly: its text as it is, control characters escaped
-/// ([`escape_controls`]), and each byte that is not UTF-8 as `\xff` (where `display()`
-/// shows U+FFFD for every one of them, so that two files print under one name).
-pub fn path_words(path: &Path) -> String {
-    #[cfg(unix)]
-    let bytes = std::os::unix::ffi::OsStrExt::as_bytes(path.as_os_str());
-    #[cfg(not(unix))]
-    let owned = path.to_string_lossy().into_owned().into_bytes();
-    #[cfg(not(unix))]
-    let bytes = owned.as_slice();
-    let mut out = String::with_capacity(bytes.len());
-    for chunk in bytes.utf8_chunks() {
-        out.push_str(&escape_controls(chunk.valid()));
-        for b in chunk.invalid() {
-            out.push_str(&format!("\\x{b:02x}"));
-        }
-    }
-    out
-}
-
-/// `text` with its control characters (and the bidirectional controls, which reorder what
-/// a terminal shows) escaped as `\x1b` or `\u{202e}`: a name shown in a message cannot
-/// clear the screen, retitle the window, move the cursor or hide what follows. Other text,
-/// non-ASCII letters included, is shown as it is.
-pub fn escape_controls(text: &str) -> std::borrow::Cow<'_, str> {
-    let bidi = |c: char| matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
-    let unsafe_char = |c: char| c.is_control() || bidi(c);
-    if !text.chars().any(unsafe_char) {
-        return std::borrow::Cow::Borrowed(text);
-    }
-    let mut out = String::with_capacity(text.len() + 8);
-    for c in text.chars() {
-        match c {
-            c if (c as u32) < 0x80 && unsafe_char(c) => {
-                out.push_str(&format!("\\x{:02x}", c as u32))
-            }
-            c if unsafe_char(c) => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    std::borrow::Cow::Owned(out)
-}
-
-/// The OS reason of an I/O error in lower case, without the "(os error N)" tail.
-pub fn io_reason(e: &std::io::Error) -> String {
-    let text = e.to_string();
-    let text = text.split(" (os error").next().unwrap_or(&text).to_string();
-    let mut chars = text.chars();
-    match chars.next() {
-        Some(c) => c.to_lowercase().chain(chars).collect(),
-        None => text,
-    }
-}
+pub use hstl_files::read::open_regular;
+pub use hstl_files::words::{escape_controls, io_reason, path_words, read_error};
 
 fn quote_list(names: &[String]) -> String {
     names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")

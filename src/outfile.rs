@@ -1,21 +1,7 @@
-//! A file of an output folder as plain data (the facade writes none itself), and the
-//! number form its CSV files use.
+//! A file of an output folder as plain data ([`OutFile`], from `hstl-files`, which writes
+//! it; the facade writes none itself), and the number form its CSV files use.
 
-/// A file to write: its name inside the output folder and its bytes.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct OutFile {
-    /// The file name, such as `policy.json`.
-    pub name: String,
-    /// The whole contents.
-    pub contents: Vec<u8>,
-}
-
-impl OutFile {
-    /// A file from text.
-    pub fn text(name: impl Into<String>, text: String) -> OutFile {
-        OutFile { name: name.into(), contents: text.into_bytes() }
-    }
-}
+pub use hstl_files::OutFile;
 
 /// `v` in the shortest form that reads back to the same double (`inf`, `-inf`, `NaN` as
 /// such).

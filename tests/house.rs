@@ -13,13 +13,15 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Every crate's source folder.
-const CRATES: [&str; 9] = [
+const CRATES: [&str; 11] = [
     "hstl-lang/src",
     "hstl-macros/src",
     "robustness/src",
     "runtime/src",
     "pictures/src",
+    "files/src",
     "outdir/src",
+    "ide/src",
     "src",
     "hstlc/src",
     "python/src",
@@ -50,7 +52,7 @@ const LONG_FILE: usize = 800;
 /// the workspace root. The test fails on a long file neither listed here nor giving its
 /// reason (a `//!` line starting `One file:` in its first 40 lines), and on a listed one
 /// that is no longer long.
-const LONG_FILES_TO_SPLIT: &[&str] = &["hstlc/src/lsp/features.rs", "python/src/policy.rs"];
+const LONG_FILES_TO_SPLIT: &[&str] = &[];
 
 /// A module's path inside its crate (`["plan_reach", "choices"]`; the root is empty).
 type Module = Vec<String>;

@@ -6,8 +6,16 @@
 use std::path::{Path, PathBuf};
 
 /// The library crates: they compute and return, and never print or read the clock.
-const LIBRARIES: [&str; 6] =
-    ["hstl-lang/src", "robustness/src", "runtime/src", "src", "pictures/src", "outdir/src"];
+const LIBRARIES: [&str; 8] = [
+    "hstl-lang/src",
+    "robustness/src",
+    "runtime/src",
+    "src",
+    "pictures/src",
+    "files/src",
+    "outdir/src",
+    "ide/src",
+];
 
 /// The lines of every `.rs` file under `dir` (relative to the workspace root) that are code,
 /// as `(file, line number, text)`.
@@ -117,4 +125,37 @@ fn messages_never_show_rust_debug_formatting() {
         })
         .collect();
     assert!(found.is_empty(), "word what a message shows:\n{}", found.join("\n"));
+}
+
+/// The crates a crate's `Cargo.toml` links (its `[dependencies]` and target-specific
+/// dependencies; not its dev-dependencies).
+fn dependencies(krate: &str) -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join(krate).join("Cargo.toml")).expect("Cargo.toml");
+    let mut linked = false;
+    let mut out = Vec::new();
+    for line in text.lines().map(str::trim) {
+        if line.starts_with('[') {
+            linked = line.ends_with("dependencies]") && !line.contains("dev-dependencies");
+        } else if linked && let Some((name, _)) = line.split_once('=') {
+            out.push(name.trim().to_string());
+        }
+    }
+    out
+}
+
+/// The shells' file library knows nothing of the learner (std and libc only), the output
+/// folders only it, and the editor features nothing of the protocol.
+#[test]
+fn the_shell_libraries_link_what_they_say() {
+    assert_eq!(dependencies("files"), ["libc"], "hstl-files: std and libc only");
+    assert_eq!(dependencies("outdir"), ["hstl-files"], "hstl-outdir: only hstl-files");
+    let ide = dependencies("ide");
+    let protocol: Vec<&String> = ide
+        .iter()
+        .filter(|d| d.starts_with("lsp") || d.contains("json") || d.contains("jsonrpc"))
+        .collect();
+    assert!(protocol.is_empty(), "hstl-ide knows nothing of LSP: {protocol:?}");
+    let found = offenders(&["ide/src"], &["lsp_types", "lsp_server", "serde_json", "Uri"]);
+    assert!(found.is_empty(), "hstl-ide knows nothing of LSP:\n{}", found.join("\n"));
 }

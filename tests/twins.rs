@@ -89,3 +89,20 @@ fn the_front_end_and_the_monitor_find_the_same_nan_culprit() {
     assert!(checked > 1000, "{checked} of 1500 drawn specs loaded");
     assert!(found > 100 && found < checked - 100, "{found} of {checked} found a NaN");
 }
+
+/// The shells' file reader (`hstl-files`, which knows nothing of the language) words a
+/// file that is not UTF-8 at the line and column of its first bad byte; the language's
+/// `LineIndex` counts lines and columns for every diagnostic. Over drawn texts of line
+/// breaks (`\n`, `\r\n`, a lone `\r`), ASCII and multi-byte characters, they agree.
+#[test]
+fn the_file_reader_and_the_language_count_lines_alike() {
+    let pieces = ["\n", "\r\n", "\r", "a", "é", "€", "𝄞", " ", "\r\r", "\n\r"];
+    let mut draw = Draw(29);
+    for _ in 0..2000 {
+        let n = draw.below(12);
+        let text: String =
+            (0..n).map(|_| pieces[draw.below(pieces.len() as u64) as usize]).collect();
+        let p = hstl::lang::LineIndex::new(&text).position(&text, text.len());
+        assert_eq!(hstl_files::read::end_position(&text), (p.line, p.column), "{text:?}");
+    }
+}

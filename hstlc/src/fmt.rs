@@ -10,7 +10,7 @@
 //! as `hstlc check` renders them, and the exit status is 1. An unreadable input stops the
 //! run before anything is printed (exit status 2).
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
@@ -80,40 +80,19 @@ pub fn run(args: &FmtArgs) -> CmdResult {
 }
 
 /// Rewrites the file `path` with `text` (after the byte order mark it had), whole or not at
-/// all: the new text goes to a new temporary file beside it (created exclusively, under a
-/// name no other file has), synced, then renamed over it, so that a run killed at any point
-/// leaves the old text or the new, never a mix, and no backup to find. It stays the same
-/// file as far as one rename allows:
-/// - through a symbolic link the file it points to is rewritten, and the link stays;
-/// - the file keeps its permissions (and its owner and group, where that is allowed);
-/// - a file with several hard links becomes a file of its own under the name given (no
-///   write in place can be whole or nothing); its other names keep the old text, and a
-///   note on standard error says so, naming the file.
+/// all, as the same file as far as one rename allows ([`hstl_files::write::rewrite`]: a
+/// symbolic link stays and the file it points to is rewritten, the permissions, owner and
+/// group are kept). A file with several hard links becomes a file of its own under the name
+/// given; its other names keep the old text, and a note on standard error says so, naming
+/// the file.
 fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
-    let fail = |source| CliError::Write { path: path.to_path_buf(), source };
-    let real = std::fs::canonicalize(path).map_err(fail)?;
-    let meta = std::fs::metadata(&real).map_err(fail)?;
     let mut bytes = Vec::with_capacity(text.len() + 3);
     if bom {
         bytes.extend_from_slice("\u{feff}".as_bytes());
     }
     bytes.extend_from_slice(text.as_bytes());
-    let (mut tmp, tmp_path) = create_beside(&real, "tmp").map_err(fail)?;
-    let written = (|| {
-        tmp.write_all(&bytes)?;
-        std::fs::set_permissions(&tmp_path, meta.permissions())?;
-        keep_owner(&tmp, &meta);
-        tmp.sync_all()?;
-        std::fs::rename(&tmp_path, &real)
-    })();
-    if let Err(source) = written {
-        let _ = std::fs::remove_file(&tmp_path);
-        return Err(fail(source));
-    }
-    if let Some(dir) = real.parent() {
-        hstl_outdir::sync_dir(dir);
-    }
-    let others = links(&meta).saturating_sub(1);
+    let others = hstl_files::write::rewrite(path, &bytes)
+        .map_err(|source| CliError::Write { path: path.to_path_buf(), source })?;
     if others > 0 {
         errln!(
             "note: `{}` had {} other hard link{}: it is now a file of its own, and {} the \
@@ -126,57 +105,4 @@ fn write_whole(path: &Path, text: &str, bom: bool) -> Result<(), CliError> {
         );
     }
     Ok(())
-}
-
-/// A new file beside `real`, `.NAME.hstlc-fmt-<pid>-<n>.<ext>`, created exclusively (with
-/// the permissions of `real` on Unix, so that its text is never more readable).
-fn create_beside(real: &Path, ext: &str) -> std::io::Result<(std::fs::File, PathBuf)> {
-    let dir = real.parent().unwrap_or(Path::new("."));
-    let name = real.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let mut options = std::fs::OpenOptions::new();
-    options.write(true).create_new(true);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
-        let mode = std::fs::metadata(real).map_or(0o600, |m| m.permissions().mode() & 0o777);
-        options.mode(mode);
-    }
-    for n in 0..1000 {
-        let path = dir.join(format!(".{name}.hstlc-fmt-{}-{n}.{ext}", std::process::id()));
-        match options.open(&path) {
-            Ok(file) => return Ok((file, path)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e),
-        }
-    }
-    Err(std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name"))
-}
-
-/// How many hard links the file has (1 where the platform does not say).
-fn links(meta: &std::fs::Metadata) -> u64 {
-    #[cfg(unix)]
-    {
-        std::os::unix::fs::MetadataExt::nlink(meta)
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = meta;
-        1
-    }
-}
-
-/// Gives `file` the owner and group of `meta`, where this process may (root may; others
-/// keep their own user, and the group when they belong to it).
-fn keep_owner(file: &std::fs::File, meta: &std::fs::Metadata) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::MetadataExt;
-        if std::os::unix::fs::fchown(file, Some(meta.uid()), Some(meta.gid())).is_err() {
-            let _ = std::os::unix::fs::fchown(file, None, Some(meta.gid()));
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = (file, meta);
-    }
 }

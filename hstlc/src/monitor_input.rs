@@ -98,7 +98,9 @@ pub(crate) fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
             // for its read error.
             match std::fs::metadata(&p) {
                 Ok(meta) if meta.is_dir() => {}
-                Ok(meta) if !meta.is_file() => skipped.push((p, not_regular(&meta))),
+                Ok(meta) if !meta.is_file() => {
+                    skipped.push((p, hstl_files::read::special_kind(&meta)))
+                }
                 _ => found.push(p),
             }
             if found.len() > MAX_BATCH_TRACES {
@@ -129,26 +131,6 @@ pub(crate) fn trace_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
         ));
     }
     Ok(paths)
-}
-
-/// What a file that is not a regular file (nor a folder) is, in words.
-fn not_regular(meta: &std::fs::Metadata) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        let t = meta.file_type();
-        if t.is_fifo() {
-            return "a named pipe";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-        if t.is_block_device() || t.is_char_device() {
-            return "a device";
-        }
-    }
-    let _ = meta;
-    "a special file"
 }
 
 /// The CSV columns the spec's state variables need.

@@ -5,12 +5,18 @@
 //! replaces, and two runs of either never write the same folder at once.
 //!
 //! The files themselves are plain data ([`OutFile`]), made by the facade
-//! (`hstl::artifacts`, `hstl::study`).
+//! (`hstl::artifacts`, `hstl::study`); the writing pieces (exclusive creation, syncing,
+//! a free hidden name, exchanging two folders) are `hstl-files`'s, and this crate, like
+//! it, knows nothing of the learner.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-pub use hstl::artifacts::OutFile;
+pub use hstl_files::OutFile;
+use hstl_files::Problem;
+use hstl_files::words::path_words;
+pub use hstl_files::write::sync_dir;
+use hstl_files::write::{exchange, exchange_unsupported, unique_sibling, write_synced};
 
 /// The file that marks a folder as one run's output: a later run may replace the folder.
 pub const MARKER: &str = ".hstlc-run";
@@ -43,14 +49,19 @@ pub enum Error {
     },
     /// The folder may not be written (another run holds it, it is a file, it holds files no
     /// run writes, a file name is not plain), and how to fix that.
-    Refused(hstl::Problem),
+    Refused(Problem),
 }
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Write { path, source } => {
-                write!(f, "cannot write `{}`: {}", path.display(), hstl::load::io_reason(source))
+                write!(
+                    f,
+                    "cannot write `{}`: {}",
+                    path_words(path),
+                    hstl_files::words::io_reason(source)
+                )
             }
             Error::Refused(p) => f.write_str(&p.message),
         }
@@ -70,7 +81,7 @@ impl Error {
 }
 
 fn refused(message: String, help: Option<String>) -> Error {
-    Error::Refused(hstl::Problem::new(message, help))
+    Error::Refused(Problem::new(message, help))
 }
 
 /// An output folder that this run holds (see [`OutDir::lock`]) and will write whole.
@@ -221,7 +232,7 @@ fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
     };
     if !meta.is_dir() {
         return Err(refused(
-            format!("`{}` is a file, not a folder", dir.display()),
+            format!("`{}` is a file, not a folder", path_words(dir)),
             Some(format!("choose another {}", writer.option)),
         ));
     }
@@ -251,7 +262,7 @@ fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
     Err(refused(
         format!(
             "`{}` holds {}{more}, which no {} run writes",
-            dir.display(),
+            path_words(dir),
             foreign[..shown].join(", "),
             writer.program
         ),
@@ -363,7 +374,7 @@ fn study_refusal(
     };
     if !meta.is_dir() {
         return Err(refused(
-            format!("`{}` is a file, not a folder", dir.display()),
+            format!("`{}` is a file, not a folder", path_words(dir)),
             Some(format!("choose another {}", writer.option)),
         ));
     }
@@ -384,14 +395,17 @@ fn study_refusal(
             return Err(refused(
                 format!(
                     "`{}` is in the way of a study's `{name}`: it is not a file",
-                    path.display()
+                    path_words(&path)
                 ),
                 Some(format!("move it out of the folder, or choose another {}", writer.option)),
             ));
         }
         if !force && !listed.iter().any(|l| l == name) {
             return Err(refused(
-                format!("`{}` was not written by a study, and would be replaced", path.display()),
+                format!(
+                    "`{}` was not written by a study, and would be replaced",
+                    path_words(&path)
+                ),
                 force_help("replace it"),
             ));
         }
@@ -419,7 +433,7 @@ fn study_refusal(
             format!(
                 "`{}` holds `{}`, another run's folder, which this study's summary would not \
                  describe",
-                dir.display(),
+                path_words(dir),
                 first.file_name().unwrap_or_default().to_string_lossy()
             ),
             force_help("remove it"),
@@ -438,26 +452,10 @@ pub fn write_beside(dir: &Path, files: &[OutFile]) -> Result<Vec<PathBuf>, Error
     let mut written = Vec::new();
     for file in files {
         let path = dir.join(&file.name);
-        let tmp = (0..1000)
-            .map(|n| dir.join(format!(".{}.{}-{n}.tmp", file.name, std::process::id())))
-            .find(|p| std::fs::symlink_metadata(p).is_err())
-            .ok_or_else(|| {
-                err(path.clone())(std::io::Error::new(
-                    std::io::ErrorKind::AlreadyExists,
-                    "no free temporary name",
-                ))
-            })?;
-        if let Err(source) = write_synced(&tmp, &file.contents) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(Error::Write { path, source });
-        }
-        if let Err(source) = std::fs::rename(&tmp, &path) {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(Error::Write { path, source });
-        }
+        hstl_files::write::replace(&path, &file.contents)
+            .map_err(|source| Error::Write { path: path.clone(), source })?;
         written.push(path);
     }
-    sync_dir(dir);
     Ok(written)
 }
 
@@ -497,7 +495,7 @@ impl Lock {
                     return Err(refused(
                         format!(
                             "`{}` is being written by another {} run",
-                            dir.display(),
+                            path_words(dir),
                             writer.program
                         ),
                         Some(format!(
@@ -514,7 +512,7 @@ impl Lock {
             }
         }
         Err(refused(
-            format!("`{}` is being written by other {} runs", dir.display(), writer.program),
+            format!("`{}` is being written by other {} runs", path_words(dir), writer.program),
             Some(format!("wait for them to finish, or choose another {}", writer.option)),
         ))
     }
@@ -544,44 +542,6 @@ fn same_file(file: &std::fs::File, path: &Path) -> bool {
         let _ = file;
         path.exists()
     }
-}
-
-/// Exchanges the entries `a` and `b` (both must exist) in one step.
-#[cfg(target_os = "linux")]
-fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
-    use std::ffi::CString;
-    use std::os::unix::ffi::OsStrExt;
-    let c = |p: &Path| {
-        CString::new(p.as_os_str().as_bytes())
-            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e))
-    };
-    let (a, b) = (c(a)?, c(b)?);
-    // SAFETY: both are valid NUL-terminated paths that live across the call.
-    let r = unsafe {
-        libc::renameat2(
-            libc::AT_FDCWD,
-            a.as_ptr(),
-            libc::AT_FDCWD,
-            b.as_ptr(),
-            libc::RENAME_EXCHANGE,
-        )
-    };
-    if r == 0 { Ok(()) } else { Err(std::io::Error::last_os_error()) }
-}
-
-/// Exchanges the entries `a` and `b` in one step: not on this system.
-#[cfg(not(target_os = "linux"))]
-fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
-    Err(std::io::Error::from(std::io::ErrorKind::Unsupported))
-}
-
-/// Whether `exchange` failed because the system or the file system lacks it.
-fn exchange_unsupported(e: &std::io::Error) -> bool {
-    #[cfg(target_os = "linux")]
-    if matches!(e.raw_os_error(), Some(libc::EINVAL | libc::ENOSYS | libc::EOPNOTSUPP)) {
-        return true;
-    }
-    e.kind() == std::io::ErrorKind::Unsupported
 }
 
 /// What tests call after each step of `OutDir::write` that renames the folder.
@@ -644,38 +604,6 @@ fn check_names(files: &[OutFile]) -> Result<(), Error> {
         }
     }
     Ok(())
-}
-
-/// Creates a new, empty file (never an existing one), writes `bytes` and syncs them.
-fn write_synced(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(path)?;
-    file.write_all(bytes)?;
-    file.sync_all()
-}
-
-/// Syncs a folder's entries to disk, where the file system allows it.
-pub fn sync_dir(dir: &Path) {
-    if let Ok(d) = std::fs::File::open(dir) {
-        let _ = d.sync_all();
-    }
-}
-
-/// A path `parent/PREFIX<pid>-<n>` that no entry has, created as a folder when `create`.
-fn unique_sibling(parent: &Path, prefix: &str, create: bool) -> std::io::Result<PathBuf> {
-    for n in 0..1000 {
-        let path = parent.join(format!("{prefix}{}-{n}", std::process::id()));
-        if create {
-            match std::fs::create_dir(&path) {
-                Ok(()) => return Ok(path),
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-                Err(e) => return Err(e),
-            }
-        } else if std::fs::symlink_metadata(&path).is_err() {
-            return Ok(path);
-        }
-    }
-    Err(std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name"))
 }
 
 #[cfg(test)]

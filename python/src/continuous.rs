@@ -37,11 +37,7 @@ impl ContinuousWorld {
 
     /// A continuous world's action names.
     pub fn actions_of(world: &AnyWorld) -> Vec<String> {
-        match world {
-            AnyWorld::Plane(p) => hstl::runtime::World::actions(p),
-            AnyWorld::MountainCar(c) => hstl::runtime::World::actions(c),
-            AnyWorld::Grid(_) => Vec::new(),
-        }
+        hstl::replayed::world_actions(world)
     }
 
     fn new(world: AnyWorld, file: Option<String>) -> PyResult<ContinuousWorld> {

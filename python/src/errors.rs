@@ -123,7 +123,10 @@ pub fn read_error_with(path: &Path, e: &std::io::Error, help: String) -> PyErr {
 
 /// A file that could not be written, as the matching `OSError`, with the CLI's words.
 pub fn write_error(path: &Path, e: &std::io::Error) -> PyErr {
-    os_error(format!("cannot write `{}`: {}", path.display(), hstl::load::io_reason(e)), e)
+    os_error(
+        format!("cannot write `{}`: {}", hstl::load::path_words(path), hstl::load::io_reason(e)),
+        e,
+    )
 }
 
 /// The `OSError` subclass of `e`'s kind (a `ValueError` for text that is not UTF-8).

@@ -1,16 +1,15 @@
 //! `hstl.Policy`: a trained policy, its `policy.json`, replays and evaluation.
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 
 use hstl::Problem;
 use hstl::continuous;
 use hstl::evaluate::{self, Evaluation, Replay, Runs};
-use hstl::runtime::approx::{ApproxAgent, Stepper};
+use hstl::replayed::{Replayed, StateIndex};
+use hstl::runtime::approx::Stepper;
 use hstl::runtime::eval::{AgentController, AgentProgress, Controller};
 use hstl::runtime::optimum::SolveConfig;
-use hstl::runtime::{Agent, Env, GridWorld, Rng, TaskSpec, Value};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -18,7 +17,7 @@ use pyo3::types::{PyDict, PyInt, PyTuple};
 
 use crate::continuous::ContinuousWorld;
 use crate::errors::{self, policy_error, problem_error, value_error};
-use crate::gym::{BoxEnv, PyEnv, Spaces};
+use crate::gym::{Spaces, box_env, failure_error, py_env};
 use crate::spec::Spec;
 use crate::trace::state_values;
 use crate::world::World;
@@ -42,23 +41,10 @@ pub struct Policy {
     replayed: Replayed,
     curve: Option<Vec<f64>>,
     steps: Option<u64>,
-    /// Every state's values (in `state_vars` order, as `f64` bits) to its index.
-    states: HashMap<Vec<u64>, usize>,
+    /// Every tabular state's values to its index.
+    states: StateIndex,
     /// Where `act` is in the running option.
     runner: Mutex<Runner>,
-}
-
-/// A replay in the environment the document describes.
-enum Replayed {
-    /// A grid world: `env` holds it whole.
-    Grid(Replay<GridWorld>),
-    /// A gymnasium environment, which the document cannot rebuild: its states as listed.
-    Listed(Replay<Listed>, Spaces),
-    /// A learned function in a continuous world (a plane, `mountain-car`) it holds whole.
-    Tiles(Box<continuous::Replay>),
-    /// A learned function in a gymnasium environment with a `Box` observation space, which
-    /// the document describes.
-    GymTiles(Box<continuous::GymReplay>),
 }
 
 #[derive(Default)]
@@ -68,177 +54,6 @@ struct Runner {
     pending: bool,
     /// A learned function's run so far.
     stepper: Stepper,
-}
-
-/// The states a `policy.json` lists (those of its first flat policy, in index order), as
-/// an environment: what a policy trained on a gymnasium environment is checked against.
-/// It cannot move: a replay that steps needs the environment itself.
-#[derive(Clone, Debug)]
-pub struct Listed {
-    name: String,
-    params: Value,
-    vars: Vec<String>,
-    actions: Vec<String>,
-    values: Vec<f64>,
-    states: usize,
-}
-
-impl Listed {
-    fn of(policy: &hstl::runtime::Policy) -> Result<Listed, Problem> {
-        let bad =
-            |m: String| Problem::new(m, "pass the policy.json that `hstl.train` wrote".to_string());
-        let entries = policy
-            .flat_policies
-            .values()
-            .next()
-            .ok_or_else(|| bad("it has no flat policy to list its states".into()))?;
-        let mut values = Vec::with_capacity(entries.len() * policy.state_vars.len());
-        for (s, e) in entries.iter().enumerate() {
-            for var in &policy.state_vars {
-                let v = e.state.get(var).ok_or_else(|| {
-                    bad(format!("state {s} of its flat policies has no number for `{var}`"))
-                })?;
-                values.push(v);
-            }
-        }
-        Ok(Listed {
-            name: policy.env.name.clone(),
-            params: policy.env.params.clone(),
-            vars: policy.state_vars.clone(),
-            actions: policy.actions.clone(),
-            values,
-            states: entries.len(),
-        })
-    }
-}
-
-impl Env for Listed {
-    type State = usize;
-
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn params(&self) -> Value {
-        self.params.clone()
-    }
-
-    fn state_vars(&self) -> Vec<String> {
-        self.vars.clone()
-    }
-
-    fn actions(&self) -> Vec<String> {
-        self.actions.clone()
-    }
-
-    fn num_states(&self) -> usize {
-        self.states
-    }
-
-    fn index(&self, state: &usize) -> usize {
-        *state
-    }
-
-    fn state(&self, index: usize) -> Option<usize> {
-        (index < self.states).then_some(index)
-    }
-
-    fn valuation(&self, state: &usize, out: &mut Vec<f64>) {
-        out.clear();
-        let k = self.vars.len();
-        if let Some(row) = self.values.get(state * k..(state + 1) * k) {
-            out.extend_from_slice(row);
-        }
-    }
-
-    fn reset(&self, _rng: &mut Rng) -> usize {
-        0
-    }
-
-    fn step(&self, state: &usize, _action: usize, _rng: &mut Rng) -> usize {
-        *state
-    }
-}
-
-impl Replayed {
-    /// The tabular agent; None for a learned function.
-    fn agent(&self) -> Option<&Agent> {
-        match self {
-            Replayed::Grid(r) => Some(&r.agent),
-            Replayed::Listed(r, _) => Some(&r.agent),
-            Replayed::Tiles(_) | Replayed::GymTiles(_) => None,
-        }
-    }
-
-    fn spec(&self) -> &TaskSpec {
-        match self {
-            Replayed::Grid(r) => &r.spec,
-            Replayed::Listed(r, _) => &r.spec,
-            Replayed::Tiles(r) => &r.spec,
-            Replayed::GymTiles(r) => &r.spec,
-        }
-    }
-
-    /// The tabular document; None for a learned function.
-    fn document(&self) -> Option<&hstl::runtime::Policy> {
-        match self {
-            Replayed::Grid(r) => Some(&r.policy),
-            Replayed::Listed(r, _) => Some(&r.policy),
-            Replayed::Tiles(_) | Replayed::GymTiles(_) => None,
-        }
-    }
-
-    fn source(&self) -> &str {
-        match self {
-            Replayed::Grid(r) => &r.source,
-            Replayed::Listed(r, _) => &r.source,
-            Replayed::Tiles(r) => &r.source,
-            Replayed::GymTiles(r) => &r.source,
-        }
-    }
-
-    fn seed(&self) -> Option<u64> {
-        match self {
-            Replayed::Grid(r) => r.seed,
-            Replayed::Listed(r, _) => r.seed,
-            Replayed::Tiles(r) => r.seed,
-            Replayed::GymTiles(r) => r.seed,
-        }
-    }
-
-    fn env_name(&self) -> String {
-        match self {
-            Replayed::Tiles(r) => r.world.name().to_string(),
-            Replayed::GymTiles(r) => r.env.name.clone(),
-            _ => self.document().map_or(String::new(), |d| d.env.name.clone()),
-        }
-    }
-
-    fn state_vars(&self) -> Vec<String> {
-        match self {
-            Replayed::Tiles(r) => r.agent.model.vars.clone(),
-            Replayed::GymTiles(r) => r.agent.model.vars.clone(),
-            _ => self.document().map_or(Vec::new(), |d| d.state_vars.clone()),
-        }
-    }
-
-    fn actions(&self) -> Vec<String> {
-        match self {
-            Replayed::Tiles(r) => ContinuousWorld::actions_of(&r.world),
-            Replayed::GymTiles(r) => hstl::runtime::World::actions(&r.env),
-            _ => self.document().map_or(Vec::new(), |d| d.actions.clone()),
-        }
-    }
-
-    /// A learned function's agent and what `act` needs of its world: the first action's
-    /// value, and which actions a state blocks.
-    fn tiles(&self) -> Option<(&ApproxAgent, i64)> {
-        match self {
-            Replayed::Tiles(r) => Some((&r.agent, 0)),
-            Replayed::GymTiles(r) => Some((&r.agent, r.env.action_start)),
-            _ => None,
-        }
-    }
 }
 
 impl Policy {
@@ -252,116 +67,22 @@ impl Policy {
         steps: Option<u64>,
     ) -> PyResult<Policy> {
         let replayed =
-            py.detach(|| replay_any(&text)).map_err(|p| policy_error(&p.in_file(file)))?;
-        if matches!(replayed, Replayed::Tiles(_) | Replayed::GymTiles(_)) {
-            let states = HashMap::new();
-            return Ok(Policy { text, replayed, curve, steps, states, runner: Mutex::default() });
-        }
-        let mut states = HashMap::new();
-        let mut row = Vec::new();
-        let mut index = |env: &dyn Fn(usize, &mut Vec<f64>), n: usize| {
-            for s in 0..n {
-                env(s, &mut row);
-                states.insert(key(&row), s);
-            }
-        };
-        match &replayed {
-            Replayed::Grid(r) => index(
-                &|s, out| {
-                    if let Some(c) = r.env.state(s) {
-                        r.env.valuation(&c, out)
-                    }
-                },
-                r.env.num_states(),
-            ),
-            Replayed::Listed(r, _) => index(&|s, out| r.env.valuation(&s, out), r.env.num_states()),
-            Replayed::Tiles(_) | Replayed::GymTiles(_) => {}
-        }
+            py.detach(|| Replayed::read(&text)).map_err(|p| policy_error(&p.in_file(file)))?;
+        let states = StateIndex::of(&replayed);
         Ok(Policy { text, replayed, curve, steps, states, runner: Mutex::default() })
     }
 
     /// The state index of `state`, as `act` takes it.
     fn index_of(&self, state: &Bound<'_, PyAny>) -> PyResult<usize> {
-        if let Replayed::Listed(r, spaces) = &self.replayed
+        if matches!(self.replayed, Replayed::Listed(..))
             && state.is_instance_of::<PyInt>()
+            && let Some(index) = self.replayed.observation_index(state.extract()?)
         {
-            let obs: i64 = state.extract()?;
-            let n = r.env.num_states();
-            return obs
-                .checked_sub(spaces.observation_start)
-                .and_then(|i| usize::try_from(i).ok())
-                .filter(|&i| i < n)
-                .ok_or_else(|| {
-                    value_error(
-                        format!(
-                            "observation {obs} is outside Discrete({n}, start={})",
-                            spaces.observation_start
-                        ),
-                        None,
-                    )
-                });
+            return index.map_err(|p| problem_error(&p));
         }
-        let vars = &self.replayed.state_vars();
-        let values = state_values(state, vars)?;
-        self.states.get(&key(&values)).copied().ok_or_else(|| {
-            let shown: Vec<String> =
-                vars.iter().zip(&values).map(|(v, x)| format!("{v} = {x}")).collect();
-            value_error(
-                format!("the policy has no state {}", shown.join(", ")),
-                Some(match &self.replayed {
-                    Replayed::Grid(r) => {
-                        format!("give a free cell of {}", hstl::world::label(&r.env, None))
-                    }
-                    _ => "give an observation of the environment".into(),
-                }),
-            )
-        })
+        let values = state_values(state, &self.replayed.state_vars())?;
+        self.replayed.state_index(&self.states, &values).map_err(|p| problem_error(&p))
     }
-}
-
-/// Replays a grid world policy, or a gymnasium one against the states it lists.
-fn replay_any(text: &str) -> Result<Replayed, Problem> {
-    if continuous::is_learned_function_text(text) {
-        return Ok(match continuous::replay_text_any(text)? {
-            continuous::AnyReplay::World(r) => Replayed::Tiles(Box::new(r)),
-            continuous::AnyReplay::Gym(r) => Replayed::GymTiles(Box::new(r)),
-        });
-    }
-    // One typed pass over the document; the world it names decides the replay.
-    let document = evaluate::read(text)?;
-    let params = &document.policy.env.params;
-    let gymnasium = params.get("gymnasium").and_then(Value::as_bool) == Some(true);
-    if !gymnasium {
-        return evaluate::replay_grid(document).map(Replayed::Grid);
-    }
-    let params = params.clone();
-    let count =
-        |key: &str| params.get(key).and_then(Value::as_u64).and_then(|n| usize::try_from(n).ok());
-    let start = |key: &str| params.get(key).and_then(Value::as_i64);
-    let replay = evaluate::replay_document(document, |p| Listed::of(p))?;
-    let spaces = match (
-        count("observations"),
-        start("observation_start"),
-        count("actions"),
-        start("action_start"),
-    ) {
-        (Some(observations), Some(observation_start), Some(actions), Some(action_start)) => {
-            Spaces {
-                name: replay.policy.env.name.clone(),
-                observations,
-                observation_start,
-                actions,
-                action_start,
-            }
-        }
-        _ => {
-            return Err(Problem::new(
-                "its `env.params` lack the spaces of its gymnasium environment",
-                "pass the policy.json that `hstl.train` wrote".to_string(),
-            ));
-        }
-    };
-    Ok(Replayed::Listed(replay, spaces))
 }
 
 #[pymethods]
@@ -391,7 +112,7 @@ impl Policy {
     /// same folder, then renamed), byte for byte what `hstlc train` writes for the same
     /// spec, world, seed and episodes.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        py.detach(|| write_whole(&path, self.text.as_bytes()))
+        py.detach(|| hstl_files::write::replace(&path, self.text.as_bytes()))
             .map_err(|e| errors::write_error(&path, &e))
     }
 
@@ -522,21 +243,12 @@ impl Policy {
     /// NaN, infinite or outside values are refused. Returns the action's index (for a
     /// gymnasium environment, the action itself).
     fn act(&self, state: &Bound<'_, PyAny>) -> PyResult<i64> {
-        if let Some((agent, start)) = self.replayed.tiles() {
-            let vars = self.replayed.state_vars();
-            let values = state_values(state, &vars)?;
-            let blocked = match &self.replayed {
-                Replayed::Tiles(r) => hstl::gym::start(&r.world, &values)
-                    .map(|_| hstl::gym::blocked(&r.world, &values))
-                    .map_err(|p| problem_error(&p))?,
-                _ => {
-                    in_ranges(self.replayed.spec(), &vars, &values)?;
-                    Vec::new()
-                }
-            };
+        if let Some(agent) = self.replayed.tiles() {
+            let values = state_values(state, &self.replayed.state_vars())?;
+            let blocked = self.replayed.blocked(&values).map_err(|p| problem_error(&p))?;
             let mut runner = self.runner.lock().unwrap_or_else(|p| p.into_inner());
             let (action, _) = runner.stepper.act(agent, &values, &blocked);
-            return Ok(start + action as i64);
+            return Ok(self.replayed.action_start() + action as i64);
         }
         let s = self.index_of(state)?;
         let Some(agent) = self.replayed.agent() else {
@@ -553,11 +265,7 @@ impl Policy {
         let decision = controller.act(s);
         runner.progress = controller.pause();
         runner.pending = true;
-        let start = match &self.replayed {
-            Replayed::Listed(_, spaces) => spaces.action_start,
-            _ => 0,
-        };
-        Ok(start + decision.action as i64)
+        Ok(self.replayed.action_start() + decision.action as i64)
     }
 
     /// Forgets the running option (and the memory counters): the next `act` starts afresh.
@@ -643,17 +351,8 @@ impl Policy {
                     .call_method1("_spaces", (env,))?
                     .extract::<(String, usize, i64, usize, i64)>()?;
                 let given = Spaces { name, observations, observation_start, actions, action_start };
-                if given.name != spaces.name || given.params() != spaces.params() {
-                    return Err(value_error(
-                        format!(
-                            "the policy was trained on {}; `env` is {}",
-                            spaces.describe(),
-                            given.describe()
-                        ),
-                        Some("pass the environment it was trained in".into()),
-                    ));
-                }
-                let pyenv = PyEnv::new(env, valuation, given, &listed.spec)?;
+                spaces.check_same(&given).map_err(|p| problem_error(&p))?;
+                let pyenv = py_env(env, valuation, given, &listed.spec)?;
                 let agent = listed.policy.agent_for(&listed.spec, &pyenv).map_err(|e| {
                     value_error(
                         e.to_string(),
@@ -671,7 +370,7 @@ impl Policy {
                 let (result, replay) =
                     py.detach(move || (evaluate::evaluate(&replay, runs), replay));
                 if let Some(e) = replay.env.take_error() {
-                    return Err(e);
+                    return Err(failure_error(e));
                 }
                 (result.map_err(|p| problem_error(&p))?, None, None)
             }
@@ -808,16 +507,16 @@ impl Policy {
                 let described =
                     hstl::gym::Described::new(&name, vars, low, high, actions, action_start)
                         .map_err(|p| problem_error(&p))?;
-                let (agent, _) = self
+                let agent = self
                     .replayed
                     .tiles()
                     .ok_or_else(|| value_error("the policy holds no learned function", None))?;
-                self.check_env(&described)?;
-                let boxed = BoxEnv::new(env, valuation, described, spec)?;
+                self.replayed.check_box_env(&described).map_err(|p| problem_error(&p))?;
+                let boxed = box_env(env, valuation, described, spec)?;
                 let (result, boxed) =
                     py.detach(move || (continuous::evaluate_in(spec, agent, &boxed, runs), boxed));
                 if let Some(e) = boxed.take_error() {
-                    return Err(e);
+                    return Err(failure_error(e));
                 }
                 (result.map_err(|p| problem_error(&p))?, None)
             }
@@ -854,90 +553,4 @@ impl Policy {
         out.set_item("seed", seed)?;
         Ok(out)
     }
-
-    /// Checks that a gymnasium environment's spaces are those the policy was trained with:
-    /// for a world it holds, the world's bounds and actions; else the recorded spaces.
-    fn check_env(&self, given: &hstl::gym::Described) -> PyResult<()> {
-        let fits = match &self.replayed {
-            Replayed::Tiles(r) => {
-                let bounds = hstl::gym::bounds(&r.world);
-                let n = ContinuousWorld::actions_of(&r.world).len();
-                let same =
-                    bounds.as_ref().is_some_and(|(lo, hi)| *lo == given.low && *hi == given.high);
-                if same && n == given.actions && given.action_start == 0 {
-                    return Ok(());
-                }
-                format!(
-                    "world `{}` (a Box of {} components, Discrete({n}))",
-                    r.world.name(),
-                    bounds.map_or(0, |b| b.0.len())
-                )
-            }
-            Replayed::GymTiles(r) => {
-                if r.env.name == given.name && r.env.params() == given.params() {
-                    return Ok(());
-                }
-                r.env.describe()
-            }
-            _ => return Ok(()),
-        };
-        Err(value_error(
-            format!("the policy was trained on {fits}; `env` is {}", given.describe()),
-            Some("pass the environment it was trained in (the same spaces and bounds)".into()),
-        ))
-    }
-}
-
-/// Checks a learned function's state against the ranges its spec declares (the tiling's).
-fn in_ranges(spec: &TaskSpec, vars: &[String], values: &[f64]) -> PyResult<()> {
-    if values.len() != vars.len() {
-        return Err(value_error(
-            format!(
-                "a state of the policy has {} numbers ({}), not {}",
-                vars.len(),
-                vars.join(", "),
-                values.len()
-            ),
-            Some("give the state variables' values in order, or a dict of them".into()),
-        ));
-    }
-    let Some(t) = &spec.learn.tiles else { return Ok(()) };
-    for (i, &x) in values.iter().enumerate() {
-        let (Some(&lo), Some(&hi)) = (t.lo.get(i), t.hi.get(i)) else { continue };
-        if !(x >= lo && x <= hi) {
-            let num = hstl::runtime::plane::num;
-            return Err(value_error(
-                format!(
-                    "`{}` = {} is outside its declared range {}..={}",
-                    vars[i],
-                    num(x),
-                    num(lo),
-                    num(hi)
-                ),
-                Some("give a state the policy was trained on".into()),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// A state's values as a lookup key (`-0` read as `0`).
-fn key(values: &[f64]) -> Vec<u64> {
-    values.iter().map(|v| (v + 0.0).to_bits()).collect()
-}
-
-/// Writes `bytes` to `path` whole or not at all: a temporary file beside it, then renamed.
-fn write_whole(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let name = path.file_name().map_or("policy.json".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
-    let renamed = written.and_then(|()| std::fs::rename(&tmp, path));
-    if renamed.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    renamed
 }

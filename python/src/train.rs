@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 
 use crate::continuous::ContinuousWorld;
 use crate::errors::{self, problem_error, value_error};
-use crate::gym::{BoxEnv, PyEnv, Spaces};
+use crate::gym::{Spaces, box_env, failure_error, py_env};
 use crate::policy::Policy;
 use crate::spec::Spec;
 use crate::world::World;
@@ -84,7 +84,7 @@ pub fn _train_env(
     let spec = spec.get();
     let task = trainable(&spec.spec, spec, episodes)?;
     let spaces = Spaces { name, observations, observation_start, actions, action_start };
-    let pyenv = PyEnv::new(env, valuation, spaces, &task)?;
+    let pyenv = py_env(env, valuation, spaces, &task)?;
     let (trained, failure, pyenv) = py.detach(move || {
         let mut reporter = Reporter::new(progress.as_ref(), task.learn.episodes);
         let trained = train_until(&task, &pyenv, seed, |e, r| {
@@ -92,7 +92,7 @@ pub fn _train_env(
         });
         (trained, reporter.failure, pyenv)
     });
-    if let Some(e) = pyenv.take_error().or(failure) {
+    if let Some(e) = pyenv.take_error().map(failure_error).or(failure) {
         return Err(e);
     }
     let trained = trained.map_err(|e| cannot_train_env(&spec.filename, spec, &e))?;
@@ -147,7 +147,7 @@ pub fn _train_continuous(
 /// Trains `spec` with the approximate learner in a gymnasium environment with a bounded
 /// `Box` observation space (`low`, `high`) and `Discrete` actions, whose observation `o`
 /// has the state `valuation(o)` (None: the observation's components in order); see
-/// `crate::gym::BoxEnv` for how its calls go.
+/// `hstl::outside::BoxEnv` for how its calls go.
 #[pyfunction]
 #[pyo3(signature = (spec, env, valuation, seed, name, low, high, actions, action_start, episodes=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
@@ -179,7 +179,7 @@ pub fn _train_box(
     let vars: Vec<String> = task.state_vars.iter().map(|v| v.name.clone()).collect();
     let described = hstl::gym::Described::new(&name, vars, low, high, actions, action_start)
         .map_err(|p| problem_error(&p))?;
-    let boxed = BoxEnv::new(env, valuation, described, &task)?;
+    let boxed = box_env(env, valuation, described, &task)?;
     let (trained, failure, boxed) = py.detach(move || {
         let mut reporter = Reporter::new(progress.as_ref(), task.learn.episodes);
         let trained = hstl::continuous::train_world_until(&task, &boxed, seed, |e, r| {
@@ -188,7 +188,7 @@ pub fn _train_box(
         .map(|t| (t, task));
         (trained, reporter.failure, boxed)
     });
-    if let Some(e) = boxed.take_error().or(failure) {
+    if let Some(e) = boxed.take_error().map(failure_error).or(failure) {
         return Err(e);
     }
     let (trained, task) = trained.map_err(|e| cannot_train_env(&spec.filename, spec, &e))?;

@@ -65,26 +65,15 @@ fn expand_file_with(path: &str, spans: (Span, Span), root: &TokenStream) -> Toke
     emit(&Target::File { path, text: &text, spans }, &text, &checked, track, root)
 }
 
-/// The text of the spec file at `path`, read within [`hstl_lang::MAX_SOURCE_BYTES`] (a
-/// larger file, or an endless one such as `/dev/zero`, is refused after one byte more),
-/// or the error to report.
+/// The text of the spec file at `path`, read within [`hstl_lang::MAX_SOURCE_BYTES`] through
+/// `hstl-files` as `hstlc` reads a spec (a larger file, or an endless one such as
+/// `/dev/zero`, is refused after one byte more), or the error to report.
 fn read_spec(path: &Path) -> Result<String, String> {
-    use std::io::Read;
-    let limit = hstl_lang::MAX_SOURCE_BYTES;
-    let too_large =
-        || format!("`{}` is larger than {} MiB, the limit for a spec", path.display(), limit >> 20);
-    let cannot = |e: std::io::Error| format!("cannot read `{}`: {e}", path.display());
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    if file.metadata().is_ok_and(|m| m.is_file() && m.len() > limit) {
-        return Err(too_large());
-    }
-    let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(cannot)?;
-    if bytes.len() as u64 > limit {
-        return Err(too_large());
-    }
-    String::from_utf8(bytes).map_err(|e| {
-        format!("`{}` is not UTF-8 text (byte {})", path.display(), e.utf8_error().valid_up_to())
+    hstl_files::read::read_file(path, hstl_lang::MAX_SOURCE_BYTES).map(|t| t.text).map_err(|e| {
+        match e.problem(&hstl_files::words::path_words(path), "spec", "hstl!") {
+            Ok(refused) => refused.message,
+            Err(e) => hstl_files::words::read_error(path, &e),
+        }
     })
 }
 

@@ -33,7 +33,8 @@ use super::convert::Encoding;
 use super::features::{self, Analysis, Leftovers};
 use super::queue::{Outgoing, Sink};
 use super::transport::{Id, Incoming};
-use super::worlds::{WorldCache, path_uri, uri_path};
+use super::worlds::{path_uri, uri_path};
+use hstl_ide::worlds::WorldCache;
 
 /// Largest document analysed (4 MiB): a larger one is kept open, but gets no
 /// diagnostics or answers, and the client is told once why.
@@ -173,7 +174,7 @@ impl Server {
             stale: BTreeMap::new(),
             next_stale: 0,
             trash: Vec::new(),
-            worlds: WorldCache::default(),
+            worlds: super::worlds::cache(),
             log,
             clock: 0,
             analysed_budget: MAX_ANALYSED_BYTES,
