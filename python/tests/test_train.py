@@ -208,6 +208,8 @@ def test_bad_arguments_raise():
 )
 def test_tampered_policies_are_refused_as_hstlc_eval_refuses_them(hstlc, tmp_path, want, edit):
     doc = json.loads(hstl.train(SMALL, seed=2, episodes=2).json)
+    # Without its checksum (which refuses any edit first), each edit meets its field's check.
+    del doc["checksum"]
     edit(doc)
     path = tmp_path / "edited.json"
     path.write_text(json.dumps(doc))
@@ -220,10 +222,27 @@ def test_tampered_policies_are_refused_as_hstlc_eval_refuses_them(hstlc, tmp_pat
 def test_a_policy_from_before_worlds_still_loads(tmp_path):
     doc = json.loads(hstl.train(SMALL, seed=2, episodes=2).json)
     doc["env"] = {"name": "gridworld", "params": {"width": 15, "height": 15, "p": 0.7}}
+    del doc["checksum"]  # written before worlds, it was written before checksums too
     path = tmp_path / "old.json"
     path.write_text(json.dumps(doc))
     old = hstl.Policy.load(path)
     assert old.world.width == 15 and old.evaluate(starts=2, steps=200, optimum=False)["window_rate"] >= 0
+
+
+def test_an_edited_policy_is_refused_by_its_checksum(hstlc, tmp_path):
+    # Issue 30: an edit that every field's check lets through (here the world's slip) is
+    # refused by the document's checksum, by Python as by `hstlc eval`.
+    doc = json.loads(hstl.train(SMALL, seed=2, episodes=2).json)
+    path = tmp_path / "same.json"
+    path.write_text(json.dumps(doc, indent=1))
+    assert hstl.Policy.load(path).seed == 2  # reformatted, it reads back
+    doc["env"]["params"]["slip"] = 0.1
+    path = tmp_path / "edited.json"
+    path.write_text(json.dumps(doc))
+    cli = first_error(run_cli(hstlc, "eval", str(path), "--no-optimum"))
+    with pytest.raises(hstl.PolicyError, match="changed after it was written") as e:
+        hstl.Policy.load(path)
+    assert str(e.value).splitlines() == cli
 
 
 def test_progress_shows_a_bar_only_when_asked_or_on_a_terminal(capfd):
