@@ -42,6 +42,19 @@ pub fn run<T: Send + 'static>(
             let _ = tx.send(work());
         })
         .map_err(|e| value_error(format!("cannot start a thread to evaluate on: {e}"), None))?;
+    wait(py, rx, || stop.store(true, Ordering::Relaxed), "the evaluating thread failed")
+}
+
+/// What a thread sends on `rx`, waited for with the GIL released and taken back every
+/// [`SIGNAL_EVERY`] to run Python's signal handlers: when one raises, `on_interrupt` is
+/// called (to tell the thread to stop) and the call ends with its exception; `failed` words
+/// a thread that ended without sending.
+pub fn wait<T: Send>(
+    py: Python<'_>,
+    rx: mpsc::Receiver<T>,
+    on_interrupt: impl FnOnce(),
+    failed: &str,
+) -> PyResult<T> {
     let mut rx = rx;
     loop {
         // The receiver goes along and back: it may not be shared with the GIL released.
@@ -54,14 +67,11 @@ pub fn run<T: Send + 'static>(
             Ok(done) => return Ok(done),
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 if let Err(e) = py.check_signals() {
-                    // The offline evaluator stops at its next group or piece.
-                    stop.store(true, Ordering::Relaxed);
+                    on_interrupt();
                     return Err(e);
                 }
             }
-            Err(mpsc::RecvTimeoutError::Disconnected) => {
-                return Err(value_error("the evaluating thread failed", None));
-            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => return Err(value_error(failed, None)),
         }
     }
 }

@@ -8,7 +8,7 @@ use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use hstl::lang::budget::MAX_EPISODES;
 use hstl::runtime::TaskSpec;
@@ -19,6 +19,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::continuous::ContinuousWorld;
 use crate::errors::{self, problem_error, value_error, write_error};
+use crate::interrupt;
 use crate::spec::Spec;
 use crate::world::World;
 
@@ -85,9 +86,6 @@ fn set_episodes(task: &mut TaskSpec, episodes: Option<usize>) -> PyResult<()> {
     }
     Ok(())
 }
-
-/// How often `_study_seeds` looks for Ctrl-C while seeds train.
-const SIGNAL_EVERY: Duration = Duration::from_millis(100);
 
 /// The spec checked against the world (the diagnostics of `hstlc check --world` as
 /// `hstl.SpecError`), with `episodes` and the `learn` values of `learn` set.
@@ -164,7 +162,7 @@ pub fn _study_seeds<'py>(
     let stop = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel();
     // The seeds train on threads of their own while this one, holding the GIL only for a
-    // moment every `SIGNAL_EVERY`, watches for Ctrl-C: on it no further seed starts.
+    // moment every `interrupt::SIGNAL_EVERY`, watches for Ctrl-C: on it no further seed starts.
     let done = std::thread::scope(|scope| {
         let (task, stop, clock) = (&task, &stop, &clock);
         let trainer = std::thread::Builder::new().spawn_scoped(scope, move || {
@@ -195,28 +193,10 @@ pub fn _study_seeds<'py>(
         if trainer.is_err() {
             return Err(value_error("cannot start a thread to train on", None));
         }
-        let mut rx = rx;
-        loop {
-            // The receiver goes along and back: it may not be shared with the GIL released.
-            let (back, got) = py.detach(move || {
-                let got = rx.recv_timeout(SIGNAL_EVERY);
-                (rx, got)
-            });
-            rx = back;
-            match got {
-                Ok(done) => return done.map_err(|p| problem_error(&p)),
-                Err(mpsc::RecvTimeoutError::Timeout) => {
-                    if let Err(e) = py.check_signals() {
-                        stop.store(true, Ordering::Relaxed);
-                        // The seeds under way end before the scope does.
-                        return Err(e);
-                    }
-                }
-                Err(mpsc::RecvTimeoutError::Disconnected) => {
-                    return Err(value_error("a training thread failed", None));
-                }
-            }
-        }
+        // On Ctrl-C no further seed starts; the seeds under way end before the scope does.
+        let stopping = || stop.store(true, Ordering::Relaxed);
+        let done = interrupt::wait(py, rx, stopping, "a training thread failed")?;
+        done.map_err(|p| problem_error(&p))
     })?;
     let out = PyList::empty(py);
     for (run, rate) in done {
