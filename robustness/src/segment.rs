@@ -11,7 +11,7 @@
 //! before `t` too, so a suffix is not the segment's tail there, but only near its start:
 //! when every past window is bounded, `f`'s value in the suffix from `i` equals its value
 //! in the segment from step `i + R` on, where `R` is `f`'s reach back (see
-//! [`start_reach`]). Each suffix then evaluates its first `R + H` steps alone and takes
+//! `start_reach`). Each suffix then evaluates its first `R + H` steps alone and takes
 //! the rest from the one running minimum: `O(m (R + H))` for a segment of `m` steps. A
 //! task without a horizon, or with an unbounded past window, scores each suffix on its
 //! own, quadratic in the segment's length.
