@@ -27,7 +27,7 @@ const PER_KIND: &[(&str, &str, &str)] = &[
     ("hstl-macros/src/expand/codegen/data.rs", "formula_data", "generated data per kind"),
     ("hstl-macros/src/expand/codegen/monitor.rs", "empty_value", "each kind's value on no steps"),
     ("hstl-macros/src/expand/codegen/monitor.rs", "horizon", "each kind's horizon"),
-    ("hstlc/src/lsp/features.rs", "operator_of", "hover: each operator's own words"),
+    ("ide/src/hover.rs", "operator_of", "hover: each operator's own words"),
     ("hstl-lang/tests/syntax.rs", "shape", "a test printer: each kind's own text"),
     ("hstl-macros/tests/macro_differential.rs", "lower", "a test lowering to runtime formulas"),
 ];
