@@ -140,6 +140,7 @@ def main() -> None:
     ap.add_argument("--episode-steps", type=int, default=1000)
     ap.add_argument("--envs", default=",".join(TASKS))
     ap.add_argument("--no-rtamt", action="store_true")
+    ap.add_argument("--vector", type=int, default=8, help="environments in the vector of the second table (0: no second table)")
     args = ap.parse_args()
     print(f"machine: {machine()}; {args.steps} random steps a repeat, median of {args.repeats} repeats, "
           f"episodes of {args.episode_steps} steps\n")
@@ -189,6 +190,57 @@ def main() -> None:
     write_csv(OUT / "physics.csv", ["env", "steps", "repeats", "bare_us", "stlreward_us", "stlreward_added",
                                      "added_min", "added_max", "rtamt_us", "rtamt_added", "empty_wrapper_added", "push_us", "push_between_steps_us", "machine"], rows)
     print(f"\nwrote {OUT / 'physics.csv'}")
+    if args.vector:
+        vector_part(args)
+
+
+def run_vector(vec, actions, steps):
+    """CPU seconds a vector step over `steps` steps (each environment resets itself)."""
+    vec.reset(seed=0)
+    t0 = time.process_time()
+    for i in range(steps):
+        vec.step(actions[i % len(actions)])
+    return (time.process_time() - t0) / steps
+
+
+def vector_part(args) -> None:
+    """The second table: `STLVectorReward` on a `SyncVectorEnv` of `--vector` copies, one
+    call into Rust a vector step, against the bare vector, interleaved and paired as above."""
+    n = args.vector
+    steps = max(args.steps // n, 500)
+    print(f"\n{n} environments in a gymnasium SyncVectorEnv, {steps} vector steps a repeat, median of {args.repeats} repeats\n")
+    print("| environment | bare vector, us/step of one env | + STLVectorReward, us/step of one env | STLVectorReward adds | goal <= 2% |")
+    print("|---|---|---|---|---|")
+    rows = []
+    for env_id in args.envs.split(","):
+        file, picks, _ = TASKS[env_id]
+        spec = hstl.Spec.load(SPECS / file)
+
+        def make(env_id=env_id):
+            return gymnasium.make(env_id, max_episode_steps=args.episode_steps)
+
+        bare = gymnasium.vector.SyncVectorEnv([make for _ in range(n)])
+        wrapped = hstl.STLVectorReward(gymnasium.vector.SyncVectorEnv([make for _ in range(n)]), spec, dict(picks))
+        space = bare.action_space
+        rng = np.random.default_rng(0)
+        actions = rng.uniform(space.low, space.high, size=(2000,) + space.shape).astype(space.dtype)
+        run_vector(bare, actions, 200)
+        run_vector(wrapped, actions, 200)
+        times = {"bare": [], "stl": []}
+        for _ in range(args.repeats):
+            times["bare"].append(run_vector(bare, actions, steps))
+            times["stl"].append(run_vector(wrapped, actions, steps))
+        paired = [s / b - 1 for s, b in zip(times["stl"], times["bare"])]
+        added = statistics.median(paired)
+        med = {k: statistics.median(v) * 1e6 / n for k, v in times.items()}
+        met = "met" if added <= 0.02 else "not met"
+        print(f"| {env_id} | {med['bare']:.1f} | {med['stl']:.1f} | {100 * added:+.1f}% (repeats {min(paired) * 100:+.1f}% to {max(paired) * 100:+.1f}%) | {met} |", flush=True)
+        rows.append([env_id, n, steps, args.repeats, med["bare"], med["stl"], added, min(paired), max(paired), machine()])
+        bare.close()
+        wrapped.close()
+    write_csv(OUT / "physics_vector.csv", ["env", "envs", "steps", "repeats", "bare_us_per_env", "stl_us_per_env",
+                                            "added", "added_min", "added_max", "machine"], rows)
+    print(f"\nwrote {OUT / 'physics_vector.csv'}")
 
 
 if __name__ == "__main__":

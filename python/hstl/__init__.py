@@ -89,7 +89,7 @@ __all__ = [
 # gymnasium is optional and costs about 150 ms to import: the gymnasium classes load on
 # first use (`__getattr__` below), and the ids are registered with gymnasium once it is
 # imported (`_registration`).
-_GYM = ("GridWorldEnv", "MountainCarEnv", "PlaneEnv", "STLReward")
+_GYM = ("GridWorldEnv", "MountainCarEnv", "PlaneEnv", "STLReward", "STLVectorReward")
 
 if _find_spec("gymnasium") is not None:
     __all__ += _GYM
@@ -103,6 +103,7 @@ if _TYPE_CHECKING:
     from ._gym import MountainCarEnv as MountainCarEnv
     from ._gym import PlaneEnv as PlaneEnv
     from ._gym import STLReward as STLReward
+    from ._gym import STLVectorReward as STLVectorReward
 else:
 
     def __getattr__(name: str) -> _Any:

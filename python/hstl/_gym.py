@@ -23,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 from gymnasium import spaces
 
-from ._hstl import ContinuousWorld, EpisodeMonitor, Generator, Spec, World, _mountain_car_patrol
+from ._hstl import ContinuousWorld, EpisodeBatch, EpisodeMonitor, Generator, Spec, World, _mountain_car_patrol
 from ._registration import MAX_EPISODE_STEPS, REGISTERED, register
 
 __all__ = [
@@ -362,6 +362,81 @@ class STLReward(gymnasium.Wrapper, gymnasium.utils.RecordConstructorArgs):
     def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         # One call into Rust scores the step and builds its info (see EpisodeMonitor._step).
         return self._monitor._step(self.env.step(action), self._step_valuation)
+
+
+class STLVectorReward(gymnasium.vector.VectorWrapper):
+    """``STLReward`` for a vector of environments (``gymnasium.vector.SyncVectorEnv``,
+    ``AsyncVectorEnv``, ``gymnasium.make_vec``): one call into Rust a vector step scores
+    every environment's new observation, so the cost of leaving Python is paid once for
+    all of them.
+
+    Each environment's episode is scored as ``STLReward`` scores it, with the same
+    ``spec``, ``formula``, ``reward``, ``offset`` and ``scale``. ``valuation`` is a dict
+    from each state variable to its index in an observation (``{"x": 0, "v": 1}``); the
+    observations are the vector's, an array of shape ``(num_envs, ...)`` read as float64.
+    The vector must reset each environment on the step after its episode ends
+    (gymnasium's default ``AutoresetMode.NEXT_STEP``): that step's observation starts the
+    environment's next episode and earns 0.
+
+    ``info`` (of ``reset`` and ``step``) gains ``task_robustness`` (an array, one value an
+    environment), for a persistent task ``window_kept``, and in ``step``
+    ``env_reward`` (the vector's own rewards), each with its ``_name`` mask as vector
+    environments give their infos.
+    """
+
+    def __init__(
+        self,
+        env: gymnasium.vector.VectorEnv,
+        spec: Union[Spec, str, "os.PathLike[str]"],
+        valuation: Mapping[str, int],
+        formula: Optional[str] = None,
+        reward: Literal["robustness", "increment", "window", "sparse"] = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
+    ) -> None:
+        super().__init__(env)
+        mode = env.metadata.get("autoreset_mode", gymnasium.vector.AutoresetMode.NEXT_STEP)
+        if mode not in (gymnasium.vector.AutoresetMode.NEXT_STEP, "NextStep"):
+            raise ValueError(
+                f"STLVectorReward needs a vector environment that resets an environment on the step after its episode ends; this one's autoreset_mode is {mode}\n"
+                "  help: make the vector with autoreset_mode=gymnasium.vector.AutoresetMode.NEXT_STEP (gymnasium's default)"
+            )
+        self.stl_spec = spec if isinstance(spec, Spec) else Spec.load(spec)
+        vars = self.stl_spec.state_vars
+        if not isinstance(valuation, Mapping):
+            raise TypeError(
+                f"valuation must be a dict from state variables to observation indices; got {type(valuation).__name__}\n"
+                '  help: pass a dict such as {"x": 0, "v": 1}'
+            )
+        missing = [v for v in vars if v not in valuation]
+        if missing:
+            raise _missing(f"valuation has no entry for state variable `{missing[0]}`", vars)
+        self.formula = formula
+        self.reward_form = reward
+        self._batch = EpisodeBatch(self.stl_spec, self.num_envs, [int(valuation[v]) for v in vars], formula, reward, offset, scale)
+        self._all = np.ones(self.num_envs, dtype=bool)
+
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[Any, dict[str, Any]]:
+        obs, info = self.env.reset(seed=seed, options=options)
+        _, task, kept = self._batch._reset(np.ascontiguousarray(obs, dtype=np.float64))
+        return obs, self._info(info, task, kept)
+
+    def step(self, actions: Any) -> tuple[Any, npt.NDArray[np.float64], Any, Any, dict[str, Any]]:
+        obs, env_reward, terminated, truncated, info = self.env.step(actions)
+        ends = np.logical_or(terminated, truncated)
+        rewards, task, kept = self._batch._step(np.ascontiguousarray(obs, dtype=np.float64), ends)
+        info = self._info(info, task, kept)
+        info["env_reward"], info["_env_reward"] = env_reward, self._all
+        return obs, rewards, terminated, truncated, info
+
+    def _info(self, info: dict[str, Any], task: Any, kept: Any) -> dict[str, Any]:
+        info = dict(info)
+        info["task_robustness"], info["_task_robustness"] = task, self._all
+        if kept is not None:
+            info["window_kept"], info["_window_kept"] = kept, self._all
+        return info
 
 
 def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Callable[[Any], Any]:

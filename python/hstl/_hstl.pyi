@@ -344,6 +344,31 @@ class Policy:
         valuation: Any = None,
     ) -> dict[str, Any]: ...
 
+class EpisodeBatch:
+    """Scores the episodes of a vector of environments, one call a vector step, for
+    ``hstl.STLVectorReward``."""
+
+    def __init__(
+        self,
+        spec: Spec,
+        envs: int,
+        indices: Sequence[int],
+        formula: Optional[str] = None,
+        reward: RewardForm = "robustness",
+        offset: float = 0.0,
+        scale: float = 1.0,
+    ) -> None: ...
+    def _reset(
+        self, obs: npt.NDArray[np.float64]
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Optional[npt.NDArray[np.bool_]]]: ...
+    def _step(
+        self, obs: npt.NDArray[np.float64], ends: npt.NDArray[np.bool_]
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], Optional[npt.NDArray[np.bool_]]]: ...
+    @property
+    def envs(self) -> int: ...
+    @property
+    def persistent(self) -> bool: ...
+
 class EpisodeMonitor:
     """Scores an episode state by state, for ``hstl.STLReward``; it pickles and
     deep-copies mid-episode."""

@@ -23,6 +23,7 @@ mod spec;
 mod study;
 mod trace;
 mod train;
+mod vector_reward;
 mod world;
 
 use pyo3::prelude::*;
@@ -38,6 +39,7 @@ fn _hstl(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<continuous::ContinuousWorld>()?;
     m.add_class::<policy::Policy>()?;
     m.add_class::<reward::EpisodeMonitor>()?;
+    m.add_class::<vector_reward::EpisodeBatch>()?;
     m.add_function(wrap_pyfunction!(check::check, m)?)?;
     m.add_function(wrap_pyfunction!(check::explain, m)?)?;
     m.add_function(wrap_pyfunction!(cli::cli, m)?)?;

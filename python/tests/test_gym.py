@@ -403,3 +403,65 @@ def test_an_observation_index_past_the_end_says_which_variable():
     env = hstl.STLReward(_Wobble(), hstl.Spec.parse(PENDULUM), valuation={"cart": 0, "angle": 4})
     with pytest.raises(ValueError, match=r"the observation has 4 entries, and `angle` is read from index 4"):
         env.reset(seed=1)
+
+
+CAR = """spec Car {
+    state { x: float in -1.2..=0.6, v: float in -0.07..=0.07 }
+    let Right = x > -0.4;
+    let Left = x < -0.6;
+    task always[0..] (eventually[0..20] Right && eventually[0..20] Left);
+}
+"""
+
+
+def test_the_vector_reward_scores_each_environment_as_stlreward_does():
+    # Three MountainCar environments cut at 25 steps, so that each resets itself within
+    # the run; each row against its own STLReward driven by the same actions and seeds.
+    spec = hstl.Spec.parse(CAR)
+
+    def make() -> gymnasium.Env:
+        return gymnasium.wrappers.TimeLimit(hstl.MountainCarEnv(), max_episode_steps=25)
+
+    vector = hstl.STLVectorReward(gymnasium.vector.SyncVectorEnv([make for _ in range(3)]), spec, {"x": 0, "v": 1})
+    singles = [hstl.STLReward(make(), spec, {"x": 0, "v": 1}) for _ in range(3)]
+    obs, info = vector.reset(seed=10)
+    for i, single in enumerate(singles):
+        o, inf = single.reset(seed=10 + i)
+        assert np.array_equal(obs[i], o) and info["task_robustness"][i] == inf["task_robustness"]
+        assert info["window_kept"][i] == inf["window_kept"]
+    rng = np.random.default_rng(3)
+    done = [False] * 3
+    restarts = 0
+    for _ in range(80):
+        actions = rng.integers(0, 3, size=3)
+        obs, rewards, terminated, truncated, info = vector.step(actions)
+        assert rewards.dtype == np.float64 and rewards.shape == (3,)
+        for i, single in enumerate(singles):
+            if done[i]:
+                # The vector reset this environment: its row starts the next episode.
+                o, inf = single.reset()
+                want_reward, restarts = 0.0, restarts + 1
+            else:
+                o, want_reward, _, _, inf = single.step(int(actions[i]))
+            assert np.array_equal(obs[i], o)
+            assert rewards[i] == want_reward
+            assert info["task_robustness"][i] == inf["task_robustness"]
+            assert info["window_kept"][i] == inf["window_kept"]
+        done = list(np.logical_or(terminated, truncated))
+    assert restarts >= 6
+
+
+def test_the_vector_reward_refuses_what_it_cannot_score():
+    spec = hstl.Spec.parse(CAR)
+
+    def make() -> gymnasium.Env:
+        return hstl.MountainCarEnv()
+
+    same_step = gymnasium.vector.SyncVectorEnv([make], autoreset_mode=gymnasium.vector.AutoresetMode.SAME_STEP)
+    with pytest.raises(ValueError, match="NEXT_STEP"):
+        hstl.STLVectorReward(same_step, spec, {"x": 0, "v": 1})
+    with pytest.raises(hstl.MissingVariableError, match="`v`"):
+        hstl.STLVectorReward(gymnasium.vector.SyncVectorEnv([make]), spec, {"x": 0})
+    vector = hstl.STLVectorReward(gymnasium.vector.SyncVectorEnv([make, make]), spec, {"x": 0, "v": 5})
+    with pytest.raises(ValueError, match="reads columns up to 5"):
+        vector.reset(seed=0)

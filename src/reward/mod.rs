@@ -65,9 +65,11 @@ use std::fmt;
 use crate::lower::{self, LowerError};
 use crate::monitor::{NanProne, TraceError};
 
+mod batch;
 mod program;
 mod running;
 
+pub use batch::{EpisodeBatch, RowError};
 use program::Program;
 use running::{Columns, Context, Running};
 
