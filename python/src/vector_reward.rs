@@ -21,6 +21,10 @@ pub struct EpisodeBatch {
     scores: Vec<StepScore>,
 }
 
+/// The most environments one batch scores: each holds an episode monitor, and a vector
+/// past this is no gymnasium vector a machine steps.
+const MAX_ENVS: usize = 1 << 16;
+
 /// A vector step's scores: the rewards, the task's robustness and, for a persistent task,
 /// whether each window is kept.
 type Scored<'py> =
@@ -51,6 +55,12 @@ impl EpisodeBatch {
             return Err(value_error(
                 format!("{} observation indices for {} state variables", indices.len(), vars.len()),
                 Some("give one index for each state variable, in `state_vars` order".into()),
+            ));
+        }
+        if envs > MAX_ENVS {
+            return Err(value_error(
+                format!("a vector of {envs} environments; at most {MAX_ENVS} are scored together"),
+                Some("split the environments into vectors of fewer".into()),
             ));
         }
         let persistent = one.is_persistent();
@@ -125,9 +135,10 @@ impl EpisodeBatch {
                 Some("pass the vector environment's observations, one row an environment".into()),
             ));
         }
-        let data = obs
-            .as_slice()
-            .map_err(|_| value_error("the observations must be a C-ordered float64 array", None))?;
+        let c_ordered = obs.is_c_contiguous();
+        let data = obs.as_slice().ok().filter(|_| c_ordered).ok_or_else(|| {
+            value_error("the observations must be a C-ordered float64 array", None)
+        })?;
         Ok((data, width))
     }
 

@@ -465,3 +465,12 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
     vector = hstl.STLVectorReward(gymnasium.vector.SyncVectorEnv([make, make]), spec, {"x": 0, "v": 5})
     with pytest.raises(ValueError, match="reads columns up to 5"):
         vector.reset(seed=0)
+    # The batch underneath: a vector size past its budget is refused before anything is
+    # allocated (it aborted the interpreter), and rows in Fortran order are not misread.
+    with pytest.raises(ValueError, match="at most 65536 are scored together"):
+        hstl._hstl.EpisodeBatch(spec, 10**12, [0, 1])
+    batch = hstl._hstl.EpisodeBatch(spec, 2, [0, 1])
+    with pytest.raises(ValueError, match="C-ordered"):
+        batch._reset(np.asfortranarray(np.zeros((2, 3))))
+    with pytest.raises(ValueError, match="environment 1 of the vector: `x` is NaN"):
+        batch._reset(np.array([[0.0, 0.0], [np.nan, 0.0]]))

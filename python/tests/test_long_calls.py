@@ -51,7 +51,15 @@ def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path) -> None:
     )
     path = tmp_path / "chain.hstl"
     path.write_text(chain_spec(2000))
-    child = subprocess.Popen([sys.executable, "-c", code, str(path)], stdout=subprocess.PIPE, text=True)
+    # Ctrl-C as at a terminal, whatever the test runner inherited (a background job has
+    # SIGINT ignored, and Python then installs no handler).
+    child = subprocess.Popen(
+        [sys.executable, "-c", code, str(path)],
+        stdout=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+
     assert child.stdout is not None
     assert child.stdout.readline().strip() == "started"
     time.sleep(1.5)

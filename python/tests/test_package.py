@@ -30,7 +30,7 @@ def stub_classes():
 def test_the_stubs_name_what_the_module_has_with_the_same_parameters():
     classes = stub_classes()
     exported = {"Diagnostic", "Spec", "OnlineMonitor", "World", "ContinuousWorld", "Policy"}
-    assert set(classes) == exported | {"Generator", "EpisodeMonitor", "_StudyOut"}
+    assert set(classes) == exported | {"Generator", "EpisodeMonitor", "EpisodeBatch", "_StudyOut"}
     for name, node in classes.items():
         runtime = getattr(hstl if name in exported else hstl._hstl, name)
         stubbed = set()

@@ -362,8 +362,13 @@ def test_ctrl_c_ends_a_study_within_its_episode_under_way(tmp_path, world):
         "except KeyboardInterrupt:\n"
         "    print('interrupted', flush=True)\n"
     )
+    # Ctrl-C as at a terminal, whatever the test runner inherited (a background job has
+    # SIGINT ignored, and Python then installs no handler).
     child = subprocess.Popen(
-        [sys.executable, "-c", code, str(spec)], stdout=subprocess.PIPE, text=True
+        [sys.executable, "-c", code, str(spec)],
+        stdout=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     assert child.stdout is not None
     assert child.stdout.readline().strip() == "started"
