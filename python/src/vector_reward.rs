@@ -21,9 +21,9 @@ pub struct EpisodeBatch {
     scores: Vec<StepScore>,
 }
 
-/// The most environments one batch scores: each holds an episode monitor, and a vector
-/// past this is no gymnasium vector a machine steps.
-const MAX_ENVS: usize = 1 << 16;
+/// The most environments one batch scores: each holds a copy of the episode monitor, and
+/// a vector past this is no gymnasium vector one process steps.
+const MAX_ENVS: usize = 1 << 12;
 
 /// A vector step's scores: the rewards, the task's robustness and, for a persistent task,
 /// whether each window is kept.

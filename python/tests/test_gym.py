@@ -467,7 +467,7 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
         vector.reset(seed=0)
     # The batch underneath: a vector size past its budget is refused before anything is
     # allocated (it aborted the interpreter), and rows in Fortran order are not misread.
-    with pytest.raises(ValueError, match="at most 65536 are scored together"):
+    with pytest.raises(ValueError, match="at most 4096 are scored together"):
         hstl._hstl.EpisodeBatch(spec, 10**12, [0, 1])
     batch = hstl._hstl.EpisodeBatch(spec, 2, [0, 1])
     with pytest.raises(ValueError, match="C-ordered"):

@@ -355,12 +355,21 @@ impl FormulaBuilder {
     }
 
     fn insert(&mut self, nodes: &[Node], root: u32) -> u32 {
+        self.insert_all(nodes)[root as usize]
+    }
+
+    /// Adds every node of `f`; returns each one's id here, in `f`'s node order.
+    pub(crate) fn formula_nodes(&mut self, f: &Formula) -> Vec<NodeId> {
+        self.insert_all(&f.inner.nodes).into_iter().map(NodeId).collect()
+    }
+
+    fn insert_all(&mut self, nodes: &[Node]) -> Vec<u32> {
         let mut map = Vec::with_capacity(nodes.len());
         for node in nodes {
             let node = node.remap(|k| map[k]);
             map.push(self.add(node));
         }
-        map[root as usize]
+        map
     }
 
     /// The formula under `root`: the nodes it reaches, in canonical order.

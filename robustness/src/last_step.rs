@@ -18,12 +18,13 @@ use crate::formula::{Formula, FormulaBuilder, Node, NodeId};
 pub fn at_last_step(f: &Formula) -> Formula {
     let nodes = f.nodes();
     let mut b = FormulaBuilder::new();
-    // `end[v]`: node `v` at the last step (`None` for expressions, which the nodes that
-    // read them import whole).
+    // Every node as it is, imported once: a state formula or a past operator is read so.
+    let kept = b.formula_nodes(f);
+    // `end[v]`: node `v` at the last step (`None` for expressions, which only the kept
+    // nodes read).
     let mut end: Vec<Option<NodeId>> = Vec::with_capacity(nodes.len());
     for (v, node) in nodes.iter().enumerate() {
         let at = |k: &NodeId, end: &[Option<NodeId>]| end[k.index()].expect("children first");
-        let whole = |b: &mut FormulaBuilder| b.formula(&f.sub(NodeId::from_index(v)));
         let e = match node {
             _ if node.is_expr() => None,
             Node::Not(g) => Some(b.not(at(g, &end))),
@@ -35,7 +36,7 @@ pub fn at_last_step(f: &Formula) -> Formula {
             Node::Until(i, _, h) => Some(if reads_now(i) { at(h, &end) } else { b.bool(false) }),
             Node::Next(_) => Some(b.bool(true)),
             // A state formula, or a past operator: read as it is.
-            _ => Some(whole(&mut b)),
+            _ => Some(kept[v]),
         };
         end.push(e);
     }

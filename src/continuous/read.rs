@@ -113,10 +113,12 @@ pub(super) fn nonzero(v: &[f64]) -> EntryIter<'_> {
 impl SparseWeights {
     /// Feeds the weights as the document gives them into [`digest`].
     pub(super) fn digest(&self, d: &mut Digest) {
-        let list = entry_list;
-        let flat =
-            self.flat.as_ref().map(|f| f.iter().map(|(n, e)| (n.as_str(), list(e))).collect());
-        digest_weights(d, (self.flat_len, self.options_len), flat, self.options.as_ref().map(list));
+        let flat = self
+            .flat
+            .as_ref()
+            .map(|f| f.iter().map(|(n, e)| (n.as_str(), entry_list(e))).collect());
+        let options = self.options.as_ref().map(entry_list);
+        digest_weights(d, (self.flat_len, self.options_len), flat, options);
     }
 }
 
