@@ -414,29 +414,15 @@ class STLVectorReward(gymnasium.vector.VectorWrapper):
         self.formula = formula
         self.reward_form = reward
         self._batch = EpisodeBatch(self.stl_spec, self.num_envs, [int(valuation[v]) for v in vars], formula, reward, offset, scale)
-        self._all = np.ones(self.num_envs, dtype=bool)
 
     def reset(
         self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
     ) -> tuple[Any, dict[str, Any]]:
-        obs, info = self.env.reset(seed=seed, options=options)
-        _, task, kept = self._batch._reset(np.ascontiguousarray(obs, dtype=np.float64))
-        return obs, self._info(info, task, kept)
+        return self._batch._reset(self.env.reset(seed=seed, options=options))
 
     def step(self, actions: Any) -> tuple[Any, npt.NDArray[np.float64], Any, Any, dict[str, Any]]:
-        obs, env_reward, terminated, truncated, info = self.env.step(actions)
-        ends = np.logical_or(terminated, truncated)
-        rewards, task, kept = self._batch._step(np.ascontiguousarray(obs, dtype=np.float64), ends)
-        info = self._info(info, task, kept)
-        info["env_reward"], info["_env_reward"] = env_reward, self._all
-        return obs, rewards, terminated, truncated, info
-
-    def _info(self, info: dict[str, Any], task: Any, kept: Any) -> dict[str, Any]:
-        info = dict(info)
-        info["task_robustness"], info["_task_robustness"] = task, self._all
-        if kept is not None:
-            info["window_kept"], info["_window_kept"] = kept, self._all
-        return info
+        # One call into Rust scores every environment and builds the new info.
+        return self._batch._step(self.env.step(actions))
 
 
 def _valuation_of(env: gymnasium.Env, spec: Spec, valuation: Valuation) -> Callable[[Any], Any]:

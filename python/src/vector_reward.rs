@@ -2,10 +2,13 @@
 //! call for every environment of the vector.
 
 use hstl::reward::{EpisodeBatch as Inner, EpisodeMonitor, RewardForm, Shaping, StepScore};
-use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::intern;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple};
 
-use crate::errors::{lower_error, trace_error, value_error};
+use crate::errors::{lower_error, trace_error, type_error, value_error};
 use crate::spec::Spec;
 
 /// The episodes of a vector of `envs` environments, each reading state variable `i` (in
@@ -19,16 +22,16 @@ pub struct EpisodeBatch {
     /// ended at the last one: gymnasium's next-step autoreset).
     starts: Vec<bool>,
     scores: Vec<StepScore>,
+    /// Which episodes ended at this step, and the second flags read (kept allocations).
+    ends: Vec<bool>,
+    flags: Vec<bool>,
+    /// All true: every entry of an info array is given (gymnasium's `_name` masks).
+    all: Py<PyArray1<bool>>,
 }
 
 /// The most environments one batch scores: each holds a copy of the episode monitor, and
 /// a vector past this is no gymnasium vector one process steps.
 const MAX_ENVS: usize = 1 << 12;
-
-/// A vector step's scores: the rewards, the task's robustness and, for a persistent task,
-/// whether each window is kept.
-type Scored<'py> =
-    (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyArray1<bool>>>);
 
 #[pymethods]
 impl EpisodeBatch {
@@ -44,6 +47,7 @@ impl EpisodeBatch {
         offset: f64,
         scale: f64,
     ) -> PyResult<EpisodeBatch> {
+        let py = spec.py();
         let spec = spec.get();
         let one = EpisodeMonitor::new(&spec.spec, &spec.source, formula)
             .map_err(|e| lower_error(&spec.filename, &e))?;
@@ -69,41 +73,57 @@ impl EpisodeBatch {
             persistent,
             starts: vec![false; envs],
             scores: Vec::with_capacity(envs),
+            ends: Vec::with_capacity(envs),
+            flags: Vec::with_capacity(envs),
+            all: PyArray1::from_vec(py, vec![true; envs]).unbind(),
         })
     }
 
-    /// Starts every episode at the rows of `obs` (float64, shape (envs, columns)) and
-    /// returns their scores, each reward 0.
-    fn _reset<'py>(&mut self, obs: PyReadonlyArray2<'py, f64>) -> PyResult<Scored<'py>> {
-        let py = obs.py();
-        let (data, width) = self.rows(&obs)?;
-        self.inner.reset(data, width, &mut self.scores).map_err(|e| row_error(py, &e))?;
+    /// `gymnasium`'s vector reset for `hstl.STLVectorReward`: starts every episode at the
+    /// rows of the observations in `result` (what the vector's `reset` returned, `(obs,
+    /// info)`) and returns `(obs, info)`, `info` a new dict with `task_robustness` and, for
+    /// a persistent task, `window_kept`, each with its `_name` mask.
+    fn _reset<'py>(&mut self, result: &Bound<'py, PyTuple>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = result.py();
+        let [obs, info] = items(result, "reset", ["obs", "info"])?;
+        let rows = self.rows(&obs)?;
+        self.inner
+            .reset(rows.data(), rows.width, &mut self.scores)
+            .map_err(|e| row_error(py, &e))?;
         self.starts.fill(false);
-        Ok(self.scored(py))
+        let info = self.info_with(&info)?;
+        PyTuple::new(py, [obs, info.into_any()])
     }
 
-    /// Scores one vector step: row `i` of `obs` is environment `i`'s new observation,
-    /// `ends[i]` whether its episode ended there. A row after an ended episode is the
-    /// first of the next one (next-step autoreset): it starts anew, its reward 0.
-    fn _step<'py>(
-        &mut self,
-        obs: PyReadonlyArray2<'py, f64>,
-        ends: PyReadonlyArray1<'py, bool>,
-    ) -> PyResult<Scored<'py>> {
-        let py = obs.py();
-        let (data, width) = self.rows(&obs)?;
-        let ends =
-            ends.as_slice().ok().filter(|e| e.len() == self.inner.len()).ok_or_else(|| {
-                value_error(
-                    format!("`terminated | truncated` must hold {} booleans", self.inner.len()),
-                    None,
-                )
-            })?;
+    /// `gymnasium`'s vector step for `hstl.STLVectorReward`, one call for the whole vector:
+    /// from `result` (what the vector's `step` returned, `(obs, rewards, terminated,
+    /// truncated, info)`), row `i` of `obs` is environment `i`'s new observation, its
+    /// episode ended there when `terminated[i] or truncated[i]`, and a row after an ended
+    /// episode is the first of the next one (next-step autoreset): it starts anew, its
+    /// reward 0. Returns `(obs, rewards, terminated, truncated, info)`, the rewards the
+    /// task's and `info` a new dict with `task_robustness`, `window_kept` (persistent tasks)
+    /// and `env_reward` (the vector's own rewards), each with its `_name` mask.
+    fn _step<'py>(&mut self, result: &Bound<'py, PyTuple>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = result.py();
+        let [obs, env_reward, terminated, truncated, info] =
+            items(result, "step", ["obs", "rewards", "terminated", "truncated", "info"])?;
+        self.ends.clear();
+        let n = self.inner.len();
+        read_flags(&terminated, n, "terminated", &mut self.ends)?;
+        read_flags(&truncated, n, "truncated", &mut self.flags)?;
+        for (end, &cut) in self.ends.iter_mut().zip(&self.flags) {
+            *end |= cut;
+        }
+        let rows = self.rows(&obs)?;
         self.inner
-            .step(data, width, ends, &self.starts, &mut self.scores)
+            .step(rows.data(), rows.width, &self.ends, &self.starts, &mut self.scores)
             .map_err(|e| row_error(py, &e))?;
-        self.starts.copy_from_slice(ends);
-        Ok(self.scored(py))
+        self.starts.copy_from_slice(&self.ends);
+        let rewards = PyArray1::from_iter(py, self.scores.iter().map(|s| s.reward));
+        let info = self.info_with(&info)?;
+        info.set_item(intern!(py, "env_reward"), env_reward)?;
+        info.set_item(intern!(py, "_env_reward"), self.all.bind(py))?;
+        PyTuple::new(py, [obs, rewards.into_any(), terminated, truncated, info.into_any()])
     }
 
     /// The number of environments.
@@ -120,9 +140,29 @@ impl EpisodeBatch {
 }
 
 impl EpisodeBatch {
-    /// The observations as rows, checked against the vector's shape.
-    fn rows<'a>(&self, obs: &'a PyReadonlyArray2<'_, f64>) -> PyResult<(&'a [f64], usize)> {
-        let shape = obs.shape();
+    /// The observations as rows, checked against the vector's shape: a C-ordered float64
+    /// array read in place, anything else converted by numpy first.
+    fn rows<'py>(&self, obs: &Bound<'py, PyAny>) -> PyResult<Rows<'py>> {
+        let py = obs.py();
+        let array = match obs.cast::<PyArray2<f64>>() {
+            Ok(a) if a.is_c_contiguous() => a.clone(),
+            _ => {
+                let kwargs = PyDict::new(py);
+                kwargs.set_item(intern!(py, "dtype"), intern!(py, "float64"))?;
+                ASCONTIGUOUSARRAY
+                    .import(py, "numpy", "ascontiguousarray")?
+                    .call((obs,), Some(&kwargs))
+                    .ok()
+                    .and_then(|a| a.cast_into::<PyArray2<f64>>().ok())
+                    .ok_or_else(|| {
+                        value_error(
+                            "the observations must be numbers, one row an environment",
+                            Some("give STLVectorReward a vector environment with a Box observation space".into()),
+                        )
+                    })?
+            }
+        };
+        let shape = array.shape();
         let (n, width) = (shape[0], shape[1]);
         if n != self.inner.len() || width < self.inner.width() {
             return Err(value_error(
@@ -135,21 +175,94 @@ impl EpisodeBatch {
                 Some("pass the vector environment's observations, one row an environment".into()),
             ));
         }
-        let c_ordered = obs.is_c_contiguous();
-        let data = obs.as_slice().ok().filter(|_| c_ordered).ok_or_else(|| {
-            value_error("the observations must be a C-ordered float64 array", None)
-        })?;
-        Ok((data, width))
+        Ok(Rows { array, width })
     }
 
-    fn scored<'py>(&self, py: Python<'py>) -> Scored<'py> {
-        let rewards = PyArray1::from_iter(py, self.scores.iter().map(|s| s.reward));
+    /// A new dict with `info`'s items (as `dict(info)` copies them) and the scores'
+    /// `task_robustness` and (persistent tasks) `window_kept`, each with its mask.
+    fn info_with<'py>(&self, info: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let py = info.py();
+        let info = match info.cast_exact::<PyDict>() {
+            Ok(d) => d.copy()?,
+            Err(_) => py.get_type::<PyDict>().call1((info,))?.cast_into::<PyDict>()?,
+        };
+        let all = self.all.bind(py);
         let task = PyArray1::from_iter(py, self.scores.iter().map(|s| s.task_robustness));
-        let kept = self.persistent.then(|| {
-            PyArray1::from_iter(py, self.scores.iter().map(|s| s.window_kept == Some(true)))
-        });
-        (rewards, task, kept)
+        info.set_item(intern!(py, "task_robustness"), task)?;
+        info.set_item(intern!(py, "_task_robustness"), all)?;
+        if self.persistent {
+            let kept =
+                PyArray1::from_iter(py, self.scores.iter().map(|s| s.window_kept == Some(true)));
+            info.set_item(intern!(py, "window_kept"), kept)?;
+            info.set_item(intern!(py, "_window_kept"), all)?;
+        }
+        Ok(info)
     }
+}
+
+/// A vector's observations, C-ordered float64, one row an environment.
+struct Rows<'py> {
+    array: Bound<'py, PyArray2<f64>>,
+    width: usize,
+}
+
+impl Rows<'_> {
+    fn data(&self) -> &[f64] {
+        // SAFETY: the rows are read while the GIL is held and no Python code runs, so
+        // nothing writes the array meanwhile; the slice does not outlive the call. The
+        // array is C-contiguous (checked or made so), hence one slice.
+        unsafe { self.array.as_slice() }.unwrap_or(&[])
+    }
+}
+
+static ASCONTIGUOUSARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+
+/// The items of a vector environment's `method` result, checked to be as many as
+/// gymnasium's.
+fn items<'py, const N: usize>(
+    result: &Bound<'py, PyTuple>,
+    method: &str,
+    names: [&str; N],
+) -> PyResult<[Bound<'py, PyAny>; N]> {
+    if result.len() != N {
+        return Err(type_error(
+            format!(
+                "the vector environment's {method} returned {} values, not the {N} of gymnasium's ({})",
+                result.len(),
+                names.join(", ")
+            ),
+            None,
+        ));
+    }
+    let items: Vec<Bound<'py, PyAny>> = result.iter().collect();
+    items
+        .try_into()
+        .map_err(|_| type_error(format!("the vector environment's {method} result changed"), None))
+}
+
+/// `flags` as booleans into `out`: a boolean array read in place, anything else entry by
+/// entry (each truthy or not), `n` of them.
+fn read_flags(flags: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut Vec<bool>) -> PyResult<()> {
+    out.clear();
+    let wrong = |len: usize| {
+        value_error(format!("`{what}` holds {len} values; this vector has {n} environments"), None)
+    };
+    if let Ok(a) = flags.cast::<PyArray1<bool>>() {
+        // SAFETY: as in `Rows::data`.
+        let view = unsafe { a.as_array() };
+        if view.len() != n {
+            return Err(wrong(view.len()));
+        }
+        out.extend(view.iter().copied());
+        return Ok(());
+    }
+    for item in flags.try_iter()? {
+        out.push(item?.is_truthy()?);
+    }
+    if out.len() != n {
+        return Err(wrong(out.len()));
+    }
+    Ok(())
 }
 
 /// A row's error, naming its environment.

@@ -470,7 +470,35 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
     with pytest.raises(ValueError, match="at most 4096 are scored together"):
         hstl._hstl.EpisodeBatch(spec, 10**12, [0, 1])
     batch = hstl._hstl.EpisodeBatch(spec, 2, [0, 1])
-    with pytest.raises(ValueError, match="C-ordered"):
-        batch._reset(np.asfortranarray(np.zeros((2, 3))))
     with pytest.raises(ValueError, match="environment 1 of the vector: `x` is NaN"):
-        batch._reset(np.array([[0.0, 0.0], [np.nan, 0.0]]))
+        batch._reset((np.array([[0.0, 0.0], [np.nan, 0.0]]), {}))
+    with pytest.raises(TypeError, match="returned 4 values, not the 5 of gymnasium's"):
+        batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros(2, dtype=bool), {}))
+    with pytest.raises(ValueError, match="`truncated` holds 3 values; this vector has 2 environments"):
+        batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros(2, dtype=bool), np.zeros(3, dtype=bool), {}))
+    with pytest.raises(ValueError, match="must be numbers"):
+        batch._step((np.array([["a", "b"], ["c", "d"]]), np.zeros(2), [False, False], [False, False], {}))
+
+
+def test_the_vector_reward_reads_rows_in_any_order_and_float_type():
+    # Rows in Fortran order (they were once misread), float32 rows and flags given as
+    # lists score as C-ordered float64 rows and boolean arrays do.
+    spec = hstl.Spec.parse(CAR)
+    rows = np.array([[-1.1, 0.01], [0.5, -0.02], [0.0, 0.0]])
+    other = np.array([[-0.3, 0.02], [-1.05, 0.0], [0.45, 0.01]])
+    forms = [
+        (rows, other, np.array([False, True, False])),
+        (np.asfortranarray(rows), np.asfortranarray(other), [False, True, False]),
+        (rows.astype(np.float32), other.astype(np.float32), (0, 1, 0)),
+    ]
+    got = []
+    for first, second, flags in forms:
+        batch = hstl._hstl.EpisodeBatch(spec, 3, [0, 1])
+        _, info = batch._reset((first, {}))
+        _, rewards, _, _, info2 = batch._step((second, np.zeros(3), flags, [False] * 3, {"k": 1}))
+        assert info2["k"] == 1 and list(info2["_env_reward"]) == [True] * 3
+        got.append((list(info["task_robustness"]), list(rewards), list(info2["task_robustness"]), list(info2["window_kept"])))
+    want = got[0]
+    assert got[1] == want
+    # float32 rows are the float32 values, widened.
+    assert np.allclose(got[2][1], want[1], atol=1e-6) and got[2][3] == want[3]
