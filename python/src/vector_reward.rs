@@ -155,9 +155,15 @@ impl EpisodeBatch {
                     .ok()
                     .and_then(|a| a.cast_into::<PyArray2<f64>>().ok())
                     .ok_or_else(|| {
+                        let shape = obs
+                            .getattr(intern!(py, "shape"))
+                            .and_then(|s| s.str())
+                            .map_or_else(|_| String::new(), |s| format!(" (shape {s})"));
                         value_error(
-                            "the observations must be numbers, one row an environment",
-                            Some("give STLVectorReward a vector environment with a Box observation space".into()),
+                            format!(
+                                "the observations{shape} must be a 2-D array of numbers, one row an environment"
+                            ),
+                            Some("give STLVectorReward a vector environment with a flat Box observation space".into()),
                         )
                     })?
             }
@@ -244,23 +250,29 @@ fn items<'py, const N: usize>(
 /// entry (each truthy or not), `n` of them.
 fn read_flags(flags: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut Vec<bool>) -> PyResult<()> {
     out.clear();
-    let wrong = |len: usize| {
+    let wrong = |len: &dyn std::fmt::Display| {
         value_error(format!("`{what}` holds {len} values; this vector has {n} environments"), None)
     };
     if let Ok(a) = flags.cast::<PyArray1<bool>>() {
         // SAFETY: as in `Rows::data`.
         let view = unsafe { a.as_array() };
         if view.len() != n {
-            return Err(wrong(view.len()));
+            return Err(wrong(&view.len()));
         }
         out.extend(view.iter().copied());
         return Ok(());
     }
-    for item in flags.try_iter()? {
+    // One past the vector's size is enough to refuse: an endless iterable is not read on.
+    for item in flags.try_iter()?.take(n + 1) {
         out.push(item?.is_truthy()?);
     }
     if out.len() != n {
-        return Err(wrong(out.len()));
+        let len = match flags.len() {
+            Ok(len) => len.to_string(),
+            Err(_) if out.len() > n => "more".into(),
+            Err(_) => out.len().to_string(),
+        };
+        return Err(wrong(&len));
     }
     Ok(())
 }

@@ -4,6 +4,7 @@ task robustness are those of `hstlc monitor` on the same trace."""
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 import warnings
@@ -476,8 +477,13 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
         batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros(2, dtype=bool), {}))
     with pytest.raises(ValueError, match="`truncated` holds 3 values; this vector has 2 environments"):
         batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros(2, dtype=bool), np.zeros(3, dtype=bool), {}))
-    with pytest.raises(ValueError, match="must be numbers"):
+    with pytest.raises(ValueError, match=r"the observations \(shape \(2, 2\)\) must be a 2-D array of numbers"):
         batch._step((np.array([["a", "b"], ["c", "d"]]), np.zeros(2), [False, False], [False, False], {}))
+    with pytest.raises(ValueError, match=r"the observations \(shape \(2, 2, 1\)\) must be a 2-D array"):
+        batch._step((np.zeros((2, 2, 1)), np.zeros(2), [False, False], [False, False], {}))
+    # An endless iterable of flags is refused after one value too many, not read forever.
+    with pytest.raises(ValueError, match="`terminated` holds more values; this vector has 2 environments"):
+        batch._step((np.zeros((2, 2)), np.zeros(2), itertools.repeat(False), [False, False], {}))
 
 
 def test_the_vector_reward_reads_rows_in_any_order_and_float_type():
