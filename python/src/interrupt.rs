@@ -2,7 +2,7 @@
 //! thread, holding the GIL only for a moment every [`SIGNAL_EVERY`], runs Python's signal
 //! handlers: a `KeyboardInterrupt` ends the call at once. The work's thread is then told to
 //! stop ([`hstl::robustness::cancel`]): the offline evaluator stops at its next group or
-//! piece, other work finishes; either way its result is dropped, and it holds only what was
+//! piece, the dense one at its next formula node, other work finishes; either way its result is dropped, and it holds only what was
 //! moved into it.
 
 use std::sync::Arc;

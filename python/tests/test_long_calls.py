@@ -16,28 +16,36 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import hstl
 
 
-def chain_spec(lets: int) -> str:
-    """A spec whose task is a chain of `lets` windowed operators over `x` and `y`."""
-    body = ["let a0 = eventually[0..=3] x > 0;"]
+def chain_spec(lets: int, dense: bool = False) -> str:
+    """A spec whose task is a chain of `lets` windowed operators over `x` and `y` (with a
+    time column `t` and windows in seconds when `dense`)."""
+    window = "[0..=0.03]" if dense else "[0..=3]"
+    body = [f"let a0 = eventually{window} x > 0;"]
     for i in range(1, lets):
         op = "eventually" if i % 2 else "always"
-        body.append(f"let a{i} = {op}[0..=3] (a{i - 1} || y > {i % 7});")
-    return "spec Chain {\n state { x: float, y: float }\n" + "\n".join(body) + f"\n task a{lets - 1};\n}}\n"
+        body.append(f"let a{i} = {op}{window} (a{i - 1} || y > {i % 7});")
+    state = "t: time, x: float, y: float" if dense else "x: float, y: float"
+    return f"spec Chain {{\n state {{ {state} }}\n" + "\n".join(body) + f"\n task a{lets - 1};\n}}\n"
 
 
-def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path) -> None:
-    # About 15 s of evaluation on the development machine; Ctrl-C after 1.5 s. A child
+@pytest.mark.parametrize("dense", [False, True], ids=["steps", "dense"])
+def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path, dense: bool) -> None:
+    # Many seconds of evaluation on the development machine; Ctrl-C after 1.5 s. A child
     # process, so that a call that does not stop fails at the timeout instead of hanging.
+    # The dense evaluator stops between the formula's nodes, the discrete one between its
+    # groups and pieces.
     code = (
         "import sys, time, numpy as np, hstl\n"
         "spec = hstl.Spec.load(sys.argv[1])\n"
         "rng = np.random.default_rng(1)\n"
         "n = 4_000_000\n"
         "trace = {'x': rng.normal(size=n), 'y': 5 * rng.normal(size=n)}\n"
+        "if spec.time_var: trace['t'] = np.arange(n) * 0.01\n"
         "print('started', flush=True)\n"
         "start = time.perf_counter()\n"
         "try:\n"
@@ -50,7 +58,7 @@ def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path) -> None:
         "    print(f'interrupted {took:.3f} {time.process_time() - cpu:.3f}', flush=True)\n"
     )
     path = tmp_path / "chain.hstl"
-    path.write_text(chain_spec(2000))
+    path.write_text(chain_spec(2000, dense))
     # Ctrl-C as at a terminal, whatever the test runner inherited (a background job has
     # SIGINT ignored, and Python then installs no handler).
     child = subprocess.Popen(

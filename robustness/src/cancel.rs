@@ -1,8 +1,8 @@
 //! Stopping an offline evaluation that nobody waits for any more (a call the user
 //! interrupted): a flag raised from another thread, looked at by the evaluator on this
-//! thread between the groups and pieces it computes. An evaluation stopped so returns NaN
-//! at every step: its result means nothing, so only a caller that will drop it raises the
-//! flag. Evaluations on threads without a flag are never stopped.
+//! thread between the groups and pieces it computes (the dense evaluator: between the
+//! formula's nodes). An evaluation stopped so returns NaN at every step: its result means
+//! nothing, so only a caller that will drop it raises the flag. Evaluations on threads without a flag are never stopped.
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -69,5 +69,24 @@ mod tests {
         }
         // The guard gone, the thread is watched no more.
         assert_eq!(Evaluator::new().signal(&f, &trace), &want[..]);
+    }
+
+    #[test]
+    fn a_raised_flag_stops_a_dense_evaluation() {
+        use crate::dense::{DenseFormula, DenseTrace, TimeScale};
+        let x = Formula::cmp(Expr::var(0), CmpOp::Gt, Expr::constant(0.5));
+        let f = Formula::eventually(Interval { start: 0, end: Bound::Inclusive(3) }, x);
+        let df = DenseFormula::new(&f, TimeScale::decimals(2)).unwrap();
+        let trace = DenseTrace::from_samples(&[vec![(0.0, 0.0), (1.5, 1.0), (4.0, 0.0)]]).unwrap();
+        let want = df.signal(&trace).unwrap();
+        assert!(want.points().all(|(_, v)| !v.is_nan()));
+        let flag = Arc::new(AtomicBool::new(true));
+        let _watch = stop_on(flag);
+        let stopped = df.signal(&trace).unwrap();
+        assert!(
+            stopped.points().all(|(_, v)| v.is_nan()),
+            "{:?}",
+            stopped.points().collect::<Vec<_>>()
+        );
     }
 }

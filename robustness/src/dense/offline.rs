@@ -94,6 +94,13 @@ pub(crate) fn evaluate(
     }
     let mut vals: Vec<Val> = Vec::with_capacity(nodes.len());
     for (i, node) in nodes.iter().enumerate() {
+        if crate::cancel::requested() {
+            // Nobody waits for the result (see `cancel`): NaN from the start, as the
+            // discrete evaluator gives.
+            let mut stopped = DenseSignal::with_capacity(1);
+            stopped.push(t0, f64::NAN);
+            return Ok((stopped, t_last));
+        }
         let e = |id: &ExprId| match &vals[id.index()] {
             Val::Expr(v) => v.as_slice(),
             _ => unreachable!("an expression operand is an expression"),
