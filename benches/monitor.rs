@@ -81,10 +81,13 @@ fn benches(c: &mut Criterion) {
 
 /// `STLReward`'s per-step scoring over an episode of 5,000 steps, for a reward with a past
 /// operator inside a future one (scored online since the reward is read at the last step;
-/// it evaluated the whole prefix each step before).
+/// it evaluated the whole prefix each step before), and for one with a future operator
+/// inside a bounded past one (the last `start_reach + 1` states evaluated again each step;
+/// the whole prefix before).
 fn reward(c: &mut Criterion) {
     let src = "spec R { state { x: float, y: float } \
                let Recent = eventually[0..=5] once[0..=10] x > 8; \
+               let Lately = once[0..=10] eventually[0..=5] x > 8; \
                task always[0..] eventually[0..40] x > 8; }";
     let spec = hstl::load::load(src, None).expect("the spec checks").spec;
     let trace = walk::walk(5_000, &mut walk::SplitMix64(walk::SEED));
@@ -92,17 +95,21 @@ fn reward(c: &mut Criterion) {
     let mut g = c.benchmark_group("reward");
     g.sample_size(10);
     g.throughput(Throughput::Elements(x.len() as u64));
-    g.bench_function("past_inside_future_5000", |b| {
-        b.iter(|| {
-            let mut episode =
-                hstl::reward::EpisodeMonitor::new(&spec, src, Some("Recent")).expect("a reward");
-            let mut sum = 0.0;
-            for (x, y) in x.iter().zip(y) {
-                sum += episode.push(&[*x, *y]).expect("a state").reward;
-            }
-            black_box(sum)
-        })
-    });
+    for (name, reward) in
+        [("past_inside_future_5000", "Recent"), ("future_inside_past_5000", "Lately")]
+    {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut episode =
+                    hstl::reward::EpisodeMonitor::new(&spec, src, Some(reward)).expect("a reward");
+                let mut sum = 0.0;
+                for (x, y) in x.iter().zip(y) {
+                    sum += episode.push(&[*x, *y]).expect("a state").reward;
+                }
+                black_box(sum)
+            })
+        });
+    }
 }
 
 criterion_group!(monitor, benches, reward);

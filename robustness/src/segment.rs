@@ -320,7 +320,10 @@ impl TabularScorer {
 /// longer history: at every step `t >= i + start_reach(f)` of the suffix from `i`, `f`
 /// reads no step before `i`, and so has the segment's value. `None` when a past window is
 /// unbounded. An upper bound: a larger reach only costs time.
-pub(crate) fn start_reach(f: &Formula) -> Option<usize> {
+///
+/// So `f`'s value at a trace's last step `t` is its value over the last `start_reach(f) +
+/// 1` steps alone: what a reward read at the newest state keeps of the episode.
+pub fn start_reach(f: &Formula) -> Option<usize> {
     let mut reach: Vec<Option<usize>> = Vec::with_capacity(f.len());
     let window = |i: &crate::Interval| crate::formula::window_end(i);
     for node in f.nodes() {

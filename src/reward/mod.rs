@@ -11,8 +11,10 @@
 //!   `-inf`). A formula with a past-time operator (`once[0..10] A`) reads the states before
 //!   `s_t` too: its streaming online monitor gives it, `O(|formula|)` a step, once the
 //!   future operators above its past ones are replaced by their value at the last step
-//!   ([`hstl_robustness::last_step`]); only a future operator under a past one (`once[0..5]
-//!   eventually[0..3] A`) makes it evaluated over the states so far, `O(t)` a step;
+//!   ([`hstl_robustness::last_step`]); a future operator under a past one (`once[0..5]
+//!   eventually[0..3] A`) makes it evaluated again over the last states it reads
+//!   ([`hstl_robustness::segment::start_reach`] + 1 of them), `O(reach)` a step, or over
+//!   all the states so far, `O(t)`, when a past window above the future one has no end;
 //! - the **task's robustness** `rho(task, 0)` over `s_0 ..= s_t`, the value
 //!   `hstlc monitor` prints for the trace so far;
 //! - for a persistent task (`always[0..] (eventually[0..N1] R1 && ...)`), whether the
@@ -31,7 +33,8 @@
 //! past-time operator, the regions, the state formulas of the task's parts) is one pass
 //! over one flat DAG holding them all, each shared node once, `O(|formula|)`; a reward
 //! with a past-time operator is `O(|formula|)` through its online monitor, and
-//! `O(t |formula|)` with a future operator under a past one. The task's
+//! `O(reach |formula|)` with a future operator under a past one (`O(t |formula|)` under
+//! a past window without an end). The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
 //! distributes over `&&` (`eventually` over `||`); `always[I] f` with `f` a state formula
@@ -208,8 +211,10 @@ pub struct EpisodeMonitor {
     /// none left at the last step).
     reward_slot: Option<usize>,
     /// The states so far, when the reward formula has a future operator under a past one
-    /// (a future window clipped at `t` read from an earlier step reads the prefix again).
-    history: Option<Columns>,
+    /// (a future window clipped at `t` read from an earlier step reads the prefix again):
+    /// only the last `start_reach + 1` when its past windows are bounded, since the value at
+    /// the newest state reads no state before them (`O(reach)` a step, not `O(t)`).
+    history: Option<(Columns, Option<usize>)>,
     /// The online monitor of the reward formula at the last step
     /// ([`last_step::at_last_step`]), when it has a past-time operator and no future one
     /// under it: `rho(formula, t)` is then final once `s_t` is in, and its streaming past
@@ -292,7 +297,8 @@ impl EpisodeMonitor {
             let m = OnlineMonitor::new(&f, vars.len());
             (f, m)
         });
-        let history = (reward_slot.is_none() && past.is_none()).then(|| Columns::new(vars.len()));
+        let history = (reward_slot.is_none() && past.is_none())
+            .then(|| (Columns::new(vars.len()), hstl_robustness::segment::start_reach(&reward)));
         Ok(EpisodeMonitor {
             vars,
             reward,
@@ -375,7 +381,7 @@ impl EpisodeMonitor {
     /// Starts a new episode.
     pub fn reset(&mut self) {
         self.task.reset();
-        if let Some(h) = &mut self.history {
+        if let Some((h, _)) = &mut self.history {
             h.clear();
         }
         if let Some((f, m)) = &mut self.past {
@@ -452,8 +458,13 @@ impl EpisodeMonitor {
         let program = &self.program;
         let robustness = match (&mut self.history, &mut self.past, self.reward_slot) {
             _ if self.shaping.form != RewardForm::Robustness => f64::NAN,
-            (Some(history), _, _) => {
+            (Some((history, reach)), _, _) => {
                 history.push(state);
+                if let Some(reach) = *reach {
+                    while history.len() > reach.saturating_add(1) {
+                        history.pop_front();
+                    }
+                }
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }

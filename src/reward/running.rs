@@ -393,6 +393,11 @@ impl Columns {
         self.start = 0;
     }
 
+    /// The number of live states.
+    pub(super) fn len(&self) -> usize {
+        self.columns.first().map_or(0, |c| c.len() - self.start)
+    }
+
     pub(super) fn slices(&self) -> Vec<&[f64]> {
         self.columns.iter().map(|c| &c[self.start..]).collect()
     }
