@@ -83,7 +83,7 @@ impl EpisodeBatch {
     /// rows of the observations in `result` (what the vector's `reset` returned, `(obs,
     /// info)`) and returns `(obs, info)`, `info` a new dict with `task_robustness` and, for
     /// a persistent task, `window_kept`, each with its `_name` mask.
-    fn _reset<'py>(&mut self, result: &Bound<'py, PyTuple>) -> PyResult<Bound<'py, PyTuple>> {
+    fn _reset<'py>(&mut self, result: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyTuple>> {
         let py = result.py();
         let [obs, info] = items(result, "reset", ["obs", "info"])?;
         let rows = self.rows(&obs)?;
@@ -103,7 +103,7 @@ impl EpisodeBatch {
     /// reward 0. Returns `(obs, rewards, terminated, truncated, info)`, the rewards the
     /// task's and `info` a new dict with `task_robustness`, `window_kept` (persistent tasks)
     /// and `env_reward` (the vector's own rewards), each with its `_name` mask.
-    fn _step<'py>(&mut self, result: &Bound<'py, PyTuple>) -> PyResult<Bound<'py, PyTuple>> {
+    fn _step<'py>(&mut self, result: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyTuple>> {
         let py = result.py();
         let [obs, env_reward, terminated, truncated, info] =
             items(result, "step", ["obs", "rewards", "terminated", "truncated", "info"])?;
@@ -190,7 +190,18 @@ impl EpisodeBatch {
         let py = info.py();
         let info = match info.cast_exact::<PyDict>() {
             Ok(d) => d.copy()?,
-            Err(_) => py.get_type::<PyDict>().call1((info,))?.cast_into::<PyDict>()?,
+            Err(_) => py
+                .get_type::<PyDict>()
+                .call1((info,))
+                .and_then(|d| Ok(d.cast_into::<PyDict>()?))
+                .map_err(|_| {
+                    let kind =
+                        info.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string());
+                    type_error(
+                        format!("the vector environment's info is a {kind}, not a dict"),
+                        None,
+                    )
+                })?,
         };
         let all = self.all.bind(py);
         let task = PyArray1::from_iter(py, self.scores.iter().map(|s| s.task_robustness));
@@ -226,10 +237,20 @@ static ASCONTIGUOUSARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
 /// The items of a vector environment's `method` result, checked to be as many as
 /// gymnasium's.
 fn items<'py, const N: usize>(
-    result: &Bound<'py, PyTuple>,
+    result: &Bound<'py, PyAny>,
     method: &str,
     names: [&str; N],
 ) -> PyResult<[Bound<'py, PyAny>; N]> {
+    let result = result.cast::<PyTuple>().map_err(|_| {
+        let kind = result.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string());
+        type_error(
+            format!(
+                "the vector environment's {method} returned a {kind}, not the tuple of gymnasium's ({})",
+                names.join(", ")
+            ),
+            None,
+        )
+    })?;
     if result.len() != N {
         return Err(type_error(
             format!(

@@ -473,6 +473,10 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
     batch = hstl._hstl.EpisodeBatch(spec, 2, [0, 1])
     with pytest.raises(ValueError, match="environment 1 of the vector: `x` is NaN"):
         batch._reset((np.array([[0.0, 0.0], [np.nan, 0.0]]), {}))
+    with pytest.raises(TypeError, match="the vector environment's reset returned a list, not the tuple of gymnasium's"):
+        batch._reset([np.zeros((2, 2)), {}])
+    with pytest.raises(TypeError, match="the vector environment's info is a NoneType, not a dict"):
+        batch._reset((np.zeros((2, 2)), None))
     with pytest.raises(TypeError, match="returned 4 values, not the 5 of gymnasium's"):
         batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros(2, dtype=bool), {}))
     with pytest.raises(ValueError, match="`truncated` holds 3 values; this vector has 2 environments"):
