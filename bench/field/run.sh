@@ -45,7 +45,7 @@ for part in "${parts[@]}"; do
             s=0 hs=0,1 ladder=1,2,preset ppo=8000 dqn=3000 runs=5 final=10 forms=4000
         else
             s=$(list "$seeds") hs=$(list "$hseeds") ladder=1,2,5,10,20,50,100,preset runs=20 final=100
-            if [ "$part" = mountain_car ]; then ppo=200000 dqn=30000 forms=40000; else ppo=100000 dqn=20000 forms=30000; fi
+            if [ "$part" = mountain_car ]; then ppo=1000000 dqn=30000 forms=40000; else ppo=100000 dqn=20000 forms=30000; fi
         fi
         rm -rf "out/patrol/$part"
         run patrol.py --part forms --task "$part" --methods ppo --seeds 0 --budget "$forms" --runs "$runs"
