@@ -52,6 +52,22 @@ pub const MAX_RUN_FILES: usize = 1000;
 pub const MAX_RUN_ROWS: usize = 10_000_000;
 
 /// Refuses a `--runs` that would write more than [`MAX_RUN_ROWS`] rows, before anything runs.
+/// The checks on what a run writes, made before anything is printed (the burn-in against
+/// the task, the rows `--runs` would write), and the `--runs` folder locked.
+fn check_and_lock(
+    args: &EvalArgs,
+    runs: &Runs,
+    spec: &hstl::runtime::TaskSpec,
+) -> Result<Option<hstl_outdir::OutDir>, CliError> {
+    runs.check_burn_in(spec, flag)?;
+    check_run_rows(args, runs.steps)?;
+    Ok(args
+        .runs
+        .as_ref()
+        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
+        .transpose()?)
+}
+
 fn check_run_rows(args: &EvalArgs, steps: usize) -> Result<(), CliError> {
     let rows = args.starts.min(MAX_RUN_FILES).saturating_mul(steps.saturating_add(1));
     if args.runs.is_some() && rows > MAX_RUN_ROWS {
@@ -119,14 +135,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     }
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
-    runs.check_burn_in(spec, flag)?;
-    // Decide what can be written before anything is printed.
-    check_run_rows(args, runs.steps)?;
-    let out = args
-        .runs
-        .as_ref()
-        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
-        .transpose()?;
+    let out = check_and_lock(args, &runs, spec)?;
     // The optimum W* of a persistent task, solved first: one past its budget is an error
     // before anything is printed, not after the report.
     let optimum = if args.no_optimum || spec.regions.is_empty() {
@@ -237,14 +246,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
         _ => runs.steps,
     };
     let runs = Runs { steps, ..runs };
-    runs.check_burn_in(spec, flag)?;
-    // Decide what can be written before anything is printed.
-    check_run_rows(args, runs.steps)?;
-    let out = args
-        .runs
-        .as_ref()
-        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
-        .transpose()?;
+    let out = check_and_lock(args, &runs, spec)?;
     outln!(
         "policy of `{}` on {}: {} options, tiles {}, {} greedy runs of {} steps (seed {})",
         spec.name,

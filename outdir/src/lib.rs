@@ -114,16 +114,7 @@ impl OutDir {
     /// it holds files no run writes (it will be replaced as a whole). Call it before the
     /// long work, so that a refusal comes at once.
     pub fn lock(dir: &Path, writer: Writer) -> Result<OutDir, Error> {
-        let write_err = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| Error::Write { path, source }
-        };
-        // `--out .`, or a symbolic link: the folder it names.
-        let dir = if dir.file_name().is_none() || dir.is_symlink() {
-            std::fs::canonicalize(dir).map_err(write_err(dir))?
-        } else {
-            dir.to_path_buf()
-        };
+        let dir = named_folder(dir)?;
         let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let parent = match dir.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -308,15 +299,7 @@ impl StudyDir {
         force: bool,
         writer: Writer,
     ) -> Result<(StudyDir, Vec<OutDir>), Error> {
-        let write_err = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| Error::Write { path, source }
-        };
-        let dir = if dir.file_name().is_none() || dir.is_symlink() {
-            std::fs::canonicalize(dir).map_err(write_err(dir))?
-        } else {
-            dir.to_path_buf()
-        };
+        let dir = named_folder(dir)?;
         let ours: Vec<String> = spec_dirs
             .iter()
             .filter_map(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
@@ -587,6 +570,21 @@ fn is_run_file(name: &str) -> bool {
 
 /// Refuses names that are not plain file names, or that two files share (also when they
 /// differ only in case, as they would on a case-insensitive file system).
+/// A write error at `path`, for `map_err`.
+fn write_err(path: &Path) -> impl FnOnce(std::io::Error) -> Error {
+    let path = path.to_path_buf();
+    move |source| Error::Write { path, source }
+}
+
+/// The folder `dir` names: `--out .`, or a symbolic link, resolved to the folder itself.
+fn named_folder(dir: &Path) -> Result<PathBuf, Error> {
+    if dir.file_name().is_none() || dir.is_symlink() {
+        std::fs::canonicalize(dir).map_err(write_err(dir))
+    } else {
+        Ok(dir.to_path_buf())
+    }
+}
+
 fn check_names(files: &[OutFile]) -> Result<(), Error> {
     let mut seen = std::collections::HashSet::new();
     for f in files {
