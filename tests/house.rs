@@ -31,12 +31,6 @@ const CRATES: [&str; 11] = [
 /// here and on a listed one that is gone, so the list stays the truth.
 const KNOWN_CIRCLES: &[(&str, &[&str], &str)] = &[
     (
-        "python/src",
-        &["online", "spec"],
-        "`Spec.online` makes an `OnlineMonitor`, which holds its `Spec` to pickle: two classes \
-         that name each other (pyo3 takes one `#[pymethods]` block a class)",
-    ),
-    (
         "robustness/src",
         &["formula", "offline::plan"],
         "a `Formula` holds the offline evaluator's `Plan`, made once when the formula is built, \

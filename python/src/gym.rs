@@ -63,25 +63,28 @@ fn observation(obs: &Bound<'_, PyAny>, call: &str) -> PyResult<i64> {
     })
 }
 
+/// `env.reset(seed=seed)`'s observation, its answer checked to be `(observation, info)`.
+fn reset<'py>(env: &Bound<'py, PyAny>, seed: u64) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = PyDict::new(env.py());
+    kwargs.set_item("seed", seed)?;
+    let out = env.call_method("reset", (), Some(&kwargs))?;
+    let pair = out.cast::<PyTuple>().map_err(|_| {
+        value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
+    })?;
+    if pair.len() != 2 {
+        return Err(value_error(
+            format!("env.reset gave {} values, not (observation, info)", pair.len()),
+            None,
+        ));
+    }
+    pair.get_item(0)
+}
+
 impl Calls for PyCalls {
     type Error = PyErr;
 
     fn reset(&self, seed: u64) -> PyResult<i64> {
-        Python::attach(|py| {
-            let kwargs = PyDict::new(py);
-            kwargs.set_item("seed", seed)?;
-            let out = self.env.bind(py).call_method("reset", (), Some(&kwargs))?;
-            let pair = out.cast::<PyTuple>().map_err(|_| {
-                value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
-            })?;
-            if pair.len() != 2 {
-                return Err(value_error(
-                    format!("env.reset gave {} values, not (observation, info)", pair.len()),
-                    None,
-                ));
-            }
-            observation(&pair.get_item(0)?, "reset")
-        })
+        Python::attach(|py| observation(&reset(self.env.bind(py), seed)?, "reset"))
     }
 
     fn step(&self, action: i64) -> PyResult<(i64, Option<EpisodeEnd>)> {
@@ -183,21 +186,7 @@ impl BoxCalls for PyBoxCalls {
     type Obs = Py<PyAny>;
 
     fn reset(&self, seed: u64, call: &str) -> PyResult<(Py<PyAny>, Vec<f64>)> {
-        Python::attach(|py| {
-            let kwargs = PyDict::new(py);
-            kwargs.set_item("seed", seed)?;
-            let out = self.env.bind(py).call_method("reset", (), Some(&kwargs))?;
-            let pair = out.cast::<PyTuple>().map_err(|_| {
-                value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
-            })?;
-            if pair.len() != 2 {
-                return Err(value_error(
-                    format!("env.reset gave {} values, not (observation, info)", pair.len()),
-                    None,
-                ));
-            }
-            numbers(&pair.get_item(0)?, call)
-        })
+        Python::attach(|py| numbers(&reset(self.env.bind(py), seed)?, call))
     }
 
     fn step(&self, action: i64, call: &str) -> PyResult<(Py<PyAny>, Vec<f64>, bool)> {
