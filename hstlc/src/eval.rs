@@ -261,13 +261,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
         c::Evaluation::Window(w) => {
             let Stats { min: lo, max: hi, .. } = Stats::of(&w.per_run);
             outln!("{}", window_line(w.rate, (lo, hi), args.burn_in, &spec.regions))?;
-            let Stats { mean, min: lo, max: hi, .. } = Stats::of(&w.robustness);
-            outln!(
-                "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
-                figure(mean),
-                figure(lo),
-                figure(hi)
-            )?;
+            print_clipped_robustness(&w.robustness)?;
         }
         c::Evaluation::Satisfaction { rate } => {
             outln!("  satisfied in {rate:.4} of {} runs of {} steps", args.starts, steps)?;
@@ -312,10 +306,8 @@ fn figure(v: f64) -> String {
     if v.is_finite() && v.abs() >= 1e6 { format!("{v:.3e}") } else { format!("{v:.3}") }
 }
 
-/// The task's robustness over each run, windows clipped and complete; satisfaction is
-/// counted over complete windows, since clipped ones fail a persistent task at the end of
-/// nearly every finite run.
-fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
+/// The task's robustness over each run, windows clipped: its mean, least and greatest.
+fn print_clipped_robustness(values: &[f64]) -> Result<(), CliError> {
     let Stats { mean, min: lo, max: hi, .. } = Stats::of(values);
     outln!(
         "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
@@ -323,6 +315,14 @@ fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliE
         figure(lo),
         figure(hi)
     )?;
+    Ok(())
+}
+
+/// The task's robustness over each run, windows clipped and complete; satisfaction is
+/// counted over complete windows, since clipped ones fail a persistent task at the end of
+/// nearly every finite run.
+fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
+    print_clipped_robustness(values)?;
     let determined: Vec<f64> = complete.iter().flatten().copied().collect();
     let satisfied = evaluate::satisfied(values, complete);
     let figures = if determined.is_empty() {

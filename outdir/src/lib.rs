@@ -212,12 +212,10 @@ impl OutDir {
     }
 }
 
-/// Refuses a folder this run may not replace: a file, or a folder holding anything
-/// that is not a run's output (a folder that an older hstlc wrote, before the marker,
-/// holds only files named as a run's).
-fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
+/// Whether the folder `dir` is there (false when nothing is); a file there is refused.
+fn folder_there(dir: &Path, writer: Writer) -> Result<bool, Error> {
     let meta = match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
         Err(source) => return Err(Error::Write { path: dir.to_path_buf(), source }),
         Ok(meta) => meta,
     };
@@ -226,6 +224,16 @@ fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
             format!("`{}` is a file, not a folder", path_words(dir)),
             Some(format!("choose another {}", writer.option)),
         ));
+    }
+    Ok(true)
+}
+
+/// Refuses a folder this run may not replace: a file, or a folder holding anything
+/// that is not a run's output (a folder that an older hstlc wrote, before the marker,
+/// holds only files named as a run's).
+fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
+    if !folder_there(dir, writer)? {
+        return Ok(());
     }
     let entries = std::fs::read_dir(dir)
         .map_err(|source| Error::Write { path: dir.to_path_buf(), source })?;
@@ -350,16 +358,8 @@ fn study_refusal(
     force: bool,
     writer: Writer,
 ) -> Result<Vec<PathBuf>, Error> {
-    let meta = match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => return Err(Error::Write { path: dir.to_path_buf(), source }),
-        Ok(meta) => meta,
-    };
-    if !meta.is_dir() {
-        return Err(refused(
-            format!("`{}` is a file, not a folder", path_words(dir)),
-            Some(format!("choose another {}", writer.option)),
-        ));
+    if !folder_there(dir, writer)? {
+        return Ok(Vec::new());
     }
     let listed: Vec<String> = std::fs::read_to_string(dir.join(STUDY_MARKER))
         .map(|t| t.lines().filter(|l| !l.starts_with('#')).map(str::to_string).collect())

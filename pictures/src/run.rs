@@ -211,6 +211,18 @@ fn draw_timeline(
             area.draw(&PathElement::new(line.to_vec(), INK.stroke_width(2))).map_err(draw_err)?;
         }
     }
+    step_axis(area, span, &x_of, band)
+}
+
+/// The step numbers under a timeline's band: ticks at `x_of(i)` for every few steps `i`
+/// of `0..=span`, numbered, and the word "step" after the band's right end.
+pub(crate) fn step_axis(
+    area: &Area<'_>,
+    span: usize,
+    x_of: &dyn Fn(usize) -> i32,
+    band: (i32, i32),
+) -> Result<()> {
+    let (left, right) = (x_of(0), x_of(span));
     let every = tick_step(span, ((right - left) / 60).max(1) as usize);
     let below = text_style(LABEL_SIZE * 0.75, &INK, HPos::Center, VPos::Top);
     for i in (0..=span).step_by(every) {

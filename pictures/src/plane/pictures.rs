@@ -16,7 +16,7 @@ use crate::draw::{
 use crate::grid::cell_boxes;
 use crate::label::CellBox;
 use crate::palette::{AVOID, INK, option_color, shade};
-use crate::run::{draw_head, tick_step};
+use crate::run::{draw_head, step_axis};
 use crate::{PictureError, Result};
 
 /// Draws a flat policy on a plane: at each arrow's point, an arrow the way its greedy
@@ -402,14 +402,5 @@ pub(super) fn draw_run_timeline(
             }
         }
     }
-    let every = tick_step(span, ((right - left) / 60).max(1) as usize);
-    let below = text_style(LABEL_SIZE * 0.75, &INK, HPos::Center, VPos::Top);
-    for i in (0..=span).step_by(every) {
-        let x = x_of(i);
-        area.draw(&PathElement::new(vec![(x, band.1), (x, band.1 + 4)], INK.stroke_width(1)))
-            .map_err(draw_err)?;
-        draw_text(area, &i.to_string(), (x, band.1 + 6), &below)?;
-    }
-    let after = text_style(LABEL_SIZE * 0.75, &INK, HPos::Left, VPos::Center);
-    draw_text(area, "step", (right + 8, (band.0 + band.1) / 2), &after)
+    step_axis(area, span, &x_of, band)
 }
