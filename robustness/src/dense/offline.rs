@@ -352,8 +352,7 @@ fn bounded_until(f: &DenseSignal, g: &DenseSignal, t0: f64, a: f64, b: f64) -> D
     let mut u = BoundedUntil::new(a, b);
     let mut points = Vec::new();
     let (mut i, mut j, mut fed) = (0usize, 0usize, 0usize);
-    loop {
-        let Some(t) = next_time(f, g, i, j) else { break };
+    while let Some(t) = next_time(f, g, i, j) {
         // Every piece before `t` is in: sweep now and then, so that the sweep keeps a
         // window's pieces rather than the trace's.
         if fed % 512 == 511 {
@@ -384,8 +383,7 @@ pub(crate) fn untimed_until(f: &DenseSignal, g: &DenseSignal, dir: Dir) -> Dense
     let mut fv = Vec::with_capacity(times.capacity());
     let mut gv = Vec::with_capacity(times.capacity());
     let (mut i, mut j) = (0usize, 0usize);
-    loop {
-        let Some(t) = next_time(f, g, i, j) else { break };
+    while let Some(t) = next_time(f, g, i, j) {
         if f.times.get(i) == Some(&t) {
             i += 1;
         }
