@@ -234,6 +234,22 @@ pub fn set_learn(spec: &mut TaskSpec, key: &str, value: f64) -> Result<(), Probl
     Ok(())
 }
 
+/// Sets the episodes `spec` trains for to `episodes` (a caller's override of
+/// `learn { episodes }`), held to `1..=MAX_EPISODES`; `None` keeps the spec's own.
+pub fn set_episodes(spec: &mut TaskSpec, episodes: Option<usize>) -> Result<(), Problem> {
+    use hstl_lang::budget::MAX_EPISODES;
+    if let Some(n) = episodes {
+        if n == 0 || n as u64 > MAX_EPISODES {
+            return Err(Problem::new(
+                format!("`episodes` must be in 1..={MAX_EPISODES}; got {n}"),
+                "leave it out to train the spec's `learn { episodes }`".to_string(),
+            ));
+        }
+        spec.learn.episodes = n;
+    }
+    Ok(())
+}
+
 /// Refuses `learn` values that are each in range but do not fit together: a level's
 /// `min_epsilon` above its `epsilon`.
 pub fn check_learn(spec: &TaskSpec) -> Result<(), Problem> {
@@ -329,6 +345,30 @@ mod tests {
         let loaded = crate::load::load_in_world(SMALL, None, &world, "world `paper`")
             .unwrap_or_else(|e| panic!("{e}"));
         (trainable(&loaded.spec, SMALL, "small.hstl").expect("trains"), world)
+    }
+
+    #[test]
+    fn an_episodes_override_is_held_to_the_spec_s_range() {
+        use hstl_lang::budget::MAX_EPISODES;
+        let (spec, _) = small();
+        let max = usize::try_from(MAX_EPISODES).expect("fits");
+        for (episodes, expect) in [
+            (None, Ok(spec.learn.episodes)),
+            (Some(1), Ok(1)),
+            (Some(max), Ok(max)),
+            (Some(0), Err("got 0".to_string())),
+            (Some(max + 1), Err(format!("must be in 1..={MAX_EPISODES}; got {}", max + 1))),
+        ] {
+            let mut task = spec.clone();
+            match (set_episodes(&mut task, episodes), expect) {
+                (Ok(()), Ok(n)) => assert_eq!(task.learn.episodes, n, "{episodes:?}"),
+                (Err(p), Err(part)) => {
+                    assert!(p.message.contains(&part), "{}", p.message);
+                    assert_eq!(task.learn.episodes, spec.learn.episodes, "left as it was");
+                }
+                (got, _) => panic!("{episodes:?}: {:?}", got.map_err(|p| p.message)),
+            }
+        }
     }
 
     #[test]

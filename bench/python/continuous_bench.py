@@ -16,7 +16,6 @@ Usage: continuous_bench.py HSTLC [--steps N] [--repeats N]
 from __future__ import annotations
 
 import argparse
-import resource
 import subprocess
 import tempfile
 import time
@@ -26,36 +25,11 @@ import gymnasium
 import numpy as np
 
 import hstl
+from timing import best, children_cpu, stepper
 
 REPO = Path(__file__).resolve().parents[2]
 PLANE = REPO / "examples" / "specs" / "surveillance_plane.hstl"
 CAR = REPO / "examples" / "specs" / "mountain_car_patrol.hstl"
-
-
-def best(fn, repeats: int) -> float:
-    """The fastest of `repeats` runs, in seconds of this process's CPU time."""
-    times = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return min(times)
-
-
-def children_cpu() -> float:
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
-def stepper(env, actions, episode: int):
-    def run():
-        env.reset(seed=0)
-        for t, a in enumerate(actions, 1):
-            env.step(a)
-            if t % episode == 0:
-                env.reset()
-
-    return run
 
 
 def main() -> None:

@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import resource
 import subprocess
 import sys
 import tempfile
@@ -29,39 +28,10 @@ import gymnasium
 import numpy as np
 
 import hstl
+from timing import best, children_cpu, stepper
 
 REPO = Path(__file__).resolve().parents[2]
 CASE = REPO / "examples" / "specs" / "surveillance_ot1.hstl"
-
-
-def best(fn, repeats: int) -> float:
-    """The fastest of `repeats` runs, in seconds of this process's CPU time (the machine is
-    shared: CPU time is what a loaded run can still measure)."""
-    times = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return min(times)
-
-
-def children_cpu() -> float:
-    """CPU seconds of the finished child processes."""
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
-def stepper(env, actions, episode: int):
-    """Steps `env` through `actions`, resetting every `episode` steps."""
-
-    def run():
-        env.reset(seed=0)
-        for t, a in enumerate(actions, 1):
-            env.step(a)
-            if t % episode == 0:
-                env.reset()
-
-    return run
 
 
 class WholeTraceReward(gymnasium.Wrapper):

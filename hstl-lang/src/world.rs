@@ -129,36 +129,27 @@ impl WorldFacts {
         let mut fits = true;
         let wanted = [("x", self.width, "wide"), ("y", self.height, "high")];
         for v in &spec.state_vars {
-            let Some(&(_, n, along)) = wanted.iter().find(|w| w.0 == v.name) else {
+            let mut wrong = |message: String| {
                 fits = false;
                 push(
-                    Diagnostic::new(
-                        "HSTL030",
-                        v.name_range.start..v.range.end,
-                        format!(
-                            "state variable `{}` is not a variable of {}: a grid world's state is its cell `x`, `y`",
-                            v.name, self.label
-                        ),
-                    )
-                    .with_help(help.clone()),
+                    Diagnostic::new("HSTL030", v.name_range.start..v.range.end, message)
+                        .with_help(help.clone()),
                 );
+            };
+            let Some(&(_, n, along)) = wanted.iter().find(|w| w.0 == v.name) else {
+                wrong(format!(
+                    "state variable `{}` is not a variable of {}: a grid world's state is its \
+                     cell `x`, `y`",
+                    v.name, self.label
+                ));
                 continue;
             };
             let hi = n.saturating_sub(1) as i64;
-            let right = v.ty == VarType::Int && v.domain == Domain::Int { lo: 0, hi };
-            if !right {
-                fits = false;
-                push(
-                    Diagnostic::new(
-                        "HSTL030",
-                        v.name_range.start..v.range.end,
-                        format!(
-                            "state variable `{}` must be `int in 0..={hi}`: {} is {n} cells {along}",
-                            v.name, self.label
-                        ),
-                    )
-                    .with_help(help.clone()),
-                );
+            if !(v.ty == VarType::Int && v.domain == Domain::Int { lo: 0, hi }) {
+                wrong(format!(
+                    "state variable `{}` must be `int in 0..={hi}`: {} is {n} cells {along}",
+                    v.name, self.label
+                ));
             }
         }
         for (name, _, _) in wanted {

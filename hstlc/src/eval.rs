@@ -52,6 +52,22 @@ pub const MAX_RUN_FILES: usize = 1000;
 pub const MAX_RUN_ROWS: usize = 10_000_000;
 
 /// Refuses a `--runs` that would write more than [`MAX_RUN_ROWS`] rows, before anything runs.
+/// The checks on what a run writes, made before anything is printed (the burn-in against
+/// the task, the rows `--runs` would write), and the `--runs` folder locked.
+fn check_and_lock(
+    args: &EvalArgs,
+    runs: &Runs,
+    spec: &hstl::runtime::TaskSpec,
+) -> Result<Option<hstl_outdir::OutDir>, CliError> {
+    runs.check_burn_in(spec, flag)?;
+    check_run_rows(args, runs.steps)?;
+    Ok(args
+        .runs
+        .as_ref()
+        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
+        .transpose()?)
+}
+
 fn check_run_rows(args: &EvalArgs, steps: usize) -> Result<(), CliError> {
     let rows = args.starts.min(MAX_RUN_FILES).saturating_mul(steps.saturating_add(1));
     if args.runs.is_some() && rows > MAX_RUN_ROWS {
@@ -119,14 +135,7 @@ pub fn run(args: &EvalArgs) -> CmdResult {
     }
     let replay = evaluate::replay(&text).map_err(|p| p.in_file(&name))?;
     let (spec, env) = (&replay.spec, &replay.env);
-    runs.check_burn_in(spec, flag)?;
-    // Decide what can be written before anything is printed.
-    check_run_rows(args, runs.steps)?;
-    let out = args
-        .runs
-        .as_ref()
-        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
-        .transpose()?;
+    let out = check_and_lock(args, &runs, spec)?;
     // The optimum W* of a persistent task, solved first: one past its budget is an error
     // before anything is printed, not after the report.
     let optimum = if args.no_optimum || spec.regions.is_empty() {
@@ -237,14 +246,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
         _ => runs.steps,
     };
     let runs = Runs { steps, ..runs };
-    runs.check_burn_in(spec, flag)?;
-    // Decide what can be written before anything is printed.
-    check_run_rows(args, runs.steps)?;
-    let out = args
-        .runs
-        .as_ref()
-        .map(|dir| hstl_outdir::OutDir::lock(dir, hstl_outdir::Writer::CLI))
-        .transpose()?;
+    let out = check_and_lock(args, &runs, spec)?;
     outln!(
         "policy of `{}` on {}: {} options, tiles {}, {} greedy runs of {} steps (seed {})",
         spec.name,
@@ -259,13 +261,7 @@ fn run_continuous(args: &EvalArgs, name: &str, text: &str, runs: Runs) -> CmdRes
         c::Evaluation::Window(w) => {
             let Stats { min: lo, max: hi, .. } = Stats::of(&w.per_run);
             outln!("{}", window_line(w.rate, (lo, hi), args.burn_in, &spec.regions))?;
-            let Stats { mean, min: lo, max: hi, .. } = Stats::of(&w.robustness);
-            outln!(
-                "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
-                figure(mean),
-                figure(lo),
-                figure(hi)
-            )?;
+            print_clipped_robustness(&w.robustness)?;
         }
         c::Evaluation::Satisfaction { rate } => {
             outln!("  satisfied in {rate:.4} of {} runs of {} steps", args.starts, steps)?;
@@ -310,10 +306,8 @@ fn figure(v: f64) -> String {
     if v.is_finite() && v.abs() >= 1e6 { format!("{v:.3e}") } else { format!("{v:.3}") }
 }
 
-/// The task's robustness over each run, windows clipped and complete; satisfaction is
-/// counted over complete windows, since clipped ones fail a persistent task at the end of
-/// nearly every finite run.
-fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
+/// The task's robustness over each run, windows clipped: its mean, least and greatest.
+fn print_clipped_robustness(values: &[f64]) -> Result<(), CliError> {
     let Stats { mean, min: lo, max: hi, .. } = Stats::of(values);
     outln!(
         "  task robustness over each run (windows clipped at the run's end): mean {}, min {}, max {}",
@@ -321,6 +315,14 @@ fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliE
         figure(lo),
         figure(hi)
     )?;
+    Ok(())
+}
+
+/// The task's robustness over each run, windows clipped and complete; satisfaction is
+/// counted over complete windows, since clipped ones fail a persistent task at the end of
+/// nearly every finite run.
+fn print_robustness(values: &[f64], complete: &[Option<f64>]) -> Result<(), CliError> {
+    print_clipped_robustness(values)?;
     let determined: Vec<f64> = complete.iter().flatten().copied().collect();
     let satisfied = evaluate::satisfied(values, complete);
     let figures = if determined.is_empty() {

@@ -280,14 +280,14 @@ fn score_batch(
     let written = if signal {
         writeln!(out, "trace,t,robustness").and_then(|()| {
             rows.iter().try_for_each(|(path, scored)| {
-                let name = csv_field(&trace_name(path));
+                let name = hstl::study::csv_field(&trace_name(path));
                 (0..scored.steps).try_for_each(|t| writeln!(out, "{name},{t},{}", scored.cell(t)))
             })
         })
     } else {
         writeln!(out, "trace,robustness").and_then(|()| {
             rows.iter().try_for_each(|(path, scored)| {
-                writeln!(out, "{},{}", csv_field(&trace_name(path)), scored.first())
+                writeln!(out, "{},{}", hstl::study::csv_field(&trace_name(path)), scored.first())
             })
         })
     }
@@ -385,13 +385,4 @@ fn online(
         );
     }
     Ok(Status::Clean)
-}
-
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
 }

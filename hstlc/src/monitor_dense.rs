@@ -107,13 +107,13 @@ pub fn run(args: &MonitorArgs, spec: &CheckedSpec, name: &str, traces: &[PathBuf
         (false, false) => writeln!(out, "{}", scored[0].1[0].1),
         (true, true) => writeln!(out, "trace,t,robustness").and_then(|()| {
             scored.iter().try_for_each(|(path, rows)| {
-                let name = csv_field(&trace_name(path));
+                let name = hstl::study::csv_field(&trace_name(path));
                 rows.iter().try_for_each(|(t, v)| writeln!(out, "{name},{t},{v}"))
             })
         }),
         (true, false) => writeln!(out, "trace,robustness").and_then(|()| {
             scored.iter().try_for_each(|(path, rows)| {
-                writeln!(out, "{},{}", csv_field(&trace_name(path)), rows[0].1)
+                writeln!(out, "{},{}", hstl::study::csv_field(&trace_name(path)), rows[0].1)
             })
         }),
     }
@@ -286,15 +286,6 @@ fn online(
         note_open(&[(name.clone(), (end >= t0).then(|| times.text(end)))], false);
     }
     Ok(Status::Clean)
-}
-
-/// A CSV field, quoted when it holds a comma, a quote or a line break.
-fn csv_field(text: &str) -> String {
-    if text.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_string()
-    }
 }
 
 /// The options that shape reading and printing a dense-time trace.

@@ -22,6 +22,7 @@
 use std::fmt;
 use std::io::BufRead;
 
+use hstl::lang::wording::thousands;
 use hstl::robustness::Trace;
 
 /// The largest trace file read: 1 GiB.
@@ -125,7 +126,7 @@ pub fn read_trace(reader: impl BufRead, vars: &[Column<'_>]) -> Result<TraceRead
                 1,
                 format!(
                     "the trace holds more than {} values (rows times state variables)",
-                    thousands(MAX_TRACE_VALUES)
+                    thousands(MAX_TRACE_VALUES as u64)
                 ),
                 "monitor a shorter stretch of it: split the file".to_string(),
             )
@@ -169,63 +170,36 @@ impl<R: BufRead> TraceRows<'_, R> {
         cells: &mut [Option<f64>],
         first: bool,
     ) -> Result<Option<DenseRow>, ReadError> {
-        loop {
-            let Some((i, bytes)) = self.lines.next()? else { return Ok(None) };
-            let line = utf8(i, bytes)?;
-            if line.trim().is_empty() {
-                continue;
-            }
-            self.row.clear();
-            self.row.extend(field_ranges(line));
-            if self.row.len() != self.width {
-                let column = match self.row.get(self.width) {
-                    Some((column, _)) => *column,
-                    None => line.chars().count() + 1,
-                };
-                return Err(csv(
-                    i,
-                    column,
-                    format!(
-                        "this row has {}, the header has {}",
-                        fields_word(self.row.len()),
-                        self.width
-                    ),
-                    "every row needs one field per header column (an empty one keeps the \
-                     variable's value)"
-                        .to_string(),
-                )
-                .into());
-            }
-            let (time_pick, time) = (self.picks[0], self.vars[0].name);
-            let (stamp_column, field) =
-                (self.row[time_pick].0, &line[self.row[time_pick].1.clone()]);
-            let stamp = stamp(field, time).map_err(|(m, h)| csv(i, stamp_column, m, h))?;
-            for ((out, &pick), var) in cells.iter_mut().zip(&self.picks[1..]).zip(&self.vars[1..]) {
-                let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
-                *out = if field.is_empty() {
-                    if first {
-                        return Err(csv(
-                            i,
-                            column,
-                            format!("`{}` is empty in the first row", var.name),
-                            format!(
-                                "every variable needs a value at the first time stamp (no \
-                                 value exists before it): give `{}` one",
-                                var.name
-                            ),
-                        )
-                        .into());
-                    }
-                    None
-                } else {
-                    Some(
-                        value(field, var)
-                            .map_err(|(message, help)| csv(i, column, message, help))?,
+        let help = "every row needs one field per header column (an empty one keeps the \
+                    variable's value)";
+        let Some((i, line)) = next_fields(&mut self.lines, &mut self.row, self.width, help)? else {
+            return Ok(None);
+        };
+        let (time_pick, time) = (self.picks[0], self.vars[0].name);
+        let (stamp_column, field) = (self.row[time_pick].0, &line[self.row[time_pick].1.clone()]);
+        let stamp = stamp(field, time).map_err(|(m, h)| csv(i, stamp_column, m, h))?;
+        for ((out, &pick), var) in cells.iter_mut().zip(&self.picks[1..]).zip(&self.vars[1..]) {
+            let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
+            *out = if field.is_empty() {
+                if first {
+                    return Err(csv(
+                        i,
+                        column,
+                        format!("`{}` is empty in the first row", var.name),
+                        format!(
+                            "every variable needs a value at the first time stamp (no \
+                             value exists before it): give `{}` one",
+                            var.name
+                        ),
                     )
-                };
-            }
-            return Ok(Some(DenseRow { line: i, stamp, stamp_column }));
+                    .into());
+                }
+                None
+            } else {
+                Some(value(field, var).map_err(|(message, help)| csv(i, column, message, help))?)
+            };
         }
+        Ok(Some(DenseRow { line: i, stamp, stamp_column }))
     }
 }
 
@@ -328,38 +302,15 @@ impl<'v, R: BufRead> TraceRows<'v, R> {
     /// Reads the next row into `state` (`state[i]` is `vars[i]`) and returns its line
     /// number, or `None` at the end of the input. Blank lines are skipped.
     pub fn next_row(&mut self, state: &mut [f64]) -> Result<Option<usize>, ReadError> {
-        loop {
-            let Some((i, bytes)) = self.lines.next()? else { return Ok(None) };
-            let line = utf8(i, bytes)?;
-            if line.trim().is_empty() {
-                continue;
-            }
-            self.row.clear();
-            self.row.extend(field_ranges(line));
-            if self.row.len() != self.width {
-                let column = match self.row.get(self.width) {
-                    Some((column, _)) => *column,
-                    None => line.chars().count() + 1,
-                };
-                return Err(csv(
-                    i,
-                    column,
-                    format!(
-                        "this row has {}, the header has {}",
-                        fields_word(self.row.len()),
-                        self.width
-                    ),
-                    "every row needs one value per header column".to_string(),
-                )
-                .into());
-            }
-            for ((out, &pick), var) in state.iter_mut().zip(&self.picks).zip(self.vars) {
-                let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
-                *out =
-                    value(field, var).map_err(|(message, help)| csv(i, column, message, help))?;
-            }
-            return Ok(Some(i));
+        let help = "every row needs one value per header column";
+        let Some((i, line)) = next_fields(&mut self.lines, &mut self.row, self.width, help)? else {
+            return Ok(None);
+        };
+        for ((out, &pick), var) in state.iter_mut().zip(&self.picks).zip(self.vars) {
+            let (column, field) = (self.row[pick].0, &line[self.row[pick].1.clone()]);
+            *out = value(field, var).map_err(|(message, help)| csv(i, column, message, help))?;
         }
+        Ok(Some(i))
     }
 
     /// The error for a trace that ended right after its header.
@@ -371,6 +322,40 @@ impl<'v, R: BufRead> TraceRows<'v, R> {
             "add one row per time step below the header".to_string(),
         )
     }
+}
+
+/// The next row that is not blank: its line number and text, its fields' columns and
+/// byte ranges in `row`, checked to be `width` of them (`help` says what a row needs).
+fn next_fields<'l, R: BufRead>(
+    lines: &'l mut Lines<R>,
+    row: &mut Vec<(usize, std::ops::Range<usize>)>,
+    width: usize,
+    help: &str,
+) -> Result<Option<(usize, &'l str)>, ReadError> {
+    let i = loop {
+        let Some((i, bytes)) = lines.next()? else { return Ok(None) };
+        if !utf8(i, bytes)?.trim().is_empty() {
+            break i;
+        }
+    };
+    // Read again, checked again: a borrow returned from inside the loop would hold `lines`.
+    let line = utf8(i, &lines.line)?;
+    row.clear();
+    row.extend(field_ranges(line));
+    if row.len() != width {
+        let column = match row.get(width) {
+            Some((column, _)) => *column,
+            None => line.chars().count() + 1,
+        };
+        return Err(csv(
+            i,
+            column,
+            format!("this row has {}, the header has {width}", fields_word(row.len())),
+            help.to_string(),
+        )
+        .into());
+    }
+    Ok(Some((i, line)))
 }
 
 /// The header's names, checked: each variable present, no name twice.
@@ -569,19 +554,6 @@ fn fields_word(n: usize) -> String {
 
 fn quote_list<'a>(items: impl Iterator<Item = &'a str>) -> String {
     items.map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
-}
-
-/// `33,554,432`.
-fn thousands(n: usize) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 #[cfg(test)]

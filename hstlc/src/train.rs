@@ -134,12 +134,7 @@ pub fn run(args: &TrainArgs) -> CmdResult {
             WindowConfig::default().steps
         )?;
     }
-    outln!(
-        "  wrote {} files to {}: {}",
-        written.len(),
-        crate::output::shown(&args.out),
-        names(&files)
-    )?;
+    print_written(written.len(), &args.out, &files)?;
     if let Some(why) = skipped {
         outln!("  {why}")?;
     }
@@ -219,12 +214,7 @@ fn run_continuous(
             c::task_steps(&spec)
         )?,
     }
-    outln!(
-        "  wrote {} files to {}: {}",
-        written.len(),
-        crate::output::shown(&args.out),
-        names(&files)
-    )?;
+    print_written(written.len(), &args.out, &files)?;
     Ok(Status::Clean)
 }
 
@@ -285,8 +275,15 @@ pub fn window_report(
 
 pub use hstl::study::tail_mean;
 
-fn names(files: &[OutFile]) -> String {
-    files.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ")
+/// `wrote N files to OUT: a, b, c`.
+fn print_written(
+    count: usize,
+    out: &std::path::Path,
+    files: &[OutFile],
+) -> Result<(), crate::cli_error::CliError> {
+    let names = files.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ");
+    outln!("  wrote {count} files to {}: {names}", crate::output::shown(out))?;
+    Ok(())
 }
 
 /// A bar on a terminal, nothing otherwise.

@@ -114,16 +114,7 @@ impl OutDir {
     /// it holds files no run writes (it will be replaced as a whole). Call it before the
     /// long work, so that a refusal comes at once.
     pub fn lock(dir: &Path, writer: Writer) -> Result<OutDir, Error> {
-        let write_err = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| Error::Write { path, source }
-        };
-        // `--out .`, or a symbolic link: the folder it names.
-        let dir = if dir.file_name().is_none() || dir.is_symlink() {
-            std::fs::canonicalize(dir).map_err(write_err(dir))?
-        } else {
-            dir.to_path_buf()
-        };
+        let dir = named_folder(dir)?;
         let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let parent = match dir.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -221,12 +212,10 @@ impl OutDir {
     }
 }
 
-/// Refuses a folder this run may not replace: a file, or a folder holding anything
-/// that is not a run's output (a folder that an older hstlc wrote, before the marker,
-/// holds only files named as a run's).
-fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
+/// Whether the folder `dir` is there (false when nothing is); a file there is refused.
+fn folder_there(dir: &Path, writer: Writer) -> Result<bool, Error> {
     let meta = match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
         Err(source) => return Err(Error::Write { path: dir.to_path_buf(), source }),
         Ok(meta) => meta,
     };
@@ -235,6 +224,16 @@ fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
             format!("`{}` is a file, not a folder", path_words(dir)),
             Some(format!("choose another {}", writer.option)),
         ));
+    }
+    Ok(true)
+}
+
+/// Refuses a folder this run may not replace: a file, or a folder holding anything
+/// that is not a run's output (a folder that an older hstlc wrote, before the marker,
+/// holds only files named as a run's).
+fn replaceable(dir: &Path, writer: Writer) -> Result<(), Error> {
+    if !folder_there(dir, writer)? {
+        return Ok(());
     }
     let entries = std::fs::read_dir(dir)
         .map_err(|source| Error::Write { path: dir.to_path_buf(), source })?;
@@ -308,15 +307,7 @@ impl StudyDir {
         force: bool,
         writer: Writer,
     ) -> Result<(StudyDir, Vec<OutDir>), Error> {
-        let write_err = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| Error::Write { path, source }
-        };
-        let dir = if dir.file_name().is_none() || dir.is_symlink() {
-            std::fs::canonicalize(dir).map_err(write_err(dir))?
-        } else {
-            dir.to_path_buf()
-        };
+        let dir = named_folder(dir)?;
         let ours: Vec<String> = spec_dirs
             .iter()
             .filter_map(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
@@ -367,16 +358,8 @@ fn study_refusal(
     force: bool,
     writer: Writer,
 ) -> Result<Vec<PathBuf>, Error> {
-    let meta = match std::fs::symlink_metadata(dir) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => return Err(Error::Write { path: dir.to_path_buf(), source }),
-        Ok(meta) => meta,
-    };
-    if !meta.is_dir() {
-        return Err(refused(
-            format!("`{}` is a file, not a folder", path_words(dir)),
-            Some(format!("choose another {}", writer.option)),
-        ));
+    if !folder_there(dir, writer)? {
+        return Ok(Vec::new());
     }
     let listed: Vec<String> = std::fs::read_to_string(dir.join(STUDY_MARKER))
         .map(|t| t.lines().filter(|l| !l.starts_with('#')).map(str::to_string).collect())
@@ -587,6 +570,21 @@ fn is_run_file(name: &str) -> bool {
 
 /// Refuses names that are not plain file names, or that two files share (also when they
 /// differ only in case, as they would on a case-insensitive file system).
+/// A write error at `path`, for `map_err`.
+fn write_err(path: &Path) -> impl FnOnce(std::io::Error) -> Error {
+    let path = path.to_path_buf();
+    move |source| Error::Write { path, source }
+}
+
+/// The folder `dir` names: `--out .`, or a symbolic link, resolved to the folder itself.
+fn named_folder(dir: &Path) -> Result<PathBuf, Error> {
+    if dir.file_name().is_none() || dir.is_symlink() {
+        std::fs::canonicalize(dir).map_err(write_err(dir))
+    } else {
+        Ok(dir.to_path_buf())
+    }
+}
+
 fn check_names(files: &[OutFile]) -> Result<(), Error> {
     let mut seen = std::collections::HashSet::new();
     for f in files {

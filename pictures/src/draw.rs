@@ -468,3 +468,82 @@ pub(crate) fn draw_entry(area: &Area<'_>, centre: (i32, i32), half: i32) -> crat
     outline.push(outline[0]);
     area.draw(&PathElement::new(outline, INK.stroke_width(2))).map_err(draw_err)
 }
+
+/// The steps of a run divided into a ramp of this many pieces: steps under one option and
+/// in one piece share a rectangle of the band.
+pub(crate) const RAMP_PIECES: usize = 240;
+
+/// A run's option band between `band.0` and `band.1`: steps `0..span` (step `i` from
+/// `x_of(i)` to `x_of(i + 1)`), each in the colour of its option, `option(i)`, shaded by
+/// its time in the run, and a frame around the band.
+pub(crate) fn option_band<K: PartialEq>(
+    area: &Area<'_>,
+    span: usize,
+    x_of: &dyn Fn(usize) -> i32,
+    band: (i32, i32),
+    option: impl Fn(usize) -> K,
+    colour_of: impl Fn(K) -> RGBColor,
+) -> Result<(), PictureError> {
+    let piece = |i: usize| i * RAMP_PIECES / span;
+    let mut start = 0;
+    while start < span {
+        let o = option(start);
+        let mut end = start + 1;
+        while end < span && option(end) == o && piece(end) == piece(start) {
+            end += 1;
+        }
+        let t = if span > 1 { start as f64 / (span - 1) as f64 } else { 0.0 };
+        let rect = [(x_of(start), band.0), (x_of(end), band.1)];
+        area.draw(&Rectangle::new(rect, shade(colour_of(o), t).filled())).map_err(draw_err)?;
+        start = end;
+    }
+    area.draw(&Rectangle::new([(x_of(0), band.0), (x_of(span), band.1)], INK.stroke_width(1)))
+        .map_err(draw_err)?;
+    Ok(())
+}
+
+/// The colour a region's name is written in: the avoid colour for a region to avoid.
+pub(crate) fn tag_colour(kind: RegionKind) -> RGBColor {
+    match kind {
+        RegionKind::Avoid => AVOID,
+        RegionKind::Reach | RegionKind::Other => INK,
+    }
+}
+
+/// Places a name box `h` pixels high beside a region whose edges are at `t` and `bottom`:
+/// above it, or below it when the box would cross `top`, with a leader at `x` from the
+/// region's edge. Returns the box's top.
+pub(crate) fn tag_leader(
+    area: &Area<'_>,
+    x: i32,
+    (t, bottom): (i32, i32),
+    h: i32,
+    top: i32,
+    colour: RGBColor,
+) -> Result<i32, PictureError> {
+    let (box_top, from, to) =
+        if t - 4 - h >= top { (t - 4 - h, t - 4, t) } else { (bottom + 4, bottom + 4, bottom) };
+    area.draw(&PathElement::new(vec![(x, from), (x, to)], colour.stroke_width(1)))
+        .map_err(draw_err)?;
+    Ok(box_top)
+}
+
+/// Writes `name` in bold, `size` pixels, in a white box `w` x `h` centred at `centre_x`
+/// with its top at `box_top`, framed in `colour`.
+pub(crate) fn name_box(
+    area: &Area<'_>,
+    name: String,
+    (centre_x, box_top): (i32, i32),
+    (w, h): (i32, i32),
+    size: f64,
+    colour: RGBColor,
+) -> Result<(), PictureError> {
+    let rect = [(centre_x - w / 2, box_top), (centre_x + w / 2, box_top + h)];
+    area.draw(&Rectangle::new(rect, WHITE.mix(0.85).filled())).map_err(draw_err)?;
+    area.draw(&Rectangle::new(rect, colour.stroke_width(1))).map_err(draw_err)?;
+    let style = TextStyle::from((FONT, size, FontStyle::Bold).into_font())
+        .color(&colour)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw(&Text::new(name, (centre_x, box_top + h / 2), style)).map_err(draw_err)?;
+    Ok(())
+}

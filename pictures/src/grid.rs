@@ -9,8 +9,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, clean_text, draw_arrow, draw_dashed, draw_err,
     draw_legend, draw_region_fill, draw_region_hatch, draw_start_cell, draw_terminate, draw_text,
-    draw_title, legend_size, shorten, text_style, text_width, title_height, title_parts,
-    title_width,
+    draw_title, legend_size, name_box, shorten, tag_colour, tag_leader, text_style, text_width,
+    title_height, title_parts, title_width,
 };
 use crate::label::{CellBox, best_box};
 use crate::palette::{AVOID, GRID_LINE, INK, REGION, WALL, option_color};
@@ -628,10 +628,7 @@ fn draw_tag(area: &Area<'_>, canvas: &Canvas, tag: &Tag) -> Result<()> {
     let size = tag.pixels * 1.24;
     let w = text_width(&tag.name, size) + 6;
     let h = tag.pixels.round() as i32 + 4;
-    let colour = match tag.kind {
-        RegionKind::Avoid => AVOID,
-        RegionKind::Reach | RegionKind::Other => INK,
-    };
+    let colour = tag_colour(tag.kind);
     let keep_inside =
         |x: i32| x.clamp(canvas.left + w / 2, (canvas.right() - w / 2).max(canvas.left + w / 2));
     let (centre_x, box_top) = match tag.place {
@@ -639,20 +636,10 @@ fn draw_tag(area: &Area<'_>, canvas: &Canvas, tag: &Tag) -> Result<()> {
         Place::Edge => (keep_inside((l + r) / 2), t - h / 2),
         Place::Beside => {
             let x = (l + r) / 2;
-            let (box_top, from, to) =
-                if t - 4 - h >= canvas.top { (t - 4 - h, t - 4, t) } else { (b + 4, b + 4, b) };
-            area.draw(&PathElement::new(vec![(x, from), (x, to)], colour.stroke_width(1)))
-                .map_err(draw_err)?;
-            (keep_inside(x), box_top)
+            (keep_inside(x), tag_leader(area, x, (t, b), h, canvas.top, colour)?)
         }
     };
-    let rect = [(centre_x - w / 2, box_top), (centre_x + w / 2, box_top + h)];
-    area.draw(&Rectangle::new(rect, WHITE.mix(0.85).filled())).map_err(draw_err)?;
-    area.draw(&Rectangle::new(rect, colour.stroke_width(1))).map_err(draw_err)?;
-    let style = TextStyle::from((crate::draw::FONT, size, FontStyle::Bold).into_font())
-        .color(&colour)
-        .pos(Pos::new(HPos::Center, VPos::Center));
-    area.draw(&Text::new(tag.name.clone(), (centre_x, box_top + h / 2), style)).map_err(draw_err)
+    name_box(area, tag.name.clone(), (centre_x, box_top), (w, h), size, colour)
 }
 
 /// The step between labelled rows and columns: the least of 1, 2, 5, 10, 20, 25, 50, 100

@@ -9,7 +9,7 @@ use plotters::style::text_anchor::{HPos, VPos};
 
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, draw_end, draw_err, draw_slip, draw_start, draw_text,
-    text_style,
+    option_band, text_style,
 };
 use crate::grid::{
     Canvas, LEFT, Layers, check_cell, check_grid, option_order, region_legend, render,
@@ -35,8 +35,6 @@ pub struct RunStep {
 const HEAD_EVERY: usize = 4;
 /// The height of the timeline under the grid, in pixels.
 const TIMELINE: i32 = 56;
-/// The timeline's shading changes in at most this many pieces.
-const RAMP_PIECES: usize = 240;
 /// Repeated passes along one cell edge take these lanes in turn, in units of the lane
 /// spacing across the edge, so that they lie side by side.
 const LANES: [i32; 7] = [0, 1, -1, 2, -2, 3, -3];
@@ -201,22 +199,7 @@ fn draw_timeline(
     let (slip_y, band) = (top + 6, (top + 13, top + 29));
     draw_text(area, "slips", (LEFT - 6, slip_y), &label)?;
     draw_text(area, "option", (LEFT - 6, (band.0 + band.1) / 2), &label)?;
-    // Steps under one option and in one of the ramp's pieces share a rectangle.
-    let piece = |i: usize| i * RAMP_PIECES / span;
-    let mut start = 0;
-    while start < span {
-        let name = steps[start].option.as_str();
-        let mut end = start + 1;
-        while end < span && steps[end].option == name && piece(end) == piece(start) {
-            end += 1;
-        }
-        let t = if span > 1 { start as f64 / (span - 1) as f64 } else { 0.0 };
-        let rect = [(x_of(start), band.0), (x_of(end), band.1)];
-        area.draw(&Rectangle::new(rect, shade(colour_of(name), t).filled())).map_err(draw_err)?;
-        start = end;
-    }
-    area.draw(&Rectangle::new([(left, band.0), (right, band.1)], INK.stroke_width(1)))
-        .map_err(draw_err)?;
+    option_band(area, span, &x_of, band, |i| steps[i].option.as_str(), colour_of)?;
     for &i in slips {
         let x = (x_of(i) + x_of(i + 1)) / 2;
         let arm = 3;
@@ -228,6 +211,18 @@ fn draw_timeline(
             area.draw(&PathElement::new(line.to_vec(), INK.stroke_width(2))).map_err(draw_err)?;
         }
     }
+    step_axis(area, span, &x_of, band)
+}
+
+/// The step numbers under a timeline's band: ticks at `x_of(i)` for every few steps `i`
+/// of `0..=span`, numbered, and the word "step" after the band's right end.
+pub(crate) fn step_axis(
+    area: &Area<'_>,
+    span: usize,
+    x_of: &dyn Fn(usize) -> i32,
+    band: (i32, i32),
+) -> Result<()> {
+    let (left, right) = (x_of(0), x_of(span));
     let every = tick_step(span, ((right - left) / 60).max(1) as usize);
     let below = text_style(LABEL_SIZE * 0.75, &INK, HPos::Center, VPos::Top);
     for i in (0..=span).step_by(every) {

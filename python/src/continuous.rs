@@ -55,15 +55,7 @@ impl ContinuousWorld {
 
     /// The world in the file at `path`, with the CLI's words for every error.
     pub fn read(path: &Path) -> PyResult<ContinuousWorld> {
-        let text = crate::files::read_regular_text(
-            path,
-            hstl::world::MAX_WORLD_BYTES as u64,
-            "world file",
-            |e| errors::read_error_with(path, e, hstl::world::read_help()),
-        )?;
-        let file = path.display().to_string();
-        let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
-        let world = hstl::world::any_from_file(&text, &file, &stem).map_err(|p| world_error(&p))?;
+        let (world, file) = read_any(path)?;
         ContinuousWorld::new(world, Some(file))
     }
 
@@ -242,6 +234,15 @@ impl ContinuousWorld {
 }
 
 /// A built-in world's name or a world file's path, as `hstlc --world` reads it: a
+/// The world in the file at `path`, of either kind, and the file's name as errors give it,
+/// with the CLI's words for every error.
+fn read_any(path: &Path) -> PyResult<(AnyWorld, String)> {
+    let w = crate::files::read_world(path)?;
+    let world =
+        hstl::world::any_from_file(&w.text, &w.file, &w.stem).map_err(|p| world_error(&p))?;
+    Ok((world, w.file))
+}
+
 /// `hstl.World` for a grid, a `hstl.ContinuousWorld` for a plane or `mountain-car`.
 #[pyfunction]
 pub fn _resolve_any_world(py: Python<'_>, arg: &str) -> PyResult<Py<PyAny>> {
@@ -251,18 +252,7 @@ pub fn _resolve_any_world(py: Python<'_>, arg: &str) -> PyResult<Py<PyAny>> {
             if !hstl::world::looks_like_file(arg) && !Path::new(arg).exists() {
                 return Err(world_error(&hstl::world::unknown(arg)));
             }
-            let path = Path::new(arg);
-            let text = crate::files::read_regular_text(
-                path,
-                hstl::world::MAX_WORLD_BYTES as u64,
-                "world file",
-                |e| errors::read_error_with(path, e, hstl::world::read_help()),
-            )?;
-            let file = path.display().to_string();
-            let stem =
-                path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
-            let world =
-                hstl::world::any_from_file(&text, &file, &stem).map_err(|p| world_error(&p))?;
+            let (world, file) = read_any(Path::new(arg))?;
             (world, Some(file))
         }
     };

@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 
 use crate::errors::{missing_variable, type_error, value_error, with_help};
-use crate::trace::{float_array, is_mapping, keys, type_name};
+use crate::trace::{column, float_array, is_mapping, type_name};
 
 /// The name `max_gap=` errors give the setting.
 pub const GAP_FLAG: &str = "max_gap=";
@@ -205,16 +205,7 @@ fn lookup<'py>(
         }
         missing_variable(py, text)
     };
-    if let Some(fields) = fields
-        && !fields.iter().any(|f| f == name)
-    {
-        return Err(missing(fields.to_vec()));
-    }
-    match trace.get_item(name) {
-        Ok(v) => Ok(v),
-        Err(e) if e.is_instance_of::<PyKeyError>(py) => Err(missing(keys(trace))),
-        Err(e) => Err(e),
-    }
+    column(trace, name, fields, missing)
 }
 
 /// The time column: integers kept whole (int64, uint64; datetime64 as nanoseconds),

@@ -35,6 +35,28 @@ pub fn read_regular_text(
     text(path, hstl_files::read::read_regular(path, limit), what, io_error)
 }
 
+/// A world file's text, read as `hstlc --world` reads it, with its name as errors give it
+/// and the name a world without `name = ...` takes (the file's stem).
+pub struct WorldText {
+    /// The file's text.
+    pub text: String,
+    /// The path as errors show it.
+    pub file: String,
+    /// The file's stem, or `world`.
+    pub stem: String,
+}
+
+/// The world file at `path` ([`read_regular_text`] at most
+/// [`hstl::world::MAX_WORLD_BYTES`]), with the CLI's words for a file that cannot be read.
+pub fn read_world(path: &Path) -> PyResult<WorldText> {
+    let text = read_regular_text(path, hstl::world::MAX_WORLD_BYTES as u64, "world file", |e| {
+        crate::errors::read_error_with(path, e, hstl::world::read_help())
+    })?;
+    let file = path.display().to_string();
+    let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
+    Ok(WorldText { text, file, stem })
+}
+
 /// The text read, or the error in the package's words.
 fn text(
     path: &Path,

@@ -39,8 +39,9 @@ pub fn py_env(
     let py = env.py();
     let calls = PyCalls { env: env.clone().unbind() };
     DiscreteEnv::new(calls, spaces, spec, |obs| {
-        let state = valuation.call1((obs,)).map_err(|e| prefix(py, e, obs))?;
-        state_values(&state, &vars).map_err(|e| prefix(py, e, obs))
+        let state =
+            valuation.call1((obs,)).map_err(|e| prefix(py, e, &format!("valuation({obs})")))?;
+        state_values(&state, &vars).map_err(|e| prefix(py, e, &format!("valuation({obs})")))
     })
     .map_err(failure_error)
 }
@@ -63,48 +64,58 @@ fn observation(obs: &Bound<'_, PyAny>, call: &str) -> PyResult<i64> {
     })
 }
 
+/// `env.reset(seed=seed)`'s observation, its answer checked to be `(observation, info)`.
+fn reset<'py>(env: &Bound<'py, PyAny>, seed: u64) -> PyResult<Bound<'py, PyAny>> {
+    let kwargs = PyDict::new(env.py());
+    kwargs.set_item("seed", seed)?;
+    let out = env.call_method("reset", (), Some(&kwargs))?;
+    let pair = out.cast::<PyTuple>().map_err(|_| {
+        value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
+    })?;
+    if pair.len() != 2 {
+        return Err(value_error(
+            format!("env.reset gave {} values, not (observation, info)", pair.len()),
+            None,
+        ));
+    }
+    pair.get_item(0)
+}
+
+/// `env.step(action)`'s answer, checked to be `(observation, reward, terminated,
+/// truncated, info)`.
+fn step<'py>(env: &Bound<'py, PyAny>, action: i64) -> PyResult<Bound<'py, PyTuple>> {
+    let out = env.call_method1("step", (action,))?;
+    let five = out.cast_into::<PyTuple>().map_err(|e| {
+        value_error(
+            format!(
+                "env.step gave {}, not (observation, reward, terminated, truncated, info)",
+                repr(&e.into_inner())
+            ),
+            None,
+        )
+    })?;
+    if five.len() != 5 {
+        return Err(value_error(
+            format!(
+                "env.step gave {} values, not (observation, reward, terminated, truncated, info)",
+                five.len()
+            ),
+            None,
+        ));
+    }
+    Ok(five)
+}
+
 impl Calls for PyCalls {
     type Error = PyErr;
 
     fn reset(&self, seed: u64) -> PyResult<i64> {
-        Python::attach(|py| {
-            let kwargs = PyDict::new(py);
-            kwargs.set_item("seed", seed)?;
-            let out = self.env.bind(py).call_method("reset", (), Some(&kwargs))?;
-            let pair = out.cast::<PyTuple>().map_err(|_| {
-                value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
-            })?;
-            if pair.len() != 2 {
-                return Err(value_error(
-                    format!("env.reset gave {} values, not (observation, info)", pair.len()),
-                    None,
-                ));
-            }
-            observation(&pair.get_item(0)?, "reset")
-        })
+        Python::attach(|py| observation(&reset(self.env.bind(py), seed)?, "reset"))
     }
 
     fn step(&self, action: i64) -> PyResult<(i64, Option<EpisodeEnd>)> {
         Python::attach(|py| {
-            let out = self.env.bind(py).call_method1("step", (action,))?;
-            let five = out.cast::<PyTuple>().map_err(|_| {
-                value_error(
-                    format!(
-                        "env.step gave {}, not (observation, reward, terminated, truncated, info)",
-                        repr(&out)
-                    ),
-                    None,
-                )
-            })?;
-            if five.len() != 5 {
-                return Err(value_error(
-                    format!(
-                        "env.step gave {} values, not (observation, reward, terminated, truncated, info)",
-                        five.len()
-                    ),
-                    None,
-                ));
-            }
+            let five = step(self.env.bind(py), action)?;
             let next = observation(&five.get_item(0)?, "step")?;
             let end = if five.get_item(2)?.is_truthy()? {
                 Some(EpisodeEnd::Terminated)
@@ -118,9 +129,9 @@ impl Calls for PyCalls {
     }
 }
 
-/// `valuation(OBS): ` before an error's message, keeping its type.
-fn prefix(py: Python<'_>, e: PyErr, obs: i64) -> PyErr {
-    let text = format!("valuation({obs}): {}", e.value(py));
+/// `head: ` before an error's message (`valuation(OBS)`), keeping its type.
+fn prefix(py: Python<'_>, e: PyErr, head: &str) -> PyErr {
+    let text = format!("{head}: {}", e.value(py));
     let kind = e.get_type(py);
     match kind.call1((text,)) {
         Ok(v) => PyErr::from_value(v),
@@ -183,35 +194,12 @@ impl BoxCalls for PyBoxCalls {
     type Obs = Py<PyAny>;
 
     fn reset(&self, seed: u64, call: &str) -> PyResult<(Py<PyAny>, Vec<f64>)> {
-        Python::attach(|py| {
-            let kwargs = PyDict::new(py);
-            kwargs.set_item("seed", seed)?;
-            let out = self.env.bind(py).call_method("reset", (), Some(&kwargs))?;
-            let pair = out.cast::<PyTuple>().map_err(|_| {
-                value_error(format!("env.reset gave {}, not (observation, info)", repr(&out)), None)
-            })?;
-            if pair.len() != 2 {
-                return Err(value_error(
-                    format!("env.reset gave {} values, not (observation, info)", pair.len()),
-                    None,
-                ));
-            }
-            numbers(&pair.get_item(0)?, call)
-        })
+        Python::attach(|py| numbers(&reset(self.env.bind(py), seed)?, call))
     }
 
     fn step(&self, action: i64, call: &str) -> PyResult<(Py<PyAny>, Vec<f64>, bool)> {
         Python::attach(|py| {
-            let out = self.env.bind(py).call_method1("step", (action,))?;
-            let five = out.cast::<PyTuple>().ok().filter(|t| t.len() == 5).ok_or_else(|| {
-                value_error(
-                    format!(
-                        "env.step gave {}, not (observation, reward, terminated, truncated, info)",
-                        repr(&out)
-                    ),
-                    None,
-                )
-            })?;
+            let five = step(self.env.bind(py), action)?;
             let (obs, values) = numbers(&five.get_item(0)?, call)?;
             let ended = five.get_item(2)?.is_truthy()? || five.get_item(3)?.is_truthy()?;
             Ok((obs, values, ended))
@@ -221,13 +209,10 @@ impl BoxCalls for PyBoxCalls {
     fn valuation(&self, obs: &Py<PyAny>, call: &str) -> Option<PyResult<Vec<f64>>> {
         let f = self.valuation.as_ref()?;
         Some(Python::attach(|py| {
-            let given = f.bind(py).call1((obs.bind(py),)).map_err(|e| {
-                let text = format!("valuation (after {call}): {}", e.value(py));
-                match e.get_type(py).call1((text,)) {
-                    Ok(v) => PyErr::from_value(v),
-                    Err(_) => e,
-                }
-            })?;
+            let given = f
+                .bind(py)
+                .call1((obs.bind(py),))
+                .map_err(|e| prefix(py, e, &format!("valuation (after {call})")))?;
             state_values(&given, &self.vars)
         }))
     }

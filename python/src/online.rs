@@ -10,7 +10,6 @@ use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 
 use crate::dense;
 use crate::errors::{trace_error, type_error, value_error};
-use crate::spec::Spec;
 use crate::trace::state_values;
 
 /// An online monitor: states arrive one at a time, each step's robustness leaves as soon as
@@ -55,7 +54,10 @@ use crate::trace::state_values;
 #[pyclass(module = "hstl")]
 pub struct OnlineMonitor {
     inner: Inner,
-    spec: Py<Spec>,
+    /// The `hstl.Spec` it monitors, held for pickling only: a restored monitor is made by
+    /// calling its `online` as a user would, so this module names no `Spec` (and `spec`,
+    /// which makes monitors, is the one that imports this one).
+    spec: Py<PyAny>,
     formula: Option<String>,
 }
 
@@ -93,11 +95,29 @@ fn field<'py, T: for<'a> FromPyObject<'a, 'py>>(
         .map_err(|_| bad(v.repr().map_or_else(|_| "unreadable".to_string(), |r| r.to_string())))
 }
 
+/// A new monitor of `spec` (an `hstl.Spec`), made by its `online` as a user makes one:
+/// what a pickled monitor is restored into.
+fn made_by<'py>(
+    spec: &Bound<'py, PyAny>,
+    formula: Option<&str>,
+    windows: Windows,
+) -> PyResult<Bound<'py, OnlineMonitor>> {
+    let kwargs = PyDict::new(spec.py());
+    kwargs.set_item("windows", windows_name(windows))?;
+    let made = spec.call_method("online", (formula,), Some(&kwargs))?;
+    made.cast_into::<OnlineMonitor>().map_err(|e| {
+        type_error(
+            format!("`spec.online` gave {}, not an `hstl.OnlineMonitor`", e.into_inner()),
+            Some("restore a pickled monitor with the `hstl.Spec` it was pickled with".into()),
+        )
+    })
+}
+
 impl OnlineMonitor {
     pub fn new(
         inner: Online,
         windows: Windows,
-        spec: Py<Spec>,
+        spec: Py<PyAny>,
         formula: Option<String>,
     ) -> OnlineMonitor {
         OnlineMonitor { inner: Inner::Discrete(inner, windows), spec, formula }
@@ -106,7 +126,7 @@ impl OnlineMonitor {
     pub fn dense(
         monitor: Arc<Dense>,
         live: DenseLive,
-        spec: Py<Spec>,
+        spec: Py<PyAny>,
         formula: Option<String>,
     ) -> OnlineMonitor {
         OnlineMonitor { inner: Inner::Dense { monitor, live }, spec, formula }
@@ -151,30 +171,51 @@ impl OnlineMonitor {
     /// the states replayed after `skipped` steps.
     #[staticmethod]
     #[pyo3(signature = (spec, formula, skipped, states, windows="clipped"))]
-    fn _restore(
-        py: Python<'_>,
-        spec: &Bound<'_, Spec>,
+    fn _restore<'py>(
+        spec: &Bound<'py, PyAny>,
         formula: Option<String>,
         skipped: usize,
         states: Vec<f64>,
         windows: &str,
-    ) -> PyResult<OnlineMonitor> {
+    ) -> PyResult<Bound<'py, OnlineMonitor>> {
         let windows =
             Windows::parse(windows).map_err(|e| value_error(e.to_string(), Some(e.help())))?;
-        let mut inner = spec.get().online_of(formula.as_deref())?;
-        inner.restore(&OnlineState { skipped, states }).map_err(|e| trace_error(py, &e))?;
-        Ok(OnlineMonitor::new(inner, windows, spec.clone().unbind(), formula))
+        let made = made_by(spec, formula.as_deref(), windows)?;
+        {
+            let mut this = made.borrow_mut();
+            let inner = this.discrete("a discrete-time monitor's pickled state").map_err(|_| {
+                value_error(
+                    "the pickled monitor state is a discrete-time monitor's, and its spec is \
+                     dense-time",
+                    Some("pickle the monitor again from a running one".into()),
+                )
+            })?;
+            inner
+                .restore(&OnlineState { skipped, states })
+                .map_err(|e| trace_error(spec.py(), &e))?;
+        }
+        Ok(made)
     }
 
     /// The dense-time monitor `__reduce__` describes: `spec.online(formula)` restored from
     /// `state`, a dict of the facade's plain data (every field checked).
     #[staticmethod]
-    fn _restore_dense(
-        spec: &Bound<'_, Spec>,
+    fn _restore_dense<'py>(
+        spec: &Bound<'py, PyAny>,
         formula: Option<String>,
-        state: &Bound<'_, PyDict>,
-    ) -> PyResult<OnlineMonitor> {
-        let monitor = spec.get().dense(formula.as_deref())?;
+        state: &Bound<'py, PyDict>,
+    ) -> PyResult<Bound<'py, OnlineMonitor>> {
+        let made = made_by(spec, formula.as_deref(), Windows::Clipped)?;
+        let monitor = match &made.borrow().inner {
+            Inner::Dense { monitor, .. } => Arc::clone(monitor),
+            Inner::Discrete(..) => {
+                return Err(value_error(
+                    "the pickled monitor state is a dense-time monitor's, and its spec is \
+                     discrete-time",
+                    Some("pickle the monitor again from a running one".into()),
+                ));
+            }
+        };
         let windows: String = field(state, "windows", "\"clipped\" or \"complete\"")?;
         let windows = Windows::parse(&windows).map_err(|e| {
             value_error(format!("the pickled monitor state's `windows`: {e}"), Some(e.help()))
@@ -203,7 +244,8 @@ impl OnlineMonitor {
         };
         let live = DenseLive::restore(&monitor, &saved, Front::Python)
             .map_err(|p| dense::problem_error(&p, &monitor, None))?;
-        Ok(OnlineMonitor::dense(monitor, live, spec.clone().unbind(), formula))
+        made.borrow_mut().inner = Inner::Dense { monitor, live };
+        Ok(made)
     }
 
     fn __reduce__<'py>(

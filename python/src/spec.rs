@@ -518,13 +518,18 @@ impl Spec {
             return Ok(OnlineMonitor::dense(
                 monitor,
                 live,
-                slf.clone().unbind(),
+                slf.clone().into_any().unbind(),
                 formula.map(String::from),
             ));
         }
         this.discrete_only(max_gap, relative)?;
         let inner = this.online_of(formula)?;
-        Ok(OnlineMonitor::new(inner, windows, slf.clone().unbind(), formula.map(String::from)))
+        Ok(OnlineMonitor::new(
+            inner,
+            windows,
+            slf.clone().into_any().unbind(),
+            formula.map(String::from),
+        ))
     }
 
     fn __reduce__<'py>(

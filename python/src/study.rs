@@ -10,7 +10,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::Instant;
 
-use hstl::lang::budget::MAX_EPISODES;
 use hstl::runtime::TaskSpec;
 use hstl::study::{self as facade, CurveSet, SeedRun, Stats, StudiedSpec};
 use hstl_outdir::{OutDir, StudyDir, Writer};
@@ -67,24 +66,11 @@ fn task_in(
                 .map_err(|e| errors::load_error(py, &spec.filename, &spec.source, e))?;
             let mut task = hstl::train::trainable(&loaded.spec, &spec.source, &spec.filename)
                 .map_err(|p| problem_error(&p))?;
-            set_episodes(&mut task, episodes)?;
+            hstl::train::set_episodes(&mut task, episodes).map_err(|p| problem_error(&p))?;
             hstl::continuous::fit_tiles(&mut task, &loaded.spec, &w.world);
             Ok((task, loaded.spec))
         }
     }
-}
-
-fn set_episodes(task: &mut TaskSpec, episodes: Option<usize>) -> PyResult<()> {
-    if let Some(n) = episodes {
-        if n == 0 || n as u64 > MAX_EPISODES {
-            return Err(value_error(
-                format!("`episodes` must be in 1..={MAX_EPISODES}; got {n}"),
-                Some("leave it out to train the spec's `learn { episodes }`".into()),
-            ));
-        }
-        task.learn.episodes = n;
-    }
-    Ok(())
 }
 
 /// The spec checked against the world (the diagnostics of `hstlc check --world` as
@@ -104,7 +90,7 @@ fn task_of(
         .map_err(|e| errors::load_error(py, &spec.filename, &spec.source, e))?;
     let mut task = hstl::train::trainable(&loaded.spec, &spec.source, &spec.filename)
         .map_err(|p| problem_error(&p))?;
-    set_episodes(&mut task, episodes)?;
+    hstl::train::set_episodes(&mut task, episodes).map_err(|p| problem_error(&p))?;
     if let Some(learn) = learn {
         for (key, value) in learn.iter() {
             let key: String = key.extract()?;

@@ -439,16 +439,25 @@ fn lookup<'py>(
     monitor: &Monitor,
 ) -> PyResult<Bound<'py, PyAny>> {
     let py = trace.py();
+    column(trace, var, fields, |known| missing(py, var, Some(known), monitor.state_vars()))
+}
+
+/// `trace[var]`; where `fields` (a record array's names) or the mapping has no `var`, the
+/// error `missing` makes from the names there are.
+pub fn column<'py>(
+    trace: &Bound<'py, PyAny>,
+    var: &str,
+    fields: Option<&[String]>,
+    missing: impl Fn(Vec<String>) -> PyErr,
+) -> PyResult<Bound<'py, PyAny>> {
     if let Some(fields) = fields
         && !fields.iter().any(|f| f == var)
     {
-        return Err(missing(py, var, Some(fields.to_vec()), monitor.state_vars()));
+        return Err(missing(fields.to_vec()));
     }
     match trace.get_item(var) {
         Ok(v) => Ok(v),
-        Err(e) if e.is_instance_of::<PyKeyError>(py) => {
-            Err(missing(py, var, Some(keys(trace)), monitor.state_vars()))
-        }
+        Err(e) if e.is_instance_of::<PyKeyError>(trace.py()) => Err(missing(keys(trace))),
         Err(e) => Err(e),
     }
 }

@@ -8,7 +8,6 @@
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
-use hstl::lang::budget::MAX_EPISODES;
 use hstl::runtime::{Error, TaskSpec};
 use hstl::train::{policy_json, train_until};
 use pyo3::prelude::*;
@@ -211,15 +210,7 @@ fn trainable(
 ) -> PyResult<TaskSpec> {
     let mut task = hstl::train::trainable(checked, &spec.source, &spec.filename)
         .map_err(|p| problem_error(&p))?;
-    if let Some(n) = episodes {
-        if n == 0 || n as u64 > MAX_EPISODES {
-            return Err(value_error(
-                format!("`episodes` must be in 1..={MAX_EPISODES}; got {n}"),
-                Some("leave it out to train the spec's `learn { episodes }`".into()),
-            ));
-        }
-        task.learn.episodes = n;
-    }
+    hstl::train::set_episodes(&mut task, episodes).map_err(|p| problem_error(&p))?;
     Ok(task)
 }
 

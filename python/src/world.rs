@@ -69,16 +69,10 @@ impl World {
 
     /// The world in the file at `path`, with the CLI's words for every error.
     pub fn read(path: &Path) -> PyResult<World> {
-        let text = crate::files::read_regular_text(
-            path,
-            hstl::world::MAX_WORLD_BYTES as u64,
-            "world file",
-            |e| errors::read_error_with(path, e, hstl::world::read_help()),
-        )?;
-        let file = path.display().to_string();
-        let stem = path.file_stem().map_or("world".into(), |s| s.to_string_lossy().into_owned());
-        let world = hstl::world::from_file(&text, &file, &stem).map_err(|p| world_error(&p))?;
-        Ok(World::new(world, Some(file)))
+        let w = crate::files::read_world(path)?;
+        let world =
+            hstl::world::from_file(&w.text, &w.file, &w.stem).map_err(|p| world_error(&p))?;
+        Ok(World::new(world, Some(w.file)))
     }
 
     /// A built-in world's name or a world file's path, as `hstlc --world` reads it.

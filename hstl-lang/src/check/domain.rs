@@ -25,18 +25,15 @@ impl Cx<'_> {
             return preset_plans;
         }
         if size > MAX_DOMAIN_STATES {
-            let r =
-                out.state_vars[0].range.start..out.state_vars[out.state_vars.len() - 1].range.end;
-            self.push(
-                Diagnostic::new(
-                    "HSTL022",
-                    r,
-                    format!(
-                        "the domain has {} states, more than the 1,000,000 the finite-domain checks enumerate; they are skipped",
-                        thousands(size)
-                    ),
-                )
-                .with_help("shrink the `int` ranges to get the region and option checks"),
+            self.domain_skipped(
+                out,
+                format!(
+                    "the domain has {} states, more than the {} the finite-domain checks \
+                     enumerate; they are skipped",
+                    thousands(size),
+                    thousands(MAX_DOMAIN_STATES)
+                ),
+                "shrink the `int` ranges to get the region and option checks",
             );
             return preset_plans;
         }
@@ -82,21 +79,17 @@ impl Cx<'_> {
         // Bound the time spent: each state evaluates the lets the regions need.
         let work = size.saturating_mul((ev.needed_lets() + roots.len()) as u64);
         if work > MAX_DOMAIN_WORK {
-            let r =
-                out.state_vars[0].range.start..out.state_vars[out.state_vars.len() - 1].range.end;
-            self.push(
-                Diagnostic::new(
-                    "HSTL022",
-                    r,
-                    format!(
-                        "the finite-domain checks would evaluate {} formulas ({} states, {} lets), more than {}; they are skipped",
-                        thousands(work),
-                        thousands(size),
-                        ev.needed_lets(),
-                        thousands(MAX_DOMAIN_WORK)
-                    ),
-                )
-                .with_help("shrink the `int` ranges, or shorten the chains of lets the regions use"),
+            self.domain_skipped(
+                out,
+                format!(
+                    "the finite-domain checks would evaluate {} formulas ({} states, {} lets), \
+                     more than {}; they are skipped",
+                    thousands(work),
+                    thousands(size),
+                    ev.needed_lets(),
+                    thousands(MAX_DOMAIN_WORK)
+                ),
+                "shrink the `int` ranges, or shorten the chains of lets the regions use",
             );
             return preset_plans;
         }
@@ -408,6 +401,13 @@ impl Cx<'_> {
             }
         }
         plan_too_large
+    }
+
+    /// HSTL022 at the state block: the finite-domain checks are skipped, `message` says
+    /// why and `help` how to get them.
+    fn domain_skipped(&mut self, out: &CheckedSpec, message: String, help: &str) {
+        let r = out.state_vars[0].range.start..out.state_vars[out.state_vars.len() - 1].range.end;
+        self.push(Diagnostic::new("HSTL022", r, message).with_help(help));
     }
 }
 

@@ -10,8 +10,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::types::*;
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, clean_text, draw_dashed, draw_err, draw_legend,
-    draw_region_fill, draw_region_hatch, draw_text, draw_title, legend_size, shorten, text_style,
-    text_width, title_height, title_parts, title_width,
+    draw_region_fill, draw_region_hatch, draw_text, draw_title, legend_size, name_box, shorten,
+    tag_colour, tag_leader, text_style, text_width, title_height, title_parts, title_width,
 };
 use crate::grid::{cell_boxes, round_joins};
 use crate::label::{CellBox, best_box};
@@ -161,8 +161,6 @@ pub(super) const Y_TICK_GAP: i32 = 40;
 pub(super) const HEAD_EVERY: usize = 4;
 /// The height of a sample run's timeline, in pixels.
 pub(super) const TIMELINE: i32 = 76;
-/// The timeline's shading changes in at most this many pieces.
-pub(super) const RAMP_PIECES: usize = 240;
 
 /// The pixel size of each map of `plane` when `panels` are drawn.
 pub(super) fn frame_size(plane: &Plane, panels: usize) -> (i32, i32) {
@@ -519,10 +517,7 @@ pub(super) fn draw_region_name(
     let size = TAG_PX * 1.24;
     let w = text_width(&name, size) + 6;
     let h = TAG_PX.round() as i32 + 4;
-    let colour = match region.kind {
-        RegionKind::Avoid => AVOID,
-        RegionKind::Reach | RegionKind::Other => INK,
-    };
+    let colour = tag_colour(region.kind);
     let [(l, t), (r, bottom)] = frame.box_rect(b, cols, rows);
     let keep_inside =
         |x: i32| x.clamp(frame.left + w / 2, (frame.right() - w / 2).max(frame.left + w / 2));
@@ -536,20 +531,7 @@ pub(super) fn draw_region_name(
             cells.iter().fold((i64::MAX, i64::MIN), |(a, b), c| (a.min(c.1), b.max(c.1)));
         let [(l, t), (r, bottom)] = frame.box_rect(CellBox { x0, x1, y0, y1 }, cols, rows);
         let x = (l + r) / 2;
-        let (box_top, from, to) = if t - 4 - h >= frame.top {
-            (t - 4 - h, t - 4, t)
-        } else {
-            (bottom + 4, bottom + 4, bottom)
-        };
-        area.draw(&PathElement::new(vec![(x, from), (x, to)], colour.stroke_width(1)))
-            .map_err(draw_err)?;
-        (keep_inside(x), box_top)
+        (keep_inside(x), tag_leader(area, x, (t, bottom), h, frame.top, colour)?)
     };
-    let rect = [(centre_x - w / 2, box_top), (centre_x + w / 2, box_top + h)];
-    area.draw(&Rectangle::new(rect, WHITE.mix(0.85).filled())).map_err(draw_err)?;
-    area.draw(&Rectangle::new(rect, colour.stroke_width(1))).map_err(draw_err)?;
-    let style = TextStyle::from((crate::draw::FONT, size, FontStyle::Bold).into_font())
-        .color(&colour)
-        .pos(Pos::new(HPos::Center, VPos::Center));
-    area.draw(&Text::new(name, (centre_x, box_top + h / 2), style)).map_err(draw_err)
+    name_box(area, name, (centre_x, box_top), (w, h), size, colour)
 }

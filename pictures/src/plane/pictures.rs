@@ -10,13 +10,13 @@ use super::frame::*;
 use super::types::*;
 use crate::draw::{
     Area, LABEL_SIZE, LegendEntry, Mark, clean_text, draw_arrow, draw_blocked, draw_end,
-    draw_entry, draw_err, draw_slip, draw_start, draw_still, draw_terminate, draw_text, shorten,
-    text_style, text_width,
+    draw_entry, draw_err, draw_slip, draw_start, draw_still, draw_terminate, draw_text,
+    option_band, shorten, text_style, text_width,
 };
 use crate::grid::cell_boxes;
 use crate::label::CellBox;
 use crate::palette::{AVOID, INK, option_color, shade};
-use crate::run::{draw_head, tick_step};
+use crate::run::{draw_head, step_axis};
 use crate::{PictureError, Result};
 
 /// Draws a flat policy on a plane: at each arrow's point, an arrow the way its greedy
@@ -359,21 +359,7 @@ pub(super) fn draw_run_timeline(
     draw_text(area, "slips", (left - 6, event_y), &label)?;
     draw_text(area, "enters", (left - 6, entry_y), &label)?;
     draw_text(area, "option", (left - 6, (band.0 + band.1) / 2), &label)?;
-    let piece = |i: usize| i * RAMP_PIECES / span;
-    let mut start = 0;
-    while start < span {
-        let o = steps[start].option;
-        let mut end = start + 1;
-        while end < span && steps[end].option == o && piece(end) == piece(start) {
-            end += 1;
-        }
-        let t = if span > 1 { start as f64 / (span - 1) as f64 } else { 0.0 };
-        let rect = [(x_of(start), band.0), (x_of(end), band.1)];
-        area.draw(&Rectangle::new(rect, shade(colour_of(o), t).filled())).map_err(draw_err)?;
-        start = end;
-    }
-    area.draw(&Rectangle::new([(left, band.0), (right, band.1)], INK.stroke_width(1)))
-        .map_err(draw_err)?;
+    option_band(area, span, &x_of, band, |i| steps[i].option, colour_of)?;
     for (i, s) in steps[..moves].iter().enumerate() {
         let x = (x_of(i) + x_of(i + 1)) / 2;
         match s.outcome {
@@ -416,14 +402,5 @@ pub(super) fn draw_run_timeline(
             }
         }
     }
-    let every = tick_step(span, ((right - left) / 60).max(1) as usize);
-    let below = text_style(LABEL_SIZE * 0.75, &INK, HPos::Center, VPos::Top);
-    for i in (0..=span).step_by(every) {
-        let x = x_of(i);
-        area.draw(&PathElement::new(vec![(x, band.1), (x, band.1 + 4)], INK.stroke_width(1)))
-            .map_err(draw_err)?;
-        draw_text(area, &i.to_string(), (x, band.1 + 6), &below)?;
-    }
-    let after = text_style(LABEL_SIZE * 0.75, &INK, HPos::Left, VPos::Center);
-    draw_text(area, "step", (right + 8, (band.0 + band.1) / 2), &after)
+    step_axis(area, span, &x_of, band)
 }

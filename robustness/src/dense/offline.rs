@@ -342,19 +342,24 @@ pub(crate) fn window(
     out
 }
 
+/// The earlier of `f`'s change point `i` and `g`'s change point `j` (either past its
+/// signal's end left out), or `None` when both are past the end.
+fn next_time(f: &DenseSignal, g: &DenseSignal, i: usize, j: usize) -> Option<f64> {
+    match (f.times.get(i), g.times.get(j)) {
+        (Some(&x), Some(&y)) => Some(x.min(y)),
+        (Some(&x), None) => Some(x),
+        (None, Some(&y)) => Some(y),
+        (None, None) => None,
+    }
+}
+
 /// `f until[a..=b] g`, `b` finite, by the sweep of [`super::until`]: the same values as
 /// [`timed_until`] at every time, and the same operations as the online monitor.
 fn bounded_until(f: &DenseSignal, g: &DenseSignal, t0: f64, a: f64, b: f64) -> DenseSignal {
     let mut u = BoundedUntil::new(a, b);
     let mut points = Vec::new();
     let (mut i, mut j, mut fed) = (0usize, 0usize, 0usize);
-    loop {
-        let t = match (f.times.get(i), g.times.get(j)) {
-            (Some(&x), Some(&y)) => x.min(y),
-            (Some(&x), None) => x,
-            (None, Some(&y)) => y,
-            (None, None) => break,
-        };
+    while let Some(t) = next_time(f, g, i, j) {
         // Every piece before `t` is in: sweep now and then, so that the sweep keeps a
         // window's pieces rather than the trace's.
         if fed % 512 == 511 {
@@ -385,13 +390,7 @@ pub(crate) fn untimed_until(f: &DenseSignal, g: &DenseSignal, dir: Dir) -> Dense
     let mut fv = Vec::with_capacity(times.capacity());
     let mut gv = Vec::with_capacity(times.capacity());
     let (mut i, mut j) = (0usize, 0usize);
-    loop {
-        let t = match (f.times.get(i), g.times.get(j)) {
-            (Some(&x), Some(&y)) => x.min(y),
-            (Some(&x), None) => x,
-            (None, Some(&y)) => y,
-            (None, None) => break,
-        };
+    while let Some(t) = next_time(f, g, i, j) {
         if f.times.get(i) == Some(&t) {
             i += 1;
         }
