@@ -54,6 +54,16 @@ def _seed_of(seed: Any) -> int:
     return int(seed)
 
 
+def _generator_for(env: gymnasium.Env[Any, Any], seed: Optional[int], current: Optional[Generator]) -> Generator:
+    """The generator a reset steps ``env`` with: a new one from ``seed`` when given, else the
+    one it has; with neither, one from the entropy gymnasium seeded ``np_random`` with."""
+    if seed is not None:
+        return Generator(_seed_of(seed))
+    if current is not None:
+        return current
+    return Generator(int(env.np_random.integers(0, 2**63)))
+
+
 def _action_of(action: Any, names: Sequence[str]) -> int:
     """``action`` as an index into ``names``: an integer (Python's or numpy's, or an integer
     array of one element, as agents give), never a float or a bool, in range."""
@@ -111,11 +121,7 @@ class GridWorldEnv(gymnasium.Env):
         self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
     ) -> tuple[npt.NDArray[np.int64], dict[str, Any]]:
         super().reset(seed=seed)
-        if seed is not None:
-            self._generator = Generator(_seed_of(seed))
-        elif self._generator is None:
-            # No seed ever given: one from the entropy gymnasium seeded np_random with.
-            self._generator = Generator(int(self.np_random.integers(0, 2**63)))
+        self._generator = _generator_for(self, seed, self._generator)
         start = (options or {}).get("start")
         if start is None:
             state, x, y = self.world._reset(self._generator)
@@ -175,11 +181,7 @@ class _ContinuousEnv(gymnasium.Env):
         self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
     ) -> tuple[npt.NDArray[np.float64], dict[str, Any]]:
         super().reset(seed=seed)
-        if seed is not None:
-            self._generator = Generator(_seed_of(seed))
-        elif self._generator is None:
-            # No seed ever given: one from the entropy gymnasium seeded np_random with.
-            self._generator = Generator(int(self.np_random.integers(0, 2**63)))
+        self._generator = _generator_for(self, seed, self._generator)
         start = (options or {}).get("start")
         if start is None:
             self._state = self.world._reset(self._generator)

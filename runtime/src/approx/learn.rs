@@ -82,6 +82,27 @@ struct Run<S> {
     met: Vec<usize>,
 }
 
+impl<S> Run<S> {
+    /// Appends position `state`, its valuation `x` and what the options level sees there
+    /// (`g` is a buffer for its features).
+    fn record(
+        &mut self,
+        model: &Model,
+        state: S,
+        x: &[f64],
+        g: &mut Vec<usize>,
+        tau: &[usize],
+        met: usize,
+    ) {
+        self.states.push(state);
+        self.values.extend_from_slice(x);
+        model.options_coder.features(x, g);
+        self.options_features.extend_from_slice(g);
+        self.codes.push(model.code(tau, met));
+        self.met.push(met);
+    }
+}
+
 impl<'w, W: World> ApproxLearner<'w, W> {
     /// A learner with zeroed weights (see [`Model::new`] for what fails).
     pub fn new(spec: &TaskSpec, world: &'w W) -> Result<ApproxLearner<'w, W>, Error> {
@@ -219,12 +240,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         run.met.clear();
         let mut state = start.clone();
         model.blocked(self.world, &state, &mut s.blocked);
-        run.states.push(state.clone());
-        run.values.extend_from_slice(&s.x);
-        model.options_coder.features(&s.x, &mut s.g);
-        run.options_features.extend_from_slice(&s.g);
-        run.codes.push(model.code(&s.tau, s.goals.met()));
-        run.met.push(s.goals.met());
+        run.record(model, state.clone(), &s.x, &mut s.g, &s.tau, s.goals.met());
         if model.is_persistent() {
             run.psi.push(s.tau.iter().zip(&model.regions).all(|(t, (_, n))| t < n));
         }
@@ -251,12 +267,7 @@ impl<'w, W: World> ApproxLearner<'w, W> {
                     );
                     run.psi.push(kept);
                 }
-                run.states.push(next.clone());
-                run.values.extend_from_slice(&s.x_next);
-                model.options_coder.features(&s.x_next, &mut s.g);
-                run.options_features.extend_from_slice(&s.g);
-                run.codes.push(model.code(&s.tau, s.goals.met()));
-                run.met.push(s.goals.met());
+                run.record(model, next.clone(), &s.x_next, &mut s.g, &s.tau, s.goals.met());
                 if model.progress.is_some() {
                     s.goals.push(&s.x_next);
                 }
