@@ -107,7 +107,6 @@ impl EpisodeBatch {
         let py = result.py();
         let [obs, env_reward, terminated, truncated, info] =
             items(result, "step", ["obs", "rewards", "terminated", "truncated", "info"])?;
-        self.ends.clear();
         let n = self.inner.len();
         read_flags(&terminated, n, "terminated", &mut self.ends)?;
         read_flags(&truncated, n, "truncated", &mut self.flags)?;
@@ -284,8 +283,17 @@ fn read_flags(flags: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut Vec<bool
         return Ok(());
     }
     // One past the vector's size is enough to refuse: an endless iterable is not read on.
-    for item in flags.try_iter()?.take(n + 1) {
-        out.push(item?.is_truthy()?);
+    let not_flags = || {
+        let kind = flags.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string());
+        type_error(
+            format!(
+                "`{what}` must be one boolean for each environment; got a value of type {kind}"
+            ),
+            Some("pass what the vector environment's step returned".into()),
+        )
+    };
+    for item in flags.try_iter().map_err(|_| not_flags())?.take(n + 1) {
+        out.push(item?.is_truthy().map_err(|_| not_flags())?);
     }
     if out.len() != n {
         let len = match flags.len() {

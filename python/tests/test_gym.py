@@ -485,6 +485,11 @@ def test_the_vector_reward_refuses_what_it_cannot_score():
         batch._step((np.array([["a", "b"], ["c", "d"]]), np.zeros(2), [False, False], [False, False], {}))
     with pytest.raises(ValueError, match=r"the observations \(shape \(2, 2, 1\)\) must be a 2-D array"):
         batch._step((np.zeros((2, 2, 1)), np.zeros(2), [False, False], [False, False], {}))
+    # Flags that are not one boolean an environment say so (a 2-D array, a number).
+    with pytest.raises(TypeError, match="`terminated` must be one boolean for each environment; got a value of type ndarray"):
+        batch._step((np.zeros((2, 2)), np.zeros(2), np.zeros((2, 2), dtype=bool), [False, False], {}))
+    with pytest.raises(TypeError, match="`truncated` must be one boolean for each environment; got a value of type int"):
+        batch._step((np.zeros((2, 2)), np.zeros(2), [False, False], 3, {}))
     # An endless iterable of flags is refused after one value too many, not read forever.
     with pytest.raises(ValueError, match="`terminated` holds more values; this vector has 2 environments"):
         batch._step((np.zeros((2, 2)), np.zeros(2), itertools.repeat(False), [False, False], {}))
