@@ -47,3 +47,37 @@ fn front_end_and_runtime_plan_the_same_sizes() {
     }
     assert!(refused > 1000 && refused < 19_000, "{refused} of 20,000 refused");
 }
+
+/// `HSTL190`'s count of the suffixes training scores is the scorer's: it warns exactly when
+/// the scorer thins a run of `max_steps` steps under `always[0..] once[0..=r] x > 0`, and
+/// says about the stride it takes.
+#[test]
+fn the_thinning_warning_states_the_scorers_stride() {
+    use hstl::lang::lints::{SUFFIX_BUDGET, suffix_stride};
+    use hstl::runtime::robustness::segment::{self, SegmentScorer};
+    use hstl::runtime::robustness::{Bound, CmpOp, Expr, Formula, Interval, Trace};
+    assert_eq!(SUFFIX_BUDGET, segment::SUFFIX_BUDGET as u64);
+    let ends = [Some(0), Some(100), Some(256), Some(257), Some(300), Some(2000), None];
+    for end in ends {
+        let window = Interval { start: 0, end: end.map_or(Bound::Unbounded, Bound::Inclusive) };
+        let seen =
+            Formula::once(window, Formula::cmp(Expr::var(0), CmpOp::Gt, Expr::constant(0.0)));
+        let mut scorer = SegmentScorer::new(&Formula::always(Interval::ALL, seen));
+        for max_steps in [10usize, 500, 510, 511, 600, 3000, 20_000] {
+            let rows = (0..=max_steps).map(|i| (i % 3) as f64 - 1.0).collect();
+            let run = Trace::from_columns(vec![rows]).expect("one column");
+            let mut rewards = Vec::new();
+            scorer.suffix_rewards(&run, &mut rewards);
+            let scored = rewards.iter().filter(|r| !r.is_nan()).count();
+            let every =
+                rewards.iter().skip(1).position(|r| !r.is_nan()).map_or(max_steps + 1, |p| p + 1);
+            let said = suffix_stride(end.map(|e| e as u64), max_steps as u64) as usize;
+            let label = format!("window end {end:?}, max_steps {max_steps}: {scored} scored");
+            assert_eq!(said == 1, every == 1, "{label}, stride {every}, said {said}");
+            assert!(
+                said <= every && every <= said + 1 + said / 128,
+                "{label}: stride {every}, said {said}"
+            );
+        }
+    }
+}

@@ -634,15 +634,22 @@ smaller.",
         code: "HSTL190",
         name: "unbounded-past-in-long-runs",
         severity: W,
-        summary: "a past window without an end in a task trained with runs over 10,000 steps",
+        summary: "a past window without an end, or over 256 steps, in a task trained with long runs",
         explanation: "The options level rewards each option run by the task's robustness over \
 the run, and credits every suffix of the run as a run of its own (the paper's intra-option \
 credit). A past window reads the steps before `t` down to the run's start, so a suffix is \
-not the run's tail there. A bounded window (`once[0..=k]`) differs only in the first `k` \
-steps of each suffix, and scoring a run stays linear in its length. A window without an end \
-reads back to each suffix's own start: every suffix is scored on its own, `max_steps^2` \
-evaluations for one run, which at `max_steps: 100000` is minutes per run.\n\n\
+not the run's tail there. A short window (`once[0..=k]`) differs only in the first `k` \
+steps of each suffix, and scoring a run costs `k` steps per step. A window without an end \
+reads back to each suffix's own start: scoring every suffix would cost `max_steps^2 / 2` \
+steps for one run, minutes at `max_steps: 100000`.\n\n\
+So training holds the steps scored for a run's suffixes to 256 per step of the run. Past \
+that, it scores the suffixes from every `s`-th step of the run, with the smallest `s` that \
+fits, each exactly, and leaves the others out of the options level's updates (the paper's \
+SMDP update uses the first alone). A window without an end on runs of `m` steps keeps about \
+512 suffixes a run; a window of `k` steps about one in `k / 256`. The warning says how many \
+at the spec's `max_steps`.\n\n\
 Example:\n    task always[0..] (once[0..] alarm > 0 -> speed < 5);\n    learn { max_steps: 100000 }\n\n\
-Fix: give the window an end (`once[0..=500]`), or keep `max_steps` at 10,000 or less.",
+Fix: give the window an end of at most 256 steps (`once[0..=200]`), or keep `max_steps` at \
+500 or less.",
     },
 ];

@@ -400,19 +400,37 @@ fn value(e: &CExpr, s: &[f64]) -> Result<f64, (std::ops::Range<usize>, String)> 
     }
 }
 
-/// Option runs longer than this many steps make a quadratic suffix scoring worth a word:
-/// `10^4` steps are `10^8` evaluations a run.
-pub const LONG_RUN_STEPS: u64 = 10_000;
+/// How many steps the suffixes of one option run may evaluate on their own, per step of
+/// the run: `hstl_robustness::segment::SUFFIX_BUDGET`, twinned here because the language
+/// crate depends on no robustness (`tests/limits.rs` holds them equal). Past it, training
+/// scores only every `s`-th suffix of a run.
+pub const SUFFIX_BUDGET: u64 = 256;
 
-/// `HSTL190` (a warning) for a past window without an end (`once`, `historically`,
-/// `since`) in a task rewarded by segment when runs may be longer than [`LONG_RUN_STEPS`]:
-/// such a window reads back to each run's start, so training scores every suffix of a run
-/// on its own, quadratic in its length, where a bounded window keeps it linear. Walks the
-/// task and the lets it uses with a stack, each let once.
+/// About one suffix in how many training scores in runs of `max_steps` steps when a past
+/// window reads `reach` steps back (`None`: without an end): the steps the suffixes read on
+/// their own over the budget, 1 when every suffix is scored. A lower bound: the task's
+/// horizon adds to what each suffix reads.
+pub fn suffix_stride(reach: Option<u64>, max_steps: u64) -> u64 {
+    let m = u128::from(max_steps) + 1;
+    // The suffix from `i` reads `min(m - i, r)` steps on its own.
+    let all = m * (m + 1) / 2;
+    let total = match reach.map(u128::from) {
+        Some(w) if w < m => w * (m - w) + w * (w + 1) / 2,
+        _ => all,
+    };
+    let every = total.div_ceil(u128::from(SUFFIX_BUDGET) * m).max(1);
+    u64::try_from(every).unwrap_or(u64::MAX)
+}
+
+/// `HSTL190` (a warning) for a past window (`once`, `historically`, `since`) without an
+/// end, or longer than [`SUFFIX_BUDGET`], in a task rewarded by segment: such a window
+/// reads back to each suffix's own start, so on long runs training scores only some of a
+/// run's suffixes for the intra-option updates, to keep each run linear in its length.
+/// Walks the task and the lets it uses with a stack, each let once.
 pub(crate) fn unbounded_past_in_long_runs(spec: &CheckedSpec, out: &mut Vec<Diagnostic>) {
     let learn = &spec.learn;
     let Some(task) = &spec.task else { return };
-    if learn.max_steps <= LONG_RUN_STEPS || learn.reward != crate::checked::Reward::Segment {
+    if learn.reward != crate::checked::Reward::Segment {
         return;
     }
     let mut seen = vec![false; spec.lets.len()];
@@ -436,24 +454,36 @@ pub(crate) fn unbounded_past_in_long_runs(spec: &CheckedSpec, out: &mut Vec<Diag
             }
         };
         stack.extend(f.operands());
-        if interval.end != Bound::Unbounded {
+        let reach = match interval.end {
+            Bound::Unbounded => None,
+            Bound::Inclusive(b) => Some(b),
+            Bound::Exclusive(b) => Some(b.saturating_sub(1)),
+        };
+        let steps = learn.max_steps;
+        let every = suffix_stride(reach, steps);
+        if every <= 1 {
             continue;
         }
-        let steps = learn.max_steps;
+        let (what, or) = match reach {
+            None => (
+                "without an end reads back to the start of each suffix of a run".to_owned(),
+                "; or keep `max_steps` at 500 or less",
+            ),
+            Some(r) => (format!("reads {} steps back", crate::wording::thousands(r)), ""),
+        };
         out.push(
             Diagnostic::new(
                 "HSTL190",
                 f.range.clone(),
                 format!(
-                    "`{name}` without an end reads back to the start of each option run: \
-                     training scores every suffix of a run on its own, up to {} evaluations a \
-                     run at `max_steps: {steps}`",
-                    crate::wording::thousands(steps.saturating_mul(steps))
+                    "`{name}` {what}: so that each run costs time linear in its length, \
+                     training scores only about one suffix in {every} for the options level \
+                     at `max_steps: {steps}`"
                 ),
             )
             .with_help(format!(
-                "give the window an end, such as `{name}[{}..={}]`: a bounded past window keeps \
-                 each run linear in its length",
+                "give the window an end of at most 256 steps, such as `{name}[{}..={}]`, to \
+                 score every suffix{or}",
                 interval.start,
                 interval.start.saturating_add(100)
             )),

@@ -84,10 +84,13 @@ fn suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
 }
 
 /// A persistent task that reads the past, over every suffix of a 2,000-step segment: a
-/// bounded past window (linear in the segment) against one without an end (quadratic).
+/// bounded past window (linear in the segment) against one without an end (each suffix
+/// reads back to its own start, held to `SUFFIX_BUDGET` steps per step); and that one over
+/// a 100,000-step option run, `max_steps^2 / 2` steps if every suffix were scored.
 fn past_suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
     use hstl_robustness::{Bound, CmpOp, Expr, Interval, segment::SegmentScorer};
     let seg = walk::walk(2000, rng);
+    let long = walk::walk(100_000, rng);
     let gt = |v, k: f64| Formula::cmp(Expr::var(v), CmpOp::Gt, Expr::constant(k));
     let task = |end| {
         let seen = Formula::once(Interval { start: 0, end }, gt(0, 10.0));
@@ -96,11 +99,16 @@ fn past_suffix_rewards(c: &mut Criterion, rng: &mut walk::SplitMix64) {
         Formula::always(Interval::ALL, Formula::implies(seen, soon))
     };
     let mut out = Vec::new();
-    for (name, end) in [("bounded_20", Bound::Inclusive(20)), ("unbounded", Bound::Unbounded)] {
+    let cases = [
+        ("bounded_20_2000", Bound::Inclusive(20), &seg),
+        ("unbounded_2000", Bound::Unbounded, &seg),
+        ("unbounded_100000", Bound::Unbounded, &long),
+    ];
+    for (name, end, seg) in cases {
         let mut scorer = SegmentScorer::new(&task(end));
-        c.bench_function(&format!("suffix_rewards/past_{name}_2000"), |b| {
+        c.bench_function(&format!("suffix_rewards/past_{name}"), |b| {
             b.iter(|| {
-                scorer.suffix_rewards(black_box(&seg), &mut out);
+                scorer.suffix_rewards(black_box(seg), &mut out);
                 black_box(out[0])
             })
         });

@@ -15,11 +15,26 @@
 //! the rest from the one running minimum: `O(m (R + H))` for a segment of `m` steps. A
 //! task without a horizon, or with an unbounded past window, scores each suffix on its
 //! own, quadratic in the segment's length.
+//!
+//! So that scoring stays linear in a segment's length whatever the task, the steps the
+//! suffixes evaluate on their own are held to [`SUFFIX_BUDGET`] per step of the segment.
+//! Past it, only every `s`-th suffix from the segment's start is scored, with the
+//! smallest `s` that fits, and the others are NaN: each scored suffix keeps its exact
+//! value, and an intra-option update from a subset of a run's states is as sound as one
+//! from all of them (the paper's SMDP update uses the first alone).
 
 use crate::formula::{Node, expr_value};
 use crate::offline::{Evaluator, Runner, Source};
 use crate::primitives::{Lattice, Max, Min};
 use crate::{CmpOp, Formula, FormulaBuilder, NodeId, Trace, reference};
+
+/// How many steps the suffixes of one segment may evaluate on their own, per step of the
+/// segment: scoring a segment's suffixes costs at most this many evaluated steps for each
+/// of its steps. A task whose suffixes would cost more (a past window without an end, or
+/// one longer than about this, on a long segment) has only every `s`-th suffix scored, the
+/// others NaN. A past window of at most 128 steps under a horizon of at most 128 never
+/// thins, nor does a segment of at most 512 steps.
+pub const SUFFIX_BUDGET: usize = 256;
 
 /// Scores segments of a trace against one task, reusing its buffers between calls.
 #[derive(Clone, Debug)]
@@ -45,7 +60,8 @@ impl SegmentScorer {
         self.reward_of_columns(&cols, segment.len())
     }
 
-    /// `out[i]` becomes the reward of the suffix `segment[i..]`, for every `i`.
+    /// `out[i]` becomes the reward of the suffix `segment[i..]`, for every `i`, or NaN for
+    /// a suffix left unscored by [`SUFFIX_BUDGET`] (never `out[0]`).
     pub fn suffix_rewards(&mut self, segment: &Trace, out: &mut Vec<f64>) {
         let cols = columns(segment);
         self.suffix_rewards_of_columns(&cols, segment.len(), out);
@@ -77,9 +93,14 @@ impl SegmentScorer {
                 });
                 return;
             }
+            let every = stride(m, |i| own_steps(m - i, self.body.is_some(), self.task.horizon()));
             for i in 0..m {
-                let tail: Vec<&[f64]> = cols.iter().map(|c| &c[i..m]).collect();
-                let r = self.reward_of_columns(&tail, m - i);
+                let r = if i % every == 0 {
+                    let tail: Vec<&[f64]> = cols.iter().map(|c| &c[i..m]).collect();
+                    self.reward_of_columns(&tail, m - i)
+                } else {
+                    f64::NAN
+                };
                 out.push(r);
             }
             return;
@@ -270,7 +291,8 @@ impl TabularScorer {
         }
     }
 
-    /// `out[i]` becomes the reward of the suffix `segment[i..]`, for every `i`.
+    /// `out[i]` becomes the reward of the suffix `segment[i..]`, for every `i`, or NaN for
+    /// a suffix left unscored by [`SUFFIX_BUDGET`] (never `out[0]`).
     pub fn suffix_rewards(&mut self, segment: &[usize], out: &mut Vec<f64>) {
         let m = segment.len();
         out.clear();
@@ -286,8 +308,10 @@ impl TabularScorer {
                 self.runner.put(sig);
                 return;
             }
+            let (persistent, horizon) = (self.persistent.is_some(), self.plan.horizon());
+            let every = stride(m, |i| own_steps(m - i, persistent, horizon));
             for i in 0..m {
-                let r = self.reward(&segment[i..]);
+                let r = if i % every == 0 { self.reward(&segment[i..]) } else { f64::NAN };
                 out.push(r);
             }
             return;
@@ -352,7 +376,8 @@ pub fn start_reach(f: &Formula) -> Option<usize> {
 /// `always[0..] f`, `f` of horizon `h` and [`start_reach`] `reach`, given `f`'s signal
 /// `sig` over the whole segment. `head(i, n, k)`: the least of `f`'s first `k` values over
 /// the `n` steps from `i`; each of those values reads at most `h` steps ahead, so `n =
-/// k + h` steps (or the rest of the segment) give them exactly.
+/// k + h` steps (or the rest of the segment) give them exactly. NaN for the suffixes
+/// [`SUFFIX_BUDGET`] leaves unscored.
 fn past_persistent_suffixes(
     m: usize,
     h: usize,
@@ -372,19 +397,62 @@ fn past_persistent_suffixes(
     for u in (0..=cut).rev() {
         tail[u] = tail[u + 1].min(sig[u]);
     }
-    for i in 0..m {
+    // The suffix from `i`: whether it is shorter than the horizon, how many of its first
+    // values differ from the segment's, and the steps that evaluating them reads.
+    let plan = |i: usize| {
         // A suffix shorter than the horizon keeps only its step 0.
         let short = m - 1 - i < h;
         let counted = if short { 1 } else { cut - i + 1 };
         let k = counted.min(reach);
+        let n = if k == 0 { 0 } else { (m - i).min(k.saturating_add(h)) };
+        (short, k, n)
+    };
+    let every = stride(m, |i| plan(i).2);
+    for i in 0..m {
+        if i % every != 0 {
+            out.push(f64::NAN);
+            continue;
+        }
+        let (short, k, n) = plan(i);
         let rest = match (short, k) {
             (false, _) => tail[i + k],
             (true, 0) => f64::INFINITY.min(sig[i]),
             (true, _) => f64::INFINITY,
         };
-        let r = if k == 0 { rest } else { head(i, (m - i).min(k.saturating_add(h)), k).min(rest) };
+        let r = if k == 0 { rest } else { head(i, n, k).min(rest) };
         out.push(r);
     }
+}
+
+/// The steps a suffix of `len` steps evaluates when scored on its own: all of them for a
+/// persistent task or one without a horizon, else those up to the horizon.
+fn own_steps(len: usize, persistent: bool, horizon: Option<usize>) -> usize {
+    match (persistent, horizon) {
+        (false, Some(h)) => len.min(h.saturating_add(1)),
+        _ => len,
+    }
+}
+
+/// The stride of the suffixes scored in a segment of `m` steps whose suffix from `i`
+/// evaluates `cost(i)` steps on its own, `cost` not increasing in `i`: 1 when all of them
+/// fit in [`SUFFIX_BUDGET`] steps per step of the segment, else the smallest stride whose
+/// suffixes (from the segment's start) do.
+fn stride(m: usize, cost: impl Fn(usize) -> usize) -> usize {
+    let budget = SUFFIX_BUDGET.saturating_mul(m);
+    let scored =
+        |every: usize| (0..m).step_by(every).fold(0usize, |a, i| a.saturating_add(cost(i)));
+    let total = scored(1);
+    if total <= budget {
+        return 1;
+    }
+    // The first suffix costs at most `m`, and each later one at most the mean over the
+    // stride before it: `m + total / every` steps in all, so this loop ends at once or
+    // soon after.
+    let mut every = total.div_ceil(budget.max(1)).max(2);
+    while scored(every) > budget {
+        every += 1;
+    }
+    every
 }
 
 /// The least of `values`, from `+inf` as the reference folds.
@@ -461,6 +529,10 @@ mod tests {
             alw(Interval::ALL, ev(window(30, Exclusive(70)), x(Lt, 1.0))),
             Formula::and(vec![]),
             alw(window(0, Inclusive(3)), Formula::bool(true)),
+            // Past windows without an end: the long segments are thinned.
+            alw(Interval::ALL, Formula::once(window(0, Unbounded), x(Gt, 8.0))),
+            ev(window(0, Unbounded), Formula::historically(window(0, Unbounded), x(Lt, 9.0))),
+            Formula::once(window(0, Unbounded), x(Gt, 8.0)),
         ]
         .into_iter()
         .chain(bounded_past_tasks())
@@ -547,6 +619,46 @@ mod tests {
                     let want = reference::segment_reward(&task, &tail);
                     assert_eq!(g.to_bits(), want.to_bits(), "{task:?}, length {len}, suffix {i}");
                 }
+            }
+        }
+    }
+
+    /// Past the budget, the suffixes from every `s`-th step are scored exactly and the others
+    /// are NaN, with the smallest `s` whose suffixes fit in `SUFFIX_BUDGET` steps per step;
+    /// within it every suffix is scored.
+    #[test]
+    fn long_segments_score_every_suffix_that_fits_the_budget_and_no_more() {
+        use Bound::{Inclusive, Unbounded};
+        let once = |i, f| Formula::once(i, f);
+        let tasks = [
+            // Every suffix reads back to its own start: `m - i` steps.
+            alw(Interval::ALL, once(window(0, Unbounded), x(CmpOp::Gt, 8.0))),
+            // A bounded window longer than the budget: `R + H` steps a suffix.
+            alw(Interval::ALL, once(window(0, Inclusive(400)), x(CmpOp::Gt, 8.0))),
+            // Within the budget: never thinned.
+            alw(Interval::ALL, once(window(0, Inclusive(100)), x(CmpOp::Gt, 8.0))),
+        ];
+        for (task, (m, thinned)) in tasks.iter().zip([(3000, true), (3000, true), (3000, false)]) {
+            let rows: Vec<f64> = (0..m).map(|i| ((i * 7919) % 11) as f64).collect();
+            let trace = Trace::from_columns(vec![rows]).unwrap();
+            let mut scorer = SegmentScorer::new(task);
+            let mut got = Vec::new();
+            scorer.suffix_rewards(&trace, &mut got);
+            let scored: Vec<usize> = (0..m).filter(|&i| !got[i].is_nan()).collect();
+            let every = scored.get(1).copied().unwrap_or(m);
+            assert_eq!(thinned, every > 1, "{task:?}");
+            assert_eq!(scored, (0..m).step_by(every).collect::<Vec<_>>(), "{task:?}");
+            for &i in &scored {
+                let tail = Trace::from_columns(vec![trace.column(0)[i..].to_vec()]).unwrap();
+                assert_eq!(got[i].to_bits(), scorer.reward(&tail).to_bits(), "{task:?} suffix {i}");
+            }
+            // The steps the scored suffixes read before the running minimum takes over.
+            let reach = start_reach(&task.sub(reference::persistent_body(task).unwrap().0));
+            let cost = |i: usize| reach.map_or(m - i, |r| (m - i).min(r));
+            let spent = |s: usize| (0..m).step_by(s).map(cost).sum::<usize>();
+            assert!(spent(every) <= SUFFIX_BUDGET * m, "{task:?}: {} steps", spent(every));
+            if thinned {
+                assert!(spent(every - 1) > SUFFIX_BUDGET * m, "{task:?}: stride {every} too wide");
             }
         }
     }

@@ -659,7 +659,8 @@ impl<'e, E: Env> Learner<'e, E> {
                 }
                 self.tables.remaining[o][leg].filter(|r| self.tables.available[s].contains(r))
             };
-            let Some(c) = credited else { continue };
+            // A NaN reward: a suffix the scorer's budget left unscored.
+            let Some(c) = credited.filter(|_| !reward.is_nan()) else { continue };
             let target = reward + self.gamma_powers[k - j] * best;
             let cell = &mut self.q.options[run.obs[j] * n + c];
             *cell += params.alpha * (target - *cell);

@@ -335,6 +335,10 @@ impl<'w, W: World> ApproxLearner<'w, W> {
         let n = model.options_coder.len();
         let step = params.alpha / t as f64;
         for j in 0..k {
+            // A NaN reward: a suffix the scorer's budget left unscored.
+            if s.rewards[j].is_nan() {
+                continue;
+            }
             let g = &run.options_features[j * t..][..t];
             let target = s.rewards[j] + self.gamma_powers[k - j] * best;
             let base = (run.codes[j] * model.legs.len() + o) * n;
