@@ -407,7 +407,8 @@ fn past_persistent_suffixes(
         let n = if k == 0 { 0 } else { (m - i).min(k.saturating_add(h)) };
         (short, k, n)
     };
-    let every = stride(m, |i| plan(i).2);
+    // Each suffix reads at most `reach + h` steps: within the budget, no count is needed.
+    let every = if reach.saturating_add(h) <= SUFFIX_BUDGET { 1 } else { stride(m, |i| plan(i).2) };
     for i in 0..m {
         if i % every != 0 {
             out.push(f64::NAN);
