@@ -81,27 +81,39 @@ fn benches(c: &mut Criterion) {
 
 /// `STLReward`'s per-step scoring over an episode of 5,000 steps, for a reward with a past
 /// operator inside a future one (scored online since the reward is read at the last step;
-/// it evaluated the whole prefix each step before), and for one with a future operator
-/// inside a bounded past one (the last `start_reach + 1` states evaluated again each step;
-/// the whole prefix before).
+/// it evaluated the whole prefix each step before), for one with a future operator inside
+/// a bounded past one and inside a past one without an end (the online monitor's state
+/// copied and its open steps ended each step; the kept states, or the whole prefix,
+/// evaluated again before), and for a task with a past operator under `always[0..]`, whose
+/// robustness the monitor reports too (its operand's online monitor; the whole prefix
+/// before).
 fn reward(c: &mut Criterion) {
     let src = "spec R { state { x: float, y: float } \
                let Recent = eventually[0..=5] once[0..=10] x > 8; \
                let Lately = once[0..=10] eventually[0..=5] x > 8; \
+               let Ever = once[0..] eventually[0..=5] x > 8; \
+               let Long = once[0..=500] eventually[0..=5] x > 8; \
                task always[0..] eventually[0..40] x > 8; }";
+    let past_task = "spec P { state { x: float, y: float } \
+               task always[0..] (x > 8 -> once[0..=10] eventually[0..=3] y > 0); }";
     let spec = hstl::load::load(src, None).expect("the spec checks").spec;
     let trace = walk::walk(5_000, &mut walk::SplitMix64(walk::SEED));
     let (x, y) = (trace.column(0), trace.column(1));
     let mut g = c.benchmark_group("reward");
     g.sample_size(10);
     g.throughput(Throughput::Elements(x.len() as u64));
-    for (name, reward) in
-        [("past_inside_future_5000", "Recent"), ("future_inside_past_5000", "Lately")]
-    {
+    let past_spec = hstl::load::load(past_task, None).expect("the spec checks").spec;
+    for (name, src, spec, reward) in [
+        ("past_inside_future_5000", src, &spec, Some("Recent")),
+        ("future_inside_past_5000", src, &spec, Some("Lately")),
+        ("future_inside_long_past_5000", src, &spec, Some("Long")),
+        ("future_inside_unbounded_past_5000", src, &spec, Some("Ever")),
+        ("task_with_past_5000", past_task, &past_spec, None),
+    ] {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let mut episode =
-                    hstl::reward::EpisodeMonitor::new(&spec, src, Some(reward)).expect("a reward");
+                    hstl::reward::EpisodeMonitor::new(spec, src, reward).expect("a reward");
                 let mut sum = 0.0;
                 for (x, y) in x.iter().zip(y) {
                     sum += episode.push(&[*x, *y]).expect("a state").reward;

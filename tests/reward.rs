@@ -18,8 +18,9 @@ fn same(a: f64, b: f64) -> bool {
     a == b || (a.is_nan() && b.is_nan())
 }
 
-/// A small reproducible generator (splitmix64).
-struct Draws(u64);
+/// A small reproducible generator (splitmix64), and how far past its start an interval
+/// may end (5 unless set).
+struct Draws(u64, u64);
 
 impl Draws {
     fn next(&mut self) -> u64 {
@@ -38,8 +39,8 @@ impl Draws {
         let a = self.below(4);
         match self.below(3) {
             0 => format!("[{a}..]"),
-            1 => format!("[{a}..={}]", a + self.below(5)),
-            _ => format!("[{a}..{}]", a + 1 + self.below(5)),
+            1 => format!("[{a}..={}]", a + self.below(self.1)),
+            _ => format!("[{a}..{}]", a + 1 + self.below(self.1)),
         }
     }
 
@@ -160,7 +161,7 @@ fn the_past_time_oracle_tasks_agree_with_the_offline_evaluator_on_every_prefix()
 
 #[test]
 fn random_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
-    let mut draws = Draws(2016);
+    let mut draws = Draws(2016, 5);
     for _ in 0..400 {
         let task = draws.formula(3);
         let len = 1 + draws.below(25) as usize;
@@ -175,7 +176,7 @@ fn random_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
 /// the offline signal's, bit for bit.
 #[test]
 fn random_past_and_future_formulas_agree_with_the_offline_evaluator_on_every_prefix() {
-    let mut draws = Draws(2026);
+    let mut draws = Draws(2026, 5);
     for _ in 0..400 {
         let task = draws.mixed_formula(4);
         let len = 1 + draws.below(25) as usize;
@@ -185,11 +186,37 @@ fn random_past_and_future_formulas_agree_with_the_offline_evaluator_on_every_pre
     }
 }
 
+/// Past windows over future ones reaching back past `FEW_STATES` (128) steps: the reward
+/// from the online monitor's open steps rather than from the last states evaluated again.
+#[test]
+fn wide_past_windows_over_future_ones_agree_with_the_offline_evaluator_on_every_prefix() {
+    let mut draws = Draws(2027, 200);
+    let mut wide = 0;
+    for _ in 0..60 {
+        let inner = draws.mixed_formula(2);
+        let outer = ["once", "historically"][draws.below(2) as usize];
+        let task =
+            format!("{outer}{} eventually[0..={}] {inner}", draws.interval(), draws.below(4));
+        let len = 150 + draws.below(100) as usize;
+        let mut values = || (0..len).map(|_| draws.below(9) as f64 - 3.0).collect::<Vec<_>>();
+        let (x, y) = (values(), values());
+        check_prefixes(&task, &x, &y);
+        let reach = hstl::robustness::segment::start_reach(&parsed(&task));
+        wide += usize::from(reach.is_none_or(|r| r >= 128));
+    }
+    assert!(wide >= 30, "only {wide} of 60 tasks read back 128 steps or more");
+}
+
+fn parsed(task: &str) -> hstl::robustness::Formula {
+    let src = spec_text(task);
+    hstl::lower::task(&load(&src, None).expect("the task checks").spec).expect("it lowers")
+}
+
 #[test]
 fn persistent_shapes_agree_with_the_offline_evaluator_on_every_prefix() {
     // `always[c..]` over `&&`s of `eventually[J]` (and the duals) of state formulas: the
     // shapes kept up to date in O(1) a step, with empty and clipped windows.
-    let mut draws = Draws(40);
+    let mut draws = Draws(40, 5);
     for _ in 0..300 {
         let (outer, inner, join) = if draws.below(2) == 0 {
             ("always", "eventually", "&&")
@@ -225,7 +252,7 @@ fn the_window_kept_is_the_window_rates_psi() {
     let spec = hstl::lower::task_spec(&loaded.spec, src).unwrap();
     let world = GridWorld::builtin("paper").unwrap();
     let regions = RegionTable::new(&spec, &world).unwrap();
-    let mut draws = Draws(7);
+    let mut draws = Draws(7, 5);
     // A walk that crosses the grid often, so that both regions come and go.
     let (mut x, mut y) = (7i64, 7i64);
     let mut states = Vec::new();

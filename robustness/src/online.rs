@@ -144,6 +144,27 @@ impl OnlineMonitor {
         Some(self.eval.robustness_of_columns(&self.formula, &cols, self.buffered()))
     }
 
+    /// What [`OnlineMonitor::finish`] would give if the trace ended now, the monitor left
+    /// as it is: `rho(f, t)` at every step without a verdict, oldest first, windows
+    /// clipped after the last state pushed. Its last value is `rho(f, t)` at the newest
+    /// state over the trace so far. A bounded formula with a past-time operator ends a
+    /// copy of its streams, `O(H |f|)` plus the values its past windows keep (one for a
+    /// window without an end), however long the trace; another formula evaluates the
+    /// states kept (the last `H` of a bounded one).
+    pub fn open_values(&mut self) -> Vec<f64> {
+        let n = self.buffered();
+        if n == 0 {
+            return Vec::new();
+        }
+        match &self.nodes {
+            Some(nodes) if self.formula.has_past() => nodes.clone().finish(&self.formula),
+            _ => {
+                let cols: Vec<&[f64]> = self.columns.iter().map(|c| &c[self.start..]).collect();
+                self.eval.signal_of_columns(&self.formula, &cols, n).to_vec()
+            }
+        }
+    }
+
     /// Ends the trace: the verdicts of every step still open, windows clipped at the end
     /// of the trace. The monitor is then ready for a new trace, counting from step 0.
     pub fn finish(&mut self) -> Vec<Verdict> {
@@ -195,7 +216,9 @@ impl OnlineMonitor {
         out
     }
 
-    fn reset(&mut self) {
+    /// Drops the trace without ending it: the monitor is ready for a new trace, counting
+    /// from step 0.
+    pub fn reset(&mut self) {
         self.columns.iter_mut().for_each(Vec::clear);
         self.len = 0;
         self.start = 0;

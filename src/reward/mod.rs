@@ -11,10 +11,14 @@
 //!   `-inf`). A formula with a past-time operator (`once[0..10] A`) reads the states before
 //!   `s_t` too: its streaming online monitor gives it, `O(|formula|)` a step, once the
 //!   future operators above its past ones are replaced by their value at the last step
-//!   ([`hstl_robustness::last_step`]); a future operator under a past one (`once[0..5]
-//!   eventually[0..3] A`) makes it evaluated again over the last states it reads
-//!   ([`hstl_robustness::segment::start_reach`] + 1 of them), `O(reach)` a step, or over
-//!   all the states so far, `O(t)`, when a past window above the future one has no end;
+//!   ([`hstl_robustness::last_step`]); with a future operator of horizon `h` under a past
+//!   one (`once[0..] eventually[0..3] A`), the monitor's open steps are ended as if the
+//!   trace stopped at `s_t` ([`OnlineMonitor::open_values`]), `O(h |formula|)` a step plus a
+//!   copy of what its past windows keep, whatever the episode's length; when the formula
+//!   reads back fewer than 128 states ([`hstl_robustness::segment::start_reach`]), those
+//!   are evaluated again instead, which is faster. Only a future window without an end
+//!   under a past one without an end (`once[0..] eventually[0..] A`) reads all the states
+//!   so far, `O(t)`;
 //! - the **task's robustness** `rho(task, 0)` over `s_0 ..= s_t`, the value
 //!   `hstlc monitor` prints for the trace so far;
 //! - for a persistent task (`always[0..] (eventually[0..N1] R1 && ...)`), whether the
@@ -33,8 +37,8 @@
 //! past-time operator, the regions, the state formulas of the task's parts) is one pass
 //! over one flat DAG holding them all, each shared node once, `O(|formula|)`; a reward
 //! with a past-time operator is `O(|formula|)` through its online monitor, and
-//! `O(reach |formula|)` with a future operator under a past one (`O(t |formula|)` under
-//! a past window without an end). The task's
+//! `O(h |formula|)` with a future operator of horizon `h` under a past one
+//! (`O(t |formula|)` when both windows have no end). The task's
 //! robustness is kept up to date without evaluating the trace again where the formula
 //! allows: `!`, `&&`, `||` and `->` combine their parts' running values, and `always`
 //! distributes over `&&` (`eventually` over `||`); `always[I] f` with `f` a state formula
@@ -43,7 +47,8 @@
 //! take `O(1)` amortised through a sliding window over `f`'s values
 //! ([`hstl_robustness::WindowStream`], the online monitor's stream of the inner operator);
 //! `always[I] f` and `eventually[I] f` with `f` of finite horizon `h` fold the values of
-//! `f` that are final and evaluate only the last `h` states again, `O(h)` a step; any
+//! `f` that are final (its online monitor's verdicts, a past-time operator in `f`
+//! included) and end the last `h` as if the trace stopped there, `O(h)` a step; any
 //! other part with a finite horizon `H` is evaluated over the states so far until `H + 1`
 //! have arrived and is fixed from then on. Only a part that is none of these (an
 //! unbounded `until`, or an unbounded operator over another one) is evaluated over the
@@ -184,6 +189,11 @@ impl RewardError {
 
 impl std::error::Error for RewardError {}
 
+/// Below this many states read back (the reward's [`hstl_robustness::segment::start_reach`]),
+/// evaluating them again each step is faster than copying and ending the online monitor's
+/// streams (`cargo bench --bench monitor -- reward/`).
+const FEW_STATES: usize = 128;
+
 /// Scores the states of one episode as they arrive (see the module docs).
 #[derive(Clone, Debug)]
 pub struct EpisodeMonitor {
@@ -210,16 +220,18 @@ pub struct EpisodeMonitor {
     /// The reward's slot, when it is read off the state alone (no past-time operator, or
     /// none left at the last step).
     reward_slot: Option<usize>,
-    /// The states so far, when the reward formula has a future operator under a past one
-    /// (a future window clipped at `t` read from an earlier step reads the prefix again):
-    /// only the last `start_reach + 1` when its past windows are bounded, since the value at
-    /// the newest state reads no state before them (`O(reach)` a step, not `O(t)`).
+    /// The states so far, when the reward formula has a future operator without an end
+    /// under a past one (no online monitor then): only the last `start_reach + 1` when its
+    /// past windows are bounded, since the value at the newest state reads no state before
+    /// them (`O(reach)` a step, not `O(t)`).
     history: Option<(Columns, Option<usize>)>,
     /// The online monitor of the reward formula at the last step
-    /// ([`last_step::at_last_step`]), when it has a past-time operator and no future one
-    /// under it: `rho(formula, t)` is then final once `s_t` is in, and its streaming past
-    /// windows give it in `O(|formula|)` a step (it was `O(t)`: quadratic over an episode).
-    past: Option<(Formula, OnlineMonitor)>,
+    /// ([`last_step::at_last_step`]), when it has a past-time operator and a finite horizon
+    /// `h` (that of the future operators under its past ones): `rho(formula, t)` is its
+    /// verdict at once when `h = 0`, and otherwise the newest of its open steps ended as if
+    /// the trace stopped at `s_t`, `O(h |formula|)` a step plus a copy of what its past
+    /// windows keep (it was `O(t)`: quadratic over an episode).
+    past: Option<OnlineMonitor>,
     /// Each region of a persistent task: its state formula and `N_j`.
     regions: Vec<(Formula, usize)>,
     /// Each region's slot.
@@ -293,12 +305,20 @@ impl EpisodeMonitor {
         let task = Running::new(&task, vars.len(), &mut slots);
         let base_slots = slots.len();
         let program = Program::new(&slots);
-        let past = at_end.filter(|f| f.has_past() && f.horizon() == Some(0)).map(|f| {
-            let m = OnlineMonitor::new(&f, vars.len());
-            (f, m)
-        });
-        let history = (reward_slot.is_none() && past.is_none())
-            .then(|| (Columns::new(vars.len()), hstl_robustness::segment::start_reach(&reward)));
+        // The episode keeps every state anyway: the monitor, which keeps the last `h` and
+        // what its past windows need, has no limit of its own.
+        // A future operator under a past one: the last `reach + 1` states evaluated again
+        // when they are few (cheaper than copying a monitor's streams), the online monitor
+        // when they are many or every state, and every state only when the monitor cannot
+        // stream the formula (a future window without an end under a past one).
+        let reach = hstl_robustness::segment::start_reach(&reward);
+        let few = reach.is_some_and(|r| r < FEW_STATES);
+        let past = at_end
+            .filter(|f| f.has_past() && f.horizon().is_some())
+            .filter(|f| f.horizon() == Some(0) || !few)
+            .map(|f| OnlineMonitor::new(&f, vars.len()).with_limit(usize::MAX));
+        let history =
+            (reward_slot.is_none() && past.is_none()).then(|| (Columns::new(vars.len()), reach));
         Ok(EpisodeMonitor {
             vars,
             reward,
@@ -384,8 +404,8 @@ impl EpisodeMonitor {
         if let Some((h, _)) = &mut self.history {
             h.clear();
         }
-        if let Some((f, m)) = &mut self.past {
-            *m = OnlineMonitor::new(f, self.vars.len());
+        if let Some(m) = &mut self.past {
+            m.reset();
         }
         self.tau.iter_mut().zip(&self.regions).for_each(|(t, r)| *t = r.1);
         if let Some(prefix) = &mut self.prefix {
@@ -468,9 +488,13 @@ impl EpisodeMonitor {
                 let signal = self.eval.signal_of_slices(&self.reward, &history.slices());
                 signal.ok().and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
             }
-            (None, Some((_, past)), _) => {
-                past.push(state).ok().flatten().map_or(f64::NAN, |v| v.value)
-            }
+            // With no future operator left the value is final at once; otherwise it is the
+            // newest open step's, as if the episode ended here.
+            (None, Some(past), _) => match past.push(state) {
+                Ok(Some(verdict)) if past.horizon() == Some(0) => verdict.value,
+                Ok(_) => past.open_values().last().copied().unwrap_or(f64::NAN),
+                Err(_) => f64::NAN,
+            },
             (None, None, Some(slot)) => program.value(slot),
             (None, None, None) => f64::NAN,
         };

@@ -3,7 +3,7 @@
 //! allows (see the module docs of [`super`]), and the states kept as columns.
 
 use hstl_robustness::{
-    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, WindowStream,
+    Bound, Evaluator, Formula, FormulaBuilder, Interval, Node, NodeId, OnlineMonitor, WindowStream,
 };
 
 use super::program::Program;
@@ -28,18 +28,18 @@ enum Part {
         states: Columns,
         fixed: Option<f64>,
     },
-    /// `always[I] f` (`min`) or `eventually[I] f` (`max`) with `f` of finite horizon `h`.
+    /// `always[I] f` (`min`) or `eventually[I] f` (`max`) with `f` of finite horizon `h`:
+    /// `f`'s online monitor gives its value at a position once final, folded in then, and
+    /// the values of the last `h` positions as if the trace ended now, `O(h |f|)` a step.
+    /// A past-time operator in `f` reads the earlier states from what its streams keep.
     Window {
         always: bool,
         interval: Interval,
-        body: Formula,
         horizon: usize,
+        /// `f`'s online monitor.
+        monitor: Box<OnlineMonitor>,
         /// The fold of the final values of `f` in the window.
         settled: f64,
-        /// The states from the first position whose value of `f` is not final.
-        states: Columns,
-        /// The position of the first state in `states`.
-        first: usize,
     },
     /// `always[I] f` (`min`) or `eventually[I] f` (`max`) with `f` a state formula: the
     /// value of `f` at a position is final when its state arrives, so the fold of those in
@@ -215,18 +215,18 @@ impl Part {
                     settled: identity(always),
                 }
             }
-            // The window drops the states before its first open position, which a
-            // past-time operator would read.
-            Node::Always(interval, body) | Node::Eventually(interval, body) if !f.has_past() => {
+            Node::Always(interval, body) | Node::Eventually(interval, body) => {
                 match f.horizon_of(*body) {
                     Some(horizon) => Part::Window {
                         always: matches!(f.root_node(), Node::Always(..)),
                         interval: *interval,
-                        body: f.sub(*body),
                         horizon,
+                        // The episode keeps every state anyway; the monitor keeps the last
+                        // `h` and what its past windows need, no more.
+                        monitor: Box::new(
+                            OnlineMonitor::new(&f.sub(*body), vars).with_limit(usize::MAX),
+                        ),
                         settled: identity(matches!(f.root_node(), Node::Always(..))),
-                        states: Columns::new(vars),
-                        first: 0,
                     },
                     None => whole(),
                 }
@@ -241,10 +241,9 @@ impl Part {
                 states.clear();
                 *fixed = None;
             }
-            Part::Window { always, settled, states, first, .. } => {
+            Part::Window { always, settled, monitor, .. } => {
                 *settled = identity(*always);
-                states.clear();
-                *first = 0;
+                monitor.reset();
             }
             Part::Fold { always, settled, .. } => *settled = identity(*always),
             Part::Stream { always, window, settled, .. } => {
@@ -280,30 +279,25 @@ impl Part {
                 }
                 value
             }
-            Part::Window { always, interval, body, horizon, settled, states, first } => {
+            Part::Window { always, interval, horizon, monitor, settled } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
-                states.push(state);
-                let signal = eval.signal_of_slices(body, &states.slices()).unwrap_or(&[]);
-                let ever = interval.window(0, usize::MAX);
+                // The state has the monitor's width (checked by the caller) and the monitor
+                // no limit: it gives no error.
+                if let Ok(Some(verdict)) = monitor.push(state)
+                    && interval.window(0, usize::MAX).contains(&verdict.step)
+                {
+                    *settled = fold(*settled, verdict.value);
+                }
+                // The positions without a final value, clipped at the trace's end.
+                let open = n.saturating_sub(*horizon)..n;
                 let now = interval.window(0, n);
                 let mut value = *settled;
-                let mut final_here = false;
-                for (i, &v) in signal.iter().enumerate() {
-                    let position = *first + i;
-                    if i == 0 && position + *horizon < n {
-                        // The value at the first position has read every state it needs.
-                        final_here = true;
-                        if ever.contains(&position) {
-                            *settled = fold(*settled, v);
+                if now.start < open.end && open.start < now.end {
+                    for (i, v) in monitor.open_values().into_iter().enumerate() {
+                        if now.contains(&(open.start + i)) {
+                            value = fold(value, v);
                         }
-                        value = *settled;
-                    } else if now.contains(&position) {
-                        value = fold(value, v);
                     }
-                }
-                if final_here {
-                    states.pop_front();
-                    *first += 1;
                 }
                 value
             }

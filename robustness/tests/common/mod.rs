@@ -62,6 +62,7 @@ fn check_online(f: &Formula, trace: &Trace, want: &[f64], label: &str) {
     let mut m = OnlineMonitor::new(f, trace.vars());
     let mut got = Vec::new();
     let mut row = Vec::new();
+    let mut prefix = Trace::new(trace.vars());
     for t in 0..trace.len() {
         trace.row_into(t, &mut row);
         let v = m.push(&row).expect("rows have the trace's width");
@@ -73,6 +74,11 @@ fn check_online(f: &Formula, trace: &Trace, want: &[f64], label: &str) {
             (Some(h), None) => assert!(t < h, "{label}: no verdict at step {t}"),
             (None, v) => assert_eq!(v, None, "{label}: verdict before the end"),
         }
+        // The open steps as if the trace ended here: the prefix's signal at those steps.
+        prefix.push(&row).expect("rows have the trace's width");
+        let open = m.open_values();
+        let whole = offline::signal(f, &prefix);
+        assert_same(&format!("open steps after {t} of {label}"), &open, &whole[got.len()..]);
     }
     got.extend(m.finish());
     let steps: Vec<usize> = got.iter().map(|v| v.step).collect();
