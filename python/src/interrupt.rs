@@ -1,9 +1,9 @@
 //! Long calls that Ctrl-C ends. The work runs on a thread of its own while the calling
 //! thread, holding the GIL only for a moment every [`SIGNAL_EVERY`], runs Python's signal
 //! handlers: a `KeyboardInterrupt` ends the call at once. The work's thread is then told to
-//! stop ([`hstl::robustness::cancel`]): the offline evaluator stops at its next group or
-//! piece, the dense one at its next formula node, other work finishes; either way its result is dropped, and it holds only what was
-//! moved into it.
+//! stop ([`hstl::robustness::cancel`]): the evaluators and the scan of a trace for NaN
+//! comparisons stop within a few milliseconds, other work finishes; either way its result
+//! is dropped, and it holds only what was moved into it.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -33,12 +33,32 @@ def chain_spec(lets: int, dense: bool = False) -> str:
     return f"spec Chain {{\n state {{ {state} }}\n" + "\n".join(body) + f"\n task a{lets - 1};\n}}\n"
 
 
-@pytest.mark.parametrize("dense", [False, True], ids=["steps", "dense"])
-def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path, dense: bool) -> None:
+def state_spec(terms: int, arithmetic: bool) -> str:
+    """A spec whose task is one state formula of `terms` disjunctions: a single group of
+    the evaluator over the whole trace, and with `arithmetic` comparisons that can be NaN
+    (`x * 3 + y > 1`), which every step is scanned for before the evaluation."""
+    if arithmetic:
+        parts = [f"(x * {i % 13 + 1} + y > {i % 17})" for i in range(terms)]
+    else:
+        parts = [f"(x > {i % 17} || y < {i % 13})" for i in range(terms)]
+    return "spec Big {\n state { x: float, y: float }\n task " + " && ".join(parts) + ";\n}\n"
+
+
+LONG_SPECS = {
+    "steps": lambda: chain_spec(2000),
+    "dense": lambda: chain_spec(2000, dense=True),
+    # Issue 30: one group over the whole trace, and the NaN scan, looked at no stop flag.
+    "one-group": lambda: state_spec(6000, arithmetic=False),
+    "nan-scan": lambda: state_spec(3000, arithmetic=True),
+}
+
+
+@pytest.mark.parametrize("kind", list(LONG_SPECS))
+def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path, kind: str) -> None:
     # Many seconds of evaluation on the development machine; Ctrl-C after 1.5 s. A child
     # process, so that a call that does not stop fails at the timeout instead of hanging.
     # The dense evaluator stops between the formula's nodes, the discrete one between its
-    # groups and pieces.
+    # groups and pieces and within a group every 512 steps, the NaN scan every 4096.
     code = (
         "import sys, time, numpy as np, hstl\n"
         "spec = hstl.Spec.load(sys.argv[1])\n"
@@ -58,7 +78,7 @@ def test_ctrl_c_ends_a_long_signal_call(tmp_path: Path, dense: bool) -> None:
         "    print(f'interrupted {took:.3f} {time.process_time() - cpu:.3f}', flush=True)\n"
     )
     path = tmp_path / "chain.hstl"
-    path.write_text(chain_spec(2000, dense))
+    path.write_text(LONG_SPECS[kind]())
     # Ctrl-C as at a terminal, whatever the test runner inherited (a background job has
     # SIGINT ignored, and Python then installs no handler).
     child = subprocess.Popen(

@@ -1,8 +1,11 @@
 //! Stopping an offline evaluation that nobody waits for any more (a call the user
 //! interrupted): a flag raised from another thread, looked at by the evaluator on this
-//! thread between the groups and pieces it computes (the dense evaluator: between the
-//! formula's nodes). An evaluation stopped so returns NaN at every step: its result means
-//! nothing, so only a caller that will drop it raises the flag. Evaluations on threads without a flag are never stopped.
+//! thread between the groups and pieces it computes, and within a group between chunks of
+//! 512 steps of its state members and between its temporal ones (the dense and the
+//! complete-window evaluators: between the formula's nodes), so that no single piece of
+//! work runs long after it. An evaluation stopped so returns NaN at every step: its result
+//! means nothing, so only a caller that will drop it raises the flag. Evaluations on
+//! threads without a flag are never stopped.
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -37,8 +40,9 @@ pub fn current() -> Option<Arc<AtomicBool>> {
     FLAG.with(|f| f.borrow().clone())
 }
 
-/// Whether this thread's flag is raised.
-pub(crate) fn requested() -> bool {
+/// Whether this thread's flag is raised: for work outside the evaluator that a stopped
+/// evaluation makes pointless (the facade's scan of a trace for NaN comparisons).
+pub fn requested() -> bool {
     FLAG.with(|f| f.borrow().as_ref().is_some_and(|flag| flag.load(Ordering::Relaxed)))
 }
 

@@ -59,6 +59,10 @@ pub fn signal(f: &Formula, trace: &Trace) -> Vec<f64> {
         if node.is_expr() {
             continue;
         }
+        // A stopped evaluation's result is dropped (see `crate::cancel`).
+        if crate::cancel::requested() {
+            return vec![f64::NAN; n];
+        }
         let kid = |k: usize| signals[k].as_deref().unwrap_or(&[]);
         let v = match node {
             // A comparison's signal is made when it is reached and dropped after its last

@@ -475,6 +475,9 @@ impl Monitor {
     }
 }
 
+/// How many steps the NaN scan takes between looks at the thread's stop flag.
+const STOP_EVERY: usize = 4096;
+
 impl NanProne {
     pub(crate) fn of(formula: &rob::Formula, vars: &[String]) -> NanProne {
         NanProne::of_all(&[formula], vars)
@@ -499,6 +502,11 @@ impl NanProne {
         let mut state = vec![0.0; self.vars.len()];
         let mut values = Vec::new();
         for step in 0..read {
+            // An interrupted call drops its result, and the evaluation after this scan
+            // stops at once: the rest of a long trace is not worth scanning.
+            if step % STOP_EVERY == 0 && hstl_robustness::cancel::requested() {
+                return Ok(());
+            }
             match samples {
                 Samples::Columns(cols) => {
                     for (v, col) in state.iter_mut().zip(cols) {

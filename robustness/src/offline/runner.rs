@@ -108,7 +108,10 @@ impl Runner {
                 _ => usize::MAX,
             };
             let out = if n / 2 <= piece {
-                self.group(f, g, src, 0, n, true)
+                match self.group(f, g, src, 0, n, true) {
+                    Some(out) => out,
+                    None => return vec![f64::NAN; n],
+                }
             } else {
                 let h = f.horizons()[root].unwrap_or(0);
                 let mut out = self.take(n);
@@ -119,7 +122,9 @@ impl Runner {
                     }
                     let hi = (lo + piece).min(n);
                     let end = hi.saturating_add(h).min(n);
-                    let v = self.group(f, g, src, lo, end - lo, hi == n);
+                    let Some(v) = self.group(f, g, src, lo, end - lo, hi == n) else {
+                        return vec![f64::NAN; n];
+                    };
                     out[lo..hi].copy_from_slice(&v[..hi - lo]);
                     self.put(v);
                     lo = hi;
@@ -144,7 +149,10 @@ impl Runner {
     }
 
     /// The group's root over steps `lo .. lo + m`. `last` says this is the group's last
-    /// piece (the reads of other groups' roots are then counted off).
+    /// piece (the reads of other groups' roots are then counted off). `None` when the
+    /// thread's flag was raised (see [`crate::cancel`]): a group over a whole long trace
+    /// looks at it between chunks of its state members and between its temporal ones, so
+    /// a large one stops within a fraction of a second too.
     fn group(
         &mut self,
         f: &Formula,
@@ -153,14 +161,16 @@ impl Runner {
         lo: usize,
         m: usize,
         last: bool,
-    ) -> Vec<f64> {
+    ) -> Option<Vec<f64>> {
         let plan = f.plan();
         for &s in &g.state {
             if plan.role[s] == Role::Piece {
                 self.piece[s] = self.take(m);
             }
         }
-        self.state_phase(f, g, src, lo, m);
+        if !self.state_phase(f, g, src, lo, m) {
+            return None;
+        }
         if last {
             for &s in &g.state {
                 for c in f.nodes()[s].children() {
@@ -176,6 +186,9 @@ impl Runner {
         // A whole-trace group (one piece) may take a group root's buffer for its own.
         let whole = last && lo == 0;
         for &v in &g.temporal {
+            if crate::cancel::requested() {
+                return None;
+            }
             let out = self.temporal(f, v, lo, m, last, whole);
             self.piece[v] = out;
         }
@@ -184,11 +197,19 @@ impl Runner {
             let buf = std::mem::take(&mut self.piece[v]);
             self.put(buf);
         }
-        out
+        Some(out)
     }
 
-    /// The stored state members of `g` over steps `lo .. lo + m`.
-    fn state_phase(&mut self, f: &Formula, g: &Group, src: Source<'_>, lo: usize, m: usize) {
+    /// The stored state members of `g` over steps `lo .. lo + m`; `false` when stopped by
+    /// the thread's flag.
+    fn state_phase(
+        &mut self,
+        f: &Formula,
+        g: &Group,
+        src: Source<'_>,
+        lo: usize,
+        m: usize,
+    ) -> bool {
         let plan = f.plan();
         let cols = match src {
             Source::Tables { tables, seg } => {
@@ -202,12 +223,15 @@ impl Runner {
                         *o = table[k.min(nan_row)];
                     }
                 }
-                return;
+                return true;
             }
             Source::Columns(cols) => cols,
         };
         let mut c0 = 0;
         while c0 < m {
+            if crate::cancel::requested() {
+                return false;
+            }
             let c1 = (c0 + CHUNK).min(m);
             for &s in &g.state {
                 self.state_left[s] = plan.state_reads[s];
@@ -239,6 +263,7 @@ impl Runner {
             }
             c0 = c1;
         }
+        true
     }
 
     /// Operand `c` of state node `s` over chunk `c0 ..` of the piece at `lo`.
