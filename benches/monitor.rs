@@ -86,7 +86,8 @@ fn benches(c: &mut Criterion) {
 /// copied and its open steps ended each step; the kept states, or the whole prefix,
 /// evaluated again before), and for a task with a past operator under `always[0..]`, whose
 /// robustness the monitor reports too (its operand's online monitor; the whole prefix
-/// before).
+/// before), and for "infinitely often" (`always[0..] eventually[0..]`, the value at the
+/// last state; the whole prefix before).
 fn reward(c: &mut Criterion) {
     let src = "spec R { state { x: float, y: float } \
                let Recent = eventually[0..=5] once[0..=10] x > 8; \
@@ -96,6 +97,8 @@ fn reward(c: &mut Criterion) {
                task always[0..] eventually[0..40] x > 8; }";
     let past_task = "spec P { state { x: float, y: float } \
                task always[0..] (x > 8 -> once[0..=10] eventually[0..=3] y > 0); }";
+    let recurrence = "spec G { state { x: float, y: float } \
+               task always[0..] eventually[0..] x > 8; }";
     let spec = hstl::load::load(src, None).expect("the spec checks").spec;
     let trace = walk::walk(5_000, &mut walk::SplitMix64(walk::SEED));
     let (x, y) = (trace.column(0), trace.column(1));
@@ -103,12 +106,14 @@ fn reward(c: &mut Criterion) {
     g.sample_size(10);
     g.throughput(Throughput::Elements(x.len() as u64));
     let past_spec = hstl::load::load(past_task, None).expect("the spec checks").spec;
+    let recurrence_spec = hstl::load::load(recurrence, None).expect("the spec checks").spec;
     for (name, src, spec, reward) in [
         ("past_inside_future_5000", src, &spec, Some("Recent")),
         ("future_inside_past_5000", src, &spec, Some("Lately")),
         ("future_inside_long_past_5000", src, &spec, Some("Long")),
         ("future_inside_unbounded_past_5000", src, &spec, Some("Ever")),
         ("task_with_past_5000", past_task, &past_spec, None),
+        ("task_recurrence_5000", recurrence, &recurrence_spec, None),
     ] {
         g.bench_function(name, |b| {
             b.iter(|| {

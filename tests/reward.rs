@@ -215,7 +215,8 @@ fn parsed(task: &str) -> hstl::robustness::Formula {
 #[test]
 fn persistent_shapes_agree_with_the_offline_evaluator_on_every_prefix() {
     // `always[c..]` over `&&`s of `eventually[J]` (and the duals) of state formulas: the
-    // shapes kept up to date in O(1) a step, with empty and clipped windows.
+    // shapes kept up to date in O(1) a step, with empty and clipped windows, and `J`
+    // without an end ("infinitely often").
     let mut draws = Draws(40, 5);
     for _ in 0..300 {
         let (outer, inner, join) = if draws.below(2) == 0 {
@@ -226,9 +227,10 @@ fn persistent_shapes_agree_with_the_offline_evaluator_on_every_prefix() {
         let parts: Vec<String> = (0..1 + draws.below(3))
             .map(|_| {
                 let a = draws.below(3);
-                let end = match draws.below(3) {
+                let end = match draws.below(4) {
                     0 => format!("..={}", a + draws.below(6)),
                     1 => format!("..{}", a + 1 + draws.below(6)),
+                    2 => "..".to_string(),
                     _ => format!("..={}", a + 20),
                 };
                 format!("{inner}[{a}{end}] {}", draws.formula(0))

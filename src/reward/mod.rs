@@ -45,14 +45,15 @@
 //! (a safety conjunct) folds `f`'s value, `O(1)`; `always[c..] eventually[J] f` and
 //! `eventually[c..] always[J] f` with `f` a state formula (the persistent task's parts)
 //! take `O(1)` amortised through a sliding window over `f`'s values
-//! ([`hstl_robustness::WindowStream`], the online monitor's stream of the inner operator);
+//! ([`hstl_robustness::WindowStream`], the online monitor's stream of the inner operator),
+//! and `O(1)` with `J` unbounded ("infinitely often": the value at the last state);
 //! `always[I] f` and `eventually[I] f` with `f` of finite horizon `h` fold the values of
 //! `f` that are final (its online monitor's verdicts, a past-time operator in `f`
 //! included) and end the last `h` as if the trace stopped there, `O(h)` a step; any
 //! other part with a finite horizon `H` is evaluated over the states so far until `H + 1`
 //! have arrived and is fixed from then on. Only a part that is none of these (an
-//! unbounded `until`, or an unbounded operator over another one) is evaluated over the
-//! whole trace at every step.
+//! unbounded `until`, or an unbounded operator over another unbounded one that is not
+//! the shape above) is evaluated over the whole trace at every step.
 //!
 //! ```
 //! let src = "spec S { state { x: float } let Hot = x > 2; task eventually[0..] Hot; }";

@@ -60,7 +60,9 @@ enum Part {
     /// monitor's stream of `g`); every other position's window is clipped at the end of
     /// the trace to a suffix of it, and of those suffixes the latest position's (`g` on the
     /// last state alone) is the least for `always` over `eventually` (the greatest for the
-    /// dual), so it alone stands for them.
+    /// dual), so it alone stands for them. With `I` unbounded (`always[0..] eventually[0..]
+    /// f`, "infinitely often") no position's value is ever final, and the latest stands
+    /// for all: `O(1)` a step, nothing kept.
     Stream {
         always: bool,
         /// The outer operator's first offset `c`.
@@ -69,8 +71,8 @@ enum Part {
         body: usize,
         /// The slot of `f` on the last state.
         inner: usize,
-        /// `g`'s final values, in order.
-        window: WindowStream,
+        /// `g`'s final values, in order; `None` when `I` is unbounded (none is final).
+        window: Option<WindowStream>,
         /// The fold of the final values of `g` at positions from `c` on.
         settled: f64,
     },
@@ -190,7 +192,7 @@ impl Part {
                     Node::Eventually(j, g) => (false, *j, body.sub(*g)),
                     _ => return whole(),
                 };
-                let Some(window) = WindowStream::new(inner_always, &j) else { return whole() };
+                let window = WindowStream::new(inner_always, &j);
                 slots.push((body, false));
                 slots.push((inner, false));
                 Part::Stream {
@@ -247,7 +249,9 @@ impl Part {
             }
             Part::Fold { always, settled, .. } => *settled = identity(*always),
             Part::Stream { always, window, settled, .. } => {
-                window.clear();
+                if let Some(window) = window {
+                    window.clear();
+                }
                 *settled = identity(*always);
             }
             Part::Not(_) | Part::And(_) | Part::Or(_) | Part::Implies(..) => {}
@@ -311,7 +315,8 @@ impl Part {
             Part::Stream { always, from, body, inner, window, settled } => {
                 let fold = |a: f64, b: f64| if *always { a.min(b) } else { a.max(b) };
                 // The state has no NaN (checked by the caller).
-                if let Some(verdict) = window.push(ctx.program.value(*inner))
+                if let Some(verdict) =
+                    window.as_mut().and_then(|w| w.push(ctx.program.value(*inner)))
                     && verdict.step >= *from
                 {
                     *settled = fold(*settled, verdict.value);
@@ -338,7 +343,7 @@ pub(super) struct Context<'a> {
 }
 
 /// Whether `f` is `always[I] eventually[J] g` or `eventually[I] always[J] g` with `g` a
-/// state formula (no temporal operator) and `J` bounded: what [`Part::Stream`] takes.
+/// state formula (no temporal operator): what [`Part::Stream`] takes.
 fn is_dual_over_state(f: &Formula) -> bool {
     let inner = match f.root_node() {
         Node::Always(_, body) => match &f[*body] {
@@ -351,7 +356,7 @@ fn is_dual_over_state(f: &Formula) -> bool {
         },
         _ => None,
     };
-    inner.is_some_and(|(j, g)| j.end != Bound::Unbounded && f.is_state(*g))
+    inner.is_some_and(|(_, g)| f.is_state(*g))
 }
 
 /// The value of an empty window: `+inf` for `always`, `-inf` for `eventually`.
