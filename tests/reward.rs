@@ -186,8 +186,8 @@ fn random_past_and_future_formulas_agree_with_the_offline_evaluator_on_every_pre
     }
 }
 
-/// Past windows over future ones reaching back past `FEW_STATES` (128) steps: the reward
-/// from the online monitor's open steps rather than from the last states evaluated again.
+/// Past windows over future ones reaching back `FEW_STATES` steps or more: the reward from
+/// the online monitor's open steps rather than from the last states evaluated again.
 #[test]
 fn wide_past_windows_over_future_ones_agree_with_the_offline_evaluator_on_every_prefix() {
     let mut draws = Draws(2027, 200);
@@ -202,9 +202,9 @@ fn wide_past_windows_over_future_ones_agree_with_the_offline_evaluator_on_every_
         let (x, y) = (values(), values());
         check_prefixes(&task, &x, &y);
         let reach = hstl::robustness::segment::start_reach(&parsed(&task));
-        wide += usize::from(reach.is_none_or(|r| r >= 128));
+        wide += usize::from(reach.is_none_or(|r| r >= hstl::reward::FEW_STATES));
     }
-    assert!(wide >= 30, "only {wide} of 60 tasks read back 128 steps or more");
+    assert!(wide >= 30, "only {wide} of 60 tasks read back `FEW_STATES` steps or more");
 }
 
 fn parsed(task: &str) -> hstl::robustness::Formula {

@@ -15,8 +15,9 @@
 //!   one (`once[0..] eventually[0..3] A`), the monitor's open steps are ended as if the
 //!   trace stopped at `s_t` ([`OnlineMonitor::open_values`]), `O(h |formula|)` a step plus a
 //!   copy of what its past windows keep, whatever the episode's length; when the formula
-//!   reads back fewer than 128 states ([`hstl_robustness::segment::start_reach`]), those
-//!   are evaluated again instead, which is faster. Only a future window without an end
+//!   reads back fewer than [`FEW_STATES`] states
+//!   ([`hstl_robustness::segment::start_reach`]), those are evaluated again instead,
+//!   which is faster. Only a future window without an end
 //!   under a past one without an end (`once[0..] eventually[0..] A`) reads all the states
 //!   so far, `O(t)`;
 //! - the **task's robustness** `rho(task, 0)` over `s_0 ..= s_t`, the value
@@ -191,9 +192,10 @@ impl RewardError {
 impl std::error::Error for RewardError {}
 
 /// Below this many states read back (the reward's [`hstl_robustness::segment::start_reach`]),
-/// evaluating them again each step is faster than copying and ending the online monitor's
-/// streams (`cargo bench --bench monitor -- reward/`).
-const FEW_STATES: usize = 128;
+/// a reward with a future operator under a past one evaluates them again each step, which
+/// measured faster than copying and ending the online monitor's streams (`cargo bench
+/// --bench monitor -- reward/`); from this many on, or without an end, it takes the monitor.
+pub const FEW_STATES: usize = 128;
 
 /// Scores the states of one episode as they arrive (see the module docs).
 #[derive(Clone, Debug)]

@@ -185,8 +185,10 @@ impl Runner {
         }
         // A whole-trace group (one piece) may take a group root's buffer for its own.
         let whole = last && lo == 0;
-        for &v in &g.temporal {
-            if crate::cancel::requested() {
+        for (k, &v) in g.temporal.iter().enumerate() {
+            // Between the members of a long group only: `run` looked before this one, and
+            // a short segment (a suffix the learner scores) takes no more looks than it did.
+            if k > 0 && m > CHUNK && crate::cancel::requested() {
                 return None;
             }
             let out = self.temporal(f, v, lo, m, last, whole);
@@ -229,7 +231,8 @@ impl Runner {
         };
         let mut c0 = 0;
         while c0 < m {
-            if crate::cancel::requested() {
+            // Between chunks: `run` looked before the first.
+            if c0 > 0 && crate::cancel::requested() {
                 return false;
             }
             let c1 = (c0 + CHUNK).min(m);
