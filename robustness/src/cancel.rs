@@ -1,9 +1,9 @@
 //! Stopping an offline evaluation that nobody waits for any more (a call the user
 //! interrupted): a flag raised from another thread, looked at by the evaluator on this
-//! thread between the groups and pieces it computes, and within a long group between chunks of
-//! 512 steps of its state members and between its temporal ones (the dense and the
-//! complete-window evaluators: between the formula's nodes), so that no single piece of
-//! work runs long after it. An evaluation stopped so returns NaN at every step: its result
+//! thread between the groups and pieces it computes, and within a long group between
+//! chunks of 512 steps of its state members and between its temporal ones (the dense and
+//! the complete-window evaluators: between the formula's nodes), so that no single piece
+//! of work runs long after it. An evaluation stopped so returns NaN at every step: its result
 //! means nothing, so only a caller that will drop it raises the flag. Evaluations on
 //! threads without a flag are never stopped.
 
